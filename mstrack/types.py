@@ -1,0 +1,122 @@
+"""Public result and box types of mstrack.
+
+Box convention (defined here, once, for the whole package): a box is
+``(x, y, w, h)`` in **0-based pixel coordinates**: ``x, y`` is the left/top
+edge of the box and ``w, h`` its width and height, so the box covers the
+continuous region ``[x, x + w) x [y, y + h)``.  Pixel ``(i, j)`` (column i,
+row j) covers ``[i, i + 1) x [j, j + 1)``; its centre is ``(i + 0.5, j + 0.5)``.
+The centre of a box is therefore ``(x + w / 2, y + h / 2)`` in these
+continuous coordinates.  The trackers work internally in *pixel-index*
+coordinates (pixel (i, j) sits at (i, j)); :func:`box_centre_index` and
+:func:`box_from_centre_index` convert.
+
+OTB ground truth is 1-based; the data readers subtract 1 from x and y.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, asdict
+from enum import Enum
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Box:
+    """Axis-aligned box ``(x, y, w, h)``, 0-based, left/top + size, in pixels."""
+
+    x: float
+    y: float
+    w: float
+    h: float
+
+    @classmethod
+    def of(cls, box: "Box | tuple[float, float, float, float] | list[float]") -> "Box":
+        """Build a Box from a Box or a 4-sequence; raises ValueError on bad shape/values."""
+        if isinstance(box, Box):
+            b = box
+        else:
+            try:
+                vals = [float(v) for v in box]
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"box must be 4 numbers (x, y, w, h), got {box!r}") from exc
+            if len(vals) != 4:
+                raise ValueError(f"box must be 4 numbers (x, y, w, h), got {len(vals)} values")
+            b = cls(*vals)
+        if not all(math.isfinite(v) for v in (b.x, b.y, b.w, b.h)):
+            raise ValueError(f"box has a non-finite value: {b}")
+        return b
+
+    def as_tuple(self) -> tuple[float, float, float, float]:
+        return (self.x, self.y, self.w, self.h)
+
+    @property
+    def centre(self) -> tuple[float, float]:
+        """Centre in continuous coordinates (x + w/2, y + h/2)."""
+        return (self.x + self.w / 2.0, self.y + self.h / 2.0)
+
+
+def box_centre_index(box: Box) -> tuple[float, float]:
+    """Centre of ``box`` in pixel-index coordinates (pixel (i, j) at (i, j))."""
+    cx, cy = box.centre
+    return (cx - 0.5, cy - 0.5)
+
+
+def box_from_centre_index(cx: float, cy: float, w: float, h: float) -> Box:
+    """Box of size (w, h) whose centre in pixel-index coordinates is (cx, cy)."""
+    return Box(cx + 0.5 - w / 2.0, cy + 0.5 - h / 2.0, w, h)
+
+
+class Status(str, Enum):
+    """Per-frame tracker status."""
+
+    OK = "ok"                  # tracked normally
+    INIT = "init"              # the frame the target was initialised on
+    LOST = "lost"              # no model bin present in the window (all weights 0)
+    CLIPPED = "clipped"        # init box clipped to the frame / to the maximum window
+    ERROR = "error"            # frame rejected (bad frame); position kept from the previous frame
+
+
+@dataclass
+class FeatureResult:
+    """Mean-shift result of one feature (colour or edge) on one frame.
+
+    centre: converged centre, pixel-index coordinates; rho: Bhattacharyya
+    coefficient at that centre (0..1); iterations: mean-shift iterations run;
+    stop: why the loop stopped ("shift", "rho", "max_iter", "lost").
+    """
+
+    centre: tuple[float, float]
+    rho: float
+    iterations: int
+    stop: str
+
+
+@dataclass
+class TrackResult:
+    """Result of one frame.
+
+    box: fused box (0-based x, y, w, h); centre: fused centre, pixel-index
+    coordinates; rho_c / rho_e: colour / edge Bhattacharyya coefficients;
+    alpha_c / alpha_e: fusion weights (sum to 1); iter_c / iter_e: iterations
+    per feature; status: :class:`Status`; extra: model-specific detail (the
+    fixed model puts its raw integers here).
+    """
+
+    box: Box
+    centre: tuple[float, float]
+    rho_c: float
+    rho_e: float
+    alpha_c: float
+    alpha_e: float
+    iter_c: int
+    iter_e: int
+    status: Status
+    message: str = ""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["box"] = list(self.box.as_tuple())
+        d["centre"] = list(self.centre)
+        d["status"] = self.status.value
+        return d

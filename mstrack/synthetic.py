@@ -1,0 +1,121 @@
+"""Synthetic test scenes with exact ground truth.
+
+:func:`make_scene` renders a textured, coloured target (a red/yellow
+checkerboard with noise, so it has both a distinctive colour histogram and
+internal edges) moving smoothly over a textured blue-green background.  The
+scene is deterministic for a given seed.  Boxes follow :mod:`mstrack.types`
+(0-based ``x, y, w, h``).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from .data import open_video_writer
+
+
+def _texture(rng: np.random.Generator, h: int, w: int, cell: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Smooth random colour texture, float32 (h, w, 3), each channel in [lo, hi]."""
+    small = rng.random((max(2, h // cell), max(2, w // cell), 3), dtype=np.float32)
+    t = cv2.resize(small, (w, h), interpolation=cv2.INTER_CUBIC)
+    t = np.clip(t, 0.0, 1.0)
+    return lo + t * (hi - lo)
+
+
+def make_scene(n_frames: int = 100, width: int = 320, height: int = 240, seed: int = 0,
+               target_size: tuple[int, int] | None = None, noise: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+    """Render a moving-target scene.
+
+    Parameters
+    ----------
+    n_frames : int
+        Number of frames N (>= 1).
+    width, height : int
+        Frame size in pixels (at least 32 x 32).
+    seed : int
+        Random seed; the same arguments give identical output.
+    target_size : (w, h), optional
+        Target size in pixels; default 64 x 64, shrunk to at most a quarter
+        of the frame's smaller side... times two (i.e. ``min(64, min(W, H) // 3)``).
+    noise : float
+        Standard deviation of per-frame sensor noise (grey levels).
+
+    Returns
+    -------
+    frames : ndarray, shape (N, height, width, 3), uint8
+        BGR frames.
+    gt : ndarray, shape (N, 4), float64
+        Target boxes ``(x, y, w, h)``, 0-based, integer-valued.
+    """
+    if n_frames < 1 or width < 32 or height < 32:
+        raise ValueError("need n_frames >= 1 and a frame of at least 32 x 32")
+    rng = np.random.default_rng(seed)
+    side = min(64, min(width, height) // 3)
+    tw, th = target_size if target_size is not None else (side, side)
+    # background: blue/green/grey, large blobs + fine grain (BGR order)
+    bg = _texture(rng, height, width, 24, np.array([90, 80, 40], np.float32), np.array([200, 170, 110], np.float32))
+    bg += _texture(rng, height, width, 3, np.float32(-25), np.float32(25))
+    # target: red/yellow checkerboard with texture (BGR)
+    yy, xx = np.mgrid[0:th, 0:tw]
+    cell = max(4, min(tw, th) // 6)
+    check = ((yy // cell + xx // cell) % 2).astype(bool)
+    tgt = np.empty((th, tw, 3), np.float32)
+    tgt[check] = (30, 40, 210)     # red
+    tgt[~check] = (40, 200, 230)   # yellow/orange
+    tgt += _texture(rng, th, tw, 4, np.float32(-20), np.float32(20))
+    # smooth Lissajous trajectory inside the frame (max speed about 3 px/frame)
+    mx, my = (width - tw) / 2.0, (height - th) / 2.0
+    ax, ay = 0.8 * mx, 0.8 * my
+    px, py = rng.uniform(0, 2 * np.pi, 2)
+    t = np.arange(n_frames, dtype=np.float64)
+    wx = min(3.0 / max(ax, 1.0), 2 * np.pi / 90)
+    wy = min(2.5 / max(ay, 1.0), 2 * np.pi / 70)
+    xs = np.round(mx + ax * np.sin(wx * t + px)).astype(int)
+    ys = np.round(my + ay * np.sin(wy * t + py)).astype(int)
+    frames = np.empty((n_frames, height, width, 3), np.uint8)
+    for i in range(n_frames):
+        f = bg.copy()
+        f[ys[i]:ys[i] + th, xs[i]:xs[i] + tw] = tgt
+        f += rng.normal(0.0, noise, f.shape).astype(np.float32)
+        frames[i] = np.clip(f, 0, 255).astype(np.uint8)
+    gt = np.stack([xs, ys, np.full(n_frames, tw), np.full(n_frames, th)], axis=1).astype(np.float64)
+    return frames, gt
+
+
+def write_video(frames: np.ndarray, path: str | Path, fps: float = 25.0) -> Path:
+    """Write BGR frames ``(N, H, W, 3)`` uint8 to a video (mp4v, else MJPG avi); returns the path written."""
+    n, h, w = frames.shape[:3]
+    writer, out = open_video_writer(path, fps, (w, h))
+    try:
+        for f in frames:
+            writer.write(f)
+    finally:
+        writer.release()
+    return out
+
+
+def write_otb_sequence(frames: np.ndarray, gt: np.ndarray, folder: str | Path,
+                       attributes: list[str] | None = None, name: str | None = None) -> Path:
+    """Write frames and 0-based boxes as an OTB sequence folder.
+
+    Creates ``img/0001.jpg ...``, ``groundtruth_rect.txt`` (1-based, comma
+    separated) and ``meta.json``.  Returns the folder.
+    """
+    d = Path(folder)
+    (d / "img").mkdir(parents=True, exist_ok=True)
+    for i, f in enumerate(frames, start=1):
+        if not cv2.imwrite(str(d / "img" / f"{i:04d}.jpg"), f, [cv2.IMWRITE_JPEG_QUALITY, 95]):
+            raise OSError(f"cannot write {d / 'img' / f'{i:04d}.jpg'}")
+    g = np.asarray(gt, dtype=np.float64).copy()
+    g[:, :2] += 1
+    lines = [",".join(f"{v:g}" for v in row) for row in g]
+    (d / "groundtruth_rect.txt").write_text("\n".join(lines) + "\n")
+    h, w = frames.shape[1:3]
+    meta = {"name": name or d.name, "format": "otb", "gt_coordinate_base": 1,
+            "attributes": list(attributes or []), "width": int(w), "height": int(h),
+            "frames": int(len(frames)), "source": "mstrack.synthetic.make_scene"}
+    (d / "meta.json").write_text(json.dumps(meta, indent=1) + "\n")
+    return d

@@ -38,8 +38,8 @@ def make_scene(n_frames: int = 100, width: int = 320, height: int = 240, seed: i
     seed : int
         Random seed; the same arguments give identical output.
     target_size : (w, h), optional
-        Target size in pixels; default 64 x 64, shrunk to at most a quarter
-        of the frame's smaller side... times two (i.e. ``min(64, min(W, H) // 3)``).
+        Target size in pixels; default a square of side
+        ``min(64, min(width, height) // 3)``.
     noise : float
         Standard deviation of per-frame sensor noise (grey levels).
 

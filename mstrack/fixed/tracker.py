@@ -73,7 +73,7 @@ class FixedTracker:
         """Initialise from an integer box, exactly as the RTL's init port does."""
         frame = check_frame(frame)
         fh, fw = frame.shape[:2]
-        if fw > (1 << self.fixed.coord_bits) or fh > (1 << self.fixed.coord_bits):
+        if fw >= (1 << self.fixed.coord_bits) or fh >= (1 << self.fixed.coord_bits):
             raise ValueError(f"frame {fw}x{fh} larger than coord_bits={self.fixed.coord_bits} allows")
         ib, clipped = ms_box_clip(x, y, w, h, fw, fh, self.fixed.max_half)
         if ib is None:

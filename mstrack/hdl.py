@@ -274,6 +274,19 @@ def _check_results(xml_path: Path | None, build_dir: Path, sim_msg: str) -> Path
     return Path(xml_path)
 
 
+#: environment variable through which run_ghdl/run_verilator hand the generics to the cocotb test
+GENERICS_ENV = "MSTRACK_GENERICS"
+
+
+def dut_generics(defaults: Mapping[str, object] | None = None) -> dict:
+    """Inside a cocotb test: the generics the design was built with (as given to
+    run_ghdl / run_verilator), over *defaults*.  Works for both simulators
+    (Verilator's netlist has no generics left to read)."""
+    out = dict(defaults or {})
+    out.update(json.loads(os.environ.get(GENERICS_ENV, "{}") or "{}"))
+    return out
+
+
 def _prepare_pythonpath(test_module: str, test_dirs: Sequence[Path | str]) -> None:
     # cocotb's runner hands sys.path to the simulator's Python as PYTHONPATH
     for d in [TB_DIR, *map(Path, test_dirs)]:
@@ -283,8 +296,8 @@ def _prepare_pythonpath(test_module: str, test_dirs: Sequence[Path | str]) -> No
 
 def _run_cocotb(runner, *, toplevel: str, test_module: str, build_dir: Path, test_params: Mapping[str, object],
                 extra_env: Mapping[str, str] | None, waves: bool, testcase, test_args: Sequence[str],
-                plusargs: Sequence[str], seed) -> Path:
-    env = {"COCOTB_REDUCED_LOG_FMT": "1", **(extra_env or {})}
+                plusargs: Sequence[str], seed, generics: Mapping[str, object] | None) -> Path:
+    env = {"COCOTB_REDUCED_LOG_FMT": "1", GENERICS_ENV: json.dumps(dict(generics or {})), **(extra_env or {})}
     msg = ""
     xml = None
     try:
@@ -352,7 +365,7 @@ def run_ghdl(
         return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
                            test_params=params, extra_env={"GHDL_BACKEND": backend, **(extra_env or {})},
                            waves=waves, testcase=testcase, test_args=["--std=08"],
-                           plusargs=["--ieee-asserts=disable-at-0"], seed=seed)
+                           plusargs=["--ieee-asserts=disable-at-0"], seed=seed, generics=generics)
 
 
 # --------------------------------------------------------------------------
@@ -392,7 +405,7 @@ def ghdl_to_verilog(
     srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
     out = Path(out_path) if out_path else BUILD_DIR / "verilog" / f"{toplevel}_{_generics_tag(generics)}.v"
     out.parent.mkdir(parents=True, exist_ok=True)
-    digest = _hash_inputs(toplevel, generics, srcs)
+    digest = _hash_inputs(toplevel, generics, srcs, extra="fix1")
     stamp = out.with_suffix(out.suffix + ".hash")
     if out.is_file() and stamp.is_file() and stamp.read_text().strip() == digest:
         return out
@@ -406,9 +419,24 @@ def ghdl_to_verilog(
     log.write_text("$ " + " ".join(cmd) + "\n" + r.stderr)
     if r.returncode != 0 or not r.stdout.strip():
         raise HdlError(f"ghdl --synth of {toplevel} failed (exit {r.returncode}), log {log}:\n{r.stderr[-4000:]}")
-    out.write_text(r.stdout)
+    text, nfix = fix_ghdl_verilog(r.stdout)
+    if nfix:
+        with open(log, "a") as f:
+            f.write(f"mstrack.hdl: rewrote {nfix} wide string-literal constants as N'b... literals\n")
+    out.write_text(text)
     stamp.write_text(digest + "\n")
     return out
+
+
+_WIDE_CONST_RE = re.compile(r'"([01xzXZ]+)"')
+
+
+def fix_ghdl_verilog(text: str) -> tuple[str, int]:
+    """Work around GHDL 2.0's Verilog writer printing constants wider than 32 bits
+    as *string literals* (``"0...0111"``), which Verilog tools read as 8 bits per
+    character (Verilator and Yosys then compute wrong values silently).  Rewrites
+    them as sized binary literals (``33'b0...0111``).  Returns (text, count)."""
+    return _WIDE_CONST_RE.subn(lambda m: f"{len(m.group(1))}'b{m.group(1).lower()}", text)
 
 
 # --------------------------------------------------------------------------
@@ -475,7 +503,7 @@ def run_verilator(
             raise HdlError(f"Verilator build of {toplevel} failed ({e}); log {log}:\n{tail}") from None
         return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
                            test_params={}, extra_env=extra_env, waves=waves, testcase=testcase,
-                           test_args=[], plusargs=[], seed=seed)
+                           test_args=[], plusargs=[], seed=seed, generics=generics)
 
 
 # --------------------------------------------------------------------------
@@ -595,6 +623,6 @@ def synth_xilinx(
 
 __all__ = [
     "REPO_ROOT", "RTL_DIR", "TB_DIR", "BUILD_DIR", "TOOLS_HDL_DIR", "HdlError", "HdlTestFailure",
-    "rtl_sources", "run_ghdl", "run_verilator", "ghdl_to_verilog", "synth_ecp5", "synth_xilinx",
-    "ghdl_backend", "have_ghdl", "have_verilator", "verilator_root",
+    "rtl_sources", "run_ghdl", "run_verilator", "ghdl_to_verilog", "fix_ghdl_verilog", "synth_ecp5", "synth_xilinx",
+    "ghdl_backend", "have_ghdl", "dut_generics", "GENERICS_ENV", "have_verilator", "verilator_root",
 ]

@@ -41,4 +41,6 @@ package ms_formats_pkg is
   constant D_ITER_W         : natural := 5;
   constant D_RHO_OUT_W      : natural := 17;
   constant D_ALPHA_W        : natural := 9;
+  constant D_WIN_W          : natural := 7;
+  constant D_RESULT_W       : natural := 144;
 end package;

@@ -28,7 +28,7 @@ def core_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None
         raise ValueError("lanes must be a power of two")
     region_max = w.region_max
     stride = -(-region_max // lanes)
-    return {
+    g = {
         "LANES": lanes,
         "COLOUR_BITS": tp.colour_bits,
         "EDGE_BINS_LOG2": tp.edge_bins_log2,
@@ -70,7 +70,10 @@ def core_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None
         "ITER_W": bits_for(tp.max_iter),
         "RHO_OUT_W": w.rho_out,
         "ALPHA_W": w.alpha,
+        "WIN_W": bits_for(2 * fp.max_half + 1),
     }
+    g["RESULT_W"] = result_width(g)
+    return g
 
 
 def formats_pkg_text(lanes: int = DEFAULT_LANES) -> str:
@@ -88,6 +91,43 @@ def formats_pkg_text(lanes: int = DEFAULT_LANES) -> str:
 def write_formats_pkg(path: Path = PKG_PATH) -> Path:
     path.write_text(formats_pkg_text())
     return path
+
+
+
+# ----------------------------------------------------------------------------- result word
+RESULT_FLAGS = ("init", "clipped", "lost", "error", "rejected", "no_target", "overflow", "reserved")
+ERR_CODE_W = 3
+FRAME_COUNT_W = 16
+
+
+def result_layout(g: dict[str, int] | None = None) -> list[tuple[str, int, int]]:
+    """Fields of the result word, LSB first: (name, offset, width).  ms_tracker packs the same order."""
+    g = g or core_generics()
+    win_w = g["WIN_W"]
+    fields_ = [("cx", g["CENTRE_ABS_W"]), ("cy", g["CENTRE_ABS_W"]), ("rho_c", g["RHO_OUT_W"]),
+               ("rho_e", g["RHO_OUT_W"]), ("alpha_c", g["ALPHA_W"]), ("iter_c", g["ITER_W"]),
+               ("iter_e", g["ITER_W"]), ("stop_c", 2), ("stop_e", 2), ("flags", len(RESULT_FLAGS)),
+               ("err_code", ERR_CODE_W), ("box_w", win_w), ("box_h", win_w),
+               ("frame_count", FRAME_COUNT_W)]
+    out, off = [], 0
+    for name, w in fields_:
+        out.append((name, off, w))
+        off += w
+    return out
+
+
+def result_width(g: dict[str, int] | None = None) -> int:
+    """Result word width: the fields rounded up to a multiple of 8 bits."""
+    name, off, w = result_layout(g)[-1]
+    return -(-(off + w) // 8) * 8
+
+
+def unpack_result(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
+    """Split a result word into its fields; flags are also given one key each (flag_<name>)."""
+    out = {name: (word >> off) & ((1 << w) - 1) for name, off, w in result_layout(g)}
+    for i, f in enumerate(RESULT_FLAGS):
+        out[f"flag_{f}"] = (out["flags"] >> i) & 1
+    return out
 
 
 if __name__ == "__main__":

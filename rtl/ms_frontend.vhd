@@ -1,0 +1,128 @@
+-- ms_frontend: streaming front end of the tracker: ms_stream_check ->
+-- (ms_colour_bin | ms_grey) -> ms_sobel.
+--
+-- Computes: the (x, y, colour bin, edge bin) of every interior pixel
+-- (1 <= x <= W-2, 1 <= y <= H-2) of each frame, in raster order, plus the
+-- frame events of ms_stream_check re-timed so that they keep their order with
+-- the pixels: every event is delayed by EVT_DELAY = 7 clocks, so that
+--   * frame_end comes 1 clock AFTER the frame's last interior pixel (ip_valid),
+--     i.e. 8 clocks after the frame's last input beat was accepted;
+--   * frame_error (any code, also ERR_CUT) comes after all the ip_* pixels of
+--     the abandoned frame;
+--   * frame_start comes 8 clocks after the sof beat, before the first interior
+--     pixel of that frame (which needs >= 2 W + 3 beats).
+-- Latency: input beat of pixel (x+1, y+1) -> ip_valid of (x, y): 7 clocks
+-- (check 1, grey 2, sobel 4).  Throughput: 1 pixel/clock; never stalls (no
+-- ready): the top must back-pressure upstream itself if it needs to.
+-- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height (not checked).
+-- Python model: mstrack.fixed.blocks ms_colour_bin and
+-- ms_edge_bin(ms_sobel(ms_grey(frame)), 2**EDGE_BINS_LOG2, EDGE_SHIFT).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_stream_pkg.all;
+
+entity ms_frontend is
+  generic (
+    COORD_W        : natural := 12;              -- width of x, y, frame size
+    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    COLOUR_BITS    : natural range 1 to 8 := 3;  -- bits per channel of the colour bin
+    EDGE_BINS_LOG2 : natural range 1 to 8 := 4;  -- edge bin width
+    EDGE_SHIFT     : natural range 0 to 11 := 5  -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
+  );
+  port (
+    clk          : in  std_logic;                                       -- clock
+    rst          : in  std_logic;                                       -- synchronous reset, active high
+    frame_width  : in  unsigned(COORD_W - 1 downto 0);                  -- W, sampled on sof
+    frame_height : in  unsigned(COORD_W - 1 downto 0);                  -- H, sampled on sof
+    in_valid     : in  std_logic;                                       -- beat present (AXI tvalid; tready = 1)
+    in_data      : in  std_logic_vector(23 downto 0);                   -- RGB: R 23:16, G 15:8, B 7:0
+    in_sof       : in  std_logic;                                       -- start of frame (AXI tuser)
+    in_eol       : in  std_logic;                                       -- end of line (AXI tlast)
+    ip_valid     : out std_logic;                                       -- interior pixel out
+    ip_x         : out unsigned(COORD_W - 1 downto 0);                  -- its column (1 .. W-2)
+    ip_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (1 .. H-2)
+    ip_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0);  -- its colour bin
+    ip_ebin      : out std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);   -- its edge bin
+    frame_start  : out std_logic;                                       -- pulse: a frame started (delayed)
+    frame_end    : out std_logic;                                       -- pulse: good frame complete, after its last ip_valid
+    frame_error  : out std_logic;                                       -- pulse: protocol error (delayed), no frame_end for that frame
+    err_code     : out std_logic_vector(ERR_CODE_W - 1 downto 0)        -- ERR_* (ms_stream_pkg), with frame_error
+  );
+end entity;
+
+architecture rtl of ms_frontend is
+  constant EVT_DELAY : natural := 7;  -- = pixel path latency (check 1 + grey 2 + sobel 4) - 1 + 1
+  constant CB_W : natural := 3 * COLOUR_BITS;
+
+  signal px_valid : std_logic;
+  signal px_data  : std_logic_vector(23 downto 0);
+  signal px_x, px_y : unsigned(COORD_W - 1 downto 0);
+  signal c_start, c_end, c_err : std_logic;
+  signal c_code   : std_logic_vector(ERR_CODE_W - 1 downto 0);
+
+  signal cb_valid : std_logic;
+  signal cb_bin, cb_bin_d : std_logic_vector(CB_W - 1 downto 0);
+  signal g_valid  : std_logic;
+  signal g_grey   : unsigned(7 downto 0);
+  type coord_pipe_t is array (1 to 2) of unsigned(COORD_W - 1 downto 0);
+  signal xd, yd   : coord_pipe_t;
+
+  constant EV_W : natural := 3 + ERR_CODE_W;
+  type ev_pipe_t is array (1 to EVT_DELAY) of std_logic_vector(EV_W - 1 downto 0);
+  signal ev : ev_pipe_t := (others => (others => '0'));
+begin
+  u_check : entity work.ms_stream_check
+    generic map (COORD_W => COORD_W, DATA_W => 24)
+    port map (
+      clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
+      in_valid => in_valid, in_data => in_data, in_sof => in_sof, in_eol => in_eol,
+      px_valid => px_valid, px_data => px_data, px_x => px_x, px_y => px_y,
+      frame_start => c_start, frame_end => c_end, frame_error => c_err, err_code => c_code);
+
+  u_colour : entity work.ms_colour_bin
+    generic map (COLOUR_BITS => COLOUR_BITS)
+    port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data,
+              out_valid => cb_valid, out_bin => cb_bin);
+
+  u_grey : entity work.ms_grey
+    port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data,
+              out_valid => g_valid, out_grey => g_grey);
+
+  -- align the colour bin (latency 1) and x, y with the grey (latency 2)
+  p_align : process (clk)
+  begin
+    if rising_edge(clk) then
+      cb_bin_d <= cb_bin;
+      xd <= px_x & xd(1);
+      yd <= px_y & yd(1);
+    end if;
+  end process;
+
+  u_sobel : entity work.ms_sobel
+    generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT)
+    port map (clk => clk, rst => rst, in_valid => g_valid, in_x => xd(2), in_y => yd(2),
+              in_grey => g_grey, in_cbin => cb_bin_d,
+              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin);
+
+  -- event delay line
+  p_events : process (clk)
+  begin
+    if rising_edge(clk) then
+      ev(1) <= c_start & c_end & c_err & c_code;
+      for i in 2 to EVT_DELAY loop
+        ev(i) <= ev(i - 1);
+      end loop;
+      if rst = '1' then
+        for i in 1 to EVT_DELAY loop
+          ev(i)(EV_W - 1 downto ERR_CODE_W) <= (others => '0');
+        end loop;
+      end if;
+    end if;
+  end process;
+  frame_start <= ev(EVT_DELAY)(EV_W - 1);
+  frame_end   <= ev(EVT_DELAY)(EV_W - 2);
+  frame_error <= ev(EVT_DELAY)(EV_W - 3);
+  err_code    <= ev(EVT_DELAY)(ERR_CODE_W - 1 downto 0);
+end architecture;

@@ -1,0 +1,135 @@
+-- ms_region_capture: writes the bins of the search region's pixels into the
+-- colour and edge region RAMs (two ms_region_ram, instantiated by the top).
+--
+-- Computes: on frame_start it latches the region (reg_x, reg_y, reg_w, reg_h;
+-- computed by the top, inside the frame interior) and arms; for each interior
+-- pixel (ip_x, ip_y) of the front end inside the region, with rx = ip_x - reg_x,
+-- ry = ip_y - reg_y, it writes
+--   bank  = rx mod LANES                (low bits of rx)
+--   waddr = ry * STRIDE + rx / LANES    (row base counter + shift, no multiplier)
+--   wdata_colour = ip_cbin, wdata_edge = ip_ebin.
+-- The row base counts STRIDE per new region row (the front end delivers every
+-- interior row in order).  frame_end or frame_error disarms; done pulses 2
+-- clocks after frame_end, once the frame's last write is in the RAMs (a read
+-- issued in the done clock or later sees all of them).
+-- Latency: ip_valid -> we 2 clocks; frame_end -> done 2 clocks.
+-- Throughput: 1 pixel/clock, no handshake.
+-- Python model: mstrack.fixed.blocks.ms_region_capture (region pixel (rx, ry)
+-- holds colour[ry, rx], edge[ry, rx]).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+
+entity ms_region_capture is
+  generic (
+    LANES          : natural := 2;    -- RAM banks (power of two)
+    COORD_W        : natural := 12;   -- width of x, y and of the region
+    REGION_MAX     : natural := 191;  -- largest region extent (reg_w, reg_h <= REGION_MAX)
+    STRIDE         : natural := 96;   -- words per region row per bank = ceil(REGION_MAX / LANES)
+    ADDR_W         : natural := 15;   -- RAM address width (bits_for(REGION_MAX * STRIDE - 1))
+    COLOUR_BITS    : natural range 1 to 8 := 3;  -- colour bin = 3 * COLOUR_BITS bits
+    EDGE_BINS_LOG2 : natural range 1 to 8 := 4   -- edge bin width
+  );
+  port (
+    clk          : in  std_logic;                                          -- clock
+    rst          : in  std_logic;                                          -- synchronous reset, active high
+    frame_start  : in  std_logic;                                          -- from ms_frontend: latch the region, arm
+    frame_end    : in  std_logic;                                          -- from ms_frontend: good frame complete
+    frame_error  : in  std_logic;                                          -- from ms_frontend: frame abandoned (disarm)
+    reg_x        : in  unsigned(COORD_W - 1 downto 0);                     -- region first column (sampled on frame_start)
+    reg_y        : in  unsigned(COORD_W - 1 downto 0);                     -- region first row
+    reg_w        : in  unsigned(COORD_W - 1 downto 0);                     -- region width (1 .. REGION_MAX)
+    reg_h        : in  unsigned(COORD_W - 1 downto 0);                     -- region height (1 .. REGION_MAX)
+    ip_valid     : in  std_logic;                                          -- interior pixel (ms_frontend)
+    ip_x         : in  unsigned(COORD_W - 1 downto 0);                     -- its column
+    ip_y         : in  unsigned(COORD_W - 1 downto 0);                     -- its row
+    ip_cbin      : in  std_logic_vector(3 * COLOUR_BITS - 1 downto 0);     -- its colour bin
+    ip_ebin      : in  std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);      -- its edge bin
+    we           : out std_logic;                                          -- RAM write enable (both RAMs)
+    wbank        : out unsigned(clog2(LANES) - 1 downto 0);                -- RAM bank
+    waddr        : out unsigned(ADDR_W - 1 downto 0);                      -- RAM word address
+    wdata_colour : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0);     -- colour RAM data
+    wdata_edge   : out std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);      -- edge RAM data
+    done         : out std_logic                                           -- pulse: region of a good frame captured
+  );
+end entity;
+
+architecture rtl of ms_region_capture is
+  function log2_lanes(n : natural) return natural is
+  begin
+    if n <= 1 then
+      return 0;
+    end if;
+    return clog2(n);
+  end function;
+  constant LOG2L  : natural := log2_lanes(LANES);  -- log2(LANES), 0 for 1 lane
+  constant BANK_W : natural := clog2(LANES);
+
+  signal armed    : std_logic := '0';
+  signal x0, y0   : unsigned(COORD_W - 1 downto 0);  -- region origin
+  signal x1, y1   : unsigned(COORD_W downto 0);      -- region end (exclusive)
+  signal row_y    : unsigned(COORD_W - 1 downto 0);  -- row of row_base
+  signal row_base : unsigned(ADDR_W - 1 downto 0);   -- ry * STRIDE of row_y
+  -- stage 1
+  signal v1       : std_logic := '0';
+  signal base1    : unsigned(ADDR_W - 1 downto 0);
+  signal rx1      : unsigned(COORD_W - 1 downto 0);
+  signal c1       : std_logic_vector(3 * COLOUR_BITS - 1 downto 0);
+  signal e1       : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal end1     : std_logic := '0';
+begin
+  assert 2 ** LOG2L = LANES report "ms_region_capture: LANES must be a power of two" severity failure;
+  assert STRIDE * LANES >= REGION_MAX report "ms_region_capture: STRIDE < REGION_MAX / LANES" severity failure;
+
+  p_capture : process (clk)
+    variable inside : boolean;
+    variable base   : unsigned(ADDR_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      -- stage 1: inside test, row base
+      inside := armed = '1' and ip_valid = '1'
+                and ip_x >= x0 and resize(ip_x, COORD_W + 1) < x1
+                and ip_y >= y0 and resize(ip_y, COORD_W + 1) < y1;
+      base := row_base;
+      if inside and ip_y /= row_y then
+        base := row_base + STRIDE;
+        row_base <= base;
+        row_y    <= ip_y;
+      end if;
+      v1    <= '1' when inside else '0';
+      base1 <= base;
+      rx1   <= ip_x - x0;
+      c1    <= ip_cbin;
+      e1    <= ip_ebin;
+      end1  <= frame_end and armed;
+      -- stage 2: RAM write
+      we           <= v1;
+      wbank        <= resize(rx1, BANK_W);
+      waddr        <= base1 + resize(shift_right(rx1, LOG2L), ADDR_W);
+      wdata_colour <= c1;
+      wdata_edge   <= e1;
+      done         <= end1;
+      -- control
+      if frame_end = '1' or frame_error = '1' then
+        armed <= '0';
+      end if;
+      if frame_start = '1' then
+        armed    <= '1';
+        x0       <= reg_x;
+        y0       <= reg_y;
+        x1       <= resize(reg_x, COORD_W + 1) + reg_w;
+        y1       <= resize(reg_y, COORD_W + 1) + reg_h;
+        row_y    <= reg_y;
+        row_base <= (others => '0');
+      end if;
+      if rst = '1' then
+        armed <= '0';
+        v1    <= '0';
+        end1  <= '0';
+        we    <= '0';
+        done  <= '0';
+      end if;
+    end if;
+  end process;
+end architecture;

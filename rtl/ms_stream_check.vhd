@@ -1,0 +1,138 @@
+-- ms_stream_check: video stream protocol checker and pixel coordinate counter.
+--
+-- Computes: for each input beat (one pixel per beat, in_sof = AXI tuser = first
+-- pixel of a frame, in_eol = AXI tlast = last pixel of a line) its column x and
+-- row y against the runtime frame size (frame_width, frame_height, sampled on
+-- the sof beat), and flags protocol errors:
+--   ERR_SHORT_LINE  eol on a pixel with x < W-1            -> frame abandoned
+--   ERR_LONG_LINE   pixel x = W-1 without eol              -> frame abandoned
+--   ERR_NO_SOF      beat without sof while waiting for a start of frame
+--                   (after reset or after a good frame); reported once until
+--                   the next sof, the beats are dropped
+--   ERR_CUT         sof while a frame is in progress: that frame is abandoned
+--                   (frame_error) AND the sof beat starts a new frame normally
+--                   (frame_start in the same clock)
+-- After an error the beats are dropped silently until the next sof.  The beat
+-- that causes SHORT_LINE / LONG_LINE is dropped too.  A frame with an error
+-- never gets frame_end.  Codes: rtl/ms_stream_pkg.vhd.
+--
+-- Accepted beats leave on px_* with their (x, y); frame_end is raised with the
+-- frame's last pixel (x = W-1, y = H-1, with eol).
+-- Latency: 1 clock (all outputs registered).  Throughput: 1 beat/clock; it
+-- never stalls its input (no ready).  Reset: synchronous, control state only.
+-- Requires frame_width >= 1, frame_height >= 1 (the front end needs >= 3 and
+-- frame_width <= MAX_FRAME_W of ms_sobel; not checked here).
+-- Python model: the front end of mstrack.fixed.tracker (frames are complete
+-- arrays there); the coordinates are the array indices (column x, row y).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_stream_pkg.all;
+
+entity ms_stream_check is
+  generic (
+    COORD_W : natural := 12;  -- width of x, y and of the frame size (frames up to 2**COORD_W - 1)
+    DATA_W  : natural := 24   -- pixel width (RGB: R 23:16, G 15:8, B 7:0)
+  );
+  port (
+    clk          : in  std_logic;                               -- clock
+    rst          : in  std_logic;                               -- synchronous reset, active high
+    frame_width  : in  unsigned(COORD_W - 1 downto 0);          -- W, sampled on each sof beat
+    frame_height : in  unsigned(COORD_W - 1 downto 0);          -- H, sampled on each sof beat
+    in_valid     : in  std_logic;                               -- beat present (no ready: never stalls)
+    in_data      : in  std_logic_vector(DATA_W - 1 downto 0);   -- pixel
+    in_sof       : in  std_logic;                               -- start of frame (AXI tuser)
+    in_eol       : in  std_logic;                               -- end of line (AXI tlast)
+    px_valid     : out std_logic;                               -- accepted pixel
+    px_data      : out std_logic_vector(DATA_W - 1 downto 0);   -- its data
+    px_x         : out unsigned(COORD_W - 1 downto 0);          -- its column
+    px_y         : out unsigned(COORD_W - 1 downto 0);          -- its row
+    frame_start  : out std_logic;                               -- pulse: sof accepted (with px_valid of pixel (0, 0))
+    frame_end    : out std_logic;                               -- pulse: last pixel of a good frame (with its px_valid)
+    frame_error  : out std_logic;                               -- pulse: protocol error, code on err_code
+    err_code     : out std_logic_vector(ERR_CODE_W - 1 downto 0) -- ERR_* of ms_stream_pkg, valid with frame_error
+  );
+end entity;
+
+architecture rtl of ms_stream_check is
+  type state_t is (S_WAIT, S_DROP, S_FRAME);  -- S_WAIT: waiting for sof, NO_SOF armed
+  signal state  : state_t := S_WAIT;
+  signal x, y   : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- position of the next beat
+  signal last_x : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- W - 1
+  signal last_y : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- H - 1
+begin
+  p_check : process (clk)
+    variable cx, cy     : unsigned(COORD_W - 1 downto 0);
+    variable lx, ly     : unsigned(COORD_W - 1 downto 0);
+    variable active     : boolean;  -- the beat belongs to a frame in progress
+  begin
+    if rising_edge(clk) then
+      px_valid    <= '0';
+      frame_start <= '0';
+      frame_end   <= '0';
+      frame_error <= '0';
+      px_data     <= in_data;
+      if in_valid = '1' then
+        active := false;
+        cx := x;
+        cy := y;
+        lx := last_x;
+        ly := last_y;
+        if in_sof = '1' then
+          if state = S_FRAME then
+            frame_error <= '1';
+            err_code    <= ERR_CUT;
+          end if;
+          frame_start <= '1';
+          lx := frame_width - 1;
+          ly := frame_height - 1;
+          last_x <= lx;
+          last_y <= ly;
+          cx := (others => '0');
+          cy := (others => '0');
+          active := true;
+        elsif state = S_FRAME then
+          active := true;
+        elsif state = S_WAIT then
+          frame_error <= '1';
+          err_code    <= ERR_NO_SOF;
+          state       <= S_DROP;
+        end if;
+        if active then
+          if in_eol = '1' and cx /= lx then
+            frame_error <= '1';
+            err_code    <= ERR_SHORT_LINE;
+            state       <= S_DROP;
+          elsif in_eol = '0' and cx = lx then
+            frame_error <= '1';
+            err_code    <= ERR_LONG_LINE;
+            state       <= S_DROP;
+          else
+            px_valid <= '1';
+            px_x     <= cx;
+            px_y     <= cy;
+            state    <= S_FRAME;
+            if cx = lx then
+              x <= (others => '0');
+              y <= cy + 1;
+              if cy = ly then
+                frame_end <= '1';
+                state     <= S_WAIT;
+              end if;
+            else
+              x <= cx + 1;
+              y <= cy;
+            end if;
+          end if;
+        end if;
+      end if;
+      if rst = '1' then
+        state       <= S_WAIT;
+        px_valid    <= '0';
+        frame_start <= '0';
+        frame_end   <= '0';
+        frame_error <= '0';
+      end if;
+    end if;
+  end process;
+end architecture;

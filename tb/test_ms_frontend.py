@@ -1,0 +1,294 @@
+"""cocotb test bench + pytest entry points for rtl/ms_frontend.vhd
+(ms_stream_check -> ms_colour_bin | ms_grey -> ms_sobel).
+
+Frames are streamed pixel by pixel (in_valid/in_data/in_sof/in_eol), at full
+speed and with random valid gaps.  Every interior pixel's (x, y, cbin, ebin) is
+compared exactly with the fixed model (``ms_colour_bin`` and
+``ms_edge_bin(ms_sobel(ms_grey(frame)))``); the frame events and error codes
+are checked against the expected sequence; protocol errors (short line, long
+line, missing sof, cut frame) are each followed by a good frame that must be
+processed exactly.
+
+Run: ``.venv/bin/python -m pytest tb/test_ms_frontend.py`` (``--waves`` for waves).
+"""
+
+from __future__ import annotations
+
+import os
+import random
+
+import numpy as np
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.handle import Immediate
+from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
+from cocotb.utils import get_sim_time
+
+from mstrack.fixed.blocks import ms_colour_bin, ms_edge_bin, ms_grey, ms_sobel
+from mstrack.hdl import dut_generics
+
+CLK_NS = 10
+DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5}
+# error codes of rtl/ms_stream_pkg.vhd
+ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT = 0, 1, 2, 3
+#: input beat (last one accepted in clock c) -> frame_end high in clock c + FRAME_END_LAT
+FRAME_END_LAT = 8
+
+
+# ---------------------------------------------------------------- frames and model
+
+def random_frame(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
+    return rng.integers(0, 256, size=(h, w, 3), dtype=np.uint8)
+
+
+def grey_frame(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
+    g = rng.integers(0, 256, size=(h, w, 1), dtype=np.uint8)
+    return np.repeat(g, 3, axis=2)
+
+
+def edge_frame(h: int, w: int) -> np.ndarray:
+    """Black/white checkerboard of 1 px with white stripes: |G| up to 2040 (bins saturate)."""
+    yy, xx = np.mgrid[0:h, 0:w]
+    on = ((xx + yy) % 2 == 0) | (xx % 5 == 0)
+    f = np.where(on[..., None], 255, 0).astype(np.uint8)
+    return np.repeat(f, 3, axis=2)
+
+
+def pixel_word(frame: np.ndarray, y: int, x: int) -> int:
+    """24-bit RGB word (R 23:16, G 15:8, B 7:0) of a BGR frame pixel."""
+    b, g, r = (int(v) for v in frame[y, x])
+    return (r << 16) | (g << 8) | b
+
+
+def frame_beats(frame: np.ndarray, sof: bool = True) -> list[tuple[int, int, int, int, int]]:
+    """(data, sof, eol, W, H) of every pixel in raster order."""
+    h, w = frame.shape[:2]
+    return [(pixel_word(frame, y, x), int(sof and x == 0 and y == 0), int(x == w - 1), w, h)
+            for y in range(h) for x in range(w)]
+
+
+def model_interior(frame: np.ndarray, g: dict) -> list[tuple[int, int, int, int]]:
+    """(x, y, cbin, ebin) of every interior pixel in raster order, from the fixed model."""
+    cb = ms_colour_bin(frame, int(g["COLOUR_BITS"]))[1:-1, 1:-1]
+    eb = ms_edge_bin(ms_sobel(ms_grey(frame)), 1 << int(g["EDGE_BINS_LOG2"]), int(g["EDGE_SHIFT"]))
+    h, w = cb.shape
+    return [(x + 1, y + 1, int(cb[y, x]), int(eb[y, x])) for y in range(h) for x in range(w)]
+
+
+# ---------------------------------------------------------------- TB
+
+class TB:
+    def __init__(self, dut, defaults=DEFAULTS):
+        self.dut = dut
+        self.g = dut_generics(defaults)
+        dut.rst.value = Immediate(1)
+        dut.in_valid.value = Immediate(0)
+        cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start(start_high=False))
+        self.ips: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin, ebin))
+        self.events: list[tuple[int, tuple]] = []    # (cycle, ("start",) | ("end",) | ("error", code))
+        self.last_beat_cycle = -1
+
+    @staticmethod
+    def cycle() -> int:
+        return int(get_sim_time("ns")) // CLK_NS
+
+    async def reset(self):
+        self.dut.rst.value = 1
+        await ClockCycles(self.dut.clk, 3)
+        self.dut.rst.value = 0
+        await RisingEdge(self.dut.clk)
+
+    async def monitor(self):
+        d = self.dut
+        has_code = hasattr(d, "err_code")
+        while True:
+            await RisingEdge(d.clk)
+            await ReadOnly()
+            c = self.cycle()
+            if int(d.frame_error.value):
+                self.events.append((c, ("error", int(d.err_code.value) if has_code else -1)))
+            if int(d.frame_start.value):
+                self.events.append((c, ("start",)))
+            if int(d.frame_end.value):
+                self.events.append((c, ("end",)))
+            if hasattr(d, "ip_valid") and int(d.ip_valid.value):
+                self.ips.append((c, (int(d.ip_x.value), int(d.ip_y.value), int(d.ip_cbin.value),
+                                     int(d.ip_ebin.value))))
+
+    async def drive(self, beats, rng: random.Random, gap: float):
+        d = self.dut
+        for data, sof, eol, w, h in beats:
+            while gap and rng.random() < gap:
+                d.in_valid.value = 0
+                d.in_data.value = rng.getrandbits(24)  # garbage while not valid
+                d.in_sof.value = rng.getrandbits(1)
+                d.in_eol.value = rng.getrandbits(1)
+                await RisingEdge(d.clk)
+            d.in_valid.value = 1
+            d.in_data.value = data
+            d.in_sof.value = sof
+            d.in_eol.value = eol
+            d.frame_width.value = w
+            d.frame_height.value = h
+            self.last_beat_cycle = self.cycle()
+            await RisingEdge(d.clk)
+        d.in_valid.value = 0
+
+
+def scenario(g: dict, seed: int):
+    """Segments (beats, expected events, expected interior pixels, exact?) of one run."""
+    rng = np.random.default_rng(seed)
+    segs = []
+
+    def good(frame):
+        segs.append((frame_beats(frame), [("start",), ("end",)], model_interior(frame, g), True))
+
+    def bad(beats, events, frame):
+        segs.append((beats, events, model_interior(frame, g), False))
+
+    good(random_frame(rng, 11, 23))
+    good(random_frame(rng, 17, 40))
+    good(grey_frame(rng, 11, 23))
+    good(edge_frame(9, 16))
+    # short line: row 4 ends (eol) at x = 9; the rest of the frame is dropped
+    f = random_frame(rng, 11, 23)
+    b = frame_beats(f)
+    b = b[:4 * 23 + 9] + [b[4 * 23 + 9][:2] + (1,) + b[4 * 23 + 9][3:]] + b[5 * 23:]
+    bad(b, [("start",), ("error", ERR_SHORT_LINE)], f)
+    good(random_frame(rng, 11, 23))
+    # long line: row 3 has 3 extra pixels (eol on the last one)
+    f = random_frame(rng, 11, 23)
+    b = frame_beats(f)
+    row3 = [(p[0], 0, 0, 23, 11) for p in b[3 * 23:4 * 23]]
+    extra = [(0x123456, 0, 0, 23, 11), (0x654321, 0, 0, 23, 11), (0xABCDEF, 0, 1, 23, 11)]
+    b = b[:3 * 23] + row3 + extra + b[4 * 23:]
+    bad(b, [("start",), ("error", ERR_LONG_LINE)], f)
+    good(random_frame(rng, 17, 40))
+    # missing sof: a whole frame without sof (reported once), then a good frame
+    f = random_frame(rng, 5, 23)
+    segs.append((frame_beats(f, sof=False), [("error", ERR_NO_SOF)], [], True))
+    good(random_frame(rng, 11, 23))
+    # cut: a new frame (sof) after 5 rows and 3 pixels
+    f = random_frame(rng, 11, 23)
+    bad(frame_beats(f)[:5 * 23 + 3], [("start",)], f)
+    f2 = random_frame(rng, 11, 23)
+    segs.append((frame_beats(f2), [("error", ERR_CUT), ("start",), ("end",)], model_interior(f2, g), True))
+    good(edge_frame(9, 16))
+    return segs
+
+
+async def run_scenario(tb: TB, gap: float, seed: int):
+    g = tb.g
+    await tb.reset()
+    mon = cocotb.start_soon(tb.monitor())
+    segs = scenario(g, seed)
+    rng = random.Random(seed)
+    for beats, _, _, _ in segs:
+        await tb.drive(beats, rng, gap)
+    await ClockCycles(tb.dut.clk, 20)
+    mon.cancel()
+    # events
+    exp_events = [e for _, evs, _, _ in segs for e in evs]
+    got_events = [e for _, e in tb.events]
+    assert got_events == exp_events, f"events {got_events} != {exp_events}"
+    # interior pixels grouped by frame: a frame is open from its start event to its end/error
+    timeline = sorted([(c, 0, e) for c, e in tb.events] + [(c, 1, px) for c, px in tb.ips],
+                      key=lambda t: (t[0], t[1]))
+    frames: list[list] = []
+    orphans = []
+    is_open = False
+    for c, kind, item in timeline:
+        if kind == 0:
+            if item == ("start",):
+                frames.append([])
+                is_open = True
+            elif item != ("error", ERR_NO_SOF):
+                is_open = False
+        elif is_open:
+            frames[-1].append(item)
+        else:
+            orphans.append((c, item))
+    assert not orphans, f"interior pixels outside a frame: {orphans[:5]}"
+    exp_frames = [(exp, exact) for _, evs, exp, exact in segs if ("start",) in evs]
+    assert len(frames) == len(exp_frames)
+    for i, (got, (exp, exact)) in enumerate(zip(frames, exp_frames)):
+        if exact:
+            if got != exp:
+                bad = next(j for j in range(min(len(got), len(exp)) + 1)
+                           if j >= len(got) or j >= len(exp) or got[j] != exp[j])
+                raise AssertionError(f"frame {i}: {len(got)} interior pixels vs {len(exp)}; first "
+                                     f"difference at #{bad}: got {got[bad:bad + 3]} exp {exp[bad:bad + 3]}")
+        else:
+            assert got == exp[:len(got)], f"abandoned frame {i}: pixels are not a prefix of the model's"
+    tb.dut._log.info("%d frames, %d interior pixels checked, gap %.2f", len(exp_frames), len(tb.ips), gap)
+
+
+@cocotb.test()
+@cocotb.parametrize(gap=[0.0, 0.3])
+async def run_test(dut, gap):
+    """Good and bad frames, full speed (gap 0) and throttled (30 % idle clocks)."""
+    tb = TB(dut)
+    await run_scenario(tb, gap, seed=int(gap * 100) + 7)
+
+
+@cocotb.test()
+async def latency(dut):
+    """Full speed: one pixel per clock; last beat -> last ip_valid -> frame_end latencies."""
+    tb = TB(dut)
+    await tb.reset()
+    mon = cocotb.start_soon(tb.monitor())
+    f = random_frame(np.random.default_rng(3), 12, 30)
+    beats = frame_beats(f)
+    first = tb.cycle()
+    await tb.drive(beats, random.Random(0), 0.0)
+    last = tb.last_beat_cycle
+    assert last - first == len(beats) - 1, "driver not at one beat per clock"
+    await ClockCycles(dut.clk, 20)
+    mon.cancel()
+    end = [c for c, e in tb.events if e == ("end",)]
+    assert len(end) == 1
+    last_ip = tb.ips[-1][0]
+    assert [p for _, p in tb.ips] == model_interior(f, tb.g)
+    dut._log.info("LATENCY last beat (clock %d) -> last ip_valid +%d, frame_end +%d", last, last_ip - last,
+                  end[0] - last)
+    assert end[0] - last == FRAME_END_LAT, f"frame_end latency {end[0] - last} != {FRAME_END_LAT}"
+    assert end[0] == last_ip + 1, "frame_end must come 1 clock after the last interior pixel"
+    # throughput: interior pixels come out at one per clock within a line
+    cyc = [c for c, _ in tb.ips[:f.shape[1] - 2]]
+    assert cyc == list(range(cyc[0], cyc[0] + len(cyc))), "interior pixels not at 1 per clock"
+
+
+# ---------------------------------------------------------------- pytest entry points
+
+import pytest  # noqa: E402
+
+from mstrack import hdl  # noqa: E402
+from mstrack.fixed.formats import FixedParams  # noqa: E402
+from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
+from mstrack.params import TrackerParams  # noqa: E402
+
+TOP = "ms_frontend"
+MODULE = "test_ms_frontend"
+
+
+def fe_generics(max_frame_w: int = 64, **tp_kw) -> dict:
+    """ms_frontend generics from the model parameters (core_generics)."""
+    g = core_generics(TrackerParams(**tp_kw), FixedParams(max_half=4, margin=2), lanes=2)
+    out = {k: g[k] for k in ("COORD_W", "COLOUR_BITS", "EDGE_BINS_LOG2", "EDGE_SHIFT")}
+    out["MAX_FRAME_W"] = max_frame_w
+    return out
+
+
+PARAMS = [
+    pytest.param(fe_generics(), id="default"),
+    pytest.param(fe_generics(max_frame_w=40), id="maxw40"),
+    pytest.param(fe_generics(colour_bits=2, edge_bins_log2=3, edge_shift=2), id="cb2_e3_s2"),
+    pytest.param(fe_generics(colour_bits=8, edge_bins_log2=8, edge_shift=0), id="cb8_e8_s0"),
+]
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("generics", PARAMS)
+def test_ms_frontend(generics, hdl_waves):
+    hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves)

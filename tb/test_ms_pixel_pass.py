@@ -1,0 +1,278 @@
+"""cocotb test bench + pytest entry points for rtl/ms_pixel_pass.vhd.
+
+The region RAM (LANES banks, region pixel (rx, ry) in bank rx mod LANES at
+ry * STRIDE + rx // LANES, data 1 clock after the address) is a cocotb model.
+The kernel tables are written from the model (mstrack.fixed.blocks.ms_kernel);
+ms_kernel_tables has its own test.  Each pass is compared exactly, bin by bin,
+with ``ms_histogram(bins, Region(0, 0, ...), win, ms_kernel(w, h, ...), n_bins)``
+after reading every bin out through the read-and-clear port; the next pass
+then checks the clear.  Cycle counts are asserted (full throughput):
+start -> done = (2 ey + 1) * groups + PASS_LAT.
+
+Run: ``.venv/bin/python -m pytest tb/test_ms_pixel_pass.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+
+import numpy as np
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.handle import Immediate
+from cocotb.triggers import ClockCycles, RisingEdge
+
+from mstrack.fixed.blocks import Region, ms_histogram, ms_kernel
+
+PASS_LAT = 5     # rtl/ms_pixel_pass.vhd header
+BIN_RD_LAT = 3   # rtl/ms_histogram.vhd header
+CFG_ENV = "MS_PIXEL_PASS_CFG"
+
+
+# ---------------------------------------------------------------- TB
+
+class TB:
+    def __init__(self, dut):
+        self.dut = dut
+        self.cfg = json.loads(os.environ[CFG_ENV])
+        c = self.cfg
+        self.L = c["LANES"]
+        self.bw = c["BIN_W"]
+        self.aw = c["ADDR_W"]
+        self.stride = c["STRIDE"]
+        self.rmax = c["REGION_MAX"]
+        self.max_half = c["MAX_HALF"]
+        self.n_bins = 1 << self.bw
+        self.kernel = "epanechnikov" if c["KERNEL_EPAN"] else "flat"
+        self.kb = c["KERNEL_BITS"]
+        self.mem = [dict() for _ in range(self.L)]
+        dut.rst.value = Immediate(1)
+        for name in ("start", "kt_we", "bin_rd_en"):
+            getattr(dut, name).value = Immediate(0)
+        cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
+        cocotb.start_soon(self._ram_and_counter())
+
+    async def _ram_and_counter(self):
+        """Region RAM model (registered read: data 1 clock after the address) and a cycle counter."""
+        L, aw, bw = self.L, self.aw, self.bw
+        amask = (1 << aw) - 1
+        while True:
+            await RisingEdge(self.dut.clk)
+            a = int(self.dut.ram_addr.value)
+            d = 0
+            for lane in range(L):
+                d |= self.mem[lane].get((a >> (lane * aw)) & amask, 0) << (lane * bw)
+            self.dut.ram_data.value = d
+
+    def load_region(self, bins: np.ndarray, rng: random.Random):
+        """bins (rmax, rmax) -> bank memories; padding words get random bins (must be masked)."""
+        L = self.L
+        self.mem = [dict() for _ in range(L)]
+        for ry in range(self.rmax):
+            for rx in range(self.stride * L):
+                v = int(bins[ry, rx]) if rx < self.rmax else rng.randrange(self.n_bins)
+                self.mem[rx % L][ry * self.stride + rx // L] = v
+
+    async def reset(self):
+        self.dut.rst.value = 1
+        await ClockCycles(self.dut.clk, 3)
+        self.dut.rst.value = 0
+        await RisingEdge(self.dut.clk)
+        n = 0
+        while not int(self.dut.ready.value):
+            await RisingEdge(self.dut.clk)
+            n += 1
+        assert n <= self.n_bins + 2, f"ready after {n} clocks"
+
+    async def write_tables(self, ker: ms_kernel):
+        d = self.dut
+        d.ex.value = ker.ex
+        d.ey.value = ker.ey
+        d.kd_d.value = ker.D
+        for i in range(max(ker.ex, ker.ey) + 1):
+            d.kt_we.value = 1
+            d.kt_addr.value = i
+            d.kt_ta.value = int(ker.TA[i]) if i <= ker.ex else 0
+            d.kt_tb.value = int(ker.TB[i]) if i <= ker.ey else 0
+            d.kt_ka.value = int(ker.KA[i]) if (i <= ker.ex and self.kernel != "flat") else 0
+            d.kt_kb.value = int(ker.KB[i]) if (i <= ker.ey and self.kernel != "flat") else 0
+            await RisingEdge(d.clk)
+        d.kt_we.value = 0
+        await RisingEdge(d.clk)
+
+    async def run_pass(self, ker: ms_kernel, wx: int, wy: int) -> int:
+        """Start a pass; return the clocks from the start edge to done (checked against the formula)."""
+        d = self.dut
+        d.win_x.value = wx
+        d.win_y.value = wy
+        d.start.value = 1
+        await RisingEdge(d.clk)  # this edge samples start
+        d.start.value = 0
+        clocks = 0
+        while True:
+            await RisingEdge(d.clk)
+            clocks += 1
+            if int(d.done.value):  # sampled at this edge
+                break
+            assert clocks < 100000, "no done"
+        groups = (wx + ker.ex) // self.L - (wx - ker.ex) // self.L + 1
+        beats = (2 * ker.ey + 1) * groups
+        assert clocks == beats + PASS_LAT, f"pass took {clocks} clocks, expected {beats} + {PASS_LAT}"
+        return clocks
+
+    async def read_bins(self, rng: random.Random | None) -> dict[str, np.ndarray]:
+        """Read and clear every bin; rng: random idle cycles between reads (throttled)."""
+        d = self.dut
+        out = {k: np.zeros(self.n_bins, np.int64) for k in ("H", "N", "SX", "SY")}
+        issued: list[tuple[int, int]] = []
+        got = 0
+        nxt = 0
+        cyc = 0
+        while got < self.n_bins:
+            await RisingEdge(d.clk)
+            cyc += 1
+            # sample (values of the cycle that just ended)
+            if int(d.bin_rd_valid.value):
+                u, c_issue = issued.pop(0)
+                # en high in cycle c_issue+1 -> valid in cycle c_issue+1+BIN_RD_LAT, sampled one edge later
+                assert cyc - c_issue == BIN_RD_LAT + 1, f"read latency {cyc - c_issue - 1}"
+                out["H"][u] = int(d.bin_h.value)
+                out["N"][u] = int(d.bin_n.value)
+                out["SX"][u] = d.bin_sx.value.to_signed()
+                out["SY"][u] = d.bin_sy.value.to_signed()
+                got += 1
+            # drive
+            if nxt < self.n_bins and (rng is None or rng.random() < 0.6):
+                d.bin_rd_en.value = 1
+                d.bin_rd_addr.value = nxt
+                issued.append((nxt, cyc))
+                nxt += 1
+            else:
+                d.bin_rd_en.value = 0
+        d.bin_rd_en.value = 0
+        return out
+
+
+def random_kernel(rng: random.Random, tb: TB, big: bool = False) -> ms_kernel:
+    mx = min(2 * tb.max_half + 1, tb.rmax)
+    if big:
+        w, h = mx, mx
+    else:
+        w, h = rng.randint(3, mx), rng.randint(3, mx)
+    return ms_kernel(w, h, tb.kernel, tb.kb)
+
+
+def region_bins(rng: np.random.Generator, tb: TB, runs: bool) -> np.ndarray:
+    n = tb.rmax
+    if not runs:
+        return rng.integers(0, tb.n_bins, size=(n, n), dtype=np.int64)
+    # long runs of equal bins (stress the read-modify-write forwarding): horizontal runs of a few
+    # bins, a few constant rows, and a constant block
+    b = np.empty((n, n), np.int64)
+    for y in range(n):
+        x = 0
+        while x < n:
+            ln = int(rng.integers(1, 2 * n))
+            b[y, x: x + ln] = rng.integers(0, min(4, tb.n_bins))
+            x += ln
+    b[n // 3] = 1
+    b[n // 2: n // 2 + 4, : n // 2] = 2 % tb.n_bins
+    return b
+
+
+async def check_passes(dut, n_passes: int, runs: bool, throttle: bool, seed: int, big: bool = False):
+    tb = TB(dut)
+    rng = random.Random(seed)
+    nrng = np.random.default_rng(seed)
+    bins = region_bins(nrng, tb, runs)
+    tb.load_region(bins, rng)
+    await tb.reset()
+    reg = Region(0, 0, tb.rmax, tb.rmax, lo=(0, 0), hi=(tb.rmax - 1, tb.rmax - 1))
+    for p in range(n_passes):
+        ker = random_kernel(rng, tb, big)
+        await tb.write_tables(ker)
+        wx = rng.randint(ker.ex, tb.rmax - 1 - ker.ex)
+        wy = rng.randint(ker.ey, tb.rmax - 1 - ker.ey)
+        clocks = await tb.run_pass(ker, wx, wy)
+        got = await tb.read_bins(rng if throttle else None)
+        exp = ms_histogram(bins, reg, (wx, wy), ker, tb.n_bins)
+        for name in ("H", "N", "SX", "SY"):
+            e = getattr(exp, name)
+            bad = np.nonzero(got[name] != e)[0]
+            assert bad.size == 0, (f"pass {p} win ({wx},{wy}) {ker.w}x{ker.h}: {name} differs at bins "
+                                   f"{bad[:8].tolist()}: got {got[name][bad[:8]].tolist()} exp {e[bad[:8]].tolist()}")
+        dut._log.info("pass %d: %dx%d at (%d,%d), %d clocks, %d px inside OK", p, ker.w, ker.h, wx, wy,
+                      clocks, int(exp.N.sum()))
+    # everything was cleared: a final read gives zeros
+    got = await tb.read_bins(None)
+    for name in ("H", "N", "SX", "SY"):
+        assert not got[name].any(), f"{name} not cleared"
+
+
+# ---------------------------------------------------------------- cocotb tests
+
+@cocotb.test()
+async def random_bins(dut):
+    """Random region, random windows, full-speed bin reads."""
+    n = int(os.environ.get("MS_PIXEL_PASS_N", "20"))
+    await check_passes(dut, n, runs=False, throttle=False, seed=1, big=n == 1)
+
+
+@cocotb.test()
+async def runs_of_equal_bins_throttled(dut):
+    """Long runs of equal bins (forwarding), throttled bin reads."""
+    n = int(os.environ.get("MS_PIXEL_PASS_N", "20"))
+    await check_passes(dut, n, runs=True, throttle=True, seed=2, big=n == 1)
+
+
+# ---------------------------------------------------------------- pytest entry points
+
+import pytest  # noqa: E402
+
+from mstrack import hdl  # noqa: E402
+from mstrack.fixed.formats import FixedParams  # noqa: E402
+from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
+from mstrack.params import TrackerParams  # noqa: E402
+
+TOP = "ms_pixel_pass"
+MODULE = "test_ms_pixel_pass"
+GEN_KEYS = ("LANES", "HALF_W", "REGION_W", "STRIDE", "ADDR_W", "KERNEL_EPAN", "KERNEL_BITS", "KVAL_W",
+            "KD_W", "HIST_W", "COUNT_W", "POSSUM_W")
+
+
+def pass_generics(tp: TrackerParams, fp: FixedParams, lanes: int) -> tuple[dict, dict]:
+    g = core_generics(tp, fp, lanes)
+    gen = {k: g[k] for k in GEN_KEYS}
+    gen["BIN_W"] = 3 * tp.colour_bits
+    cfg = {**gen, "REGION_MAX": g["REGION_MAX"], "MAX_HALF": g["MAX_HALF"]}
+    return gen, cfg
+
+
+SMALL_FP = FixedParams(max_half=7, margin=4)
+CASES = [
+    pytest.param("flat", 2, id="flat_L2"),
+    pytest.param("flat", 1, id="flat_L1"),
+    pytest.param("flat", 4, id="flat_L4"),
+    pytest.param("epanechnikov", 2, id="epan_L2"),
+    pytest.param("epanechnikov", 1, id="epan_L1"),
+    pytest.param("epanechnikov", 4, id="epan_L4"),
+]
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("kernel,lanes", CASES)
+def test_ms_pixel_pass_small(kernel, lanes, hdl_waves):
+    gen, cfg = pass_generics(TrackerParams(colour_bits=2, kernel=kernel), SMALL_FP, lanes)
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+                 extra_env={CFG_ENV: json.dumps(cfg)})
+
+
+@pytest.mark.ghdl
+def test_ms_pixel_pass_default_config(hdl_waves):
+    """Default colour config (512 bins, MAX_HALF 63), Epanechnikov, one full-size window per test."""
+    gen, cfg = pass_generics(TrackerParams(kernel="epanechnikov"), FixedParams(), 2)
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+                 extra_env={CFG_ENV: json.dumps(cfg), "MS_PIXEL_PASS_N": "1"})

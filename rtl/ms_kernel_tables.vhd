@@ -1,0 +1,214 @@
+-- ms_kernel_tables: kernel tables of a w x h target (run once per target, at init).
+--
+-- On `start` with the integer target size (w, h), 3 <= w, h <= 2 MAX_HALF + 1:
+--   ex = (w - 1) / 2, ey = (h - 1) / 2, kd_d = D = w^2 h^2        (held until the next start)
+-- and, for i = 0 .. max(ex, ey), one write on the table port:
+--   kt_addr = i, kt_ta = TA[i] = 4 i^2 h^2, kt_tb = TB[i] = 4 i^2 w^2,
+--   kt_ka = KA[i] = floor((4 i^2 << KERNEL_BITS) / w^2),
+--   kt_kb = KB[i] = floor((4 i^2 << KERNEL_BITS) / h^2)   (KERNEL_EPAN = 1; 0 when flat).
+-- Entries i > ex (TA, KA) or i > ey (TB, KB) are never used by ms_kernel (it tests
+-- |dx| <= ex, |dy| <= ey): TA/TB are still exact there, KA/KB saturate at
+-- 2**KVAL_W - 1 in the divider.  Then `done` pulses.
+-- TA, TB are built by additions (TA[i+1] = TA[i] + 4 h^2 (2 i + 1)); KA, KB come from
+-- one pipelined ms_divider shared by both (KA[i] issued, then KB[i]: 2 clocks per entry).
+--
+-- Latency (start -> done): flat 3 + max(ex, ey) + 1 clocks; Epanechnikov
+-- 2 + 2 (max(ex, ey) + 1) + divider latency (KVAL_W + 1) + 1 clocks.  Speed is irrelevant
+-- (once per target).  Handshake: `start` pulse, ignored while busy; `done` pulse.
+-- Model: mstrack.fixed.blocks.ms_kernel(w, h, kernel, KERNEL_BITS): .ex .ey .D .TA .TB .KA .KB.
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+
+entity ms_kernel_tables is
+  generic (
+    HALF_W      : natural := 6;   -- width of ex, ey, table address; w, h have HALF_W + 1 bits
+    KERNEL_EPAN : natural := 0;   -- 1: KA/KB through a KVAL_W-stage divider; 0: no divider, KA = KB = 0
+    KERNEL_BITS : natural := 8;   -- KA, KB scale: 2**KERNEL_BITS
+    KVAL_W      : natural := 1;   -- width of KA, KB (divider quotient bits)
+    KD_W        : natural := 29   -- width of TA, TB, D
+  );
+  port (
+    clk     : in  std_logic;                          -- clock
+    rst     : in  std_logic;                          -- synchronous reset (control state)
+    start   : in  std_logic;                          -- pulse: compute the tables of a w x h target
+    w       : in  unsigned(HALF_W downto 0);          -- target width in px (3 .. 2 MAX_HALF + 1)
+    h       : in  unsigned(HALF_W downto 0);          -- target height in px (3 .. 2 MAX_HALF + 1)
+    busy    : out std_logic;                          -- computing
+    done    : out std_logic;                          -- pulse: all entries written, ex/ey/kd_d valid
+    ex      : out unsigned(HALF_W - 1 downto 0);      -- (w - 1) / 2
+    ey      : out unsigned(HALF_W - 1 downto 0);      -- (h - 1) / 2
+    kd_d    : out unsigned(KD_W - 1 downto 0);        -- D = w^2 h^2
+    kt_we   : out std_logic;                          -- table write strobe
+    kt_addr : out unsigned(HALF_W - 1 downto 0);      -- entry i
+    kt_ta   : out unsigned(KD_W - 1 downto 0);        -- TA[i] = 4 i^2 h^2
+    kt_tb   : out unsigned(KD_W - 1 downto 0);        -- TB[i] = 4 i^2 w^2
+    kt_ka   : out unsigned(KVAL_W - 1 downto 0);      -- KA[i] (0 when flat)
+    kt_kb   : out unsigned(KVAL_W - 1 downto 0)       -- KB[i] (0 when flat)
+  );
+end entity;
+
+architecture rtl of ms_kernel_tables is
+  constant WW   : natural := HALF_W + 1;              -- w, h
+  constant SQ_W : natural := 2 * WW;                  -- w^2, h^2
+  constant T_W  : natural := KD_W + 2;                -- TA/TB accumulators and steps (headroom)
+  constant N_W  : natural := 2 * HALF_W + 2 + KERNEL_BITS;  -- (4 i^2) << KERNEL_BITS
+  constant TAG_W : natural := HALF_W + 1;             -- [sel | i], sel = 0 KA, 1 KB
+
+  type state_t is (S_IDLE, S_SETUP1, S_SETUP2, S_ISSUE, S_WAIT);
+  signal state : state_t := S_IDLE;
+
+  signal wl, hl         : unsigned(WW - 1 downto 0) := (others => '0');
+  signal w2, h2         : unsigned(SQ_W - 1 downto 0) := (others => '0');
+  signal ex_r, ey_r     : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal n_last         : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal d_r            : unsigned(KD_W - 1 downto 0) := (others => '0');
+  -- issue side
+  signal i_iss          : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal sel            : std_logic := '0';
+  signal sq4, sq4_step  : unsigned(N_W - 1 downto 0) := (others => '0');  -- 4 i^2, 8 i + 4
+  -- write side
+  signal ta_acc, tb_acc : unsigned(T_W - 1 downto 0) := (others => '0');
+  signal ta_stp, tb_stp : unsigned(T_W - 1 downto 0) := (others => '0');
+  signal ka_hold        : unsigned(KVAL_W - 1 downto 0) := (others => '0');
+  signal we_r, done_r   : std_logic := '0';
+  signal addr_r         : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal ta_r, tb_r     : unsigned(KD_W - 1 downto 0) := (others => '0');
+  signal ka_r, kb_r     : unsigned(KVAL_W - 1 downto 0) := (others => '0');
+  -- divider
+  signal dv_in_valid    : std_logic;
+  signal dv_in_n        : unsigned(N_W - 1 downto 0);
+  signal dv_in_d        : unsigned(SQ_W - 1 downto 0);
+  signal dv_in_tag      : std_logic_vector(TAG_W - 1 downto 0);
+  signal dv_out_valid   : std_logic := '0';
+  signal dv_out_q       : unsigned(KVAL_W - 1 downto 0) := (others => '0');
+  signal dv_out_tag     : std_logic_vector(TAG_W - 1 downto 0) := (others => '0');
+begin
+  dv_in_valid <= '1' when state = S_ISSUE and KERNEL_EPAN = 1 else '0';
+  dv_in_n     <= shift_left(sq4, KERNEL_BITS);
+  dv_in_d     <= h2 when sel = '1' else w2;
+  dv_in_tag   <= sel & std_logic_vector(i_iss);
+
+  g_div : if KERNEL_EPAN = 1 generate
+    u_div : entity work.ms_divider
+      generic map (N_W => N_W, D_W => SQ_W, Q_W => KVAL_W, TAG_W => TAG_W)
+      port map (
+        clk => clk, rst => rst, in_valid => dv_in_valid, in_n => dv_in_n, in_d => dv_in_d,
+        in_tag => dv_in_tag, out_valid => dv_out_valid, out_q => dv_out_q, out_tag => dv_out_tag);
+  end generate;
+
+  p_ctrl : process (clk)
+    variable wr   : boolean;
+    variable wr_i : unsigned(HALF_W - 1 downto 0);
+    variable e_x, e_y : unsigned(HALF_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      we_r   <= '0';
+      done_r <= '0';
+      wr     := false;
+      wr_i   := i_iss;
+      case state is
+        when S_IDLE =>
+          if start = '1' then
+            wl    <= w;
+            hl    <= h;
+            state <= S_SETUP1;
+          end if;
+
+        when S_SETUP1 =>
+          w2   <= wl * wl;
+          h2   <= hl * hl;
+          e_x  := resize(shift_right(wl - 1, 1), HALF_W);
+          e_y  := resize(shift_right(hl - 1, 1), HALF_W);
+          ex_r <= e_x;
+          ey_r <= e_y;
+          if e_x > e_y then
+            n_last <= e_x;
+          else
+            n_last <= e_y;
+          end if;
+          state <= S_SETUP2;
+
+        when S_SETUP2 =>
+          d_r      <= resize(w2 * h2, KD_W);
+          ta_acc   <= (others => '0');
+          tb_acc   <= (others => '0');
+          ta_stp   <= resize(shift_left(resize(h2, T_W), 2), T_W);
+          tb_stp   <= resize(shift_left(resize(w2, T_W), 2), T_W);
+          i_iss    <= (others => '0');
+          sel      <= '0';
+          sq4      <= (others => '0');
+          sq4_step <= to_unsigned(4, N_W);
+          state    <= S_ISSUE;
+
+        when S_ISSUE =>
+          if KERNEL_EPAN = 1 then
+            sel <= not sel;
+            if sel = '1' then
+              i_iss    <= i_iss + 1;
+              sq4      <= sq4 + sq4_step;
+              sq4_step <= sq4_step + 8;
+              if i_iss = n_last then
+                state <= S_WAIT;
+              end if;
+            end if;
+          else
+            wr    := true;
+            wr_i  := i_iss;
+            i_iss <= i_iss + 1;
+            if i_iss = n_last then
+              state <= S_WAIT;
+            end if;
+          end if;
+
+        when S_WAIT =>
+          null;
+      end case;
+
+      -- write side (Epanechnikov: divider results, KA of entry i then KB of entry i)
+      if KERNEL_EPAN = 1 and dv_out_valid = '1' then
+        if dv_out_tag(TAG_W - 1) = '0' then
+          ka_hold <= dv_out_q;
+        else
+          wr   := true;
+          wr_i := unsigned(dv_out_tag(HALF_W - 1 downto 0));
+          ka_r <= ka_hold;
+          kb_r <= dv_out_q;
+        end if;
+      end if;
+      if wr then
+        we_r   <= '1';
+        addr_r <= wr_i;
+        ta_r   <= resize(ta_acc, KD_W);
+        tb_r   <= resize(tb_acc, KD_W);
+        ta_acc <= ta_acc + ta_stp;
+        tb_acc <= tb_acc + tb_stp;
+        ta_stp <= ta_stp + shift_left(resize(h2, T_W), 3);
+        tb_stp <= tb_stp + shift_left(resize(w2, T_W), 3);
+        if wr_i = n_last then
+          done_r <= '1';
+          state  <= S_IDLE;
+        end if;
+      end if;
+
+      if rst = '1' then
+        state  <= S_IDLE;
+        we_r   <= '0';
+        done_r <= '0';
+        sel    <= '0';
+      end if;
+    end if;
+  end process;
+
+  busy    <= '0' when state = S_IDLE else '1';
+  done    <= done_r;
+  ex      <= ex_r;
+  ey      <= ey_r;
+  kd_d    <= d_r;
+  kt_we   <= we_r;
+  kt_addr <= addr_r;
+  kt_ta   <= ta_r;
+  kt_tb   <= tb_r;
+  kt_ka   <= ka_r;
+  kt_kb   <= kb_r;
+end architecture;

@@ -1,0 +1,140 @@
+"""cocotb test bench + pytest entry points for rtl/ms_kernel_tables.vhd.
+
+A monitor records every write of the table port; after `done` the tables,
+ex, ey and kd_d are compared with mstrack.fixed.blocks.ms_kernel(w, h, kernel,
+KERNEL_BITS) for many target sizes (3x3, odd/even, thin, max size).  Entries
+beyond ex (TA, KA) / ey (TB, KB) are never used by ms_kernel; they are checked
+to be the exact TA/TB and the saturating KA/KB (ms_divider of the model).
+
+Run: ``.venv/bin/python -m pytest tb/test_ms_kernel_tables.py``.
+"""
+
+from __future__ import annotations
+
+import random
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.handle import Immediate
+from cocotb.triggers import ClockCycles, RisingEdge
+
+from mstrack.fixed.blocks import ms_kernel
+from mstrack.fixed.primitives import ms_divider
+from mstrack.hdl import dut_generics
+
+
+class TB:
+    def __init__(self, dut):
+        self.dut = dut
+        self.g = dut_generics()
+        self.max_half = int(self.g["MAX_HALF_TB"]) if "MAX_HALF_TB" in self.g else (1 << int(self.g["HALF_W"])) - 1
+        self.epan = int(self.g["KERNEL_EPAN"])
+        self.kb = int(self.g["KERNEL_BITS"])
+        self.kval_w = int(self.g["KVAL_W"])
+        self.writes: list[tuple[int, int, int, int, int]] = []
+        dut.rst.value = Immediate(1)
+        dut.start.value = Immediate(0)
+        cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
+        cocotb.start_soon(self._monitor())
+
+    async def _monitor(self):
+        d = self.dut
+        while True:
+            await RisingEdge(d.clk)
+            if int(d.kt_we.value):
+                self.writes.append((int(d.kt_addr.value), int(d.kt_ta.value), int(d.kt_tb.value),
+                                    int(d.kt_ka.value), int(d.kt_kb.value)))
+
+    async def reset(self):
+        self.dut.rst.value = 1
+        await ClockCycles(self.dut.clk, 3)
+        self.dut.rst.value = 0
+        await RisingEdge(self.dut.clk)
+
+    async def check(self, w: int, h: int):
+        d = self.dut
+        self.writes = []
+        d.w.value = w
+        d.h.value = h
+        d.start.value = 1
+        await RisingEdge(d.clk)
+        d.start.value = 0
+        n = 0
+        while True:
+            await RisingEdge(d.clk)
+            n += 1
+            if int(d.done.value):
+                break
+            assert n < 10000, "no done"
+        await RisingEdge(d.clk)  # the monitor has seen the write that came with done
+        ker = ms_kernel(w, h, "epanechnikov" if self.epan else "flat", self.kb)
+        assert int(d.ex.value) == ker.ex and int(d.ey.value) == ker.ey, (w, h)
+        assert int(d.kd_d.value) == ker.D, (w, h, int(d.kd_d.value), ker.D)
+        n_last = max(ker.ex, ker.ey)
+        assert [a for a, *_ in self.writes] == list(range(n_last + 1)), f"{w}x{h}: addresses {self.writes}"
+        sat = (1 << self.kval_w) - 1
+        for i, ta, tb, ka, kb in self.writes:
+            assert ta == 4 * i * i * h * h and tb == 4 * i * i * w * w, (w, h, i, ta, tb)
+            if i <= ker.ex:
+                assert ta == int(ker.TA[i]), (w, h, i)
+            if i <= ker.ey:
+                assert tb == int(ker.TB[i]), (w, h, i)
+            if self.epan:
+                if i <= ker.ex:
+                    assert ka == int(ker.KA[i]), (w, h, i, ka, int(ker.KA[i]))
+                if i <= ker.ey:
+                    assert kb == int(ker.KB[i]), (w, h, i, kb, int(ker.KB[i]))
+                assert ka == int(ms_divider((4 * i * i) << self.kb, w * w, self.kval_w)) <= sat
+                assert kb == int(ms_divider((4 * i * i) << self.kb, h * h, self.kval_w)) <= sat
+            else:
+                assert ka == 0 and kb == 0
+        return n
+
+
+@cocotb.test()
+async def tables(dut):
+    tb = TB(dut)
+    await tb.reset()
+    mx = 2 * tb.max_half + 1
+    sizes = [(3, 3), (3, mx), (mx, 3), (mx, mx), (4, 4), (mx - 1, mx - 1), (5, 8), (8, 5)]
+    rng = random.Random(7)
+    sizes += [(rng.randint(3, mx), rng.randint(3, mx)) for _ in range(30)]
+    for w, h in sizes:
+        n = await tb.check(w, h)
+        dut._log.debug("%dx%d: %d clocks", w, h, n)
+
+
+# ---------------------------------------------------------------- pytest entry points
+
+import pytest  # noqa: E402
+
+from mstrack import hdl  # noqa: E402
+from mstrack.fixed.formats import FixedParams  # noqa: E402
+from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
+from mstrack.params import TrackerParams  # noqa: E402
+
+TOP = "ms_kernel_tables"
+MODULE = "test_ms_kernel_tables"
+
+
+def tables_generics(kernel: str, fp: FixedParams) -> dict:
+    g = core_generics(TrackerParams(kernel=kernel), fp)
+    return {k: g[k] for k in ("HALF_W", "KERNEL_EPAN", "KERNEL_BITS", "KVAL_W", "KD_W")}
+
+
+CASES = [
+    pytest.param("epanechnikov", FixedParams(), id="epan_default"),
+    pytest.param("flat", FixedParams(), id="flat_default"),
+    pytest.param("epanechnikov", FixedParams(max_half=7, margin=4), id="epan_mh7"),
+    pytest.param("epanechnikov", FixedParams(kernel_bits=4), id="epan_kb4"),
+]
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("kernel,fp", CASES)
+def test_ms_kernel_tables(kernel, fp, hdl_waves):
+    gen = tables_generics(kernel, fp)
+    # MAX_HALF is not a generic of the entity: pass it to the test through the generics env only
+    import json
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+                 extra_env={hdl.GENERICS_ENV: json.dumps({**gen, "MAX_HALF_TB": fp.max_half})})

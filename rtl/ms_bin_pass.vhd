@@ -1,0 +1,323 @@
+-- ms_bin_pass: one pass over the histogram bins (learn the model, or Bhattacharyya sum + weights).
+--
+-- Owns the model histogram RAM Q (N_BINS = 2**BIN_W words of HIST_W bits).  A `start` pulse
+-- (ignored while busy = 1) reads the pixel-pass accumulators bin by bin, 0 .. N_BINS-1, one per
+-- clock, through the histogram's read-and-clear port (bin_rd_en/bin_rd_addr -> bin_rd_valid,
+-- bin_h, bin_n, bin_sx, bin_sy; results are only assumed to come back in order, the return
+-- side counts them, so any latency works; BIN_RD_LAT is documentation / checking only).
+--   learn = 1 : Q[u] <= H[u]; k_sum = sum H  (fits in HIST_W: sum H = K).
+--   learn = 0 : per bin t = isqrt((H Q) << 2RF)                    (ms_isqrt, SQRT_IN_W)
+--               w = 0 if H = 0 else isqrt(min(floor((Q << 2WF) / H), 2**RATIO_Q_W - 1))
+--                                     (ms_divider Q_W = RATIO_Q_W, then ms_isqrt IN_W = RATIO_Q_W)
+--               s_sum = sum t, sw = sum w N, swx = sum w SX, swy = sum w SY; k_sum = sum H too.
+-- Must match mstrack.fixed.blocks.ms_bin_pass / ms_weight (and sum(H) for k_sum).
+-- The product H Q is kept in SQRT_IN_W - 2RF bits (the model sizes SQRT_IN_W for H, Q <= the
+-- largest possible histogram value, so it never truncates in use).
+--
+-- Latency    : learn: done 2 + N_BINS + BIN_RD_LAT clocks after start;
+--              track: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 2, RATIO_Q_W + RATIO_Q_W/2 + 3)
+--              clocks after start (rho path: product + isqrt; weight path: divider + isqrt + multiply)
+--              (start in cycle c, done high in cycle c + latency; tb/test_ms_bin_pass.py asserts it).
+-- Throughput : one bin per clock; a pass takes N_BINS + pipeline latency clocks.
+-- Handshake  : start/learn sampled when busy = 0; done is a one-clock pulse; s_sum, sw, swx,
+--              swy, k_sum are stable from done until the next accepted start.
+-- Reset      : synchronous, active high; control state only (the Q RAM keeps its contents).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+
+entity ms_bin_pass is
+  generic (
+    BIN_W      : natural := 9;   -- bin index bits, N_BINS = 2**BIN_W (Q RAM depth, clocks per pass)
+    HIST_W     : natural := 14;  -- H and Q bits (Q RAM width)
+    COUNT_W    : natural := 14;  -- N (pixel count per bin) bits
+    POSSUM_W   : natural := 21;  -- SX, SY (signed position sums per bin) bits
+    SQRT_IN_W  : natural := 40;  -- Bhattacharyya isqrt input bits (even, >= 2 RF + 2)
+    RHO_SUM_W  : natural := 21;  -- s_sum bits
+    RATIO_Q_W  : natural := 16;  -- quotient bits of (Q << 2WF) / H (even; divider stages)
+    WEIGHT_W   : natural := 8;   -- weight bits (= RATIO_Q_W / 2)
+    WF         : natural := 4;   -- weight fraction bits
+    RF         : natural := 6;   -- rho fraction bits
+    SW_W       : natural := 22;  -- sw bits (unsigned sum w N)
+    SWX_W      : natural := 29;  -- swx, swy bits (signed sums w SX, w SY)
+    BIN_RD_LAT : natural := 2    -- latency of the histogram read port (checking only, >= 1)
+  );
+  port (
+    clk          : in  std_logic;                             -- clock
+    rst          : in  std_logic;                             -- synchronous reset, active high
+    -- control
+    start        : in  std_logic;                             -- pulse: start a pass (when busy = 0)
+    learn        : in  std_logic;                             -- with start: 1 = store H into Q, 0 = track
+    busy         : out std_logic;                             -- pass in progress
+    -- histogram read-and-clear port
+    bin_rd_en    : out std_logic;                             -- read bin bin_rd_addr
+    bin_rd_addr  : out unsigned(BIN_W - 1 downto 0);          -- bin index, 0 .. N_BINS-1 in order
+    bin_rd_valid : in  std_logic;                             -- read data valid (in request order)
+    bin_h        : in  unsigned(HIST_W - 1 downto 0);         -- H[u] = sum of kernel values
+    bin_n        : in  unsigned(COUNT_W - 1 downto 0);        -- N[u] = pixel count
+    bin_sx       : in  signed(POSSUM_W - 1 downto 0);         -- SX[u] = sum of dx
+    bin_sy       : in  signed(POSSUM_W - 1 downto 0);         -- SY[u] = sum of dy
+    -- results
+    done         : out std_logic;                             -- pulse: pass finished, results valid
+    s_sum        : out unsigned(RHO_SUM_W - 1 downto 0);      -- S = sum isqrt(H Q 2**2RF) (track)
+    sw           : out unsigned(SW_W - 1 downto 0);           -- sum w N (track)
+    swx          : out signed(SWX_W - 1 downto 0);            -- sum w SX (track)
+    swy          : out signed(SWX_W - 1 downto 0);            -- sum w SY (track)
+    k_sum        : out unsigned(HIST_W - 1 downto 0)          -- sum H (K in learn mode)
+  );
+end entity;
+
+architecture rtl of ms_bin_pass is
+  constant N_BINS : natural := 2 ** BIN_W;
+  constant PW     : natural := SQRT_IN_W - 2 * RF;            -- H Q product bits
+  constant DN_W   : natural := HIST_W + 2 * WF;               -- divider dividend bits
+  -- divider / weight-isqrt tag: last & hzero & N & SX & SY
+  constant TG_W   : natural := 2 + COUNT_W + 2 * POSSUM_W;
+
+  type ram_t is array (0 to N_BINS - 1) of std_logic_vector(HIST_W - 1 downto 0);
+  signal q_ram : ram_t;
+
+  -- issue side
+  signal busy_r    : std_logic := '0';
+  signal learn_r   : std_logic := '0';
+  signal rd_en_r   : std_logic := '0';
+  signal rd_addr_r : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  -- return side
+  signal ret_cnt   : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal q_rd      : std_logic_vector(HIST_W - 1 downto 0);
+  signal va        : std_logic := '0';                        -- stage A valid (track bins)
+  signal last_a    : std_logic;
+  signal h_a       : unsigned(HIST_W - 1 downto 0);
+  signal n_a       : unsigned(COUNT_W - 1 downto 0);
+  signal sx_a      : signed(POSSUM_W - 1 downto 0);
+  signal sy_a      : signed(POSSUM_W - 1 downto 0);
+  -- rho path
+  signal vb        : std_logic := '0';
+  signal last_b    : std_logic;
+  signal prod_b    : unsigned(PW - 1 downto 0);
+  signal sq_in     : unsigned(SQRT_IN_W - 1 downto 0);
+  signal sq_ov     : std_logic;
+  signal sq_r      : unsigned(SQRT_IN_W / 2 - 1 downto 0);
+  signal sq_tag    : std_logic_vector(0 downto 0);
+  -- weight path
+  signal div_n     : unsigned(DN_W - 1 downto 0);
+  signal div_tag_i : std_logic_vector(TG_W - 1 downto 0);
+  signal div_ov    : std_logic;
+  signal div_q     : unsigned(RATIO_Q_W - 1 downto 0);
+  signal div_tag_o : std_logic_vector(TG_W - 1 downto 0);
+  signal wq_ov     : std_logic;
+  signal wq_r      : unsigned(RATIO_Q_W / 2 - 1 downto 0);
+  signal wq_tag    : std_logic_vector(TG_W - 1 downto 0);
+  signal vm        : std_logic := '0';
+  signal last_m    : std_logic;
+  signal wn_m      : unsigned(SW_W - 1 downto 0);
+  signal wsx_m     : signed(SWX_W - 1 downto 0);
+  signal wsy_m     : signed(SWX_W - 1 downto 0);
+  -- accumulators and completion
+  signal s_acc     : unsigned(RHO_SUM_W - 1 downto 0);
+  signal sw_acc    : unsigned(SW_W - 1 downto 0);
+  signal swx_acc   : signed(SWX_W - 1 downto 0);
+  signal swy_acc   : signed(SWX_W - 1 downto 0);
+  signal k_acc     : unsigned(HIST_W - 1 downto 0);
+  signal k_fin     : std_logic := '0';
+  signal s_fin     : std_logic := '0';
+  signal w_fin     : std_logic := '0';
+  signal done_r    : std_logic := '0';
+begin
+  assert WEIGHT_W = RATIO_Q_W / 2 and RATIO_Q_W mod 2 = 0 and SQRT_IN_W mod 2 = 0
+    report "ms_bin_pass: need WEIGHT_W = RATIO_Q_W / 2, RATIO_Q_W and SQRT_IN_W even" severity failure;
+  assert PW >= 1 and BIN_RD_LAT >= 1
+    report "ms_bin_pass: need SQRT_IN_W > 2 RF and BIN_RD_LAT >= 1" severity failure;
+
+  ---------------------------------------------------------------- issue side: bins 0 .. N_BINS-1
+  p_issue : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        busy_r  <= '0';
+        rd_en_r <= '0';
+        learn_r <= '0';
+      else
+        if busy_r = '0' and start = '1' then
+          busy_r    <= '1';
+          learn_r   <= learn;
+          rd_en_r   <= '1';
+          rd_addr_r <= (others => '0');
+        elsif rd_en_r = '1' then
+          if rd_addr_r = N_BINS - 1 then
+            rd_en_r <= '0';
+          else
+            rd_addr_r <= rd_addr_r + 1;
+          end if;
+        end if;
+        if done_r = '1' then
+          busy_r <= '0';
+        end if;
+      end if;
+    end if;
+  end process;
+
+  bin_rd_en   <= rd_en_r;
+  bin_rd_addr <= rd_addr_r;
+  busy        <= busy_r;
+
+  ---------------------------------------------------------------- Q RAM (registered read, read-first)
+  p_ram : process (clk)
+  begin
+    if rising_edge(clk) then
+      if bin_rd_valid = '1' and learn_r = '1' then
+        q_ram(to_integer(ret_cnt)) <= std_logic_vector(bin_h);
+      end if;
+      q_rd <= q_ram(to_integer(ret_cnt));
+    end if;
+  end process;
+
+  ---------------------------------------------------------------- return side: stage A
+  p_ret : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        ret_cnt <= (others => '0');
+        va      <= '0';
+      else
+        if busy_r = '0' and start = '1' then
+          ret_cnt <= (others => '0');
+        elsif bin_rd_valid = '1' then
+          ret_cnt <= ret_cnt + 1;
+        end if;
+        va <= bin_rd_valid and not learn_r;
+      end if;
+      if ret_cnt = N_BINS - 1 then
+        last_a <= '1';
+      else
+        last_a <= '0';
+      end if;
+      h_a  <= bin_h;
+      n_a  <= bin_n;
+      sx_a <= bin_sx;
+      sy_a <= bin_sy;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------- rho path: H Q -> isqrt
+  p_prod : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        vb <= '0';
+      else
+        vb <= va;
+      end if;
+      last_b <= last_a;
+      prod_b <= resize(h_a * unsigned(q_rd), PW);
+    end if;
+  end process;
+
+  sq_in <= shift_left(resize(prod_b, SQRT_IN_W), 2 * RF);
+
+  u_sqrt_rho : entity work.ms_isqrt
+    generic map (IN_W => SQRT_IN_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => vb, in_x => sq_in, in_tag(0) => last_b,
+              out_valid => sq_ov, out_r => sq_r, out_tag => sq_tag);
+
+  ---------------------------------------------------------------- weight path: divide, isqrt, multiply
+  div_n     <= shift_left(resize(unsigned(q_rd), DN_W), 2 * WF);
+  div_tag_i <= last_a & (nor h_a) & std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
+
+  u_div : entity work.ms_divider
+    generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W, TAG_W => TG_W)
+    port map (clk => clk, rst => rst, in_valid => va, in_n => div_n, in_d => h_a, in_tag => div_tag_i,
+              out_valid => div_ov, out_q => div_q, out_tag => div_tag_o);
+
+  u_sqrt_w : entity work.ms_isqrt
+    generic map (IN_W => RATIO_Q_W, TAG_W => TG_W)
+    port map (clk => clk, rst => rst, in_valid => div_ov, in_x => div_q, in_tag => div_tag_o,
+              out_valid => wq_ov, out_r => wq_r, out_tag => wq_tag);
+
+  p_mult : process (clk)
+    variable w  : unsigned(WEIGHT_W - 1 downto 0);
+    variable n  : unsigned(COUNT_W - 1 downto 0);
+    variable sx : signed(POSSUM_W - 1 downto 0);
+    variable sy : signed(POSSUM_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        vm <= '0';
+      else
+        vm <= wq_ov;
+      end if;
+      if wq_tag(TG_W - 2) = '1' then                         -- H = 0: weight 0
+        w := (others => '0');
+      else
+        w := wq_r;
+      end if;
+      n  := unsigned(wq_tag(2 * POSSUM_W + COUNT_W - 1 downto 2 * POSSUM_W));
+      sx := signed(wq_tag(2 * POSSUM_W - 1 downto POSSUM_W));
+      sy := signed(wq_tag(POSSUM_W - 1 downto 0));
+      last_m <= wq_tag(TG_W - 1);
+      wn_m   <= resize(w * n, SW_W);
+      wsx_m  <= resize(signed('0' & w) * sx, SWX_W);
+      wsy_m  <= resize(signed('0' & w) * sy, SWX_W);
+    end if;
+  end process;
+
+  ---------------------------------------------------------------- accumulators and done
+  p_acc : process (clk)
+  begin
+    if rising_edge(clk) then
+      if busy_r = '0' and start = '1' then
+        s_acc   <= (others => '0');
+        sw_acc  <= (others => '0');
+        swx_acc <= (others => '0');
+        swy_acc <= (others => '0');
+        k_acc   <= (others => '0');
+      else
+        if bin_rd_valid = '1' then
+          k_acc <= k_acc + bin_h;
+        end if;
+        if sq_ov = '1' then
+          s_acc <= s_acc + resize(sq_r, RHO_SUM_W);
+        end if;
+        if vm = '1' then
+          sw_acc  <= sw_acc + wn_m;
+          swx_acc <= swx_acc + wsx_m;
+          swy_acc <= swy_acc + wsy_m;
+        end if;
+      end if;
+      if rst = '1' then
+        k_fin  <= '0';
+        s_fin  <= '0';
+        w_fin  <= '0';
+        done_r <= '0';
+      else
+        done_r <= '0';
+        if busy_r = '0' and start = '1' then
+          k_fin <= '0';
+          s_fin <= '0';
+          w_fin <= '0';
+        else
+          if bin_rd_valid = '1' and ret_cnt = N_BINS - 1 then
+            k_fin <= '1';
+          end if;
+          if sq_ov = '1' and sq_tag(0) = '1' then
+            s_fin <= '1';
+          end if;
+          if vm = '1' and last_m = '1' then
+            w_fin <= '1';
+          end if;
+          if busy_r = '1' and done_r = '0' and k_fin = '1'
+             and (learn_r = '1' or (s_fin = '1' and w_fin = '1')) then
+            done_r <= '1';
+          end if;
+        end if;
+      end if;
+    end if;
+  end process;
+
+  done  <= done_r;
+  s_sum <= s_acc;
+  sw    <= sw_acc;
+  swx   <= swx_acc;
+  swy   <= swy_acc;
+  k_sum <= k_acc;
+end architecture;

@@ -35,6 +35,7 @@ entity ms_capture_tb_top is
     frame_start  : out std_logic;                                                 -- front end event
     frame_end    : out std_logic;                                                 -- front end event
     frame_error  : out std_logic;                                                 -- front end event
+    err_code     : out std_logic_vector(ERR_CODE_W - 1 downto 0);                 -- front end error code
     done         : out std_logic;                                                 -- capture done
     raddr        : in  std_logic_vector(LANES * ADDR_W - 1 downto 0);             -- read address per bank
     rdata_colour : out std_logic_vector(LANES * 3 * COLOUR_BITS - 1 downto 0);    -- colour RAM data per bank
@@ -51,7 +52,6 @@ architecture tb of ms_capture_tb_top is
   signal we : std_logic;
   signal wbank : unsigned(clog2(LANES) - 1 downto 0);
   signal waddr : unsigned(ADDR_W - 1 downto 0);
-  signal code : std_logic_vector(ERR_CODE_W - 1 downto 0);
 begin
   frame_start <= fs;
   frame_end <= fe;
@@ -63,7 +63,7 @@ begin
     port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
               in_valid => in_valid, in_data => in_data, in_sof => in_sof, in_eol => in_eol,
               ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
-              frame_start => fs, frame_end => fe, frame_error => ferr, err_code => code);
+              frame_start => fs, frame_end => fe, frame_error => ferr, err_code => err_code);
 
   u_cap : entity work.ms_region_capture
     generic map (LANES => LANES, COORD_W => COORD_W, REGION_MAX => REGION_MAX, STRIDE => STRIDE,

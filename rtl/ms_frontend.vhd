@@ -52,7 +52,7 @@ entity ms_frontend is
 end entity;
 
 architecture rtl of ms_frontend is
-  constant EVT_DELAY : natural := 7;  -- = pixel path latency (check 1 + grey 2 + sobel 4) - 1 + 1
+  constant EVT_DELAY : natural := 7;  -- = pixel path after ms_stream_check (grey 2 + sobel 4) + 1
   constant CB_W : natural := 3 * COLOUR_BITS;
 
   signal px_valid : std_logic;

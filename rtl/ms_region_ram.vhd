@@ -17,7 +17,7 @@ use work.ms_pkg.all;
 entity ms_region_ram is
   generic (
     LANES  : natural := 2;    -- banks (power of two); one read port each
-    DEPTH  : natural := 192;  -- words per bank (REGION_MAX * STRIDE)
+    DEPTH  : natural := 18336; -- words per bank (REGION_MAX * STRIDE = 191 * 96 by default)
     DATA_W : natural := 9;    -- word width (bin index)
     ADDR_W : natural := 15    -- address width, 2**ADDR_W >= DEPTH
   );

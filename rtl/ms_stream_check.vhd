@@ -14,7 +14,9 @@
 --                   (frame_start in the same clock)
 -- After an error the beats are dropped silently until the next sof.  The beat
 -- that causes SHORT_LINE / LONG_LINE is dropped too.  A frame with an error
--- never gets frame_end.  Codes: rtl/ms_stream_pkg.vhd.
+-- never gets frame_end.  Codes: rtl/ms_stream_pkg.vhd.  Only one code per clock:
+-- if a sof beat both cuts a frame and is itself bad (eol while W > 1), the
+-- SHORT_LINE code wins over CUT (the new frame is then abandoned at once).
 --
 -- Accepted beats leave on px_* with their (x, y); frame_end is raised with the
 -- frame's last pixel (x = W-1, y = H-1, with eol).

@@ -14,6 +14,8 @@ All return :class:`mstrack.types.TrackResult` (``rho_*`` / ``alpha_*`` are NaN:
 these trackers have no such quantities).  Boxes are 0-based ``(x, y, w, h)``
 (:mod:`mstrack.types`).  An init box partly outside the frame is clipped to
 it (status ``CLIPPED``); a box with no pixel inside raises ``ValueError``.
+Bad frames (not uint8 BGR, or a size other than the init frame's) raise
+:class:`mstrack.FrameError` and leave the state unchanged.
 """
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ from typing import Callable
 import cv2
 import numpy as np
 
+from .frames import FrameError
 from .types import Box, Status, TrackResult, box_centre_index
 
 TERM_CRITERIA = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 10, 1)
@@ -30,12 +33,16 @@ HSV_LO = np.array((0.0, 60.0, 32.0))
 HSV_HI = np.array((180.0, 255.0, 255.0))
 
 
-def _check_frame(frame: np.ndarray) -> np.ndarray:
+def _check_frame(frame: np.ndarray, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    """Return a BGR uint8 (H, W, 3) frame or raise FrameError (grey frames are expanded)."""
     if not isinstance(frame, np.ndarray) or frame.dtype != np.uint8 or frame.ndim not in (2, 3) \
             or frame.size == 0 or (frame.ndim == 3 and frame.shape[2] != 3):
-        raise ValueError("frame must be a non-empty BGR uint8 array of shape (H, W, 3)")
+        raise FrameError("frame must be a non-empty BGR uint8 array of shape (H, W, 3)")
     if frame.ndim == 2:
         frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
+    if shape is not None and frame.shape[:2] != shape[:2]:
+        raise FrameError(f"frame size {frame.shape[1]}x{frame.shape[0]} differs from the init frame's "
+                         f"{shape[1]}x{shape[0]}")
     return frame
 
 
@@ -78,6 +85,7 @@ class _HueTracker:
         self._hist: np.ndarray | None = None
         self._window: tuple[int, int, int, int] | None = None
         self._box: tuple[float, float, float, float] | None = None
+        self._shape: tuple[int, ...] | None = None
 
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
         """Build the hue histogram of ``box`` in ``frame`` (BGR uint8)."""
@@ -89,14 +97,14 @@ class _HueTracker:
         mask = cv2.inRange(hsv, HSV_LO, HSV_HI)
         hist = cv2.calcHist([hsv], [0], mask, [180], [0, 180])
         cv2.normalize(hist, hist, 0, 255, cv2.NORM_MINMAX)
-        self._hist, self._window = hist, win
+        self._hist, self._window, self._shape = hist, win, frame.shape
         self._box = tuple(float(v) for v in win)
         return _result(self._box, Status.CLIPPED if clipped else Status.INIT)
 
     def _backproject(self, frame: np.ndarray) -> np.ndarray:
         if self._hist is None:
             raise RuntimeError("update() called before init()")
-        hsv = cv2.cvtColor(_check_frame(frame), cv2.COLOR_BGR2HSV)
+        hsv = cv2.cvtColor(_check_frame(frame, self._shape), cv2.COLOR_BGR2HSV)
         return cv2.calcBackProject([hsv], [0], self._hist, [0, 180], 1)
 
 
@@ -153,6 +161,7 @@ class OpenCVTracker:
         self._factory = _contrib_factory(self.kind)
         self._trk: object | None = None
         self._box: tuple[float, float, float, float] | None = None
+        self._shape: tuple[int, ...] | None = None
 
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
         frame = _check_frame(frame)
@@ -160,13 +169,14 @@ class OpenCVTracker:
         win, clipped = clip_box(box, w, h)
         self._trk = self._factory()
         self._trk.init(frame, win)
+        self._shape = frame.shape
         self._box = tuple(float(v) for v in win)
         return _result(self._box, Status.CLIPPED if clipped else Status.INIT)
 
     def update(self, frame: np.ndarray) -> TrackResult:
         if self._trk is None:
             raise RuntimeError("update() called before init()")
-        ok, box = self._trk.update(_check_frame(frame))
+        ok, box = self._trk.update(_check_frame(frame, self._shape))
         if not ok:
             return _result(self._box, Status.LOST, message=f"{self.kind} lost the target")
         self._box = tuple(float(v) for v in box)

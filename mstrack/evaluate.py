@@ -113,7 +113,7 @@ def result_status(result: Any) -> str:
 def frame_error_types() -> tuple[type[BaseException], ...]:
     """Exception types meaning "bad frame, go on" (``mstrack.FrameError`` once it exists)."""
     try:
-        from .tracker import FrameError
+        from .frames import FrameError
     except ImportError:
         return ()
     return (FrameError,)

@@ -405,7 +405,7 @@ def ghdl_to_verilog(
     srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
     out = Path(out_path) if out_path else BUILD_DIR / "verilog" / f"{toplevel}_{_generics_tag(generics)}.v"
     out.parent.mkdir(parents=True, exist_ok=True)
-    digest = _hash_inputs(toplevel, generics, srcs, extra="fix1")
+    digest = _hash_inputs(toplevel, generics, srcs, extra="fix2")
     stamp = out.with_suffix(out.suffix + ".hash")
     if out.is_file() and stamp.is_file() and stamp.read_text().strip() == digest:
         return out
@@ -420,15 +420,85 @@ def ghdl_to_verilog(
     if r.returncode != 0 or not r.stdout.strip():
         raise HdlError(f"ghdl --synth of {toplevel} failed (exit {r.returncode}), log {log}:\n{r.stderr[-4000:]}")
     text, nfix = fix_ghdl_verilog(r.stdout)
-    if nfix:
+    notes = [f"rewrote {nfix} wide string-literal constants as N'b... literals"] if nfix else []
+    if _PMUX_RE.search(text):
+        # GHDL 2.0 drops the `others` input of every pmux (VHDL `case`) in its
+        # Verilog; take it from the VHDL netlist of the same design.
+        rv = subprocess.run(["--out=vhdl" if c == "--out=verilog" else c for c in cmd], cwd=work, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+        if rv.returncode != 0:
+            raise HdlError(f"ghdl --synth --out=vhdl of {toplevel} failed:\n{rv.stderr[-2000:]}")
+        text, npmux = fix_ghdl_pmux(text, rv.stdout, log)
+        notes.append(f"added the missing `default:` to {npmux} case blocks (pmux) from the VHDL netlist")
+    if notes:
         with open(log, "a") as f:
-            f.write(f"mstrack.hdl: rewrote {nfix} wide string-literal constants as N'b... literals\n")
+            f.write("".join(f"mstrack.hdl: {n}\n" for n in notes))
     out.write_text(text)
     stamp.write_text(digest + "\n")
     return out
 
 
 _WIDE_CONST_RE = re.compile(r'"([01xzXZ]+)"')
+
+
+_PMUX_RE = re.compile(r"(?P<head>  always @\*\n\s*case \((?P<sel>\w+)\)\n(?P<body>(?:\s+\d+'b[01]+: (?P<out>\w+) <= [^\n]*\n)+))"
+                      r"(?P<end>\s*endcase)")
+_VHDL_WITH_RE = re.compile(r"with (\w+) select (\w+) <=\n(?:[^;]*?\n)?\s*([^\n;]*?) when others;", re.S)
+
+
+def _vhdl_to_verilog_value(v: str, verilog_text: str) -> str | None:
+    v = v.strip()
+    m = re.fullmatch(r'"([01XZUWLH-]+)"', v)
+    if m:
+        bits = m.group(1).upper().translate(str.maketrans("UWLH-", "XX01X")).lower()
+        return f"{len(bits)}'b{bits}"
+    m = re.fullmatch(r"'([01XZUWLH-])'", v)
+    if m:
+        b = m.group(1).upper().translate(str.maketrans("UWLH-", "XX01X")).lower()
+        return f"1'b{b}"
+    if re.fullmatch(r"\w+", v):
+        for name in (v, v[5:] if v.startswith("wrap_") else None):
+            if name and re.search(rf"\b{re.escape(name)}\b", verilog_text):
+                return name
+    return None
+
+
+def fix_ghdl_pmux(verilog: str, vhdl_netlist: str, log: Path | None = None) -> tuple[str, int]:
+    """Work around GHDL 2.0's Verilog writer dropping the ``default:`` (VHDL
+    ``when others``) of every pmux it emits for a ``case`` statement (GHDL issue
+    #2041): Yosys then infers a latch and Verilator keeps the old value.  The
+    default is read from ``ghdl --synth --out=vhdl`` of the same design (same net
+    names).  Also refuses a selector that GHDL tied to a constant, which is how
+    GHDL 2.0 mis-synthesises the VHDL-2008 matching ``case?``.  Returns
+    (fixed Verilog, number of case blocks fixed); raises HdlError if a default
+    cannot be mapped."""
+    defaults = {(m.group(1), m.group(2)): m.group(3) for m in _VHDL_WITH_RE.finditer(vhdl_netlist)}
+    count = 0
+    errors = []
+
+    def repl(m: re.Match) -> str:
+        nonlocal count
+        sel, out = m.group("sel"), m.group("out")
+        if re.search(rf"assign {sel} = \{{(?:\d+'b[01]+(?:, )?)+\}};", verilog):
+            errors.append(f"case selector {sel} (output {out}) is a constant: GHDL 2.0 mis-synthesises "
+                          f"the matching `case?` statement; rewrite it as `case` or if/elsif")
+            return m.group(0)
+        d = defaults.get((sel, out))
+        val = _vhdl_to_verilog_value(d, verilog) if d is not None else None
+        if val is None:
+            errors.append(f"cannot find the `when others` value of pmux {out} (select {sel}; VHDL: {d!r})")
+            return m.group(0)
+        count += 1
+        indent = re.match(r"\s*", m.group("body")).group(0)
+        return m.group("head") + f"{indent}default: {out} <= {val};\n" + m.group("end").lstrip("\n")
+
+    fixed = _PMUX_RE.sub(repl, verilog)
+    if errors:
+        # find the VHDL source line printed just above each bad block
+        raise HdlError("GHDL 2.0 Verilog output cannot be repaired:\n  " + "\n  ".join(errors)
+                       + (f"\n(log {log}; the `/* file:line */` comment above the `always @*` block in the "
+                          f"Verilog gives the VHDL source line)" if log else ""))
+    return fixed, count
 
 
 def fix_ghdl_verilog(text: str) -> tuple[str, int]:
@@ -623,6 +693,6 @@ def synth_xilinx(
 
 __all__ = [
     "REPO_ROOT", "RTL_DIR", "TB_DIR", "BUILD_DIR", "TOOLS_HDL_DIR", "HdlError", "HdlTestFailure",
-    "rtl_sources", "run_ghdl", "run_verilator", "ghdl_to_verilog", "fix_ghdl_verilog", "synth_ecp5", "synth_xilinx",
+    "rtl_sources", "run_ghdl", "run_verilator", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "synth_ecp5", "synth_xilinx",
     "ghdl_backend", "have_ghdl", "dut_generics", "GENERICS_ENV", "have_verilator", "verilator_root",
 ]

@@ -88,6 +88,7 @@ begin
   pipe_p : process (clk)
     variable first_v : std_logic;
     variable above_v : unsigned(WIDTH - 1 downto 0);
+    variable sel_v   : std_logic_vector(1 downto 0);
   begin
     if rising_edge(clk) then
       if rst = '1' then
@@ -118,13 +119,18 @@ begin
         v2     <= v1;
         last2  <= last1;
         first2 <= first1;
-        if not USE_ABOVE then
-          above_v := pix1;
-        elsif first1 = '1' then
-          above_v := (others => '0');
-        else
-          above_v := unsigned(above1);
+        -- (a `case` with `others` on purpose: GHDL 2.0 drops the others branch
+        -- in its Verilog output, mstrack.hdl.fix_ghdl_pmux repairs it; the
+        -- USE_ABOVE=false co-simulation checks that)
+        sel_v := '0' & first1;
+        if USE_ABOVE then
+          sel_v(1) := '1';
         end if;
+        case sel_v is
+          when "10"   => above_v := unsigned(above1);
+          when "11"   => above_v := (others => '0');
+          when others => above_v := pix1;
+        end case;
         prod2 <= pix1 * above_v;
 
         -- stage 2 -> 3: accumulate, emit on end of line

@@ -1,0 +1,199 @@
+-- ms_centre: new window centre from the weighted position sums of a bin pass.
+--
+-- Computes, per axis (x shown, y the same with swy, win_y, lo_y, hi_y):
+--   cx = clamp((win_x << CF) + sgn(swx) * min(floor(((|swx| << CF) + (sw >> 1)) / sw), 2**SHIFT_Q_W - 1),
+--              lo_x << CF, hi_x << CF)          (clamp = min(max(c, lo), hi))
+--   lost = (sw = 0)  (cx, cy are then don't-care)
+-- i.e. mstrack.fixed.blocks.ms_centre (round_div_signed + clamp_centre) on region-relative
+-- coordinates.  One ms_divider (N_W = max(SWX_W + CF, SW_W - 1) + 1, D_W = SW_W,
+-- Q_W = SHIFT_Q_W) is shared: x is issued the clock after start, y the clock after that.
+--
+-- Latency    : done SHIFT_Q_W + 4 clocks after start (start in cycle c, done in c + SHIFT_Q_W + 4).
+-- Throughput : one centre per SHIFT_Q_W + 4 clocks; a start is accepted when busy = 0
+--              (busy is already low in the done cycle, so starts can follow back to back).
+-- Handshake  : start samples sw, swx, swy, win_*, lo_*, hi_* (latched); done is a one-clock
+--              pulse; cx, cy, lost are registered and stable until the next result.
+-- Reset      : synchronous, active high; control state only.
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+
+entity ms_centre is
+  generic (
+    SW_W      : natural := 22;  -- sw bits (unsigned)
+    SWX_W     : natural := 29;  -- swx, swy bits (signed)
+    SHIFT_Q_W : natural := 14;  -- quotient bits of the shift division (saturates at 2**SHIFT_Q_W - 1)
+    CF        : natural := 8;   -- centre fraction bits
+    REGION_W  : natural := 8;   -- region coordinate bits (win, lo, hi)
+    CENTRE_W  : natural := 16   -- centre bits (= REGION_W + CF)
+  );
+  port (
+    clk   : in  std_logic;                             -- clock
+    rst   : in  std_logic;                             -- synchronous reset, active high
+    start : in  std_logic;                             -- pulse: compute a centre (when busy = 0)
+    sw    : in  unsigned(SW_W - 1 downto 0);           -- sum w N
+    swx   : in  signed(SWX_W - 1 downto 0);            -- sum w SX
+    swy   : in  signed(SWX_W - 1 downto 0);            -- sum w SY
+    win_x : in  unsigned(REGION_W - 1 downto 0);       -- window centre column (region-relative px)
+    win_y : in  unsigned(REGION_W - 1 downto 0);       -- window centre row (region-relative px)
+    lo_x  : in  unsigned(REGION_W - 1 downto 0);       -- lowest allowed centre column (px)
+    hi_x  : in  unsigned(REGION_W - 1 downto 0);       -- highest allowed centre column (px)
+    lo_y  : in  unsigned(REGION_W - 1 downto 0);       -- lowest allowed centre row (px)
+    hi_y  : in  unsigned(REGION_W - 1 downto 0);       -- highest allowed centre row (px)
+    busy  : out std_logic;                             -- computing (start ignored)
+    done  : out std_logic;                             -- pulse: cx, cy, lost valid
+    cx    : out unsigned(CENTRE_W - 1 downto 0);       -- new centre column, Q.CF region-relative
+    cy    : out unsigned(CENTRE_W - 1 downto 0);       -- new centre row, Q.CF region-relative
+    lost  : out std_logic                              -- sw = 0: target lost (cx, cy don't-care)
+  );
+end entity;
+
+architecture rtl of ms_centre is
+  function maxn(a, b : natural) return natural is
+  begin
+    if a > b then return a; end if;
+    return b;
+  end function;
+  constant LATENCY : natural := SHIFT_Q_W + 4;                    -- start -> done
+  constant N_W     : natural := maxn(SWX_W + CF, SW_W - 1) + 1;   -- divider dividend bits
+  constant CW      : natural := maxn(CENTRE_W, SHIFT_Q_W) + 2;    -- signed centre arithmetic bits
+
+  signal busy_r : std_logic := '0';
+  signal ph_x   : std_logic := '0';   -- issue x this clock
+  signal ph_y   : std_logic := '0';   -- issue y this clock
+  signal sw_r   : unsigned(SW_W - 1 downto 0);
+  signal swx_r  : signed(SWX_W - 1 downto 0);
+  signal swy_r  : signed(SWX_W - 1 downto 0);
+  signal win_x_r, win_y_r, lo_x_r, hi_x_r, lo_y_r, hi_y_r : unsigned(REGION_W - 1 downto 0);
+  signal lost_r : std_logic;
+
+  signal d_valid : std_logic;
+  signal d_n     : unsigned(N_W - 1 downto 0);
+  signal d_tag   : std_logic_vector(1 downto 0);  -- (1) = y, (0) = negative
+  signal q_valid : std_logic;
+  signal q_mag   : unsigned(SHIFT_Q_W - 1 downto 0);
+  signal q_tag   : std_logic_vector(1 downto 0);
+
+  signal cx_r, cy_r : unsigned(CENTRE_W - 1 downto 0);
+  signal done_r     : std_logic := '0';
+  signal lost_o     : std_logic := '0';
+begin
+  assert CENTRE_W = REGION_W + CF
+    report "ms_centre: CENTRE_W must be REGION_W + CF" severity failure;
+
+  p_ctrl : process (clk)
+  begin
+    if rising_edge(clk) then
+      if rst = '1' then
+        busy_r <= '0';
+        ph_x   <= '0';
+        ph_y   <= '0';
+        done_r <= '0';
+      else
+        ph_x   <= '0';
+        ph_y   <= ph_x;
+        done_r <= '0';
+        if busy_r = '0' and start = '1' then
+          busy_r <= '1';
+          ph_x   <= '1';
+        end if;
+        if q_valid = '1' and q_tag(1) = '1' then  -- y result: done
+          done_r <= '1';
+          busy_r <= '0';
+        end if;
+      end if;
+    end if;
+  end process;
+
+  p_latch : process (clk)
+  begin
+    if rising_edge(clk) then
+      if busy_r = '0' and start = '1' then
+        sw_r    <= sw;
+        swx_r   <= swx;
+        swy_r   <= swy;
+        win_x_r <= win_x;
+        win_y_r <= win_y;
+        lo_x_r  <= lo_x;
+        hi_x_r  <= hi_x;
+        lo_y_r  <= lo_y;
+        hi_y_r  <= hi_y;
+        if sw = 0 then
+          lost_r <= '1';
+        else
+          lost_r <= '0';
+        end if;
+      end if;
+    end if;
+  end process;
+
+  -- divider operands: (|s| << CF) + (sw >> 1), s = swx in the x phase, swy in the y phase
+  p_operands : process (ph_x, ph_y, sw_r, swx_r, swy_r)
+    variable s   : signed(SWX_W - 1 downto 0);
+    variable mag : unsigned(SWX_W - 1 downto 0);
+  begin
+    if ph_x = '1' then
+      s := swx_r;
+    else
+      s := swy_r;
+    end if;
+    if s < 0 then
+      mag := unsigned(-s);        -- -(-2**(SWX_W-1)) wraps to 2**(SWX_W-1), correct as unsigned
+      d_tag(0) <= '1';
+    else
+      mag := unsigned(s);
+      d_tag(0) <= '0';
+    end if;
+    d_tag(1) <= ph_y;
+    d_n      <= shift_left(resize(mag, N_W), CF) + resize(shift_right(sw_r, 1), N_W);
+  end process;
+  d_valid <= ph_x or ph_y;
+
+  u_div : entity work.ms_divider
+    generic map (N_W => N_W, D_W => SW_W, Q_W => SHIFT_Q_W, TAG_W => 2)
+    port map (clk => clk, rst => rst, in_valid => d_valid, in_n => d_n, in_d => sw_r, in_tag => d_tag,
+              out_valid => q_valid, out_q => q_mag, out_tag => q_tag);
+
+  p_result : process (clk)
+    variable c, lo, hi : signed(CW - 1 downto 0);
+    variable w         : unsigned(REGION_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      if q_tag(1) = '1' then
+        w  := win_y_r;
+        lo := signed(shift_left(resize(lo_y_r, CW), CF));
+        hi := signed(shift_left(resize(hi_y_r, CW), CF));
+      else
+        w  := win_x_r;
+        lo := signed(shift_left(resize(lo_x_r, CW), CF));
+        hi := signed(shift_left(resize(hi_x_r, CW), CF));
+      end if;
+      c := signed(shift_left(resize(w, CW), CF));
+      if q_tag(0) = '1' then
+        c := c - signed(resize(q_mag, CW));
+      else
+        c := c + signed(resize(q_mag, CW));
+      end if;
+      if c < lo then
+        c := lo;
+      end if;
+      if c > hi then
+        c := hi;
+      end if;
+      if q_valid = '1' then
+        if q_tag(1) = '1' then
+          cy_r   <= resize(unsigned(c), CENTRE_W);
+          lost_o <= lost_r;
+        else
+          cx_r <= resize(unsigned(c), CENTRE_W);
+        end if;
+      end if;
+    end if;
+  end process;
+
+  busy <= busy_r;
+  done <= done_r;
+  cx   <= cx_r;
+  cy   <= cy_r;
+  lost <= lost_o;
+end architecture;

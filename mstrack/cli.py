@@ -63,7 +63,8 @@ def _fmt(v: Any, nd: int = 3) -> str:
     return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{nd}f}"
 
 
-def _print_table(header: list[str], rows: list[list[str]], file=sys.stdout) -> None:
+def _print_table(header: list[str], rows: list[list[str]], file: Any = None) -> None:
+    file = file or sys.stdout
     w = [max(len(str(h)), *(len(str(r[i])) for r in rows)) if rows else len(h) for i, h in enumerate(header)]
     print("  ".join(str(h).ljust(w[i]) for i, h in enumerate(header)), file=file)
     for r in rows:

@@ -87,8 +87,17 @@ begin
     variable ix, iy   : natural range 0 to N_ENT - 1;
   begin
     if rising_edge(clk) then
-      adx := unsigned(abs(in_dx));
-      ady := unsigned(abs(in_dy));
+      -- |dx|, |dy| (explicit: GHDL 2.0's Verilog writer has no abs)
+      if in_dx(D_W - 1) = '1' then
+        adx := unsigned(-in_dx);
+      else
+        adx := unsigned(in_dx);
+      end if;
+      if in_dy(D_W - 1) = '1' then
+        ady := unsigned(-in_dy);
+      else
+        ady := unsigned(in_dy);
+      end if;
       ix  := to_integer(adx(HALF_W - 1 downto 0));
       iy  := to_integer(ady(HALF_W - 1 downto 0));
       ta1 <= ta_ram(ix);

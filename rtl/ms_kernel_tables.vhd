@@ -107,63 +107,63 @@ begin
       done_r <= '0';
       wr     := false;
       wr_i   := i_iss;
-      case state is
-        when S_IDLE =>
-          if start = '1' then
-            wl    <= w;
-            hl    <= h;
-            state <= S_SETUP1;
-          end if;
+      e_x    := (others => '0');
+      e_y    := (others => '0');
+      -- if/elsif instead of case: GHDL 2.0's Verilog output of a full enum case has no default
+      if state = S_IDLE then
+        if start = '1' then
+          wl    <= w;
+          hl    <= h;
+          state <= S_SETUP1;
+        end if;
 
-        when S_SETUP1 =>
-          w2   <= wl * wl;
-          h2   <= hl * hl;
-          e_x  := resize(shift_right(wl - 1, 1), HALF_W);
-          e_y  := resize(shift_right(hl - 1, 1), HALF_W);
-          ex_r <= e_x;
-          ey_r <= e_y;
-          if e_x > e_y then
-            n_last <= e_x;
-          else
-            n_last <= e_y;
-          end if;
-          state <= S_SETUP2;
+      elsif state = S_SETUP1 then
+        w2   <= wl * wl;
+        h2   <= hl * hl;
+        e_x  := resize(shift_right(wl - 1, 1), HALF_W);
+        e_y  := resize(shift_right(hl - 1, 1), HALF_W);
+        ex_r <= e_x;
+        ey_r <= e_y;
+        if e_x > e_y then
+          n_last <= e_x;
+        else
+          n_last <= e_y;
+        end if;
+        state <= S_SETUP2;
 
-        when S_SETUP2 =>
-          d_r      <= resize(w2 * h2, KD_W);
-          ta_acc   <= (others => '0');
-          tb_acc   <= (others => '0');
-          ta_stp   <= resize(shift_left(resize(h2, T_W), 2), T_W);
-          tb_stp   <= resize(shift_left(resize(w2, T_W), 2), T_W);
-          i_iss    <= (others => '0');
-          sel      <= '0';
-          sq4      <= (others => '0');
-          sq4_step <= to_unsigned(4, N_W);
-          state    <= S_ISSUE;
+      elsif state = S_SETUP2 then
+        d_r      <= resize(w2 * h2, KD_W);
+        ta_acc   <= (others => '0');
+        tb_acc   <= (others => '0');
+        ta_stp   <= resize(shift_left(resize(h2, T_W), 2), T_W);
+        tb_stp   <= resize(shift_left(resize(w2, T_W), 2), T_W);
+        i_iss    <= (others => '0');
+        sel      <= '0';
+        sq4      <= (others => '0');
+        sq4_step <= to_unsigned(4, N_W);
+        state    <= S_ISSUE;
 
-        when S_ISSUE =>
-          if KERNEL_EPAN = 1 then
-            sel <= not sel;
-            if sel = '1' then
-              i_iss    <= i_iss + 1;
-              sq4      <= sq4 + sq4_step;
-              sq4_step <= sq4_step + 8;
-              if i_iss = n_last then
-                state <= S_WAIT;
-              end if;
-            end if;
-          else
-            wr    := true;
-            wr_i  := i_iss;
-            i_iss <= i_iss + 1;
+      elsif state = S_ISSUE then
+        if KERNEL_EPAN = 1 then
+          sel <= not sel;
+          if sel = '1' then
+            i_iss    <= i_iss + 1;
+            sq4      <= sq4 + sq4_step;
+            sq4_step <= sq4_step + 8;
             if i_iss = n_last then
               state <= S_WAIT;
             end if;
           end if;
+        else
+          wr    := true;
+          wr_i  := i_iss;
+          i_iss <= i_iss + 1;
+          if i_iss = n_last then
+            state <= S_WAIT;
+          end if;
+        end if;
 
-        when S_WAIT =>
-          null;
-      end case;
+      end if;
 
       -- write side (Epanechnikov: divider results, KA of entry i then KB of entry i)
       if KERNEL_EPAN = 1 and dv_out_valid = '1' then

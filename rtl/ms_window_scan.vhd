@@ -92,66 +92,74 @@ begin
     variable dy_n        : signed(D_W - 1 downto 0);
   begin
     if rising_edge(clk) then
-      case state is
-        when S_IDLE =>
+      -- defaults (no don't-care values in the netlist)
+      lo        := (others => '0');
+      hi        := (others => '0');
+      g0        := (others => '0');
+      g1        := (others => '0');
+      first_row := (others => '0');
+      gcnt_n    := gcnt;
+      dy_n      := dyr;
+      -- if/elsif instead of case: GHDL 2.0's Verilog output of a full enum case has no default
+      if state = S_IDLE then
+        valid <= '0';
+        last  <= '0';
+        if start = '1' then
+          wx    <= win_x;
+          wy    <= win_y;
+          exl   <= ex;
+          eyl   <= ey;
+          state <= S_SETUP;
+        end if;
+
+      elsif state = S_SETUP then
+        lo := resize(wx, REGION_W + 1) - resize(exl, REGION_W + 1);
+        hi := resize(wx, REGION_W + 1) + resize(exl, REGION_W + 1);
+        g0 := shift_right(lo, SH);
+        g1 := shift_right(hi, SH);
+        first_row := wy - resize(eyl, REGION_W);
+        ngrp_m1  <= resize(g1 - g0, REGION_W);
+        dx0      <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
+        dxb      <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
+        ey_s     <= signed(resize(eyl, D_W));
+        dyr      <= -signed(resize(eyl, D_W));
+        row_addr <= resize(first_row * to_unsigned(STRIDE, ADDR_W) + resize(g0, ADDR_W), ADDR_W);
+        addr     <= resize(first_row * to_unsigned(STRIDE, ADDR_W) + resize(g0, ADDR_W), ADDR_W);
+        gcnt     <= (others => '0');
+        valid    <= '1';
+        -- single-beat scan is impossible (ey >= 1), but keep it exact anyway
+        if g1 = g0 and eyl = 0 then
+          last <= '1';
+        else
+          last <= '0';
+        end if;
+        state <= S_RUN;
+
+      else  -- S_RUN
+        if last = '1' then
           valid <= '0';
           last  <= '0';
-          if start = '1' then
-            wx    <= win_x;
-            wy    <= win_y;
-            exl   <= ex;
-            eyl   <= ey;
-            state <= S_SETUP;
+          state <= S_IDLE;
+        else
+          if gcnt = ngrp_m1 then
+            gcnt_n   := (others => '0');
+            dy_n     := dyr + 1;
+            row_addr <= row_addr + STRIDE;
+            addr     <= row_addr + STRIDE;
+            dxb      <= dx0;
+          else
+            gcnt_n   := gcnt + 1;
+            dy_n     := dyr;
+            addr     <= addr + 1;
+            dxb      <= dxb + LANES;
           end if;
-
-        when S_SETUP =>
-          lo := resize(wx, REGION_W + 1) - resize(exl, REGION_W + 1);
-          hi := resize(wx, REGION_W + 1) + resize(exl, REGION_W + 1);
-          g0 := shift_right(lo, SH);
-          g1 := shift_right(hi, SH);
-          first_row := wy - resize(eyl, REGION_W);
-          ngrp_m1  <= resize(g1 - g0, REGION_W);
-          dx0      <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
-          dxb      <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
-          ey_s     <= signed(resize(eyl, D_W));
-          dyr      <= -signed(resize(eyl, D_W));
-          row_addr <= resize(first_row * to_unsigned(STRIDE, ADDR_W) + resize(g0, ADDR_W), ADDR_W);
-          addr     <= resize(first_row * to_unsigned(STRIDE, ADDR_W) + resize(g0, ADDR_W), ADDR_W);
-          gcnt     <= (others => '0');
-          valid    <= '1';
-          -- single-beat scan is impossible (ey >= 1), but keep it exact anyway
-          if g1 = g0 and eyl = 0 then
+          gcnt <= gcnt_n;
+          dyr  <= dy_n;
+          if gcnt_n = ngrp_m1 and dy_n = ey_s then
             last <= '1';
-          else
-            last <= '0';
           end if;
-          state <= S_RUN;
-
-        when S_RUN =>
-          if last = '1' then
-            valid <= '0';
-            last  <= '0';
-            state <= S_IDLE;
-          else
-            if gcnt = ngrp_m1 then
-              gcnt_n   := (others => '0');
-              dy_n     := dyr + 1;
-              row_addr <= row_addr + STRIDE;
-              addr     <= row_addr + STRIDE;
-              dxb      <= dx0;
-            else
-              gcnt_n   := gcnt + 1;
-              dy_n     := dyr;
-              addr     <= addr + 1;
-              dxb      <= dxb + LANES;
-            end if;
-            gcnt <= gcnt_n;
-            dyr  <= dy_n;
-            if gcnt_n = ngrp_m1 and dy_n = ey_s then
-              last <= '1';
-            end if;
-          end if;
-      end case;
+        end if;
+      end if;
       if rst = '1' then
         state <= S_IDLE;
         valid <= '0';

@@ -71,6 +71,8 @@ class TB:
         assert int(d.ex.value) == ker.ex and int(d.ey.value) == ker.ey, (w, h)
         assert int(d.kd_d.value) == ker.D, (w, h, int(d.kd_d.value), ker.D)
         n_last = max(ker.ex, ker.ey)
+        exp_n = 2 * (n_last + 1) + self.kval_w + 4 if self.epan else n_last + 4
+        assert n == exp_n, f"{w}x{h}: done after {n} clocks, documented {exp_n}"
         assert [a for a, *_ in self.writes] == list(range(n_last + 1)), f"{w}x{h}: addresses {self.writes}"
         sat = (1 << self.kval_w) - 1
         for i, ta, tb, ka, kb in self.writes:
@@ -138,3 +140,11 @@ def test_ms_kernel_tables(kernel, fp, hdl_waves):
     import json
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
                  extra_env={hdl.GENERICS_ENV: json.dumps({**gen, "MAX_HALF_TB": fp.max_half})})
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("kernel", ["flat", "epanechnikov"])
+def test_ms_kernel_tables_synth(kernel, tmp_path):
+    """ghdl --synth (to Verilog, as the Verilator/yosys flow does) succeeds."""
+    gen = tables_generics(kernel, FixedParams())
+    hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")

@@ -276,3 +276,11 @@ def test_ms_pixel_pass_default_config(hdl_waves):
     gen, cfg = pass_generics(TrackerParams(kernel="epanechnikov"), FixedParams(), 2)
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
                  extra_env={CFG_ENV: json.dumps(cfg), "MS_PIXEL_PASS_N": "1"})
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("kernel,lanes", [("flat", 2), ("epanechnikov", 4), ("flat", 1)])
+def test_ms_pixel_pass_synth(kernel, lanes, tmp_path):
+    """ghdl --synth (to Verilog, as the Verilator/yosys flow does) of the default-size pass succeeds."""
+    gen, _ = pass_generics(TrackerParams(kernel=kernel), FixedParams(), lanes)
+    hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")

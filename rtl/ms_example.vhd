@@ -12,7 +12,8 @@
 --   m_axis_tlast = '1' (each result is a one-beat packet)
 -- The previous line is held in an inferred block RAM (registered read,
 -- read-before-write on the same address) and the product uses a WIDTH x WIDTH
--- multiplier, so RAM and DSP inference are exercised by synthesis.
+-- multiplier, so RAM and DSP inference are exercised by synthesis.  The RAM
+-- output is registered once more (OUTREG) so that ECP5 reaches ~150 MHz.
 --
 -- Flow control: one global clock enable.  The pipeline stalls when the output
 -- register holds a beat that is not accepted; s_axis_tready = that enable.
@@ -60,6 +61,10 @@ architecture rtl of ms_example is
   signal v1, last1, first1 : std_logic := '0';
   signal pix1              : unsigned(WIDTH - 1 downto 0);
   signal above1            : std_logic_vector(WIDTH - 1 downto 0);
+  -- stage 1r: RAM output register (DP16KD OUTREG / RAMB DOB_REG) for Fmax
+  signal v1r, last1r, first1r : std_logic := '0';
+  signal pix1r                : unsigned(WIDTH - 1 downto 0);
+  signal above1r              : std_logic_vector(WIDTH - 1 downto 0);
   -- stage 2: product
   signal v2, last2, first2 : std_logic := '0';
   signal prod2             : unsigned(2 * WIDTH - 1 downto 0);
@@ -80,7 +85,8 @@ begin
         if s_axis_tvalid = '1' then
           ram(to_integer(col)) <= s_axis_tdata;
         end if;
-        above1 <= ram(to_integer(col));
+        above1  <= ram(to_integer(col));
+        above1r <= above1;
       end if;
     end if;
   end process;
@@ -95,6 +101,7 @@ begin
         col       <= (others => '0');
         in_first  <= '0';
         v1        <= '0';
+        v1r       <= '0';
         v2        <= '0';
         acc       <= (others => '0');
         out_valid <= '0';
@@ -115,23 +122,29 @@ begin
           end if;
         end if;
 
-        -- stage 1 -> 2: multiply by the pixel above (0 on the first line)
-        v2     <= v1;
-        last2  <= last1;
-        first2 <= first1;
+        -- stage 1 -> 1r: wait for the registered RAM output
+        v1r     <= v1;
+        last1r  <= last1;
+        first1r <= first1;
+        pix1r   <= pix1;
+
+        -- stage 1r -> 2: multiply by the pixel above (0 on the first line)
+        v2     <= v1r;
+        last2  <= last1r;
+        first2 <= first1r;
         -- (a `case` with `others` on purpose: GHDL 2.0 drops the others branch
         -- in its Verilog output, mstrack.hdl.fix_ghdl_pmux repairs it; the
         -- USE_ABOVE=false co-simulation checks that)
-        sel_v := '0' & first1;
+        sel_v := '0' & first1r;
         if USE_ABOVE then
           sel_v(1) := '1';
         end if;
         case sel_v is
-          when "10"   => above_v := unsigned(above1);
+          when "10"   => above_v := unsigned(above1r);
           when "11"   => above_v := (others => '0');
-          when others => above_v := pix1;
+          when others => above_v := pix1r;
         end case;
-        prod2 <= pix1 * above_v;
+        prod2 <= pix1r * above_v;
 
         -- stage 2 -> 3: accumulate, emit on end of line
         out_valid <= '0';

@@ -571,7 +571,10 @@ def run_verilator(
     vfile = ghdl_to_verilog(toplevel, generics, srcs, out_path=build_dir / f"{toplevel}.v")
     _prepare_pythonpath(test_module, test_dirs)
     vargs = list(VERILATOR_ARGS if verilator_args is None else verilator_args)
-    with _environ(VERILATOR_ROOT=str(root)):
+    # ccache (if installed) caches the C++ objects, above all Verilator's runtime
+    # (verilated*.cpp), which is the same for every design and build dir
+    objcache = os.environ.get("OBJCACHE", "ccache" if shutil.which("ccache") else "")
+    with _environ(VERILATOR_ROOT=str(root), OBJCACHE=objcache or None):
         try:
             runner.build(sources=[vfile], hdl_toplevel=toplevel, build_dir=build_dir,
                          build_args=vargs, waves=waves, log_file=build_dir / "build.log")

@@ -215,3 +215,13 @@ def test_failure_is_reported():
     with pytest.raises(hdl.HdlTestFailure, match="deliberate failure"):
         hdl.run_ghdl(TOP, MODULE, {"WIDTH": 8}, hdl.rtl_sources(TOP), build_name="ghdl_ms_example_fail",
                      testcase="deliberate_failure", extra_env={"MS_EXAMPLE_DELIBERATE_FAIL": "1"})
+
+
+@pytest.mark.synth
+def test_ms_example_synth():
+    """Flow smoke test: GHDL -> Yosys (ECP5 + Xilinx) -> nextpnr; RAM and multiplier inferred."""
+    r = hdl.synth_ecp5(TOP, {"WIDTH": 8}, hdl.rtl_sources(TOP), seed=1, freq_mhz=150)
+    assert (r["DP16KD"], r["MULT18X18D"]) == (1, 1), r["cells"]
+    assert r["fmax_min_mhz"] and r["fmax_min_mhz"] > 60, r["fmax_mhz"]
+    x = hdl.synth_xilinx(TOP, {"WIDTH": 8}, hdl.rtl_sources(TOP))
+    assert (x["BRAM36"], x["DSP48E1"]) == (0.5, 1), x["cells"]

@@ -115,3 +115,18 @@ def test_real_data_issue_target(agreement):
     assert held
     for a in held:
         assert a.mean < MEAN_DIFF_MAX and abs(a.auc_diff) <= AUC_DIFF_MAX, a.row()
+
+
+def test_write_table_replaces_marked_section(tmp_path):
+    from mstrack.agreement import write_table
+
+    p = tmp_path / "r.md"
+    p.write_text("# title\n\ntext\n")
+    write_table("| a |", p, command="cmd 1")
+    write_table("| b |", p, command="cmd 2")
+    write_table("| s |", p, command="cmd 3", section="sweep")
+    text = p.read_text()
+    assert text.count("agreement-table:begin") == 1 and "| b |" in text and "| a |" not in text
+    assert "cmd 2" in text and "| s |" in text and text.startswith("# title\n\ntext\n")
+    write_table("| c |", p, command="cmd 4")
+    assert p.read_text().index("| c |") < p.read_text().index("| s |")

@@ -23,7 +23,6 @@ import platform
 import shlex
 import sys
 import time
-import warnings
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any, Callable, Iterable
@@ -95,9 +94,14 @@ def draw_overlay(frame: np.ndarray, row: dict[str, Any], gt: np.ndarray | None =
     cv2.circle(img, (int(round(row["cx"])), int(round(row["cy"]))), 3, (0, 0, 255), -1)
     txt = f"#{row['frame']} rho_c={_fmt(row['rho_c'], 2)} rho_e={_fmt(row['rho_e'], 2)} " \
           f"a_c={_fmt(row['alpha_c'], 2)} {row['status']}"
-    for c, t in (((0, 0, 0), 3), ((255, 255, 255), 1)):
-        cv2.putText(img, txt, (5, 16), cv2.FONT_HERSHEY_SIMPLEX, 0.45, c, t, cv2.LINE_AA)
+    (tw, th), base = cv2.getTextSize(txt, cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)
+    cv2.rectangle(img, (0, 0), (tw + 8, th + base + 8), (0, 0, 0), -1)
+    cv2.putText(img, txt, (4, th + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
     return img
+
+
+def _warn(msg: str) -> None:
+    print(f"mstrack: warning: {msg}", file=sys.stderr)
 
 
 class _Display:
@@ -106,7 +110,7 @@ class _Display:
     def __init__(self, enabled: bool) -> None:
         self.on = enabled
         if enabled and not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
-            warnings.warn("--show: no display (DISPLAY not set); not showing frames", stacklevel=2)
+            _warn("--show: no display (DISPLAY not set); not showing frames")
             self.on = False
 
     def show(self, img: np.ndarray) -> None:
@@ -117,7 +121,7 @@ class _Display:
             cv2.imshow("mstrack", img)
             cv2.waitKey(1)
         except cv2.error:
-            warnings.warn("--show: this OpenCV build has no GUI support; not showing frames", stacklevel=2)
+            _warn("--show: this OpenCV build has no GUI support (opencv-*-headless); not showing frames")
             self.on = False
 
     def close(self) -> None:

@@ -11,8 +11,9 @@ reports per sequence:
   (:mod:`mstrack.metrics`; frame 0, the init box, is *included*, as
   :func:`mstrack.evaluate.run_sequence` does).
 
-Run ``python -m mstrack.agreement [SEQ_ROOT] [--out docs/results_fixed.md]``;
-``FixedParams`` fields can be varied with ``--fixed weight_frac=6`` (repeatable)
+Run ``python -m mstrack.agreement [SEQ_ROOT] [--write]`` (or ``mstrack agree`` once
+``"mstrack.agreement:register_cli"`` is in ``mstrack.cli.EXTENSIONS``);
+``FixedParams`` fields can be varied with ``--param weight_frac=6`` (repeatable)
 to see which format the data supports.  The tables in docs/results_fixed.md are
 written by this module (``--write``, between ``agreement-*`` markers;
 ``--resync`` and ``--sweep`` are the analysis runs).
@@ -294,8 +295,8 @@ def _parse_kv(items: list[str]) -> dict[str, Any]:
     return out
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mstrack.agreement", description=__doc__.split("\n\n")[0])
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """Arguments of ``python -m mstrack.agreement`` and ``mstrack agree``."""
     ap.add_argument("root", nargs="?", default=str(DEFAULT_ROOT), help="folder of sequence folders")
     ap.add_argument("--max-frames", type=int, default=None)
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
@@ -307,7 +308,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sweep", action="store_true",
                     help="format sweep (mean diff / dAUC per FixedParams variant); with --write "
                          "rewrites the sweep section")
-    args = ap.parse_args(argv)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler of ``mstrack agree`` / ``python -m mstrack.agreement``."""
     params = _parse_kv(args.param)
     if args.sweep:
         md = sweep_table(args.root, max_frames=args.max_frames)
@@ -335,6 +339,20 @@ def main(argv: list[str] | None = None) -> int:
         section = "resync" if args.resync else ("table" if not args.param else "variant")
         print(write_table(md, command=cmd, section=section))
     return 0
+
+
+def register_cli(sub: argparse._SubParsersAction) -> None:
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.agreement:register_cli"``): ``mstrack agree``."""
+    p = sub.add_parser("agree", help="float vs fixed-point agreement on every sequence of a folder",
+                       description=__doc__.split("\n\n")[0])
+    add_arguments(p)
+    p.set_defaults(func=run)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m mstrack.agreement", description=__doc__.split("\n\n")[0])
+    add_arguments(ap)
+    return run(ap.parse_args(argv))
 
 
 if __name__ == "__main__":

@@ -22,7 +22,8 @@ JSON lines with sorted keys.  Line 1 is the header::
 
 then one line per chosen frame: ``{"frame": i, "kind": "init" | "update", "trace": ...}``.
 
-Command line: ``python -m mstrack.vectors SEQ_DIR --frames 0,1,5 --out FILE [--param NAME=VALUE]``.
+Command line: ``python -m mstrack.vectors SEQ_DIR --frames 0,1,5 --out FILE [--param NAME=VALUE]``,
+or ``mstrack vectors ...`` once ``"mstrack.vectors:register_cli"`` is in ``mstrack.cli.EXTENSIONS``.
 """
 from __future__ import annotations
 
@@ -138,20 +139,23 @@ def _parse_frames(s: str) -> list[int]:
     return [int(v) for v in s.split(",") if v.strip()]
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mstrack.vectors", description=__doc__.split("\n\n")[0])
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """Arguments of ``python -m mstrack.vectors`` and ``mstrack vectors``."""
     ap.add_argument("seq_dir")
     ap.add_argument("--frames", type=_parse_frames, default=[0, 1], help="comma separated, e.g. 0,1,5")
     ap.add_argument("--out", required=True)
     ap.add_argument("--lanes", type=int, default=DEFAULT_LANES)
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                     help="TrackerParams or FixedParams field (repeatable)")
-    args = ap.parse_args(argv)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler of ``mstrack vectors`` / ``python -m mstrack.vectors``."""
     params: dict[str, Any] = {}
     for it in args.param:
         k, sep, v = it.partition("=")
         if not sep:
-            ap.error(f"--param expects NAME=VALUE, got {it!r}")
+            raise ValueError(f"--param expects NAME=VALUE, got {it!r}")
         try:
             params[k] = int(v)
         except ValueError:
@@ -161,6 +165,20 @@ def main(argv: list[str] | None = None) -> int:
                 params[k] = v
     print(dump_vectors(args.seq_dir, args.frames, args.out, args.lanes, **params))
     return 0
+
+
+def register_cli(sub: argparse._SubParsersAction) -> None:
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.vectors:register_cli"``): ``mstrack vectors``."""
+    p = sub.add_parser("vectors", help="dump RTL test vectors (every fixed-point intermediate) of chosen frames",
+                       description=__doc__.split("\n\n")[0])
+    add_arguments(p)
+    p.set_defaults(func=run)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m mstrack.vectors", description=__doc__.split("\n\n")[0])
+    add_arguments(ap)
+    return run(ap.parse_args(argv))
 
 
 if __name__ == "__main__":

@@ -113,3 +113,15 @@ def test_errors(seq_dir, tmp_path):
         f.write('{"format": "other"}\n')
     with pytest.raises(ValueError):
         load_vectors(bad)
+
+
+def test_cli_extension(seq_dir, tmp_path):
+    """`mstrack vectors` and `mstrack agree` register through mstrack.cli's extension list."""
+    cli = pytest.importorskip("mstrack.cli")
+    parser = cli.build_parser(extensions=["mstrack.vectors:register_cli", "mstrack.agreement:register_cli"])
+    out = tmp_path / "ext.jsonl.gz"
+    args = parser.parse_args(["vectors", str(seq_dir), "--frames", "0,1,5", "--out", str(out)])
+    assert args.func(args) == 0
+    assert [r["frame"] for r in load_vectors(out)[1]] == FRAMES
+    args = parser.parse_args(["agree", str(seq_dir.parent), "--max-frames", "3"])
+    assert args.func(args) == 0

@@ -34,6 +34,10 @@ log() { printf 'setup: %s\n' "$*"; }
 
 # --- 1. apt -------------------------------------------------------------------
 missing=()
+# a Debian python3 without ensurepip cannot create venvs: needs python3-venv
+if [ ! -x "$VENV/bin/python" ] && ! "$PYTHON" -c 'import ensurepip, venv' 2>/dev/null; then
+    APT_PACKAGES+=(python3-venv)
+fi
 for p in "${APT_PACKAGES[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
 done
@@ -61,9 +65,9 @@ if [ "${#missing[@]}" -gt 0 ] && [ -z "${SETUP_NO_APT:-}" ]; then
 fi
 
 # --- 2. venv -------------------------------------------------------------------
-if [ ! -x "$VENV/bin/python" ]; then
+if [ ! -x "$VENV/bin/python" ] || ! "$VENV/bin/python" -c '' 2>/dev/null; then
     log "creating $VENV"
-    "$PYTHON" -m venv "$VENV"
+    if [ -d "$VENV" ]; then "$PYTHON" -m venv --clear "$VENV"; else "$PYTHON" -m venv "$VENV"; fi
 fi
 
 # --- 3. pip ---------------------------------------------------------------------

@@ -41,6 +41,13 @@ fi
 for p in "${APT_PACKAGES[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
 done
+# remember what was tried, so a package unavailable here does not cost an
+# 'apt-get update' on every 'make test' (delete build/setup-apt.tried to retry)
+APT_TRIED=build/setup-apt.tried
+if [ "${#missing[@]}" -gt 0 ] && [ "$(cat "$APT_TRIED" 2>/dev/null)" = "${missing[*]}" ]; then
+    log "apt packages ${missing[*]} unavailable at the last try; skipped (rm $APT_TRIED to retry)"
+    missing=()
+fi
 if [ "${#missing[@]}" -gt 0 ] && [ -z "${SETUP_NO_APT:-}" ]; then
     if [ "$(id -u)" -eq 0 ]; then
         log "apt-get update (missing: ${missing[*]})"
@@ -59,6 +66,12 @@ if [ "${#missing[@]}" -gt 0 ] && [ -z "${SETUP_NO_APT:-}" ]; then
         else
             log "warning: apt-get update failed; skipping apt packages ${missing[*]}"
         fi
+        still=()
+        for p in "${missing[@]}"; do
+            dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || still+=("$p")
+        done
+        mkdir -p "$(dirname "$APT_TRIED")"
+        if [ "${#still[@]}" -gt 0 ]; then echo "${still[*]}" > "$APT_TRIED"; else rm -f "$APT_TRIED"; fi
     else
         log "not root: skipping apt packages ${missing[*]} (install them with: sudo apt-get install ${missing[*]})"
     fi

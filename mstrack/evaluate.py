@@ -4,7 +4,8 @@ Each tracker is initialised on frame 0 with the ground-truth box and updated
 on every following frame; frame 0 counts in the scores with the box the
 tracker reports from ``init`` (as in OTB).  Speed is measured on ``update()``
 only (frame decoding excluded).  Per-sequence results are cached as
-``<out>/results/<label>/<sequence>.json`` and reused unless ``force``.
+``<out>/results/<label>/<sequence>.json`` and reused unless ``force``, or
+the frame count, model or tracker code (:func:`tracker_fingerprint`) changed.
 
 Aggregates (:class:`Evaluation`): per sequence, per attribute and overall,
 the latter two frame-weighted (the per-frame values of all sequences are
@@ -204,16 +205,43 @@ def run_sequence(tracker: Any, seq: Sequence, max_frames: int | None = None, lab
     return SequenceRun(label, seq.name, boxes, status, total, model)
 
 
+def tracker_fingerprint(name: str) -> str:
+    """Short hash of the code behind tracker ``name``, stored with cached runs.
+
+    mstrack trackers: the sources of the tracker modules (``tracker``,
+    ``float_model``, ``params``, ``frames``, ``types``, ``fixed/``); OpenCV
+    baselines: ``baselines.py`` and the OpenCV version.  A cached run whose
+    fingerprint differs is recomputed, so editing the tracker invalidates it.
+    """
+    import hashlib
+
+    import cv2
+
+    pkg = Path(__file__).resolve().parent
+    if uses_model(name):
+        files = [pkg / f"{m}.py" for m in ("tracker", "float_model", "params", "frames", "types")]
+        files += sorted((pkg / "fixed").glob("*.py"))
+        extra = ""
+    else:
+        files, extra = [pkg / "baselines.py"], cv2.__version__
+    h = hashlib.sha1(extra.encode())
+    for f in files:
+        if f.is_file():
+            h.update(f.name.encode() + f.read_bytes())
+    return h.hexdigest()[:12]
+
+
 def cache_path(out_dir: str | Path, label: str, seq_name: str) -> Path:
     """``<out>/results/<label>/<seq>.json``."""
     return Path(out_dir) / "results" / label / f"{seq_name}.json"
 
 
-def load_cached(path: Path, n_frames: int, model: str) -> SequenceRun | None:
-    """A cached run if it exists and matches (frame count, model, cache version); else None."""
+def load_cached(path: Path, n_frames: int, model: str, fingerprint: str | None = None) -> SequenceRun | None:
+    """A cached run if it exists and matches (frame count, model, code fingerprint, cache version); else None."""
     try:
         d = json.loads(path.read_text())
-        if d.get("version") != CACHE_VERSION or d.get("n_frames") != n_frames or d.get("model") != model:
+        if d.get("version") != CACHE_VERSION or d.get("n_frames") != n_frames or d.get("model") != model \
+                or d.get("fingerprint") != fingerprint:
             return None
         return SequenceRun.from_json(d)
     except (OSError, ValueError, KeyError, TypeError):
@@ -304,10 +332,11 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
         m = model if uses_model(name) else "float"
         n = len(seq) if max_frames is None else min(len(seq), max_frames)
         path = cache_path(out_dir, label, seq.name)
-        run = None if force else load_cached(path, n, m)
+        fp = tracker_fingerprint(name) if name in TRACKERS else None
+        run = None if force else load_cached(path, n, m, fp)
         if run is None:
             run = run_sequence(factory(name, model), seq, n, label=label, model=m, progress=progress)
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps(run.to_json()) + "\n")
+            path.write_text(json.dumps({**run.to_json(), "fingerprint": fp}) + "\n")
         runs.setdefault(label, {})[seq.name] = run
     return aggregate(runs, sequences)

@@ -94,13 +94,14 @@ def plot_curves(ev: Evaluation, out_dir: str | Path) -> tuple[Path, Path]:
              ("precision.png", CE_THRESHOLDS, "precision", "precision20", "Location error threshold (px)",
               "Precision", "Precision plots of OPE")]
     for fname, x, curve, key, xl, yl, title in specs:
-        fig, ax = plt.subplots(figsize=(6, 4.5), dpi=100)
-        for t in sorted(ev.trackers, key=lambda t: -getattr(ev.overall[t], key)):
+        fig, ax = plt.subplots(figsize=(8.5, 4.5), dpi=100)
+        for i, t in enumerate(sorted(ev.trackers, key=lambda t: -getattr(ev.overall[t], key))):
             s = ev.overall[t]
-            ax.plot(x, getattr(s, curve), lw=2, label=f"{t} [{getattr(s, key):.3f}]")
+            ax.plot(x, getattr(s, curve), lw=2, ls=("-", "--", ":")[i // 10 % 3],
+                    label=f"{t} [{getattr(s, key):.3f}]")
         ax.set(xlabel=xl, ylabel=yl, title=title, ylim=(0, 1), xlim=(x[0], x[-1]))
         ax.grid(alpha=0.3)
-        ax.legend(loc="lower left" if curve == "success" else "lower right", fontsize=8)
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, borderaxespad=0)
         fig.tight_layout()
         p = out / fname
         fig.savefig(p)

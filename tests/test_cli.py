@@ -200,3 +200,18 @@ def test_bench_dataset_both_models(tiny_dataset, capsys):
 
 def test_load_dataset_of_tiny(tiny_dataset):
     assert [s.name for s in load_dataset(tiny_dataset)] == ["seq0", "seq1"]
+
+
+def test_eval_cache_invalidated_by_code_change(tiny_dataset, tmp_path, monkeypatch):
+    from mstrack import evaluate as ev_mod
+    seqs = load_dataset(tiny_dataset, ["seq0"])
+    evaluate(seqs, ["opencv-meanshift"], tmp_path, quiet=True)
+    cached = tmp_path / "results" / "opencv-meanshift" / "seq0.json"
+    fp = json.loads(cached.read_text())["fingerprint"]
+    assert fp == ev_mod.tracker_fingerprint("opencv-meanshift") and len(fp) == 12
+    t0 = cached.stat().st_mtime_ns
+    evaluate(seqs, ["opencv-meanshift"], tmp_path, quiet=True)
+    assert cached.stat().st_mtime_ns == t0
+    monkeypatch.setattr(ev_mod, "tracker_fingerprint", lambda name: "changed")
+    evaluate(seqs, ["opencv-meanshift"], tmp_path, quiet=True)
+    assert json.loads(cached.read_text())["fingerprint"] == "changed"

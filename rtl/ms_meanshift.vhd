@@ -110,6 +110,8 @@ architecture rtl of ms_meanshift is
   signal dxs, dys         : sc_t;
 
   -- sub-block handshakes
+  constant BIN_RD_LAT : natural := 3;                             -- ms_pixel_pass bin read latency
+  signal pp_ready          : std_logic;
   signal pp_start, pp_done : std_logic;
   signal bp_start, bp_done : std_logic;
   signal ce_start, ce_done, ce_lost : std_logic;
@@ -139,7 +141,7 @@ begin
                  STRIDE => STRIDE, ADDR_W => ADDR_W, KERNEL_EPAN => KERNEL_EPAN,
                  KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
                  COUNT_W => COUNT_W, POSSUM_W => POSSUM_W)
-    port map (clk => clk, rst => rst, start => pp_start, win_x => win_x, win_y => win_y,
+    port map (clk => clk, rst => rst, ready => pp_ready, start => pp_start, win_x => win_x, win_y => win_y,
               ex => ex, ey => ey, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d,
               ram_addr => ram_addr, ram_data => ram_data, done => pp_done,
@@ -149,8 +151,9 @@ begin
   u_bins : entity work.ms_bin_pass
     generic map (BIN_W => BIN_W, HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W,
                  SQRT_IN_W => SQRT_IN_W, RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W,
-                 WEIGHT_W => WEIGHT_W, WF => WF, RF => RF, SW_W => SW_W, SWX_W => SWX_W)
-    port map (clk => clk, rst => rst, start => bp_start, learn => learn_r,
+                 WEIGHT_W => WEIGHT_W, WF => WF, RF => RF, SW_W => SW_W, SWX_W => SWX_W,
+                 BIN_RD_LAT => BIN_RD_LAT)
+    port map (clk => clk, rst => rst, start => bp_start, learn => learn_r, busy => open,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
               done => bp_done, s_sum => bp_s, sw => bp_sw, swx => bp_swx, swy => bp_swy,
@@ -204,9 +207,11 @@ begin
           win_y <= round_c(unsigned(cy(CENTRE_W - 1 downto 0)));
           state <= S_PASS;
 
-        when S_PASS =>
-          pp_start <= '1';
-          state <= S_PASS_WAIT;
+        when S_PASS =>                        -- (the histogram clears itself after reset)
+          if pp_ready = '1' then
+            pp_start <= '1';
+            state <= S_PASS_WAIT;
+          end if;
 
         when S_PASS_WAIT =>
           if pp_done = '1' then

@@ -121,8 +121,9 @@ begin
           - signed(resize(t0, MAG_W + 1) + shift_left(resize(m0, MAG_W + 1), 1) + resize(b0, MAG_W + 1));
       gy := signed(resize(b0, MAG_W + 1) + shift_left(resize(b1, MAG_W + 1), 1) + resize(b2, MAG_W + 1))
           - signed(resize(t0, MAG_W + 1) + shift_left(resize(t1, MAG_W + 1), 1) + resize(t2, MAG_W + 1));
-      agx <= resize(unsigned(abs(gx)), MAG_W - 1);
-      agy <= resize(unsigned(abs(gy)), MAG_W - 1);
+      -- |g| written out: GHDL 2.0's Verilog writer emits invalid code for `abs`
+      if gx < 0 then agx <= resize(unsigned(-gx), MAG_W - 1); else agx <= resize(unsigned(gx), MAG_W - 1); end if;
+      if gy < 0 then agy <= resize(unsigned(-gy), MAG_W - 1); else agy <= resize(unsigned(gy), MAG_W - 1); end if;
       v3  <= v2;
       x3  <= x2;
       y3  <= y2;

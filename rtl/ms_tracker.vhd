@@ -224,6 +224,7 @@ architecture rtl of ms_tracker is
     return '0' & ovf & notgt & rej & err & lost & clipped & init;
   end function;
 begin
+  assert WIN_W = HALF_W + 1 report "ms_tracker: WIN_W must be HALF_W + 1" severity failure;
   assert RESULT_W >= 2 * CENTRE_ABS_W + 2 * RHO_OUT_W + ALPHA_W + 2 * ITER_W + 4 + FLAGS_W + ERR_W
                      + 2 * WIN_W + FCOUNT_W
     report "ms_tracker: RESULT_W too small" severity failure;
@@ -315,9 +316,10 @@ begin
               ey => bc_ey, cx => bc_cx, cy => bc_cy);
 
   u_tables : entity work.ms_kernel_tables
-    generic map (HALF_W => HALF_W, MAX_HALF => MAX_HALF, WIN_W => WIN_W, KD_W => KD_W,
-                 KERNEL_EPAN => KERNEL_EPAN, KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W)
-    port map (clk => clk, rst => rst, start => kt_start, w => tab_w, h => tab_h, done => kt_done,
+    generic map (HALF_W => HALF_W, KD_W => KD_W, KERNEL_EPAN => KERNEL_EPAN,
+                 KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W)
+    port map (clk => clk, rst => rst, start => kt_start, w => tab_w, h => tab_h, busy => open,
+              done => kt_done,
               ex => kt_ex, ey => kt_ey, kd_d => kd_d, kt_we => kt_we, kt_addr => kt_addr,
               kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb);
 
@@ -420,7 +422,7 @@ begin
           end if;
 
         when T_IDLE =>
-          if fe_end = '1' then                       -- a good frame is in the region RAMs
+          if cap_done = '1' then                     -- a good frame is in the region RAMs
             if init_pending = '1' or target_valid = '1' then
               learn_run <= init_pending;
               eng_start <= '1';
@@ -553,7 +555,7 @@ begin
     end if;
   end process;
 
-  init_ready <= '1' when state = T_IDLE and fe_end = '0' and err_pending = '0' and in_frame = '0'
+  init_ready <= '1' when state = T_IDLE and cap_done = '0' and err_pending = '0' and in_frame = '0'
                          and gate_closed = '0' else '0';
   s_init_tready <= init_ready;
 end architecture;

@@ -464,7 +464,9 @@ BUILTIN_COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
 #: EXTENSION POINT: "module:function" entries, each function registering one or
 #: more subcommands exactly like the built-in ``register_*`` functions above.
 EXTENSIONS: list[str] = [
-    # "mstrack.hdl:register_cli",   # vectors / synth / cosim (HDL helpers add this line)
+    "mstrack.vectors:register_cli",     # vectors: test vectors for the VHDL core
+    "mstrack.agreement:register_cli",   # agree: float vs fixed-point agreement
+    # "mstrack.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
 ]
 
 

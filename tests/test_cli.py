@@ -215,3 +215,12 @@ def test_eval_cache_invalidated_by_code_change(tiny_dataset, tmp_path, monkeypat
     monkeypatch.setattr(ev_mod, "tracker_fingerprint", lambda name: "changed")
     evaluate(seqs, ["opencv-meanshift"], tmp_path, quiet=True)
     assert json.loads(cached.read_text())["fingerprint"] == "changed"
+
+
+def test_default_parser_has_builtin_and_listed_extension_commands(capsys):
+    parser = cli.build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")
+    assert {"eval", "track", "bench", "demo"} <= set(sub.choices)
+    for spec in cli.EXTENSIONS:                      # every listed extension loads
+        assert spec.partition(":")[0] != "" and "not found" not in capsys.readouterr().err
+    assert len(sub.choices) >= 4 + len(cli.EXTENSIONS)

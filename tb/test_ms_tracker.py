@@ -255,7 +255,7 @@ def test_tracker_protocol_errors(fault, tmp_path):
            extra_env=_job_env(job))
 
 
-REAL_RUNS = [("Girl", 0, 400), ("Crossing", 0, 60), ("Couple", 0, 60)]
+REAL_RUNS = [("Girl", 0, 40), ("Crossing", 0, 10), ("Couple", 0, 10)]
 
 
 @pytest.mark.parametrize("name,start,n", REAL_RUNS)

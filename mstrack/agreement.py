@@ -279,6 +279,59 @@ def write_table(md: str, path: Path = RESULTS_MD, command: str = "", section: st
     return path
 
 
+GRID_STEPS = (1.0, 0.5, 0.25)
+
+
+def float_on_grid(seq_dir: str | Path, grid: float, max_frames: int | None = None) -> np.ndarray:
+    """Fused centres (N, 2) of the float tracker with its window centre snapped to a ``grid``-px grid.
+
+    Analysis of the fixed model's window placement (docs/results_fixed.md, "window grid"): the
+    fixed model places its window at round(c) (grid 1 px); everything else stays float.  The
+    snap is applied inside :func:`mstrack.float_model.kernel_window` for the duration of the
+    call only (grid 0 = the unmodified float tracker).
+    """
+    import math
+
+    from . import float_model as fm
+
+    seq = load_sequence(seq_dir)
+    n = len(seq) if max_frames is None else min(len(seq), max_frames)
+    orig = fm.kernel_window
+
+    def snapped(cx: float, cy: float, *rest: Any):  # same signature as kernel_window
+        return orig(math.floor(cx / grid + 0.5) * grid, math.floor(cy / grid + 0.5) * grid, *rest)
+
+    if grid:
+        fm.kernel_window = snapped
+    try:
+        trk = Tracker(model="float")
+        out = np.empty((n, 2))
+        for i in range(n):
+            frame = seq.frame(i)
+            r = trk.init(frame, Box.of(seq.gt[0])) if i == 0 else trk.update(frame)
+            out[i] = r.centre
+    finally:
+        fm.kernel_window = orig
+    return out
+
+
+def grid_table(root: str | Path = DEFAULT_ROOT, names: tuple[str, ...] = ("Crossing", "Girl"),
+               max_frames: int | None = None) -> str:
+    """Markdown table: mean/p95 distance (px) of the grid-snapped float tracker from the continuous one."""
+    lines = ["| sequence | " + " | ".join(f"grid {g:g} px: mean / p95" for g in GRID_STEPS) + " |",
+             "|---|" + "---:|" * len(GRID_STEPS)]
+    for name in names:
+        d = Path(root) / name
+        ref = float_on_grid(d, 0.0, max_frames)
+        cells = []
+        for g in GRID_STEPS:
+            dist = np.hypot(*(float_on_grid(d, g, max_frames) - ref).T)
+            cells.append(f"{dist.mean():.3f} / {np.percentile(dist, 95):.3f}")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+        print(lines[-1], flush=True)
+    return "\n".join(lines)
+
+
 def _parse_kv(items: list[str]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for it in items:
@@ -308,11 +361,20 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--sweep", action="store_true",
                     help="format sweep (mean diff / dAUC per FixedParams variant); with --write "
                          "rewrites the sweep section")
+    ap.add_argument("--grid", action="store_true",
+                    help="analysis: float tracker with its window snapped to 1, 1/2, 1/4 px grids vs "
+                         "the continuous float tracker (Crossing, Girl); with --write rewrites the grid section")
 
 
 def run(args: argparse.Namespace) -> int:
     """Handler of ``mstrack agree`` / ``python -m mstrack.agreement``."""
     params = _parse_kv(args.param)
+    if args.grid:
+        md = grid_table(args.root, max_frames=args.max_frames)
+        print(md)
+        if args.write:
+            print(write_table(md, command="python -m mstrack.agreement --grid --write", section="grid"))
+        return 0
     if args.sweep:
         md = sweep_table(args.root, max_frames=args.max_frames)
         print(md)

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 import pytest
 
 from mstrack import Tracker
@@ -106,9 +108,9 @@ def test_real_data_init_agrees(agreement):
         assert a.diff[0] <= 1.0, (a.sequence, a.diff[0])
 
 
-@pytest.mark.xfail(reason="issue target not met: integer window placement and the rho stop rule make the "
-                          "fixed loop end up to ~1 px from the float one per frame (docs/results_fixed.md)",
-                   strict=False)
+@pytest.mark.xfail(reason="issue target not met: integer-grid window placement (kept by decision, "
+                          "docs/results_fixed.md 'Decision') puts the fixed loop ~1 px from the float one",
+                   strict=True)
 def test_real_data_issue_target(agreement):
     """Issue target: mean centre difference < 0.5 px and |dAUC| <= 0.01 where the float tracker holds."""
     held = [a for a in agreement if a.holds]
@@ -130,3 +132,20 @@ def test_write_table_replaces_marked_section(tmp_path):
     assert "cmd 2" in text and "| s |" in text and text.startswith("# title\n\ntext\n")
     write_table("| c |", p, command="cmd 4")
     assert p.read_text().index("| c |") < p.read_text().index("| s |")
+
+
+def test_grid_analysis_reproduces_window_quantisation():
+    """The grid analysis of docs/results_fixed.md: snapping only the float window to the 1 px grid
+    moves the float tracker by about as much as the fixed model differs; a finer grid moves it less.
+    Grid 0 must be the unmodified float tracker (the snap is undone after the call)."""
+    from mstrack.agreement import DEFAULT_ROOT, float_on_grid
+
+    seq = DEFAULT_ROOT / "Girl"
+    if not seq.is_dir():
+        pytest.skip(f"{seq} not found: the grid analysis needs ../shared/data/sequences")
+    ref = float_on_grid(seq, 0.0, max_frames=120)
+    d1 = np.hypot(*(float_on_grid(seq, 1.0, max_frames=120) - ref).T).mean()
+    d4 = np.hypot(*(float_on_grid(seq, 0.25, max_frames=120) - ref).T).mean()
+    again = float_on_grid(seq, 0.0, max_frames=120)
+    assert np.array_equal(again, ref)
+    assert d1 > 0.3 and d4 < d1

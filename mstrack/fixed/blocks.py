@@ -23,15 +23,16 @@ MIN_WINDOW = 3                    # smallest window extent in px (ex, ey >= 1)
 def ms_colour_bin(frame: np.ndarray, bits: int) -> np.ndarray:
     """Colour bin: ((R >> s) << 2b) | ((G >> s) << b) | (B >> s), s = 8 - b.  (H, W) int64."""
     s = 8 - bits
-    f = frame.astype(np.int64) >> s
-    return (f[..., 2] << (2 * bits)) | (f[..., 1] << bits) | f[..., 0]
+    f = frame >> s  # uint8; the bin (< 2**24) is built in int32, returned as int64
+    return ((f[..., 2].astype(np.int32) << (2 * bits)) | (f[..., 1].astype(np.int32) << bits)
+            | f[..., 0]).astype(np.int64)
 
 
 def ms_grey(frame: np.ndarray) -> np.ndarray:
     """Grey: (77 R + 150 G + 29 B) >> 8 (truncating), 0..255.  frame BGR uint8 -> (H, W) int64."""
-    f = frame.astype(np.int64)
-    wr, wg, wb = GREY_WEIGHTS_RGB
-    return (wr * f[..., 2] + wg * f[..., 1] + wb * f[..., 0]) >> GREY_SHIFT
+    wr, wg, wb = GREY_WEIGHTS_RGB  # the sum (< 2**16) is formed in int32, returned as int64
+    return ((wr * frame[..., 2].astype(np.int32) + wg * frame[..., 1].astype(np.int32)
+             + wb * frame[..., 0].astype(np.int32)) >> GREY_SHIFT).astype(np.int64)
 
 
 def ms_sobel(grey: np.ndarray) -> np.ndarray:
@@ -201,6 +202,10 @@ class ms_kernel:  # noqa: N801 -- named after rtl/ms_kernel.vhd
         self._k_in = self.k[yy, xx]
         self._dx_in = xx - self.ex
         self._dy_in = yy - self.ey
+        # float64 copies for np.bincount's weights (integer sums < 2**53: exact in any order)
+        self._k_f = self._k_in.astype(np.float64)
+        self._dx_f = self._dx_in.astype(np.float64)
+        self._dy_f = self._dy_in.astype(np.float64)
         self.K = int(self._k_in.sum())          # sum of k over the window (same at every position)
 
 
@@ -226,12 +231,14 @@ def ms_histogram(bins: np.ndarray, reg: Region, win: tuple[int, int], ker: ms_ke
     c0 = win[0] - ker.ex - reg.x
     if r0 < 0 or c0 < 0 or r0 + 2 * ker.ey + 1 > reg.h or c0 + 2 * ker.ex + 1 > reg.w:
         raise AssertionError("window outside the captured region (centre not clamped)")
-    b = bins[r0 + ker._iy, c0 + ker._ix]
-    def acc(weights: np.ndarray | None) -> np.ndarray:
+    # inside pixels in row-major order (the order of np.nonzero(ker.inside))
+    b = bins[r0: r0 + 2 * ker.ey + 1, c0: c0 + 2 * ker.ex + 1][ker.inside]
+
+    def acc(weights: np.ndarray) -> np.ndarray:
         return np.rint(np.bincount(b, weights=weights, minlength=n_bins)).astype(np.int64)
     N = np.bincount(b, minlength=n_bins).astype(np.int64)
-    H = N if ker.kernel == "flat" else acc(ker._k_in.astype(np.float64))
-    return Hist(H=H, N=N, SX=acc(ker._dx_in.astype(np.float64)), SY=acc(ker._dy_in.astype(np.float64)))
+    H = N if ker.kernel == "flat" else acc(ker._k_f)
+    return Hist(H=H, N=N, SX=acc(ker._dx_f), SY=acc(ker._dy_f))
 
 
 # ----------------------------------------------------------------------------- bin pass
@@ -253,18 +260,24 @@ def ms_weight(Q: np.ndarray, H: np.ndarray, fp: FixedParams) -> np.ndarray:
     true weight in WF fraction bits, saturated at 2**WI - 2**-WF.
     """
     qbits = 2 * (fp.weight_int + fp.weight_frac)
-    nz = H > 0
-    ratio = np.zeros_like(Q)
-    ratio[nz] = ms_divider(Q[nz] << (2 * fp.weight_frac), H[nz], qbits)
-    return ms_isqrt(ratio)
+    nz = (H > 0) & (Q > 0)  # elsewhere the ratio and its root are 0
+    w = np.zeros_like(Q)
+    w[nz] = ms_isqrt(ms_divider(Q[nz] << (2 * fp.weight_frac), H[nz], qbits))
+    return w
 
 
 def ms_bin_pass(Q: np.ndarray, hist: Hist, fp: FixedParams) -> BinPass:
-    """Bhattacharyya sum, weight table and weighted position sums (one pass over the bins)."""
-    S = int(ms_isqrt((hist.H * Q) << (2 * fp.rho_frac)).sum())
+    """Bhattacharyya sum, weight table and weighted position sums (one pass over the bins).
+
+    Bins with H Q = 0 add isqrt(0) = 0 and have weight 0: only the others are evaluated.
+    """
+    hq = hist.H * Q
+    nz = np.flatnonzero(hq)
+    S = int(ms_isqrt(hq[nz] << (2 * fp.rho_frac)).sum())
     w = ms_weight(Q, hist.H, fp)
-    return BinPass(S=S, w=w, Sw=int((w * hist.N).sum()), Swx=int((w * hist.SX).sum()),
-                   Swy=int((w * hist.SY).sum()))
+    wn = w[nz]
+    return BinPass(S=S, w=w, Sw=int((wn * hist.N[nz]).sum()), Swx=int((wn * hist.SX[nz]).sum()),
+                   Swy=int((wn * hist.SY[nz]).sum()))
 
 
 def ms_centre(bp: BinPass, win: tuple[int, int], reg: Region, fp: FixedParams,

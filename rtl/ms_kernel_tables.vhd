@@ -5,17 +5,28 @@
 -- and, for i = 0 .. max(ex, ey), one write on the table port:
 --   kt_addr = i, kt_ta = TA[i] = 4 i^2 h^2, kt_tb = TB[i] = 4 i^2 w^2,
 --   kt_ka = KA[i] = floor((4 i^2 << KERNEL_BITS) / w^2),
---   kt_kb = KB[i] = floor((4 i^2 << KERNEL_BITS) / h^2)   (KERNEL_EPAN = 1; 0 when flat).
+--   kt_kb = KB[i] = floor((4 i^2 << KERNEL_BITS) / h^2)   (KERNEL_EPAN = 1; 0 when flat),
+--   kt_xr = XR[i] = the largest dx in 0 .. ex with TA[dx] + TB[i] < D, 0 if there is none
+--           (row extent of the ellipse: XR[0] = ex, non-increasing; i <= ey always has dx = 0
+--           inside; i > ey has none and gives 0).
 -- Entries i > ex (TA, KA) or i > ey (TB, KB) are never used by ms_kernel (it tests
 -- |dx| <= ex, |dy| <= ey): TA/TB are still exact there, KA/KB saturate at
 -- 2**KVAL_W - 1 in the divider.  Then `done` pulses.
 -- TA, TB are built by additions (TA[i+1] = TA[i] + 4 h^2 (2 i + 1)); KA, KB come from
 -- one pipelined ms_divider shared by both (KA[i] issued, then KB[i]: 2 clocks per entry).
+-- XR comes from a sequential walk with no multiplier and no comparator on a residual
+-- R = D - 1 - TA[dx] - TB[i] (dx is outside row i when R < 0, its sign bit): a set-up
+-- walk takes dx from 0 up to ex by additions (ex clocks), then, before entry i is issued,
+-- dx walks down from XR[i-1] (one clock per step: TA[dx] - TA[dx-1] = 4 h^2 (2 dx - 1))
+-- while dx > 0 and R < 0.  The down walk takes ex - XR[max(ex, ey)] steps in all.
 --
--- Latency (start -> done): flat 3 + max(ex, ey) + 1 clocks; Epanechnikov
--- 2 + 2 (max(ex, ey) + 1) + divider latency (KVAL_W + 1) + 1 clocks.  Speed is irrelevant
--- (once per target).  Handshake: `start` pulse, ignored while busy; `done` pulse.
--- Model: mstrack.fixed.blocks.ms_kernel(w, h, kernel, KERNEL_BITS): .ex .ey .D .TA .TB .KA .KB.
+-- Latency (start -> done), n = max(ex, ey), X = 2 ex - XR[n] (walk clocks):
+-- flat n + 4 + X clocks; Epanechnikov 2 (n + 1) + KVAL_W + 4 + X clocks (set-up 3,
+-- issue 1 or 2 per entry, divider KVAL_W + 1, write register 1).  At most 193 (flat) /
+-- 267 (Epanechnikov, KVAL_W 9) clocks for HALF_W = 6.  Speed is irrelevant (once per target).
+-- Handshake: `start` pulse, ignored while busy; `done` pulse.
+-- Model: mstrack.fixed.blocks.ms_kernel(w, h, kernel, KERNEL_BITS): .ex .ey .D .TA .TB .KA .KB
+-- (XR[i] = max dx with ms_kernel.inside in row |dy| = i).
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -44,7 +55,8 @@ entity ms_kernel_tables is
     kt_ta   : out unsigned(KD_W - 1 downto 0);        -- TA[i] = 4 i^2 h^2
     kt_tb   : out unsigned(KD_W - 1 downto 0);        -- TB[i] = 4 i^2 w^2
     kt_ka   : out unsigned(KVAL_W - 1 downto 0);      -- KA[i] (0 when flat)
-    kt_kb   : out unsigned(KVAL_W - 1 downto 0)       -- KB[i] (0 when flat)
+    kt_kb   : out unsigned(KVAL_W - 1 downto 0);      -- KB[i] (0 when flat)
+    kt_xr   : out unsigned(HALF_W - 1 downto 0)       -- XR[i]: last dx inside in row |dy| = i
   );
 end entity;
 
@@ -53,9 +65,9 @@ architecture rtl of ms_kernel_tables is
   constant SQ_W : natural := 2 * WW;                  -- w^2, h^2
   constant T_W  : natural := KD_W + 2;                -- TA/TB accumulators and steps (headroom)
   constant N_W  : natural := 2 * HALF_W + 2 + KERNEL_BITS;  -- (4 i^2) << KERNEL_BITS
-  constant TAG_W : natural := HALF_W + 1;             -- [sel | i], sel = 0 KA, 1 KB
+  constant TAG_W : natural := 2 * HALF_W + 1;         -- [sel | XR[i] | i], sel = 0 KA, 1 KB
 
-  type state_t is (S_IDLE, S_SETUP1, S_SETUP2, S_ISSUE, S_WAIT);
+  type state_t is (S_IDLE, S_SETUP1, S_SETUP2, S_XUP, S_ISSUE, S_WAIT);
   signal state : state_t := S_IDLE;
 
   signal wl, hl         : unsigned(WW - 1 downto 0) := (others => '0');
@@ -71,6 +83,13 @@ architecture rtl of ms_kernel_tables is
   signal ta_acc, tb_acc : unsigned(T_W - 1 downto 0) := (others => '0');
   signal ta_stp, tb_stp : unsigned(T_W - 1 downto 0) := (others => '0');
   signal ka_hold        : unsigned(KVAL_W - 1 downto 0) := (others => '0');
+  -- XR walk: xr = dx, xres = D - 1 - TA[xr] - TB[i_iss] (signed), xstp = TA[xr+1] - TA[xr]
+  -- (S_XUP) / TA[xr] - TA[xr-1] (S_ISSUE), tbw_stp = TB[i_iss+1] - TB[i_iss]
+  signal xr             : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal xres           : signed(T_W downto 0) := (others => '0');
+  signal xstp, tbw_stp  : unsigned(T_W - 1 downto 0) := (others => '0');
+  signal walk           : std_logic;                  -- dx = xr is outside row i_iss: step down
+  signal xr_r           : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal we_r, done_r   : std_logic := '0';
   signal addr_r         : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal ta_r, tb_r     : unsigned(KD_W - 1 downto 0) := (others => '0');
@@ -84,10 +103,13 @@ architecture rtl of ms_kernel_tables is
   signal dv_out_q       : unsigned(KVAL_W - 1 downto 0) := (others => '0');
   signal dv_out_tag     : std_logic_vector(TAG_W - 1 downto 0) := (others => '0');
 begin
-  dv_in_valid <= '1' when state = S_ISSUE and KERNEL_EPAN = 1 else '0';
+  -- walk only before KA of an entry is issued (sel = 0); at sel = 1 the test is already false
+  walk <= '1' when xr /= 0 and xres(T_W) = '1' else '0';
+
+  dv_in_valid <= '1' when state = S_ISSUE and walk = '0' and KERNEL_EPAN = 1 else '0';
   dv_in_n     <= shift_left(sq4, KERNEL_BITS);
   dv_in_d     <= h2 when sel = '1' else w2;
-  dv_in_tag   <= sel & std_logic_vector(i_iss);
+  dv_in_tag   <= sel & std_logic_vector(xr) & std_logic_vector(i_iss);
 
   g_div : if KERNEL_EPAN = 1 generate
     u_div : entity work.ms_divider
@@ -100,13 +122,16 @@ begin
   p_ctrl : process (clk)
     variable wr   : boolean;
     variable wr_i : unsigned(HALF_W - 1 downto 0);
+    variable wr_x : unsigned(HALF_W - 1 downto 0);
     variable e_x, e_y : unsigned(HALF_W - 1 downto 0);
+    variable dd       : unsigned(KD_W - 1 downto 0);
   begin
     if rising_edge(clk) then
       we_r   <= '0';
       done_r <= '0';
       wr     := false;
       wr_i   := i_iss;
+      wr_x   := xr;
       e_x    := (others => '0');
       e_y    := (others => '0');
       -- if/elsif instead of case: GHDL 2.0's Verilog output of a full enum case has no default
@@ -132,7 +157,8 @@ begin
         state <= S_SETUP2;
 
       elsif state = S_SETUP2 then
-        d_r      <= resize(w2 * h2, KD_W);
+        dd       := resize(w2 * h2, KD_W);
+        d_r      <= dd;
         ta_acc   <= (others => '0');
         tb_acc   <= (others => '0');
         ta_stp   <= resize(shift_left(resize(h2, T_W), 2), T_W);
@@ -141,23 +167,49 @@ begin
         sel      <= '0';
         sq4      <= (others => '0');
         sq4_step <= to_unsigned(4, N_W);
-        state    <= S_ISSUE;
+        xr       <= (others => '0');
+        xres     <= signed(resize(dd, T_W + 1)) - 1;
+        xstp     <= resize(shift_left(resize(h2, T_W), 2), T_W);
+        tbw_stp  <= resize(shift_left(resize(w2, T_W), 2), T_W);
+        if ex_r = 0 then
+          state <= S_ISSUE;
+        else
+          state <= S_XUP;
+        end if;
+
+      elsif state = S_XUP then           -- xr = 0 .. ex by additions
+        xres <= xres - signed(resize(xstp, T_W + 1));
+        xr   <= xr + 1;
+        if xr + 1 = ex_r then
+          state <= S_ISSUE;               -- xstp stays TA[ex] - TA[ex-1]: the down step
+        else
+          xstp <= xstp + shift_left(resize(h2, T_W), 3);
+        end if;
 
       elsif state = S_ISSUE then
-        if KERNEL_EPAN = 1 then
+        if walk = '1' then                -- TA[xr] + TB[i] >= D: dx = xr is outside, step down
+          xres <= xres + signed(resize(xstp, T_W + 1));
+          xstp <= xstp - shift_left(resize(h2, T_W), 3);
+          xr   <= xr - 1;
+        elsif KERNEL_EPAN = 1 then
           sel <= not sel;
           if sel = '1' then
             i_iss    <= i_iss + 1;
             sq4      <= sq4 + sq4_step;
             sq4_step <= sq4_step + 8;
+            xres     <= xres - signed(resize(tbw_stp, T_W + 1));
+            tbw_stp  <= tbw_stp + shift_left(resize(w2, T_W), 3);
             if i_iss = n_last then
               state <= S_WAIT;
             end if;
           end if;
         else
-          wr    := true;
-          wr_i  := i_iss;
-          i_iss <= i_iss + 1;
+          wr      := true;
+          wr_i    := i_iss;
+          wr_x    := xr;
+          i_iss   <= i_iss + 1;
+          xres    <= xres - signed(resize(tbw_stp, T_W + 1));
+          tbw_stp <= tbw_stp + shift_left(resize(w2, T_W), 3);
           if i_iss = n_last then
             state <= S_WAIT;
           end if;
@@ -172,6 +224,7 @@ begin
         else
           wr   := true;
           wr_i := unsigned(dv_out_tag(HALF_W - 1 downto 0));
+          wr_x := unsigned(dv_out_tag(2 * HALF_W - 1 downto HALF_W));
           ka_r <= ka_hold;
           kb_r <= dv_out_q;
         end if;
@@ -181,6 +234,7 @@ begin
         addr_r <= wr_i;
         ta_r   <= resize(ta_acc, KD_W);
         tb_r   <= resize(tb_acc, KD_W);
+        xr_r   <= wr_x;
         ta_acc <= ta_acc + ta_stp;
         tb_acc <= tb_acc + tb_stp;
         ta_stp <= ta_stp + shift_left(resize(h2, T_W), 3);
@@ -211,4 +265,5 @@ begin
   kt_tb   <= tb_r;
   kt_ka   <= ka_r;
   kt_kb   <= kb_r;
+  kt_xr   <= xr_r;
 end architecture;

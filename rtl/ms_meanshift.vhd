@@ -63,6 +63,7 @@ entity ms_meanshift is
     kt_tb     : in  unsigned(KD_W - 1 downto 0);                  -- 4 i^2 w^2
     kt_ka     : in  unsigned(KVAL_W - 1 downto 0);                -- Epanechnikov x term
     kt_kb     : in  unsigned(KVAL_W - 1 downto 0);                -- Epanechnikov y term
+    kt_xr     : in  unsigned(HALF_W - 1 downto 0);                -- row extent XR[i] (window scan)
     kd_d      : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2
     ex        : in  unsigned(HALF_W - 1 downto 0);                -- window half extent x
     ey        : in  unsigned(HALF_W - 1 downto 0);                -- window half extent y
@@ -143,7 +144,7 @@ begin
                  COUNT_W => COUNT_W, POSSUM_W => POSSUM_W)
     port map (clk => clk, rst => rst, ready => pp_ready, start => pp_start, win_x => win_x, win_y => win_y,
               ex => ex, ey => ey, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
-              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d,
+              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d,
               ram_addr => ram_addr, ram_data => ram_data, done => pp_done,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);

@@ -1,19 +1,22 @@
 -- ms_pixel_pass: one pixel pass of the mean-shift engine (scan -> region RAM -> kernel -> histogram).
 --
 -- On `start` it scans the window centred at (win_x, win_y) (region-relative px,
--- half extents ex, ey) LANES pixels per clock (ms_window_scan), reads the bins
+-- half extents ex, ey) LANES pixels per clock (ms_window_scan: in each row only the
+-- LANES-aligned groups that reach the kernel ellipse, |dx| <= XR[|dy|]), reads the bins
 -- from the external region RAM (LANES banks, data 1 clock after the address),
 -- evaluates the kernel of each lane (LANES x ms_kernel, private table copies
--- written through the kt_* port) and accumulates H, N, SX, SY of the inside
--- pixels into the per-bin accumulators (ms_histogram).  `done` pulses when the
+-- written through the kt_* port; the scan keeps the XR table) and accumulates
+-- H, N, SX, SY of the inside pixels into the per-bin accumulators (ms_histogram).
+-- The groups left out hold only pixels outside the ellipse, which ms_kernel would
+-- mask: the sums are those of the whole bounding box.  `done` pulses when the
 -- last pixel has been accumulated; the accumulators are then read and cleared
 -- through the bin_rd_* port (BIN_RD_LAT = 3 clocks, one bin per clock).
 --
 -- Cycle count: if rising edge s samples start = '1', done = '1' is sampled by
 -- edge s + C (done is high during the cycle before that edge), with
---   C = (2 ey + 1) * G + PASS_LAT, PASS_LAT = 5
---   (scan set-up 1, RAM 1, kernel 2 (RAM read overlaps), histogram 2: see docs/blocks/ms_pixel_pass.md),
---   G = floor((win_x + ex) / LANES) - floor((win_x - ex) / LANES) + 1.
+--   C = sum over dy = -ey .. ey of G(dy) + PASS_LAT, PASS_LAT = 6
+--   (scan row pipeline 2, RAM 1, kernel 2 (RAM read overlaps), histogram 2: see docs/blocks/ms_pixel_pass.md),
+--   G(dy) = floor((win_x + XR[|dy|]) / LANES) - floor((win_x - XR[|dy|]) / LANES) + 1.
 -- Throughput: LANES pixels per clock, no stall.  Handshake: `start` is a pulse,
 -- accepted only when idle (after `done` of the previous pass) and ready = '1';
 -- the bin read port is used only between passes.  ex, ey, kd_d and the kernel
@@ -57,6 +60,7 @@ entity ms_pixel_pass is
     kt_tb        : in  unsigned(KD_W - 1 downto 0);                  -- TB[i] = 4 i^2 w^2
     kt_ka        : in  unsigned(KVAL_W - 1 downto 0);                -- KA[i]
     kt_kb        : in  unsigned(KVAL_W - 1 downto 0);                -- KB[i]
+    kt_xr        : in  unsigned(HALF_W - 1 downto 0);                -- XR[i]: largest |dx| inside in row |dy| = i
     kd_d         : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2 (stable)
     -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
     ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
@@ -95,7 +99,8 @@ begin
   u_scan : entity work.ms_window_scan
     generic map (LANES => LANES, HALF_W => HALF_W, REGION_W => REGION_W, STRIDE => STRIDE, ADDR_W => ADDR_W)
     port map (
-      clk => clk, rst => rst, start => start, win_x => win_x, win_y => win_y, ex => ex, ey => ey,
+      clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_xr => kt_xr,
+      start => start, win_x => win_x, win_y => win_y, ex => ex, ey => ey,
       busy => open, out_valid => sc_valid, out_addr => sc_addr, out_dx => sc_dx, out_dy => sc_dy,
       out_last => sc_last);
 

@@ -169,6 +169,7 @@ architecture rtl of ms_tracker is
   signal kt_ta, kt_tb, kd_d : unsigned(KD_W - 1 downto 0);
   signal kt_ka, kt_kb   : unsigned(KVAL_W - 1 downto 0);
   signal kt_ex, kt_ey   : unsigned(HALF_W - 1 downto 0);
+  signal kt_xr          : unsigned(HALF_W - 1 downto 0);
   signal tab_w, tab_h   : unsigned(WIN_W - 1 downto 0);
   -- engines
   signal eng_start      : std_logic := '0';
@@ -321,7 +322,7 @@ begin
     port map (clk => clk, rst => rst, start => kt_start, w => tab_w, h => tab_h, busy => open,
               done => kt_done,
               ex => kt_ex, ey => kt_ey, kd_d => kd_d, kt_we => kt_we, kt_addr => kt_addr,
-              kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb);
+              kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr);
 
   u_region : entity work.ms_region
     generic map (COORD_W => COORD_W, HALF_W => HALF_W, REGION_W => REGION_W, MARGIN => MARGIN, CF => CF)
@@ -341,7 +342,7 @@ begin
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
                  ITER_W => ITER_W, EPS2 => EPS2)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
-              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex_r, ey => ey_r,
+              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
               reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
               learn => learn_run, start_cx => c8x, start_cy => c8y, busy => c_busy, done => c_done,
               res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
@@ -357,7 +358,7 @@ begin
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
                  ITER_W => ITER_W, EPS2 => EPS2)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
-              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex_r, ey => ey_r,
+              kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
               reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
               learn => learn_run, start_cx => c8x, start_cy => c8y, busy => e_busy, done => e_done,
               res_cx => e_cx, res_cy => e_cy, res_s => e_s, res_iter => e_iter, res_stop => e_stop,

@@ -2,22 +2,34 @@
 --
 -- On `start` it latches the window centre (win_x, win_y, region-relative px)
 -- and the half extents (ex, ey) and then emits, one beat per clock with no
--- gaps, for each row ry = win_y - ey .. win_y + ey (top to bottom) and each
--- LANES-aligned group g = floor((win_x - ex) / LANES) .. floor((win_x + ex) / LANES)
--- (left to right):
+-- gaps (also between rows), for each row ry = win_y - ey .. win_y + ey (top to
+-- bottom, dy = ry - win_y) and each LANES-aligned group
+--   g = floor((win_x - XR[|dy|]) / LANES) .. floor((win_x + XR[|dy|]) / LANES)
+-- (left to right), where XR[|dy|] is the row extent of the kernel ellipse (the
+-- largest |dx| inside in that row, from ms_kernel_tables through the kt_* port):
 --   * out_addr = ry * STRIDE + g  (the same address for every region RAM bank:
 --     region pixel (rx, ry) lives in bank rx mod LANES at ry * STRIDE + rx / LANES),
 --   * out_dx   = g * LANES - win_x, the offset of lane 0 (lane l has out_dx + l),
 --   * out_dy   = ry - win_y,
 --   * out_last on the final beat.
--- Beats = (2 ey + 1) * (floor((win_x + ex) / L) - floor((win_x - ex) / L) + 1).
+-- Only pixels with |dx| > XR[|dy|] are left out, and ms_kernel masks all of them
+-- (TA[|dx|] + TB[|dy|] >= D), so the sums of the pass do not change; the corners
+-- of the bounding box (about 21 % of it) are no longer read.  Lanes of a scanned
+-- group that lie outside the row extent are still masked by ms_kernel.
+-- Beats = sum over dy = -ey .. ey of G(dy),
+--   G(dy) = floor((win_x + XR[|dy|]) / L) - floor((win_x - XR[|dy|]) / L) + 1.
 --
--- Latency: the first beat is valid SCAN_LAT = 2 clocks after the clock edge
--- that samples start = '1' (one set-up cycle computes the first address).
+-- Row parameters come from a 3-stage row pipeline that runs one row ahead of the
+-- beats and moves on the last beat of each row: stage A reads XR[|dy|] (registered
+-- table read) and keeps the row's RAM base ry * STRIDE; stage B computes the
+-- row's first address, lane-0 dx and group count; the beat registers load stage B.
+-- Latency: the first beat is valid SCAN_LAT = 3 clocks after the clock edge
+-- that samples start = '1' (two cycles fill the row pipeline).
 -- Throughput: one beat (LANES pixels) per clock; no back-pressure.
 -- Handshake: `start` is a one-cycle pulse, ignored while busy = '1'.  The caller
 -- guarantees win_x >= ex, win_y >= ey and that the window fits in the region
--- (the model asserts the same: ms_histogram raises on a window outside the region).
+-- (the model asserts the same: ms_histogram raises on a window outside the region),
+-- and that the XR table (written at init) is stable during a scan.
 -- Model: the scan order of mstrack.fixed.blocks.ms_histogram (sums are order free).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -28,7 +40,7 @@ use work.ms_pkg.all;
 entity ms_window_scan is
   generic (
     LANES    : natural := 2;   -- pixels per clock (power of 2); more lanes = fewer beats, wider RAM
-    HALF_W   : natural := 6;   -- width of ex, ey (max half extent MAX_HALF < 2**HALF_W)
+    HALF_W   : natural := 6;   -- width of ex, ey, XR (max half extent MAX_HALF < 2**HALF_W); XR table 2**HALF_W x HALF_W
     REGION_W : natural := 8;   -- width of region-relative coordinates
     STRIDE   : natural := 96;  -- RAM words per region row (ceil(REGION_MAX / LANES))
     ADDR_W   : natural := 15   -- region RAM address width
@@ -36,6 +48,11 @@ entity ms_window_scan is
   port (
     clk      : in  std_logic;                                -- clock
     rst      : in  std_logic;                                -- synchronous reset (control state)
+    -- row extent table write port (from ms_kernel_tables, at init)
+    kt_we    : in  std_logic;                                -- write entry kt_addr
+    kt_addr  : in  unsigned(HALF_W - 1 downto 0);            -- entry i = |dy|
+    kt_xr    : in  unsigned(HALF_W - 1 downto 0);            -- XR[i]: largest |dx| inside in row |dy| = i
+    -- scan
     start    : in  std_logic;                                -- pulse: start a scan
     win_x    : in  unsigned(REGION_W - 1 downto 0);          -- window centre column (region-relative)
     win_y    : in  unsigned(REGION_W - 1 downto 0);          -- window centre row (region-relative)
@@ -65,74 +82,93 @@ architecture rtl of ms_window_scan is
   end function;
   constant SH : natural := log2_exact(LANES);
 
-  type state_t is (S_IDLE, S_SETUP, S_RUN);
+  -- S_FILL: stage B takes row 0; S_LOAD: the beat registers take row 0
+  type state_t is (S_IDLE, S_FILL, S_LOAD, S_RUN);
   signal state : state_t := S_IDLE;
 
+  -- row extent table (LUT RAM, registered read)
+  type xr_ram_t is array (0 to 2 ** HALF_W - 1) of unsigned(HALF_W - 1 downto 0);
+  signal xr_ram : xr_ram_t := (others => (others => '0'));
+
   -- latched inputs
-  signal wx, wy       : unsigned(REGION_W - 1 downto 0) := (others => '0');
-  signal exl, eyl     : unsigned(HALF_W - 1 downto 0) := (others => '0');
-  -- per-scan constants (set-up cycle)
-  signal ngrp_m1      : unsigned(REGION_W - 1 downto 0) := (others => '0');  -- groups per row - 1
-  signal dx0          : signed(D_W - 1 downto 0) := (others => '0');         -- lane-0 dx of the first group
+  signal wx           : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal ey_s         : signed(D_W - 1 downto 0) := (others => '0');
-  -- running state = output registers
-  signal row_addr     : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+  -- row pipeline, stage A: XR of its row, RAM base of its row, |dy| of the row after it
+  signal xr_a         : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal rb_a         : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+  signal ra           : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal ra_dn        : std_logic := '0';                                     -- |dy| still falling
+  -- row pipeline, stage B: first address, lane-0 dx and groups - 1 of its row
+  signal addr_b       : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+  signal dx_b         : signed(D_W - 1 downto 0) := (others => '0');
+  signal ngm1_b       : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  -- beat registers = outputs
   signal addr         : unsigned(ADDR_W - 1 downto 0) := (others => '0');
-  signal gcnt         : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  signal rem_g        : unsigned(REGION_W - 1 downto 0) := (others => '0');   -- groups left in the row after this beat
   signal dxb, dyr     : signed(D_W - 1 downto 0) := (others => '0');
   signal valid, last  : std_logic := '0';
 begin
   assert LANES >= 1 and 2 ** SH = LANES report "ms_window_scan: LANES must be a power of 2" severity failure;
 
+  p_table : process (clk)
+  begin
+    if rising_edge(clk) then
+      if kt_we = '1' then
+        xr_ram(to_integer(kt_addr)) <= kt_xr;
+      end if;
+    end if;
+  end process;
+
   p_scan : process (clk)
-    variable lo, hi      : unsigned(REGION_W downto 0);
-    variable g0, g1      : unsigned(REGION_W downto 0);
-    variable first_row   : unsigned(REGION_W - 1 downto 0);
-    variable gcnt_n      : unsigned(REGION_W - 1 downto 0);
-    variable dy_n        : signed(D_W - 1 downto 0);
+    variable lo, hi   : unsigned(REGION_W downto 0);
+    variable g0, g1   : unsigned(REGION_W downto 0);
+    variable adv      : boolean;   -- row pipeline moves: A reads the next row, B takes A
+    variable ld       : boolean;   -- beat registers take stage B (first beat of a row)
+    variable dy_n     : signed(D_W - 1 downto 0);
+    variable rd_a     : unsigned(HALF_W - 1 downto 0);  -- the table's one read address
   begin
     if rising_edge(clk) then
       -- defaults (no don't-care values in the netlist)
-      lo        := (others => '0');
-      hi        := (others => '0');
-      g0        := (others => '0');
-      g1        := (others => '0');
-      first_row := (others => '0');
-      gcnt_n    := gcnt;
-      dy_n      := dyr;
+      lo   := (others => '0');
+      hi   := (others => '0');
+      g0   := (others => '0');
+      g1   := (others => '0');
+      dy_n := dyr + 1;
+      adv  := false;
+      ld   := false;
+      if state = S_IDLE then
+        rd_a := ey;
+      else
+        rd_a := ra;
+      end if;
       -- if/elsif instead of case: GHDL 2.0's Verilog output of a full enum case has no default
       if state = S_IDLE then
         valid <= '0';
         last  <= '0';
         if start = '1' then
+          -- stage A takes row 0 (|dy| = ey)
           wx    <= win_x;
-          wy    <= win_y;
-          exl   <= ex;
-          eyl   <= ey;
-          state <= S_SETUP;
+          ey_s  <= signed(resize(ey, D_W));
+          xr_a  <= xr_ram(to_integer(rd_a));
+          rb_a  <= resize((win_y - resize(ey, REGION_W)) * to_unsigned(STRIDE, ADDR_W), ADDR_W);
+          if ey /= 0 then
+            ra    <= ey - 1;
+            ra_dn <= '1';
+          else
+            ra    <= to_unsigned(1, HALF_W);
+            ra_dn <= '0';
+          end if;
+          state <= S_FILL;
         end if;
 
-      elsif state = S_SETUP then
-        lo := resize(wx, REGION_W + 1) - resize(exl, REGION_W + 1);
-        hi := resize(wx, REGION_W + 1) + resize(exl, REGION_W + 1);
-        g0 := shift_right(lo, SH);
-        g1 := shift_right(hi, SH);
-        first_row := wy - resize(eyl, REGION_W);
-        ngrp_m1  <= resize(g1 - g0, REGION_W);
-        dx0      <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
-        dxb      <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
-        ey_s     <= signed(resize(eyl, D_W));
-        dyr      <= -signed(resize(eyl, D_W));
-        row_addr <= resize(first_row * to_unsigned(STRIDE, ADDR_W) + resize(g0, ADDR_W), ADDR_W);
-        addr     <= resize(first_row * to_unsigned(STRIDE, ADDR_W) + resize(g0, ADDR_W), ADDR_W);
-        gcnt     <= (others => '0');
-        valid    <= '1';
-        -- single-beat scan is impossible (ey >= 1), but keep it exact anyway
-        if g1 = g0 and eyl = 0 then
-          last <= '1';
-        else
-          last <= '0';
-        end if;
+      elsif state = S_FILL then
+        adv   := true;
+        state <= S_LOAD;
+
+      elsif state = S_LOAD then
+        adv   := true;
+        ld    := true;
+        dy_n  := -ey_s;
         state <= S_RUN;
 
       else  -- S_RUN
@@ -140,26 +176,52 @@ begin
           valid <= '0';
           last  <= '0';
           state <= S_IDLE;
+        elsif rem_g = 0 then
+          adv := true;
+          ld  := true;
         else
-          if gcnt = ngrp_m1 then
-            gcnt_n   := (others => '0');
-            dy_n     := dyr + 1;
-            row_addr <= row_addr + STRIDE;
-            addr     <= row_addr + STRIDE;
-            dxb      <= dx0;
-          else
-            gcnt_n   := gcnt + 1;
-            dy_n     := dyr;
-            addr     <= addr + 1;
-            dxb      <= dxb + LANES;
-          end if;
-          gcnt <= gcnt_n;
-          dyr  <= dy_n;
-          if gcnt_n = ngrp_m1 and dy_n = ey_s then
+          rem_g <= rem_g - 1;
+          addr  <= addr + 1;
+          dxb   <= dxb + LANES;
+          if rem_g = 1 and dyr = ey_s then
             last <= '1';
           end if;
         end if;
       end if;
+
+      if ld then                     -- first beat of the next row
+        valid <= '1';
+        addr  <= addr_b;
+        dxb   <= dx_b;
+        dyr   <= dy_n;
+        rem_g <= ngm1_b;
+        if ngm1_b = 0 and dy_n = ey_s then
+          last <= '1';
+        else
+          last <= '0';
+        end if;
+      end if;
+
+      if adv then
+        -- stage B <- stage A: groups floor((wx - XR) / L) .. floor((wx + XR) / L)
+        lo := resize(wx, REGION_W + 1) - resize(xr_a, REGION_W + 1);
+        hi := resize(wx, REGION_W + 1) + resize(xr_a, REGION_W + 1);
+        g0 := shift_right(lo, SH);
+        g1 := shift_right(hi, SH);
+        ngm1_b <= resize(g1 - g0, REGION_W);
+        dx_b   <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
+        addr_b <= rb_a + resize(g0, ADDR_W);
+        -- stage A <- next row: |dy| = ey, ey - 1, .., 0, 1, .., ey (reads past the last row are unused)
+        xr_a <= xr_ram(to_integer(rd_a));
+        rb_a <= rb_a + STRIDE;
+        if ra_dn = '1' and ra /= 0 then
+          ra <= ra - 1;
+        else
+          ra_dn <= '0';
+          ra    <= ra + 1;
+        end if;
+      end if;
+
       if rst = '1' then
         state <= S_IDLE;
         valid <= '0';

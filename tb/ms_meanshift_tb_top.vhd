@@ -21,7 +21,8 @@ entity ms_meanshift_tb_top is
     wdata : in std_logic_vector(BIN_W - 1 downto 0);
     kt_we : in std_logic; kt_addr : in unsigned(HALF_W - 1 downto 0); kt_ta : in unsigned(KD_W - 1 downto 0);
     kt_tb : in unsigned(KD_W - 1 downto 0); kt_ka : in unsigned(KVAL_W - 1 downto 0);
-    kt_kb : in unsigned(KVAL_W - 1 downto 0); kd_d : in unsigned(KD_W - 1 downto 0);
+    kt_kb : in unsigned(KVAL_W - 1 downto 0); kt_xr : in unsigned(HALF_W - 1 downto 0);
+    kd_d : in unsigned(KD_W - 1 downto 0);
     ex : in unsigned(HALF_W - 1 downto 0); ey : in unsigned(HALF_W - 1 downto 0);
     reg_x : in unsigned(COORD_W - 1 downto 0); reg_y : in unsigned(COORD_W - 1 downto 0);
     hi_x : in unsigned(REGION_W - 1 downto 0); hi_y : in unsigned(REGION_W - 1 downto 0);
@@ -50,7 +51,8 @@ begin
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER, ITER_W => ITER_W,
                  EPS2 => EPS2)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta, kt_tb => kt_tb,
-              kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex, ey => ey, reg_x => reg_x, reg_y => reg_y,
+              kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d, ex => ex, ey => ey,
+              reg_x => reg_x, reg_y => reg_y,
               hi_x => hi_x, hi_y => hi_y, start => start, learn => learn, start_cx => start_cx,
               start_cy => start_cy, busy => busy, done => done, res_cx => res_cx, res_cy => res_cy,
               res_s => res_s, res_iter => res_iter, res_stop => res_stop, res_k => res_k,

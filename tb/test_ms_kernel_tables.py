@@ -5,6 +5,9 @@ ex, ey and kd_d are compared with mstrack.fixed.blocks.ms_kernel(w, h, kernel,
 KERNEL_BITS) for many target sizes (3x3, odd/even, thin, max size).  Entries
 beyond ex (TA, KA) / ey (TB, KB) are never used by ms_kernel; they are checked
 to be the exact TA/TB and the saturating KA/KB (ms_divider of the model).
+XR[i] (row extent of the ellipse, for ms_window_scan) is checked against
+:func:`model_xr`, computed from the model's TA, TB, D (and its ``inside`` mask),
+and the start -> done latency against the documented formula.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_kernel_tables.py``.
 """
@@ -23,6 +26,22 @@ from mstrack.fixed.primitives import ms_divider
 from mstrack.hdl import dut_generics
 
 
+def model_xr(ker: ms_kernel, n: int) -> list[int]:
+    """XR[i], i = 0 .. n - 1: largest dx in 0..ex with TA[dx] + TB[i] < D (0 if none, i.e. i > ey)."""
+    xr = []
+    for i in range(n):
+        if i > ker.ey:
+            xr.append(0)
+            continue
+        inside = [dx for dx in range(ker.ex + 1) if int(ker.TA[dx]) + int(ker.TB[i]) < ker.D]
+        assert inside and inside[0] == 0
+        # same as the model's inside mask: row dy = +-i holds exactly |dx| <= XR[i]
+        row = ker.inside[ker.ey + i]
+        assert row.tolist() == [abs(dx) <= inside[-1] for dx in range(-ker.ex, ker.ex + 1)]
+        xr.append(inside[-1])
+    return xr
+
+
 class TB:
     def __init__(self, dut):
         self.dut = dut
@@ -31,7 +50,7 @@ class TB:
         self.epan = int(self.g["KERNEL_EPAN"])
         self.kb = int(self.g["KERNEL_BITS"])
         self.kval_w = int(self.g["KVAL_W"])
-        self.writes: list[tuple[int, int, int, int, int]] = []
+        self.writes: list[tuple[int, int, int, int, int, int]] = []
         dut.rst.value = Immediate(1)
         dut.start.value = Immediate(0)
         cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
@@ -43,7 +62,7 @@ class TB:
             await RisingEdge(d.clk)
             if int(d.kt_we.value):
                 self.writes.append((int(d.kt_addr.value), int(d.kt_ta.value), int(d.kt_tb.value),
-                                    int(d.kt_ka.value), int(d.kt_kb.value)))
+                                    int(d.kt_ka.value), int(d.kt_kb.value), int(d.kt_xr.value)))
 
     async def reset(self):
         self.dut.rst.value = 1
@@ -71,11 +90,15 @@ class TB:
         assert int(d.ex.value) == ker.ex and int(d.ey.value) == ker.ey, (w, h)
         assert int(d.kd_d.value) == ker.D, (w, h, int(d.kd_d.value), ker.D)
         n_last = max(ker.ex, ker.ey)
-        exp_n = 2 * (n_last + 1) + self.kval_w + 4 if self.epan else n_last + 4
+        xr = model_xr(ker, n_last + 1)
+        walk = 2 * ker.ex - xr[n_last]  # set-up walk to TA[ex] + the down steps
+        exp_n = (2 * (n_last + 1) + self.kval_w + 4 if self.epan else n_last + 4) + walk
         assert n == exp_n, f"{w}x{h}: done after {n} clocks, documented {exp_n}"
         assert [a for a, *_ in self.writes] == list(range(n_last + 1)), f"{w}x{h}: addresses {self.writes}"
+        got_xr = [x for *_, x in self.writes]
+        assert got_xr == xr, f"{w}x{h}: XR {got_xr} != model {xr}"
         sat = (1 << self.kval_w) - 1
-        for i, ta, tb, ka, kb in self.writes:
+        for i, ta, tb, ka, kb, _ in self.writes:
             assert ta == 4 * i * i * h * h and tb == 4 * i * i * w * w, (w, h, i, ta, tb)
             if i <= ker.ex:
                 assert ta == int(ker.TA[i]), (w, h, i)
@@ -101,9 +124,17 @@ async def tables(dut):
     sizes = [(3, 3), (3, mx), (mx, 3), (mx, mx), (4, 4), (mx - 1, mx - 1), (5, 8), (8, 5)]
     rng = random.Random(7)
     sizes += [(rng.randint(3, mx), rng.randint(3, mx)) for _ in range(30)]
+    sizes += [(64, 64), (127, 127), (mx, 4), (4, mx)]
+    sizes = [(w, h) for w, h in sizes if w <= mx and h <= mx]
+    worst = 0
     for w, h in sizes:
         n = await tb.check(w, h)
+        worst = max(worst, n)
         dut._log.debug("%dx%d: %d clocks", w, h, n)
+    # documented bound (rtl/ms_kernel_tables.vhd header): n + 4 + 2 ex (+ n + 2 + KVAL_W when Epanechnikov)
+    bound = 3 * tb.max_half + 4 + (tb.max_half + 2 + tb.kval_w if tb.epan else 0)
+    assert worst <= bound, f"latency {worst} > bound {bound}"
+    dut._log.info("%d sizes OK, worst latency %d clocks (bound %d)", len(sizes), worst, bound)
 
 
 # ---------------------------------------------------------------- pytest entry points

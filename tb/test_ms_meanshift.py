@@ -52,8 +52,15 @@ async def write_region(dut, bins: np.ndarray, g: dict) -> None:
     dut.we.value = 0
 
 
+def model_xr(ker: ms_kernel, n: int) -> list[int]:
+    """Row extents XR[i] (ms_kernel_tables): largest dx with TA[dx] + TB[i] < D, 0 when i > ey."""
+    return [max((dx for dx in range(ker.ex + 1) if i <= ker.ey and int(ker.TA[dx]) + int(ker.TB[i]) < ker.D),
+                default=0) for i in range(n)]
+
+
 async def write_tables(dut, ker: ms_kernel) -> None:
     n = max(ker.ex, ker.ey) + 1
+    xr = model_xr(ker, n)
     dut.kd_d.value = ker.D
     dut.ex.value = ker.ex
     dut.ey.value = ker.ey
@@ -65,6 +72,7 @@ async def write_tables(dut, ker: ms_kernel) -> None:
         kmask = (1 << len(dut.kt_ka)) - 1
         dut.kt_ka.value = int(ker.KA[i]) & kmask if i <= ker.ex else kmask
         dut.kt_kb.value = int(ker.KB[i]) & kmask if i <= ker.ey else kmask
+        dut.kt_xr.value = xr[i]
         await RisingEdge(dut.clk)
     dut.kt_we.value = 0
 

@@ -6,8 +6,10 @@ The kernel tables are written from the model (mstrack.fixed.blocks.ms_kernel);
 ms_kernel_tables has its own test.  Each pass is compared exactly, bin by bin,
 with ``ms_histogram(bins, Region(0, 0, ...), win, ms_kernel(w, h, ...), n_bins)``
 after reading every bin out through the read-and-clear port; the next pass
-then checks the clear.  Cycle counts are asserted (full throughput):
-start -> done = (2 ey + 1) * groups + PASS_LAT.
+then checks the clear.  Cycle counts are asserted on every pass (full throughput):
+start -> done = sum over rows dy of groups(dy) + PASS_LAT, where a row scans only the
+LANES-aligned groups reaching |dx| <= XR[|dy|] (row extent of the kernel ellipse,
+:func:`model_xr`).
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_pixel_pass.py``.
 """
@@ -27,9 +29,25 @@ from cocotb.triggers import ClockCycles, RisingEdge
 
 from mstrack.fixed.blocks import Region, ms_histogram, ms_kernel
 
-PASS_LAT = 5     # rtl/ms_pixel_pass.vhd header
+PASS_LAT = 6     # rtl/ms_pixel_pass.vhd header
 BIN_RD_LAT = 3   # rtl/ms_histogram.vhd header
 CFG_ENV = "MS_PIXEL_PASS_CFG"
+
+
+def model_xr(ker: ms_kernel) -> list[int]:
+    """XR[i], i = 0 .. max(ex, ey): largest dx with TA[dx] + TB[i] < D (0 when i > ey), from the model."""
+    xr = []
+    for i in range(max(ker.ex, ker.ey) + 1):
+        ins = [dx for dx in range(ker.ex + 1) if i <= ker.ey and int(ker.TA[dx]) + int(ker.TB[i]) < ker.D]
+        xr.append(ins[-1] if ins else 0)
+    return xr
+
+
+def pass_beats(ker: ms_kernel, wx: int, lanes: int) -> int:
+    """Beats of one pass (ms_window_scan): sum over rows of the LANES-aligned groups of |dx| <= XR[|dy|]."""
+    xr = model_xr(ker)
+    return sum((wx + xr[abs(dy)]) // lanes - (wx - xr[abs(dy)]) // lanes + 1
+               for dy in range(-ker.ey, ker.ey + 1))
 
 
 # ---------------------------------------------------------------- TB
@@ -92,6 +110,7 @@ class TB:
         d.ex.value = ker.ex
         d.ey.value = ker.ey
         d.kd_d.value = ker.D
+        xr = model_xr(ker)
         for i in range(max(ker.ex, ker.ey) + 1):
             d.kt_we.value = 1
             d.kt_addr.value = i
@@ -99,6 +118,7 @@ class TB:
             d.kt_tb.value = int(ker.TB[i]) if i <= ker.ey else 0
             d.kt_ka.value = int(ker.KA[i]) if (i <= ker.ex and self.kernel != "flat") else 0
             d.kt_kb.value = int(ker.KB[i]) if (i <= ker.ey and self.kernel != "flat") else 0
+            d.kt_xr.value = xr[i]
             await RisingEdge(d.clk)
         d.kt_we.value = 0
         await RisingEdge(d.clk)
@@ -118,8 +138,7 @@ class TB:
             if int(d.done.value):  # sampled at this edge
                 break
             assert clocks < 100000, "no done"
-        groups = (wx + ker.ex) // self.L - (wx - ker.ex) // self.L + 1
-        beats = (2 * ker.ey + 1) * groups
+        beats = pass_beats(ker, wx, self.L)
         assert clocks == beats + PASS_LAT, f"pass took {clocks} clocks, expected {beats} + {PASS_LAT}"
         return clocks
 
@@ -156,10 +175,10 @@ class TB:
         return out
 
 
-def random_kernel(rng: random.Random, tb: TB, big: bool = False) -> ms_kernel:
+def random_kernel(rng: random.Random, tb: TB, big: bool = False, p: int = 0) -> ms_kernel:
     mx = min(2 * tb.max_half + 1, tb.rmax)
-    if big:
-        w, h = mx, mx
+    if big:  # the largest window, then 64 x 64 (the sizes quoted in docs/blocks/ms_pixel_pass.md)
+        w = h = mx if p % 2 == 0 or mx < 64 else 64
     else:
         w, h = rng.randint(3, mx), rng.randint(3, mx)
     return ms_kernel(w, h, tb.kernel, tb.kb)
@@ -192,7 +211,7 @@ async def check_passes(dut, n_passes: int, runs: bool, throttle: bool, seed: int
     await tb.reset()
     reg = Region(0, 0, tb.rmax, tb.rmax, lo=(0, 0), hi=(tb.rmax - 1, tb.rmax - 1))
     for p in range(n_passes):
-        ker = random_kernel(rng, tb, big)
+        ker = random_kernel(rng, tb, big, p)
         await tb.write_tables(ker)
         wx = rng.randint(ker.ex, tb.rmax - 1 - ker.ex)
         wy = rng.randint(ker.ey, tb.rmax - 1 - ker.ey)
@@ -204,8 +223,9 @@ async def check_passes(dut, n_passes: int, runs: bool, throttle: bool, seed: int
             bad = np.nonzero(got[name] != e)[0]
             assert bad.size == 0, (f"pass {p} win ({wx},{wy}) {ker.w}x{ker.h}: {name} differs at bins "
                                    f"{bad[:8].tolist()}: got {got[name][bad[:8]].tolist()} exp {e[bad[:8]].tolist()}")
-        dut._log.info("pass %d: %dx%d at (%d,%d), %d clocks, %d px inside OK", p, ker.w, ker.h, wx, wy,
-                      clocks, int(exp.N.sum()))
+        box = (2 * ker.ey + 1) * ((wx + ker.ex) // tb.L - (wx - ker.ex) // tb.L + 1)
+        dut._log.info("pass %d: %dx%d at (%d,%d), %d clocks = %d beats (bounding box: %d) + %d, %d px inside OK",
+                      p, ker.w, ker.h, wx, wy, clocks, clocks - PASS_LAT, box, PASS_LAT, int(exp.N.sum()))
     # everything was cleared: a final read gives zeros
     got = await tb.read_bins(None)
     for name in ("H", "N", "SX", "SY"):
@@ -218,14 +238,14 @@ async def check_passes(dut, n_passes: int, runs: bool, throttle: bool, seed: int
 async def random_bins(dut):
     """Random region, random windows, full-speed bin reads."""
     n = int(os.environ.get("MS_PIXEL_PASS_N", "20"))
-    await check_passes(dut, n, runs=False, throttle=False, seed=1, big=n == 1)
+    await check_passes(dut, n, runs=False, throttle=False, seed=1, big="MS_PIXEL_PASS_BIG" in os.environ)
 
 
 @cocotb.test()
 async def runs_of_equal_bins_throttled(dut):
     """Long runs of equal bins (forwarding), throttled bin reads."""
     n = int(os.environ.get("MS_PIXEL_PASS_N", "20"))
-    await check_passes(dut, n, runs=True, throttle=True, seed=2, big=n == 1)
+    await check_passes(dut, n, runs=True, throttle=True, seed=2, big="MS_PIXEL_PASS_BIG" in os.environ)
 
 
 # ---------------------------------------------------------------- pytest entry points
@@ -259,6 +279,8 @@ CASES = [
     pytest.param("epanechnikov", 2, id="epan_L2"),
     pytest.param("epanechnikov", 1, id="epan_L1"),
     pytest.param("epanechnikov", 4, id="epan_L4"),
+    pytest.param("flat", 8, id="flat_L8"),
+    pytest.param("epanechnikov", 8, id="epan_L8"),
 ]
 
 
@@ -271,11 +293,12 @@ def test_ms_pixel_pass_small(kernel, lanes, hdl_waves):
 
 
 @pytest.mark.ghdl
-def test_ms_pixel_pass_default_config(hdl_waves):
-    """Default colour config (512 bins, MAX_HALF 63), Epanechnikov, one full-size window per test."""
-    gen, cfg = pass_generics(TrackerParams(kernel="epanechnikov"), FixedParams(), 2)
+@pytest.mark.parametrize("kernel,lanes", [("epanechnikov", 2), ("flat", 8)])
+def test_ms_pixel_pass_default_config(kernel, lanes, hdl_waves):
+    """Default colour config (512 bins, MAX_HALF 63): a 127 x 127 and a 64 x 64 window per test."""
+    gen, cfg = pass_generics(TrackerParams(kernel=kernel), FixedParams(), lanes)
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
-                 extra_env={CFG_ENV: json.dumps(cfg), "MS_PIXEL_PASS_N": "1"})
+                 extra_env={CFG_ENV: json.dumps(cfg), "MS_PIXEL_PASS_N": "2", "MS_PIXEL_PASS_BIG": "1"})
 
 
 @pytest.mark.ghdl

@@ -12,7 +12,7 @@ import numpy as np
 
 from .fixed import FixedParams, FixedTracker
 from .fixed.blocks import ms_box_clip
-from .fixed.vhdl_pkg import RESULT_FLAGS, core_generics, result_layout
+from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, core_generics, result_layout
 from .params import TrackerParams
 from .types import Status
 
@@ -73,7 +73,7 @@ class CoreConfig:
 
     tp: TrackerParams
     fp: FixedParams
-    lanes: int = 2
+    lanes: int = DEFAULT_LANES
     max_frame_w: int = 2048
 
     def generics(self) -> dict[str, int]:

@@ -27,7 +27,7 @@ from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStream
 
 from mstrack.cosim import CoreConfig, diff_fields, expected_results, frame_words, flags_word
 from mstrack.fixed import FixedParams
-from mstrack.fixed.vhdl_pkg import unpack_result
+from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, unpack_result
 from mstrack.params import TrackerParams
 
 REPO = Path(__file__).resolve().parents[1]
@@ -49,7 +49,7 @@ def load_frames(job: dict) -> list[np.ndarray]:
 
 def config_of(job: dict) -> CoreConfig:
     return CoreConfig(TrackerParams(**job.get("tp", {})), FixedParams(**job.get("fp", {})),
-                      lanes=job.get("lanes", 2), max_frame_w=job.get("max_frame_w", 1024))
+                      lanes=job.get("lanes", DEFAULT_LANES), max_frame_w=job.get("max_frame_w", 1024))
 
 
 def lines_of(frame: np.ndarray, fault: str | None = None) -> list[AxiStreamFrame]:

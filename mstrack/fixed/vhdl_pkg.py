@@ -15,7 +15,7 @@ from .formats import FixedParams, widths
 from .primitives import bits_for
 
 PKG_PATH = Path(__file__).resolve().parents[2] / "rtl" / "ms_formats_pkg.vhd"
-DEFAULT_LANES = 2
+DEFAULT_LANES = 4
 
 
 def core_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None,

@@ -150,7 +150,7 @@ def test_long_real_video(name, stream):
     frames = [cv2.imread(str(f), cv2.IMREAD_COLOR) for f in s.img_files]
     box = round_box(*[float(v) for v in s.gt[0]])
     tp, fp = TrackerParams(), FixedParams()
-    run = fastsim.simulate(frames, box, tp, fp, lanes=2, seed=11, **stream)
+    run = fastsim.simulate(frames, box, tp, fp, lanes=DEFAULT_LANES, seed=11, **stream)
     exp = expected_results(frames, box, tp, fp)
     mism = fastsim.compare(run.results, exp)
     _report(f"long_{name}", {

@@ -55,7 +55,7 @@ def rows(tp: TrackerParams | None = None, fp: FixedParams | None = None) -> list
          f"min({tp.n_edge_bins - 1}, \\|G\\| >> {tp.edge_shift}); saturates",
          f"bins cover \\|G\\| = 0 .. {tp.n_edge_bins << tp.edge_shift}; stronger edges share the last bin"),
         ("region coordinates", "REGION_W, COORD_W", f"{_u(g['REGION_W'])} (relative), {_u(fp.coord_bits)} (frame)",
-         f"0 .. {w.region_max - 1}; frames up to {1 << fp.coord_bits} px",
+         f"0 .. {w.region_max - 1}; frames narrower/lower than {1 << fp.coord_bits} px",
          f"region = window box + MARGIN = {fp.margin} px per side, clamped into the frame interior",
          f"REGION_MAX = 2 MAX_HALF + 1 + 2 MARGIN = {w.region_max}"),
         ("window offsets dx, dy", "HALF_W", f"{_s(g['HALF_W'] + 1)}", f"-{mh} .. {mh}",

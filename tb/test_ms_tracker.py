@@ -164,23 +164,39 @@ async def run_job(dut):
     tb = TB(dut, job)
     await tb.reset(w, h)
     cocotb.start_soon(tb.monitor(h))
-    await tb.init(box)
     per_frame_budget = 40 * w * h + 400_000          # watchdog per frame (cycles)
+    offset = 0
+    mismatches: list[str] = []
+    if "bad_box" in job:
+        # an init box with less than 3x3 px inside the frame is rejected: the next frame's
+        # result says so (and, with no earlier target, no_target); a good init then works
+        await tb.init(tuple(job["bad_box"]))
+        for line in lines_of(frames[0]):
+            tb.source.send_nowait(line)
+        got = await recv_result(tb, g, per_frame_budget)
+        d = diff_fields(got, {"flags": flags_word(rejected=1, no_target=1), "frame_count": 0},
+                        fields=("flags", "frame_count"))
+        if d:
+            mismatches.append("rejected box: " + "; ".join(d))
+        frames = frames[1:]
+        good = good[1:]
+        exp_good = expected_results(good, box, cfg.tp, cfg.fp)
+        offset = 1
+    await tb.init(box)
     # queue every frame (a cut frame's error only shows when the next start of frame comes)
     for i, frame in enumerate(frames):
         for line in lines_of(frame, faults.get(i)):
             tb.source.send_nowait(line)
-    mismatches: list[str] = []
     gi = 0
     for i in range(len(frames)):
         got = await recv_result(tb, g, per_frame_budget)
         if i in faults:
             # one error result for the bad frame; nothing tracked, state unchanged
-            exp = {"flags": flags_word(error=1), "frame_count": i & 0xFFFF}
+            exp = {"flags": flags_word(error=1), "frame_count": (i + offset) & 0xFFFF}
             d = diff_fields(got, exp, fields=("flags", "frame_count"))
         else:
             exp = dict(exp_good[gi])
-            exp["frame_count"] = i & 0xFFFF
+            exp["frame_count"] = (i + offset) & 0xFFFF
             d = diff_fields(got, exp)
             gi += 1
         if d:
@@ -253,6 +269,16 @@ def test_tracker_protocol_errors(fault, tmp_path):
     runner = run_verilator if have_verilator() else run_ghdl
     runner("ms_tracker", "test_ms_tracker", generics=g, build_name=f"ms_tracker_fault",
            extra_env=_job_env(job))
+
+
+@pytest.mark.parametrize("bad_box", [[-40, -40, 20, 20], [30, 10, 2, 30]], ids=["outside", "too_narrow"])
+def test_tracker_rejected_box(bad_box, tmp_path):
+    """A box with < 3x3 px inside the frame: flag `rejected` (+ `no_target`); a good init then tracks."""
+    from mstrack.hdl import run_ghdl
+    job = {**SMALL, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
+           "bad_box": bad_box, "report": str(tmp_path / "r.json")}
+    run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
+             build_name="ms_tracker_rejected", extra_env=_job_env(job))
 
 
 REAL_RUNS = [("Girl", 0, 40), ("Crossing", 0, 10), ("Couple", 0, 10)]

@@ -466,6 +466,7 @@ BUILTIN_COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
 EXTENSIONS: list[str] = [
     "mstrack.vectors:register_cli",     # vectors: test vectors for the VHDL core
     "mstrack.agreement:register_cli",   # agree: float vs fixed-point agreement
+    "mstrack.synth:register_cli",       # synth: open synthesis, Fmax, cycle figures (performance.md)
     # "mstrack.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
 ]
 

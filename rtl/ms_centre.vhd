@@ -8,6 +8,10 @@
 -- coordinates.  One ms_divider (N_W = max(SWX_W + CF, SW_W - 1) + 1, D_W = SW_W,
 -- Q_W = SHIFT_Q_W) is shared: x is issued the clock after start, y the clock after that.
 --
+-- The clamp bounds relative to the window centre (lo - (win << CF), hi - (win << CF) and their
+-- negatives) are computed while the division runs, one axis at a time (x after start, y when
+-- the x quotient is taken), so the result clock compares the quotient with registers in
+-- parallel with the add, instead of add -> compare -> compare in series (ECP5: 81 MHz).
 -- Latency    : done SHIFT_Q_W + 4 clocks after start (start in cycle c, done in c + SHIFT_Q_W + 4).
 -- Throughput : one centre per SHIFT_Q_W + 4 clocks; a start is accepted when busy = 0
 --              (busy is already low in the done cycle, so starts can follow back to back).
@@ -73,6 +77,11 @@ architecture rtl of ms_centre is
   signal q_valid : std_logic;
   signal q_mag   : unsigned(SHIFT_Q_W - 1 downto 0);
   signal q_tag   : std_logic_vector(1 downto 0);
+
+  -- clamp of the axis whose quotient comes next: base = win << CF, lo, hi (<< CF),
+  -- dl = lo - base, dh = hi - base, ndl = -dl, ndh = -dh, lo_gt_hi = (lo > hi)
+  signal ax_base, ax_lo, ax_hi, ax_dl, ax_dh, ax_ndl, ax_ndh : signed(CW - 1 downto 0);
+  signal ax_lo_gt_hi : std_logic;
 
   signal cx_r, cy_r : unsigned(CENTRE_W - 1 downto 0);
   signal done_r     : std_logic := '0';
@@ -154,31 +163,57 @@ begin
     port map (clk => clk, rst => rst, in_valid => d_valid, in_n => d_n, in_d => sw_r, in_tag => d_tag,
               out_valid => q_valid, out_q => q_mag, out_tag => q_tag);
 
-  p_result : process (clk)
-    variable c, lo, hi : signed(CW - 1 downto 0);
-    variable w         : unsigned(REGION_W - 1 downto 0);
+  p_axis : process (clk)
+    variable w, lo, hi : unsigned(REGION_W - 1 downto 0);
+    variable b, l, h   : signed(CW - 1 downto 0);
   begin
     if rising_edge(clk) then
-      if q_tag(1) = '1' then
-        w  := win_y_r;
-        lo := signed(shift_left(resize(lo_y_r, CW), CF));
-        hi := signed(shift_left(resize(hi_y_r, CW), CF));
-      else
-        w  := win_x_r;
-        lo := signed(shift_left(resize(lo_x_r, CW), CF));
-        hi := signed(shift_left(resize(hi_x_r, CW), CF));
+      if ph_x = '1' or (q_valid = '1' and q_tag(1) = '0') then
+        if ph_x = '1' then                        -- operands latched: x comes first
+          w := win_x_r; lo := lo_x_r; hi := hi_x_r;
+        else                                      -- x taken now: y is next
+          w := win_y_r; lo := lo_y_r; hi := hi_y_r;
+        end if;
+        b := signed(shift_left(resize(w, CW), CF));
+        l := signed(shift_left(resize(lo, CW), CF));
+        h := signed(shift_left(resize(hi, CW), CF));
+        ax_base <= b;
+        ax_lo   <= l;
+        ax_hi   <= h;
+        ax_dl   <= l - b;
+        ax_dh   <= h - b;
+        ax_ndl  <= b - l;
+        ax_ndh  <= b - h;
+        ax_lo_gt_hi <= '1' when lo > hi else '0';
       end if;
-      c := signed(shift_left(resize(w, CW), CF));
+    end if;
+  end process;
+
+  -- c = base + d, d = +q or -q:  c < lo <=> d < dl,  c > hi <=> d > dh;
+  -- clamp = min(max(c, lo), hi), as the model (lo if c < lo, then hi if that exceeds hi)
+  p_result : process (clk)
+    variable c, q     : signed(CW - 1 downto 0);
+    variable lt, gt   : boolean;
+  begin
+    if rising_edge(clk) then
+      q := signed(resize(q_mag, CW));
       if q_tag(0) = '1' then
-        c := c - signed(resize(q_mag, CW));
+        c  := ax_base - q;
+        lt := q > ax_ndl;
+        gt := q < ax_ndh;
       else
-        c := c + signed(resize(q_mag, CW));
+        c  := ax_base + q;
+        lt := q < ax_dl;
+        gt := q > ax_dh;
       end if;
-      if c < lo then
-        c := lo;
-      end if;
-      if c > hi then
-        c := hi;
+      if lt then
+        if ax_lo_gt_hi = '1' then
+          c := ax_hi;
+        else
+          c := ax_lo;
+        end if;
+      elsif gt then
+        c := ax_hi;
       end if;
       if q_valid = '1' then
         if q_tag(1) = '1' then

@@ -7,9 +7,15 @@
 --   alpha_e = 2**AF - alpha_c
 --   c       = (alpha_c * c_c + alpha_e * c_e + 2**(AF-1)) >> AF        (x and y)
 --   rho_f   = floor((S_f << (RHO_OUT_FRAC - RF)) / K)   (0 for an unused feature)
--- The three divisions share one pipelined ms_divider (issued on consecutive clocks).
--- Latency: about Q_W + 8 clocks from start to done (Q_W = RHO_OUT_FRAC + 1); one
--- fusion per frame.  Handshake: start pulse (while idle) -> done pulse; outputs held.
+-- The three divisions share one pipelined ms_divider (issued on consecutive clocks).  The
+-- blend needs no multiplier: alpha_c c_c and alpha_e c_e are built by shift-and-add, one bit
+-- of alpha per clock, MSB first (acc = 2 acc + bit c), then summed and rounded in two more
+-- clocks, so every clock has at most one adder between registers (no MULT18X18D, which yosys
+-- maps without its registers on ECP5: the blend in one clock was a 63-76 MHz path).
+-- Latency: start in cycle c, done in cycle c + Q_W + 9 + ALPHA_W when the alpha division is
+-- issued (fused, S_c + S_e > 0), c + Q_W + 8 + ALPHA_W otherwise (Q_W = RHO_OUT_FRAC + 1):
+-- 3 issue clocks, the divider (Q_W + 1), S_WAIT, S_BLEND, ALPHA_W x S_MAC, S_SUM, S_ROUND,
+-- S_DONE; one fusion per frame.  Handshake: start pulse (while idle) -> done pulse; outputs held.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -53,7 +59,9 @@ architecture rtl of ms_fusion is
   constant D_W : natural := max(RHO_SUM_W + 1, HIST_W);
   constant ONE : natural := 2 ** AF;
 
-  type state_t is (S_IDLE, S_ISSUE1, S_ISSUE2, S_WAIT, S_BLEND, S_DONE);
+  constant PW  : natural := CENTRE_ABS_W + ALPHA_W;        -- one product alpha * c
+
+  type state_t is (S_IDLE, S_ISSUE1, S_ISSUE2, S_WAIT, S_BLEND, S_MAC, S_SUM, S_ROUND, S_DONE);
   signal state : state_t := S_IDLE;
 
   signal sc_r, se_r     : unsigned(RHO_SUM_W - 1 downto 0);
@@ -69,6 +77,11 @@ architecture rtl of ms_fusion is
   signal div_out_tag    : std_logic_vector(1 downto 0);
   signal n_results      : unsigned(1 downto 0);
   signal a_c            : unsigned(ALPHA_W - 1 downto 0);
+  -- blend: multiplier bits (shifted out MSB first), products, sums
+  signal m_c, m_e       : unsigned(ALPHA_W - 1 downto 0);
+  signal p_cx, p_cy, p_ex, p_ey : unsigned(PW - 1 downto 0);
+  signal sum_x, sum_y   : unsigned(PW downto 0);
+  signal nbit           : natural range 0 to ALPHA_W - 1;
 begin
   assert Q_W >= AF + 1 report "ms_fusion: RHO_OUT_FRAC must be >= AF" severity failure;
   assert RHO_OUT_FRAC >= RF report "ms_fusion: RHO_OUT_FRAC must be >= RF" severity failure;
@@ -79,8 +92,6 @@ begin
               in_tag => div_tag, out_valid => div_out_valid, out_q => div_q, out_tag => div_out_tag);
 
   p_fsm : process(clk)
-    variable bx, by : unsigned(CENTRE_ABS_W + ALPHA_W downto 0);
-    variable a_e    : unsigned(ALPHA_W - 1 downto 0);
   begin
     if rising_edge(clk) then
       div_in_valid <= '0';
@@ -138,12 +149,44 @@ begin
               state <= S_BLEND;
             end if;
           end if;
-        when S_BLEND =>
-          a_e := to_unsigned(ONE, ALPHA_W) - a_c;
-          bx := resize(a_c * ccx_r, CENTRE_ABS_W + ALPHA_W + 1) + a_e * ecx_r + ONE / 2;
-          by := resize(a_c * ccy_r, CENTRE_ABS_W + ALPHA_W + 1) + a_e * ecy_r + ONE / 2;
-          cx <= resize(shift_right(bx, AF), CENTRE_ABS_W);
-          cy <= resize(shift_right(by, AF), CENTRE_ABS_W);
+        when S_BLEND =>                   -- set up alpha_c c_c and alpha_e c_e (x and y)
+          m_c <= a_c;
+          m_e <= to_unsigned(ONE, ALPHA_W) - a_c;
+          p_cx <= (others => '0');
+          p_cy <= (others => '0');
+          p_ex <= (others => '0');
+          p_ey <= (others => '0');
+          nbit <= ALPHA_W - 1;
+          state <= S_MAC;
+        when S_MAC =>                     -- p = 2 p + (alpha bit) c, MSB first
+          if m_c(ALPHA_W - 1) = '1' then
+            p_cx <= shift_left(p_cx, 1) + resize(ccx_r, PW);
+            p_cy <= shift_left(p_cy, 1) + resize(ccy_r, PW);
+          else
+            p_cx <= shift_left(p_cx, 1);
+            p_cy <= shift_left(p_cy, 1);
+          end if;
+          if m_e(ALPHA_W - 1) = '1' then
+            p_ex <= shift_left(p_ex, 1) + resize(ecx_r, PW);
+            p_ey <= shift_left(p_ey, 1) + resize(ecy_r, PW);
+          else
+            p_ex <= shift_left(p_ex, 1);
+            p_ey <= shift_left(p_ey, 1);
+          end if;
+          m_c <= shift_left(m_c, 1);
+          m_e <= shift_left(m_e, 1);
+          if nbit = 0 then
+            state <= S_SUM;
+          else
+            nbit <= nbit - 1;
+          end if;
+        when S_SUM =>
+          sum_x <= resize(p_cx, PW + 1) + p_ex;
+          sum_y <= resize(p_cy, PW + 1) + p_ey;
+          state <= S_ROUND;
+        when S_ROUND =>                   -- (alpha_c c_c + alpha_e c_e + 2**(AF-1)) >> AF
+          cx <= resize(shift_right(sum_x + ONE / 2, AF), CENTRE_ABS_W);
+          cy <= resize(shift_right(sum_y + ONE / 2, AF), CENTRE_ABS_W);
           alpha_c <= a_c;
           state <= S_DONE;
         when S_DONE =>

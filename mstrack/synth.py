@@ -21,7 +21,7 @@ Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`):
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
 cycle for cycle against simulation by ``tb/test_ms_tracker_cycles.py``.
 
-Outputs go to ``build/synth/`` (one folder per tool run, ``summary_<config>.json``).
+Outputs go to ``build/synth/`` (one folder per tool run, ``summary_<config>[_<sha>].json``, ``_<sha>`` with --rtl-commit).
 """
 from __future__ import annotations
 
@@ -92,6 +92,11 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
 #: rtl/ directory to synthesise (None: the working tree) and its description; :func:`use_rtl_commit`
 _RTL_ROOT: Path | None = None
 _RTL_DESC = "working tree"
+
+
+def _tag() -> str:
+    """Suffix of the summary files: '' for the working tree, '_<sha>' for --rtl-commit."""
+    return "" if _RTL_ROOT is None else "_" + _RTL_ROOT.name.removeprefix("rtl_")
 
 
 def use_rtl_commit(rev: str | None) -> str:
@@ -328,7 +333,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         log(f"[{cfg.name}] xc7: {out['xc7']} ({secs['xc7']} s)")
 
     SYNTH_DIR.mkdir(parents=True, exist_ok=True)
-    (SYNTH_DIR / f"summary_{cfg.name}.json").write_text(json.dumps(out, indent=1))
+    (SYNTH_DIR / f"summary_{cfg.name}{_tag()}.json").write_text(json.dumps(out, indent=1))
     return out
 
 
@@ -385,7 +390,7 @@ def synth_blocks(cfg: Config | str = "default", blocks: Sequence[str] | None = N
             f"({cp.get('total_ns')} ns), LUT4 {r['LUT4']} FF {r['TRELLIS_FF']} ({row['seconds']} s)")
         out.append(row)
         SYNTH_DIR.mkdir(parents=True, exist_ok=True)
-        (SYNTH_DIR / f"blocks_{cfg.name}.json").write_text(json.dumps(out, indent=1))
+        (SYNTH_DIR / f"blocks_{cfg.name}{_tag()}.json").write_text(json.dumps(out, indent=1))
     return out
 
 
@@ -413,7 +418,7 @@ def blocks_table(rows: Iterable[dict]) -> str:
 
 
 def load_summary(name: str) -> dict[str, Any] | None:
-    p = SYNTH_DIR / f"summary_{name}.json"
+    p = SYNTH_DIR / f"summary_{name}{_tag()}.json"
     return json.loads(p.read_text()) if p.is_file() else None
 
 
@@ -426,12 +431,16 @@ PASS_LAT_ROWS = 6       # ms_pixel_pass, row-extent scan: sum G(dy) beats + 6
 BIN_RD_LAT = 3          # ms_histogram read port inside ms_pixel_pass
 
 
+def _rtl_text(entity: str) -> str:
+    f = (_RTL_ROOT or REPO_ROOT / "rtl") / f"{entity}.vhd"
+    return f.read_text(errors="replace") if f.is_file() else ""
+
+
 def scan_kind() -> str:
     """``"rows"`` when the RTL being modelled (working tree or --rtl-commit) scans only the
     LANES groups of each row that reach the kernel ellipse (ms_window_scan with the row-extent
-    table XR), ``"box"`` when it scans the whole (2ex+1) x (2ey+1) bounding box."""
-    f = (_RTL_ROOT or REPO_ROOT / "rtl") / "ms_window_scan.vhd"
-    return "rows" if f.is_file() and "kt_xr" in f.read_text(errors="replace") else "box"
+    table XR, since 4f7b201), ``"box"`` when it scans the whole (2ex+1) x (2ey+1) bounding box."""
+    return "rows" if "kt_xr" in _rtl_text("ms_window_scan") else "box"
 
 
 def row_extents(w: int, h: int, kernel: str = "flat", kernel_bits: int = 8) -> list[int]:
@@ -513,9 +522,13 @@ FRONT = 11
 
 def fusion_cycles(g: dict[str, int], alpha_division: bool = True) -> int:
     """ms_fusion start -> done: divisions issued in 3 consecutive clocks into one ms_divider
-    (Q_W = RHO_OUT_FRAC + 1, latency Q_W + 1), S_WAIT, S_BLEND, S_DONE.  The alpha division
-    is issued only when fused with S_c + S_e > 0 (else one clock less)."""
-    return g["RHO_OUT_FRAC"] + 1 + (7 if alpha_division and g["FEATURES"] == 0 else 6)
+    (Q_W = RHO_OUT_FRAC + 1, latency Q_W + 1), S_WAIT, S_BLEND, S_DONE, and (shift-and-add
+    blend, the RTL since the multipliers were removed) ALPHA_W x S_MAC, S_SUM, S_ROUND.  The
+    alpha division is issued only when fused with S_c + S_e > 0 (else one clock less)."""
+    f = g["RHO_OUT_FRAC"] + 1 + (7 if alpha_division and g["FEATURES"] == 0 else 6)
+    if "S_MAC" in _rtl_text("ms_fusion"):
+        f += g["ALPHA_W"] + 2
+    return f
 
 
 def back_cycles(g: dict[str, int], learn: bool = False) -> int:
@@ -764,7 +777,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.blocks:
         for name in args.config:
-            bl = (json.loads((SYNTH_DIR / f"blocks_{name}.json").read_text()) if args.from_summaries
+            bl = (json.loads((SYNTH_DIR / f"blocks_{name}{_tag()}.json").read_text()) if args.from_summaries
                   else synth_blocks(name, seed=args.seeds[0], freq_mhz=args.freq))
             md = blocks_table(bl)
             print(f"\n{md}")

@@ -1,0 +1,97 @@
+"""mstrack.synth without tools: cycle model, critical-path parsing, doc sections."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from mstrack import synth
+
+
+def test_pixel_pass_cycles_box_and_rows():
+    # bounding-box scan: (2 ey + 1) G + 5; 63 px rows are ex + 1 = 32 groups of 2 lanes
+    assert synth.pixel_pass_cycles(31, 31, 2, 50) == 63 * 32 + 5 == 2021
+    # LANES 4: 16 or 17 groups depending on the alignment; worst case taken when wx is None
+    assert {synth.pixel_pass_cycles(31, 31, 4, wx) for wx in range(31, 35)} == {63 * 16 + 5, 63 * 17 + 5}
+    assert synth.pixel_pass_cycles(31, 31, 4) == 63 * 17 + 5
+    # row-extent scan of a 64x64 flat kernel (docs/performance.md: 1,640 with L 2, 863 worst with L 4)
+    xr = synth.row_extents(64, 64)
+    assert len(xr) == 32 and xr[0] == 31 and xr == sorted(xr, reverse=True)
+    assert synth.pixel_pass_cycles(31, 31, 2, 50, xr) == 1640
+    assert synth.pixel_pass_cycles(31, 31, 4, None, xr) == 863
+
+
+def test_engine_cycles_matches_documented_worst_case():
+    """docs/realtime.md: 127x127 window, LANES 2, box scan, 20 colour iterations: 182,763 clocks
+    from the last pixel = 11 + engine + 28 (fusion of that RTL: RHO_OUT_FRAC + 8)."""
+    g = synth.CONFIGS["lanes2"].generics()
+    p = synth.pixel_pass_cycles(63, 63, 2)                  # box scan, 127 x 64 + 5
+    eng = synth.engine_cycles(g, [p] * 21, 512, 20)
+    assert 11 + eng + 1 + (g["RHO_OUT_FRAC"] + 8) + 3 == 182_763
+    # stop "lost" at the first centre: one pass, one bin pass, one centre
+    assert synth.engine_cycles(g, [p], 512, 1, "lost") == p + 545 + 18 + 7
+    with pytest.raises(AssertionError):
+        synth.engine_cycles(g, [p] * 20, 512, 20)           # n iterations need n + 1 passes
+
+
+def test_bin_pass_and_centre_latencies():
+    g = synth.CONFIGS["default"].generics()
+    assert synth.bin_pass_cycles(g, 512) == 545 and synth.bin_pass_cycles(g, 16) == 49
+    assert synth.bin_pass_cycles(g, 512, learn=True) == 517
+    assert synth.centre_cycles(g) == 18
+
+
+NETLIST = """module sub_1_2 (input clk);
+  reg [3:0] n12_q;
+  assign cnt = n12_q; // (signal)
+endmodule
+module top (input clk);
+  reg n5_q;
+  assign flag = n5_q; // (signal)
+  sub_1_2 u_sub (
+    .clk(clk));
+endmodule
+"""
+
+
+def test_netlist_names_and_critical_path(tmp_path):
+    v = tmp_path / "top.v"
+    v.write_text(NETLIST)
+    n = synth.NetlistNames(v, "top")
+    assert n.vhdl("u_sub.n12_q_TRELLIS_FF_Q_3") == "u_sub.cnt"
+    assert n.vhdl("n5_q_TRELLIS_FF_Q") == "flag"
+    assert n.module_of("u_sub.n12_q_TRELLIS_FF_Q_3") == "sub"
+    rep = {"critical_paths": [{"from": "posedge clk", "to": "posedge clk", "path": [
+        {"type": "clk-to-q", "delay": 0.5, "from": {"cell": "n5_q_TRELLIS_FF_Q", "port": "Q"},
+         "to": {"cell": "n5_q_TRELLIS_FF_Q", "port": "Q"}},
+        {"type": "routing", "delay": 1.0, "net": "x", "from": {"cell": "n5_q_TRELLIS_FF_Q", "port": "Q"},
+         "to": {"cell": "u_sub.n12_q_TRELLIS_FF_Q_3", "port": "DI"}},
+        {"type": "setup", "delay": 0.25, "from": {"cell": "u_sub.n12_q_TRELLIS_FF_Q_3", "port": "DI"},
+         "to": {"cell": "u_sub.n12_q_TRELLIS_FF_Q_3", "port": "DI"}}]}]}
+    cp = synth.critical_path(rep, n)
+    assert cp["total_ns"] == 1.75 and cp["routing_ns"] == 1.0 and cp["logic_ns"] == 0.75
+    assert (cp["source"], cp["sink"], cp["sink_module"]) == ("flag", "u_sub.cnt", "sub")
+    assert synth.path_summary(cp) == "flag -> u_sub.cnt"
+
+
+def test_write_section_replaces_in_place(tmp_path):
+    p = tmp_path / "perf.md"
+    p.write_text("# P\n\n<!-- perf-x:begin -->\nold\n<!-- perf-x:end -->\n\ntail\n")
+    synth.write_section("| a |\n|---|", "x", "mstrack synth --x", p)
+    synth.write_section("| b |\n|---|", "x", "mstrack synth --x", p)
+    text = p.read_text()
+    assert "| b |" in text and "| a |" not in text and "old" not in text and text.endswith("tail\n")
+    assert text.count("perf-x:begin") == 1 and "Command: `mstrack synth --x`" in text
+
+
+def test_tables_from_a_summary():
+    s = {"config": "c", "ecp5": {"LUT4": 1, "TRELLIS_FF": 2, "CCU2C": 3, "DP16KD": 4, "MULT18X18D": 5,
+                                 "TRELLIS_DPR16X4": 6},
+         "pnr": [{"fmax_mhz": 70.0, "utilization": {"TRELLIS_COMB": (10, 100), "TRELLIS_FF": (2, 100)}}],
+         "fmax_max_mhz": 70.0, "fmax_median_mhz": 70.0,
+         "xc7": {"LUT": 10, "FF": 20, "BRAM36": 1.5, "RAMB36E1": 1, "RAMB18E1": 1, "DSP48E1": 2, "CARRY4": 3,
+                 "LUTRAM": 4, "SRL": 5}}
+    assert "| c | 1 | 2 | 3 | 4 | 5 | 6 | 70.0 | 70.0 | 70.0 | yes: 10 % / 2 % / 0 % / 0 % |" in synth.ecp5_table([s])
+    assert "1.5 (1 + 1/2)" in synth.xc7_table([s])
+    assert "1,006 / 1,320 / 7.6 / 1.4" in synth.vitis_table([s])
+    json.dumps(s)

@@ -394,15 +394,30 @@ def synth_blocks(cfg: Config | str = "default", blocks: Sequence[str] | None = N
     return out
 
 
-def path_summary(cp: dict) -> str:
-    """``a -> b -> c`` over the distinct cells of a critical path (VHDL names)."""
+_CELL_SUFFIX_RE = re.compile(r"(_TRELLIS|_LUT4|_CCU2C|\$CCU2|_PFUMX|_L6MUX|_DO[AB]\d|_MULT18X18D|_DI_|\.\d+\.\d+)")
+
+
+def path_summary(cp: dict, max_items: int = 8) -> str:
+    """``a -> b [MULT18X18D] -> c`` over the distinct cells of a critical path: VHDL signal
+    names where GHDL kept them, yosys/nextpnr suffixes cut, block RAM outputs marked [DP16KD]
+    and multiplier outputs [MULT18X18D]."""
     seq: list[str] = []
     for st in cp.get("steps", []):
         c = st["cell"]
         if c.startswith("$nextpnr"):
             continue
-        if not seq or seq[-1] != c:
-            seq.append(c)
+        name = _CELL_SUFFIX_RE.split(c)[0]
+        port = st.get("port", "")
+        if port.startswith("DO"):
+            name += " [DP16KD]"
+        elif re.fullmatch(r"P\d+", port):
+            name += " [MULT18X18D]"
+        if not seq or seq[-1] != name:
+            if seq and seq[-1].split(" [")[0] == name.split(" [")[0] and "[" in seq[-1] and "[" not in name:
+                continue                      # the same cell again after its marked output
+            seq.append(name)
+    if len(seq) > max_items:
+        seq = seq[: max_items // 2] + ["..."] + seq[-(max_items // 2):]
     return " -> ".join(seq)
 
 
@@ -766,8 +781,9 @@ def run(args: argparse.Namespace) -> int:
           + ("bounding box" if scan_kind() == "box" else "row extents of the kernel ellipse")
           + f".  Worst window alignment, 20 iterations for both features.\n\n" + cycles_table(figs))
     print(ct)
-    if args.write:
-        write_section(ct, "cycles", "mstrack synth --cycles --write")
+    if args.write and args.cycles:
+        write_section(ct, f"cycles{_tag()}", "mstrack synth --cycles"
+                      + (f" --rtl-commit {args.rtl_commit}" if args.rtl_commit else "") + " --write")
     if args.check_cosim is not None:
         paths = args.check_cosim or sorted((REPO_ROOT / "build" / "cosim").glob("*.json"))
         for line in check_cosim_reports(paths, args.seq_root):
@@ -779,10 +795,10 @@ def run(args: argparse.Namespace) -> int:
         for name in args.config:
             bl = (json.loads((SYNTH_DIR / f"blocks_{name}{_tag()}.json").read_text()) if args.from_summaries
                   else synth_blocks(name, seed=args.seeds[0], freq_mhz=args.freq))
-            md = blocks_table(bl)
+            md = f"RTL: {_RTL_DESC}.\n\n" + blocks_table(bl)
             print(f"\n{md}")
             if args.write:
-                write_section(md, f"blocks-{name}", cmd)
+                write_section(md, f"blocks-{name}{_tag()}", cmd)
         return 0
     rows = []
     for name in args.config:
@@ -799,9 +815,10 @@ def run(args: argparse.Namespace) -> int:
         tables["xc7"] = xc7_table(rows)
         tables["vitis"] = vitis_table(rows)
     for sec, md in tables.items():
+        md = f"RTL: {_RTL_DESC}.\n\n" + md
         print(f"\n{md}")
         if args.write:
-            write_section(md, sec, cmd)
+            write_section(md, f"{sec}{_tag()}", cmd)
     print("\nseconds: " + "; ".join(f"{s['config']}: " + ", ".join(f"{k} {v}" for k, v in s["seconds"].items())
                                    for s in rows))
     return 0

@@ -1,15 +1,16 @@
 -- ms_tracker_pins: ms_tracker with few pins, for place-and-route (Fmax) runs only.
 --
--- The core has about 260 ports (a 144-bit result word, 80 bits of frame size and init box),
--- more than the 205 user I/Os of the LFE5U-85F in CABGA381, and in a system these ports are
--- internal anyway (video from a receiver, results to a CPU).  This wrapper keeps the video
--- stream ports as they are, loads frame_width, frame_height and the init box from a serial
--- configuration chain (cfg_shift/cfg_din, 6 x (COORD_W + 2) register bits, LSB first:
--- frame_width, frame_height, init x, y, w, h) and shifts each result word out one bit per
--- clock (res_dout, res_valid high while shifting; the core's result FIFO holds the next ones).
+-- The core has 258 ports (a 144-bit result word, 80 bits of frame size and init box): in a
+-- system they are internal (video from a receiver, results to a CPU), and they are more than
+-- the LFE5U-85F bonds in CABGA381 (about 200 user I/Os by Lattice's data sheet; nextpnr 0.11
+-- counts 365 IO sites in this package and would place them all).  This wrapper keeps the video stream ports as they are, loads frame_width,
+-- frame_height and the init box from a serial configuration chain (cfg_shift/cfg_din,
+-- 6 x (COORD_W + 2) register bits, LSB first: frame_width, frame_height, init x, y, w, h) and
+-- shifts each result word out one bit per clock (res_dout, res_valid high while shifting; the
+-- core's result FIFO holds the next ones).
 -- Every result bit stays observable, so synthesis removes nothing of the core.
--- Cost over the core: 6 (COORD_W + 2) + RESULT_W + clog2(RESULT_W) + 1 flip-flops and about as
--- many LUTs (loads / shifts); no block RAM, no multiplier.  Resource figures of the core itself
+-- Cost over the core: 6 (COORD_W + 2) + RESULT_W + clog2(RESULT_W) + 1 flip-flops and a few
+-- LUTs per bit (ECP5, default generics: +234 FF, +87 LUT4, +19 CCU2C); no RAM, no multiplier.  Resource figures of the core itself
 -- come from synthesising ms_tracker (mstrack/synth.py); this top is only for nextpnr.
 -- Generics: exactly those of ms_tracker (passed through).
 library ieee;

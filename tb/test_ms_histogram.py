@@ -26,6 +26,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from mstrack.hdl import dut_generics
 
 BIN_RD_LAT = 3
+HIST_ACC_LAT = 4   # rtl/ms_histogram.vhd header: last_done after in_last
 
 
 def model_hist(pix: list[tuple[int, int, int, int]], n_bins: int, flat: bool) -> dict[str, np.ndarray]:
@@ -103,7 +104,7 @@ class TB:
             if int(d.last_done.value):
                 break
             assert n < 10, "no last_done"
-        assert n == 2, f"last_done {n} clocks after the last beat"
+        assert n == HIST_ACC_LAT, f"last_done {n} clocks after the last beat"
 
     async def read_bins(self, rng: random.Random | None) -> dict[str, np.ndarray]:
         d = self.dut

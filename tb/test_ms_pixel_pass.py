@@ -29,7 +29,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 
 from mstrack.fixed.blocks import Region, ms_histogram, ms_kernel
 
-PASS_LAT = 6     # rtl/ms_pixel_pass.vhd header
+PASS_LAT = 10    # rtl/ms_pixel_pass.vhd header
 BIN_RD_LAT = 3   # rtl/ms_histogram.vhd header
 CFG_ENV = "MS_PIXEL_PASS_CFG"
 
@@ -282,6 +282,22 @@ CASES = [
     pytest.param("flat", 8, id="flat_L8"),
     pytest.param("epanechnikov", 8, id="epan_L8"),
 ]
+
+
+def test_row_extent_is_inside_test():
+    """The RTL's inside test is the scan's row-extent mask |dx| <= XR[|dy|] (|dy| <= ey), XR as
+    ms_kernel_tables defines it (largest dx in 0..ex with TA[dx] + TB[i] < D).  It equals the
+    model's ms_kernel.inside (TA[|dx|] + TB[|dy|] < D) for every target size w, h in 3 .. 127
+    (MAX_HALF 63) and every offset of the window, both kernels (the mask does not depend on k)."""
+    for w in range(3, 128):
+        for h in range(3, 128):
+            ker = ms_kernel(w, h, "flat", 8)
+            xr = model_xr(ker)
+            dx = np.abs(np.arange(-ker.ex, ker.ex + 1))[None, :]
+            dy = np.abs(np.arange(-ker.ey, ker.ey + 1))[:, None]
+            mask = dx <= np.asarray(xr)[dy]
+            assert np.array_equal(mask, ker.inside), (w, h)
+            assert ker.inside[:, ker.ex].all()     # dx = 0 inside every row: no empty row
 
 
 @pytest.mark.ghdl

@@ -540,8 +540,8 @@ def engine_cycles_learn(g: dict[str, int], pixel_pass: int, bins: int) -> int:
 
 
 #: clocks from the cycle of a frame's last input beat to the engines' start pulse: ms_frontend
-#: (frame_end 8 clocks after the last beat), ms_region_capture (done 2 later), T_IDLE (1)
-FRONT = 11
+#: (frame_end 9 clocks after the last beat), ms_region_capture (done 2 later), T_IDLE (1)
+FRONT = 12
 
 
 def fusion_cycles(g: dict[str, int], alpha_division: bool = True) -> int:

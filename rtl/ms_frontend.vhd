@@ -4,15 +4,16 @@
 -- Computes: the (x, y, colour bin, edge bin) of every interior pixel
 -- (1 <= x <= W-2, 1 <= y <= H-2) of each frame, in raster order, plus the
 -- frame events of ms_stream_check re-timed so that they keep their order with
--- the pixels: every event is delayed by EVT_DELAY = 7 clocks, so that
+-- the pixels: every event is delayed by EVT_DELAY = 8 clocks, so that
 --   * frame_end comes 1 clock AFTER the frame's last interior pixel (ip_valid),
---     i.e. 8 clocks after the frame's last input beat was accepted;
+--     i.e. 9 clocks after the frame's last input beat was accepted;
 --   * frame_error (any code, also ERR_CUT) comes after all the ip_* pixels of
 --     the abandoned frame;
---   * frame_start comes 8 clocks after the sof beat, before the first interior
+--   * frame_start comes 9 clocks after the sof beat, before the first interior
 --     pixel of that frame (which needs >= 2 W + 3 beats).
--- Latency: input beat of pixel (x+1, y+1) -> ip_valid of (x, y): 7 clocks
--- (check 1, grey 2, sobel 4).  Throughput: 1 pixel/clock; never stalls (no
+-- Latency: input beat of pixel (x+1, y+1) -> ip_valid of (x, y): 8 clocks
+-- (check 1, grey 2, sobel 5 after the grey; ms_sobel reads its line buffer
+-- with the position, which it gets one clock before the grey).  Throughput: 1 pixel/clock; never stalls (no
 -- ready): the top must back-pressure upstream itself if it needs to.
 -- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height (not checked).
 -- Python model: mstrack.fixed.blocks ms_colour_bin and
@@ -52,7 +53,7 @@ entity ms_frontend is
 end entity;
 
 architecture rtl of ms_frontend is
-  constant EVT_DELAY : natural := 7;  -- = pixel path after ms_stream_check (grey 2 + sobel 4) + 1
+  constant EVT_DELAY : natural := 8;  -- = pixel path after ms_stream_check (grey 2 + sobel 5) + 1
   constant CB_W : natural := 3 * COLOUR_BITS;
 
   signal px_valid : std_logic;
@@ -65,8 +66,8 @@ architecture rtl of ms_frontend is
   signal cb_bin, cb_bin_d : std_logic_vector(CB_W - 1 downto 0);
   signal g_valid  : std_logic;
   signal g_grey   : unsigned(7 downto 0);
-  type coord_pipe_t is array (1 to 2) of unsigned(COORD_W - 1 downto 0);
-  signal xd, yd   : coord_pipe_t;
+  signal pv1      : std_logic := '0';              -- px_valid delayed 1 clock
+  signal x1, y1   : unsigned(COORD_W - 1 downto 0);  -- px_x, px_y delayed 1 clock
 
   constant EV_W : natural := 3 + ERR_CODE_W;
   type ev_pipe_t is array (1 to EVT_DELAY) of std_logic_vector(EV_W - 1 downto 0);
@@ -89,20 +90,25 @@ begin
     port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data,
               out_valid => g_valid, out_grey => g_grey);
 
-  -- align the colour bin (latency 1) and x, y with the grey (latency 2)
+  -- align the colour bin (latency 1) with the grey (latency 2); ms_sobel takes the
+  -- position (valid, x, y) one clock before the grey
   p_align : process (clk)
   begin
     if rising_edge(clk) then
       cb_bin_d <= cb_bin;
-      xd <= px_x & xd(1);
-      yd <= px_y & yd(1);
+      pv1 <= px_valid;
+      x1  <= px_x;
+      y1  <= px_y;
+      if rst = '1' then
+        pv1 <= '0';
+      end if;
     end if;
   end process;
 
   u_sobel : entity work.ms_sobel
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
                  EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT)
-    port map (clk => clk, rst => rst, in_valid => g_valid, in_x => xd(2), in_y => yd(2),
+    port map (clk => clk, rst => rst, in_valid => pv1, in_x => x1, in_y => y1,
               in_grey => g_grey, in_cbin => cb_bin_d,
               ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin);
 

@@ -1,8 +1,11 @@
 -- ms_grey: grey level of an RGB pixel.
 --
 -- Computes: grey = (77 R + 150 G + 29 B) >> 8 (truncating, 0..255; the
--- weights sum to 256).  Stage 1 registers the three constant products
--- (15, 16 and 13 bits), stage 2 their sum (16 bits) and keeps bits 15:8.
+-- weights sum to 256), without multipliers: each constant product is a sum of
+-- shifted copies of its channel (77 = 64+8+4+1, 150 = 128+16+4+2,
+-- 29 = 16+8+4+1).  Stage 1 registers the three products, each as two adder
+-- levels ((a + b) + (c + d)); stage 2 their 16-bit sum (two adder levels) and
+-- keeps bits 15:8.  No MULT18X18D: at most two carry chains per clock.
 -- Latency: 2 clocks.  Throughput: 1 pixel/clock, no handshake (valid only).
 -- Python model: mstrack.fixed.blocks.ms_grey.
 library ieee;
@@ -21,16 +24,27 @@ entity ms_grey is
 end entity;
 
 architecture rtl of ms_grey is
+  constant P_W : natural := 16;  -- product / sum width (77 + 150 + 29 = 256: sum <= 65280)
   signal v1         : std_logic := '0';
-  signal pr, pg, pb : unsigned(15 downto 0);  -- 77 R, 150 G, 29 B
+  signal pr, pg, pb : unsigned(P_W - 1 downto 0);  -- 77 R, 150 G, 29 B
+
+  -- c shifted left by s bits, P_W wide
+  function sh(c : unsigned(7 downto 0); s : natural) return unsigned is
+  begin
+    return shift_left(resize(c, P_W), s);
+  end function;
 begin
   p_grey : process (clk)
+    variable r, g, b : unsigned(7 downto 0);
   begin
     if rising_edge(clk) then
+      r := unsigned(in_data(23 downto 16));
+      g := unsigned(in_data(15 downto 8));
+      b := unsigned(in_data(7 downto 0));
       v1        <= in_valid;
-      pr        <= resize(unsigned(in_data(23 downto 16)) * to_unsigned(77, 8), 16);
-      pg        <= resize(unsigned(in_data(15 downto 8)) * to_unsigned(150, 8), 16);
-      pb        <= resize(unsigned(in_data(7 downto 0)) * to_unsigned(29, 8), 16);
+      pr        <= (sh(r, 6) + sh(r, 3)) + (sh(r, 2) + sh(r, 0));  -- 77 R
+      pg        <= (sh(g, 7) + sh(g, 4)) + (sh(g, 2) + sh(g, 1));  -- 150 G
+      pb        <= (sh(b, 4) + sh(b, 3)) + (sh(b, 2) + sh(b, 0));  -- 29 B
       out_valid <= v1;
       out_grey  <= resize(shift_right(pr + pg + pb, 8), 8);
       if rst = '1' then

@@ -60,12 +60,22 @@ architecture rtl of ms_stream_check is
   type state_t is (S_WAIT, S_DROP, S_FRAME);  -- S_WAIT: waiting for sof, NO_SOF armed
   signal state  : state_t := S_WAIT;
   signal x, y   : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- position of the next beat
-  signal last_x : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- W - 1
-  signal last_y : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- H - 1
+  -- timing: the end-of-line / end-of-frame compares are kept as registered flags, updated
+  -- with x and y (the next flag compares the current x with W - 2), so that no compare sits
+  -- in front of the control decisions of a beat
+  signal pre_x  : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- W - 2
+  signal pre_y  : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- H - 2
+  signal x_last : std_logic := '1';  -- x = W - 1
+  signal y_last : std_logic := '1';  -- y = H - 1
+  signal w_one  : std_logic := '1';  -- W = 1
 begin
   p_check : process (clk)
     variable cx, cy     : unsigned(COORD_W - 1 downto 0);
-    variable lx, ly     : unsigned(COORD_W - 1 downto 0);
+    variable cx_last    : boolean;  -- cx = W - 1
+    variable cy_last    : boolean;  -- cy = H - 1
+    variable cx_pre     : boolean;  -- cx = W - 2
+    variable cy_pre     : boolean;  -- cy = H - 2
+    variable w1         : std_logic;
     variable active     : boolean;  -- the beat belongs to a frame in progress
   begin
     if rising_edge(clk) then
@@ -78,20 +88,27 @@ begin
         active := false;
         cx := x;
         cy := y;
-        lx := last_x;
-        ly := last_y;
+        cx_last := x_last = '1';
+        cy_last := y_last = '1';
+        cx_pre  := x = pre_x;
+        cy_pre  := y = pre_y;
+        w1      := w_one;
         if in_sof = '1' then
           if state = S_FRAME then
             frame_error <= '1';
             err_code    <= ERR_CUT;
           end if;
           frame_start <= '1';
-          lx := frame_width - 1;
-          ly := frame_height - 1;
-          last_x <= lx;
-          last_y <= ly;
+          pre_x  <= frame_width - 2;
+          pre_y  <= frame_height - 2;
           cx := (others => '0');
           cy := (others => '0');
+          cx_last := frame_width = 1;
+          cy_last := frame_height = 1;
+          cx_pre  := frame_width = 2;
+          cy_pre  := frame_height = 2;
+          w1      := '1' when frame_width = 1 else '0';
+          w_one   <= w1;
           active := true;
         elsif state = S_FRAME then
           active := true;
@@ -101,11 +118,11 @@ begin
           state       <= S_DROP;
         end if;
         if active then
-          if in_eol = '1' and cx /= lx then
+          if in_eol = '1' and not cx_last then
             frame_error <= '1';
             err_code    <= ERR_SHORT_LINE;
             state       <= S_DROP;
-          elsif in_eol = '0' and cx = lx then
+          elsif in_eol = '0' and cx_last then
             frame_error <= '1';
             err_code    <= ERR_LONG_LINE;
             state       <= S_DROP;
@@ -114,16 +131,20 @@ begin
             px_x     <= cx;
             px_y     <= cy;
             state    <= S_FRAME;
-            if cx = lx then
-              x <= (others => '0');
-              y <= cy + 1;
-              if cy = ly then
+            if cx_last then
+              x      <= (others => '0');
+              x_last <= w1;
+              y      <= cy + 1;
+              y_last <= '1' when cy_pre else '0';
+              if cy_last then
                 frame_end <= '1';
                 state     <= S_WAIT;
               end if;
             else
-              x <= cx + 1;
-              y <= cy;
+              x      <= cx + 1;
+              x_last <= '1' when cx_pre else '0';
+              y      <= cy;
+              y_last <= '1' when cy_last else '0';
             end if;
           end if;
         end if;

@@ -33,7 +33,7 @@ DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2"
 # error codes of rtl/ms_stream_pkg.vhd
 ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT = 0, 1, 2, 3
 #: input beat (last one accepted in clock c) -> frame_end high in clock c + FRAME_END_LAT
-FRAME_END_LAT = 8
+FRAME_END_LAT = 9
 
 
 # ---------------------------------------------------------------- frames and model

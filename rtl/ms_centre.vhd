@@ -12,8 +12,9 @@
 -- negatives) are computed while the division runs, one axis at a time (x after start, y when
 -- the x quotient is taken), so the result clock compares the quotient with registers in
 -- parallel with the add, instead of add -> compare -> compare in series (ECP5: 81 MHz).
--- Latency    : done SHIFT_Q_W + 4 clocks after start (start in cycle c, done in c + SHIFT_Q_W + 4).
--- Throughput : one centre per SHIFT_Q_W + 4 clocks; a start is accepted when busy = 0
+-- The divider operands are registered (x the clock after start, y the clock after that).
+-- Latency    : done SHIFT_Q_W + 5 clocks after start (start in cycle c, done in c + SHIFT_Q_W + 5).
+-- Throughput : one centre per SHIFT_Q_W + 5 clocks; a start is accepted when busy = 0
 --              (busy is already low in the done cycle, so starts can follow back to back).
 -- Handshake  : start samples sw, swx, swy, win_*, lo_*, hi_* (latched); done is a one-clock
 --              pulse; cx, cy, lost are registered and stable until the next result.
@@ -58,7 +59,7 @@ architecture rtl of ms_centre is
     if a > b then return a; end if;
     return b;
   end function;
-  constant LATENCY : natural := SHIFT_Q_W + 4;                    -- start -> done
+  constant LATENCY : natural := SHIFT_Q_W + 5;                    -- start -> done
   constant N_W     : natural := maxn(SWX_W + CF, SW_W - 1) + 1;   -- divider dividend bits
   constant CW      : natural := maxn(CENTRE_W, SHIFT_Q_W) + 2;    -- signed centre arithmetic bits
 
@@ -66,12 +67,14 @@ architecture rtl of ms_centre is
   signal ph_x   : std_logic := '0';   -- issue x this clock
   signal ph_y   : std_logic := '0';   -- issue y this clock
   signal sw_r   : unsigned(SW_W - 1 downto 0);
+  signal swh_r  : unsigned(SW_W - 2 downto 0);   -- sw >> 1
+  signal swh1_r : unsigned(N_W - 1 downto 0);    -- (sw >> 1) + 2**CF  (the + 1 of -s, shifted)
   signal swx_r  : signed(SWX_W - 1 downto 0);
   signal swy_r  : signed(SWX_W - 1 downto 0);
   signal win_x_r, win_y_r, lo_x_r, hi_x_r, lo_y_r, hi_y_r : unsigned(REGION_W - 1 downto 0);
   signal lost_r : std_logic;
 
-  signal d_valid : std_logic;
+  signal d_valid : std_logic := '0';               -- divider operands registered
   signal d_n     : unsigned(N_W - 1 downto 0);
   signal d_tag   : std_logic_vector(1 downto 0);  -- (1) = y, (0) = negative
   signal q_valid : std_logic;
@@ -119,6 +122,8 @@ begin
     if rising_edge(clk) then
       if busy_r = '0' and start = '1' then
         sw_r    <= sw;
+        swh_r   <= shift_right(sw, 1)(SW_W - 2 downto 0);
+        swh1_r  <= resize(shift_right(sw, 1), N_W) + to_unsigned(2 ** CF, N_W);
         swx_r   <= swx;
         swy_r   <= swy;
         win_x_r <= win_x;
@@ -136,27 +141,33 @@ begin
     end if;
   end process;
 
-  -- divider operands: (|s| << CF) + (sw >> 1), s = swx in the x phase, swy in the y phase
-  p_operands : process (ph_x, ph_y, sw_r, swx_r, swy_r)
+  -- divider operands, registered: (|s| << CF) + (sw >> 1), s = swx in the x phase, swy in the
+  -- y phase.  For s < 0, |s| = not s + 1 (as SWX_W-bit unsigned, also for s = -2**(SWX_W-1)),
+  -- so the operand is (not s << CF) + ((sw >> 1) + 2**CF): one adder after a select.
+  p_operands : process (clk)
     variable s   : signed(SWX_W - 1 downto 0);
-    variable mag : unsigned(SWX_W - 1 downto 0);
   begin
-    if ph_x = '1' then
-      s := swx_r;
-    else
-      s := swy_r;
+    if rising_edge(clk) then
+      if ph_x = '1' then
+        s := swx_r;
+      else
+        s := swy_r;
+      end if;
+      if s < 0 then
+        d_n      <= shift_left(resize(unsigned(not s), N_W), CF) + swh1_r;
+        d_tag(0) <= '1';
+      else
+        d_n      <= shift_left(resize(unsigned(s), N_W), CF) + resize(swh_r, N_W);
+        d_tag(0) <= '0';
+      end if;
+      d_tag(1) <= ph_y;
+      if rst = '1' then
+        d_valid <= '0';
+      else
+        d_valid <= ph_x or ph_y;
+      end if;
     end if;
-    if s < 0 then
-      mag := unsigned(-s);        -- -(-2**(SWX_W-1)) wraps to 2**(SWX_W-1), correct as unsigned
-      d_tag(0) <= '1';
-    else
-      mag := unsigned(s);
-      d_tag(0) <= '0';
-    end if;
-    d_tag(1) <= ph_y;
-    d_n      <= shift_left(resize(mag, N_W), CF) + resize(shift_right(sw_r, 1), N_W);
   end process;
-  d_valid <= ph_x or ph_y;
 
   u_div : entity work.ms_divider
     generic map (N_W => N_W, D_W => SW_W, Q_W => SHIFT_Q_W, TAG_W => 2)

@@ -499,9 +499,10 @@ def bin_pass_cycles(g: dict[str, int], n_bins: int, learn: bool = False) -> int:
 
 
 def centre_cycles(g: dict[str, int]) -> int:
-    """ms_centre: start -> done (docs/blocks/ms_centre.md); + 4 in the RTL before the divider
-    operands were registered."""
-    return g["SHIFT_Q_W"] + (5 if "swh1_r" in _rtl_text("ms_centre") else 4)
+    """ms_centre: start -> done (docs/blocks/ms_centre.md): + 6 with one iterative divider per
+    axis, + 5 with registered operands into one pipelined divider, + 4 before."""
+    t = _rtl_text("ms_centre")
+    return g["SHIFT_Q_W"] + (6 if "ms_divider_iter" in t else 5 if "swh1_r" in t else 4)
 
 
 def n_bins(g: dict[str, int]) -> tuple[int, int]:

@@ -19,6 +19,9 @@
 -- The products H Q, w N, w SX, w SY are pipelined radix-4 LUT multipliers (ms_mult_r4, latency
 -- M(a) = 1 + max(1, ceil(log2(ceil(a/2)))) for an a of a bits), not MULT18X18D (unregistered as
 -- yosys maps it on ECP5); H = 0 forces the ratio, not the weight, to 0 (isqrt(0) = 0).
+-- N, SX, SY do not travel through the divider and isqrt stages: they wait in a small delay
+-- memory (2**ceil(log2(DLY)) x (COUNT_W + 2 POSSUM_W), DLY = the two latencies) and two
+-- registers, read out beside the weight.
 --
 -- Latency    : learn: done 2 + N_BINS + BIN_RD_LAT clocks after start;
 --              track: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 1 + M(HIST_W),
@@ -78,8 +81,20 @@ architecture rtl of ms_bin_pass is
   constant N_BINS : natural := 2 ** BIN_W;
   constant PW     : natural := SQRT_IN_W - 2 * RF;            -- H Q product bits
   constant DN_W   : natural := HIST_W + 2 * WF;               -- divider dividend bits
-  -- divider / weight-isqrt tag: last & hzero & N & SX & SY
-  constant TG_W   : natural := 2 + COUNT_W + 2 * POSSUM_W;
+  -- N, SX, SY of a bin wait beside the divider and the weight isqrt in a delay memory (not
+  -- in every pipeline stage): DLY_W bits, DLY clocks from stage A to the isqrt output
+  constant DLY_W  : natural := COUNT_W + 2 * POSSUM_W;
+  constant DLY    : natural := (RATIO_Q_W + 1) + (RATIO_Q_W / 2 + 1);  -- ms_divider + ms_isqrt
+  function clog2(n : natural) return natural is
+    variable r : natural := 0;
+  begin
+    while 2 ** r < n loop
+      r := r + 1;
+    end loop;
+    return r;
+  end function;
+  constant DP_W   : natural := clog2(DLY);                     -- delay memory address bits
+  type dly_ram_t is array (0 to 2 ** DP_W - 1) of std_logic_vector(DLY_W - 1 downto 0);
 
   type ram_t is array (0 to N_BINS - 1) of std_logic_vector(HIST_W - 1 downto 0);
   signal q_ram : ram_t;
@@ -112,13 +127,18 @@ architecture rtl of ms_bin_pass is
   signal sq_tag    : std_logic_vector(0 downto 0);
   -- weight path
   signal div_n     : unsigned(DN_W - 1 downto 0);
-  signal div_tag_i : std_logic_vector(TG_W - 1 downto 0);
+  signal div_tag_i : std_logic_vector(1 downto 0);            -- last & hzero
   signal div_ov    : std_logic;
   signal div_q     : unsigned(RATIO_Q_W - 1 downto 0);
-  signal div_tag_o : std_logic_vector(TG_W - 1 downto 0);
+  signal div_tag_o : std_logic_vector(1 downto 0);
   signal wq_ov     : std_logic;
   signal wq_r      : unsigned(RATIO_Q_W / 2 - 1 downto 0);
-  signal wq_tag    : std_logic_vector(TG_W - 1 downto 0);
+  signal wq_tag    : std_logic_vector(0 downto 0);             -- last
+  signal dly_ram   : dly_ram_t;
+  signal dly_wp    : unsigned(DP_W - 1 downto 0) := (others => '0');
+  signal dly_rp    : unsigned(DP_W - 1 downto 0) := to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
+  signal dly_rd    : std_logic_vector(DLY_W - 1 downto 0);    -- memory read register
+  signal dly_o     : std_logic_vector(DLY_W - 1 downto 0);    -- N & SX & SY beside wq_r
   signal sqw_in    : unsigned(RATIO_Q_W - 1 downto 0);
   signal w_n       : unsigned(COUNT_W - 1 downto 0);
   signal vm        : std_logic;
@@ -241,40 +261,58 @@ begin
 
   ---------------------------------------------------------------- weight path: divide, isqrt, multiply
   div_n     <= shift_left(resize(q_a, DN_W), 2 * WF);
-  div_tag_i <= last_a & (nor h_a) & std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
+  div_tag_i <= last_a & (nor h_a);
 
   u_div : entity work.ms_divider
-    generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W, TAG_W => TG_W)
+    generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W, TAG_W => 2)
     port map (clk => clk, rst => rst, in_valid => va, in_n => div_n, in_d => h_a, in_tag => div_tag_i,
               out_valid => div_ov, out_q => div_q, out_tag => div_tag_o);
 
   -- H = 0: the divider saturates (d = 0); the ratio is forced to 0 here, so w = isqrt(0) = 0
-  sqw_in <= (others => '0') when div_tag_o(TG_W - 2) = '1' else div_q;
+  sqw_in <= (others => '0') when div_tag_o(0) = '1' else div_q;
 
   u_sqrt_w : entity work.ms_isqrt
-    generic map (IN_W => RATIO_Q_W, TAG_W => TG_W)
-    port map (clk => clk, rst => rst, in_valid => div_ov, in_x => sqw_in, in_tag => div_tag_o,
+    generic map (IN_W => RATIO_Q_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => div_ov, in_x => sqw_in, in_tag => div_tag_o(1 downto 1),
               out_valid => wq_ov, out_r => wq_r, out_tag => wq_tag);
 
+  -- delay memory: written every clock with stage A's N, SX, SY, read DLY - 2 clocks later into
+  -- dly_rd and registered once more (dly_o, no logic after the memory), so dly_o holds the
+  -- values of the bin whose weight is in wq_r (the pipelines always flow: a fixed delay)
+  p_dly : process (clk)
+  begin
+    if rising_edge(clk) then
+      dly_ram(to_integer(dly_wp)) <= std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
+      dly_rd <= dly_ram(to_integer(dly_rp));
+      dly_o  <= dly_rd;
+      dly_wp <= dly_wp + 1;
+      dly_rp <= dly_rp + 1;
+      if rst = '1' then
+        dly_wp <= (others => '0');
+        dly_rp <= to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
+      end if;
+    end if;
+  end process;
+
   -- weights w N, w SX, w SY (no mux after the isqrt: w = 0 for H = 0 comes from isqrt(0))
-  w_n  <= unsigned(wq_tag(2 * POSSUM_W + COUNT_W - 1 downto 2 * POSSUM_W));
+  w_n  <= unsigned(dly_o(2 * POSSUM_W + COUNT_W - 1 downto 2 * POSSUM_W));
 
   u_mult_n : entity work.ms_mult_r4
     generic map (A_W => WEIGHT_W, B_W => COUNT_W, B_SIGNED => false, P_W => SW_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r, in_b => std_logic_vector(w_n),
-              in_tag(0) => wq_tag(TG_W - 1), out_valid => vm, unsigned(out_p) => wn_m,
+              in_tag(0) => wq_tag(0), out_valid => vm, unsigned(out_p) => wn_m,
               out_tag(0) => last_m);
 
   u_mult_sx : entity work.ms_mult_r4
     generic map (A_W => WEIGHT_W, B_W => POSSUM_W, B_SIGNED => true, P_W => SWX_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r,
-              in_b => wq_tag(2 * POSSUM_W - 1 downto POSSUM_W), in_tag => "0",
+              in_b => dly_o(2 * POSSUM_W - 1 downto POSSUM_W), in_tag => "0",
               out_valid => open, signed(out_p) => wsx_m, out_tag => open);
 
   u_mult_sy : entity work.ms_mult_r4
     generic map (A_W => WEIGHT_W, B_W => POSSUM_W, B_SIGNED => true, P_W => SWX_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r,
-              in_b => wq_tag(POSSUM_W - 1 downto 0), in_tag => "0",
+              in_b => dly_o(POSSUM_W - 1 downto 0), in_tag => "0",
               out_valid => open, signed(out_p) => wsy_m, out_tag => open);
 
   ---------------------------------------------------------------- accumulators and done

@@ -1,8 +1,8 @@
 -- ms_mult_r4: pipelined radix-4 multiplier in LUTs and carry chains (no DSP block).
 --
 -- Computes p = (a * b) mod 2**P_W for an unsigned a (A_W bits) and a b of B_W bits, signed
--- (B_SIGNED = true, two's complement) or unsigned, i.e. resize(a * b, P_W) in numeric_std
--- terms (the exact product when P_W >= A_W + B_W).
+-- (B_SIGNED = true, two's complement) or unsigned: the low P_W bits of the product (equal to
+-- numeric_std resize(a * b, P_W) whenever the product fits in P_W bits, as in ms_bin_pass).
 -- a is split into ND = ceil(A_W / 2) radix-4 digits; digit j selects 0, b, 2b or 3b (3b is
 -- registered in stage 0 with the operands), weighted 4**j.  The ND partial products are summed
 -- by a pipelined binary tree, NLEV = max(1, ceil(log2 ND)) levels, one adder of P_W bits per
@@ -59,6 +59,7 @@ architecture rtl of ms_mult_r4 is
   constant NLEV    : natural := maxn(1, clog2(ND));          -- adder tree levels
   constant NDP     : natural := 2 ** NLEV;                   -- digits padded to a power of two
   constant LATENCY : natural := 1 + NLEV;                    -- in_valid -> out_valid
+  constant BX_W    : natural := maxn(P_W, B_W);              -- b extended
 
   subtype p_t is unsigned(P_W - 1 downto 0);
   type p_arr_t is array (0 to NDP - 1) of p_t;
@@ -87,17 +88,19 @@ begin
   end process;
 
   p_data : process (clk)
+    variable bx  : unsigned(BX_W - 1 downto 0);
     variable b   : p_t;
     variable sel : p_arr_t;
     variable d   : unsigned(1 downto 0);
   begin
     if rising_edge(clk) then
       -- stage 0: operands and 3 b
-      if B_SIGNED then
-        b := unsigned(resize(signed(in_b), P_W));
+      if B_SIGNED then                            -- b mod 2**P_W (low bits, also if P_W < B_W)
+        bx := unsigned(resize(signed(in_b), BX_W));
       else
-        b := resize(unsigned(in_b), P_W);
+        bx := resize(unsigned(in_b), BX_W);
       end if;
+      b := bx(P_W - 1 downto 0);
       a_r      <= resize(in_a, 2 * NDP);
       b1_r     <= b;
       b3_r     <= b + shift_left(b, 1);

@@ -499,12 +499,19 @@ def bin_pass_cycles(g: dict[str, int], n_bins: int, learn: bool = False) -> int:
     """ms_bin_pass: start -> done (docs/blocks/ms_bin_pass.md) for N_BINS = n_bins."""
     if learn:
         return 2 + n_bins + BIN_RD_LAT
-    return 3 + n_bins + BIN_RD_LAT + max(g["SQRT_IN_W"] // 2 + 2, g["RATIO_Q_W"] + g["RATIO_Q_W"] // 2 + 3)
+    def mult(a_w: int) -> int:   # ms_mult_r4 latency, 1 + max(1, ceil(log2(ceil(A_W / 2))))
+        return 1 + max(1, (((a_w + 1) // 2) - 1).bit_length())
+    if "ms_mult_r4" not in _rtl_text("ms_bin_pass"):     # RTL before the LUT multipliers
+        return 3 + n_bins + BIN_RD_LAT + max(g["SQRT_IN_W"] // 2 + 2, g["RATIO_Q_W"] + g["RATIO_Q_W"] // 2 + 3)
+    return 3 + n_bins + BIN_RD_LAT + max(g["SQRT_IN_W"] // 2 + 1 + mult(g["HIST_W"]),
+                                         g["RATIO_Q_W"] + g["RATIO_Q_W"] // 2 + 2 + mult(g["WEIGHT_W"]))
 
 
 def centre_cycles(g: dict[str, int]) -> int:
-    """ms_centre: start -> done (docs/blocks/ms_centre.md)."""
-    return g["SHIFT_Q_W"] + 4
+    """ms_centre: start -> done (docs/blocks/ms_centre.md): + 6 with one iterative divider per
+    axis, + 5 with registered operands into one pipelined divider, + 4 before."""
+    t = _rtl_text("ms_centre")
+    return g["SHIFT_Q_W"] + (6 if "ms_divider_iter" in t else 5 if "swh1_r" in t else 4)
 
 
 def n_bins(g: dict[str, int]) -> tuple[int, int]:

@@ -14,12 +14,19 @@
 -- The product H Q is kept in SQRT_IN_W - 2RF bits (the model sizes SQRT_IN_W for H, Q <= the
 -- largest possible histogram value, so it never truncates in use).
 -- The Q RAM is read one clock ahead (address = index of the next returning bin) and its word
--- registered beside H in stage A, so the H Q multiplier and the divider are fed from registers,
+-- registered beside H in stage A, so the H Q product and the divider are fed from registers,
 -- not from the block RAM's 5.6 ns output (ECP5: 79 MHz -> the multiplier path).
+-- The products H Q, w N, w SX, w SY are pipelined radix-4 LUT multipliers (ms_mult_r4, latency
+-- M(a) = 1 + max(1, ceil(log2(ceil(a/2)))) for an a of a bits), not MULT18X18D (unregistered as
+-- yosys maps it on ECP5); H = 0 forces the ratio, not the weight, to 0 (isqrt(0) = 0).
+-- N, SX, SY do not travel through the divider and isqrt stages: they wait in a small delay
+-- memory (2**ceil(log2(DLY)) x (COUNT_W + 2 POSSUM_W), DLY = the two latencies) and two
+-- registers, read out beside the weight.
 --
 -- Latency    : learn: done 2 + N_BINS + BIN_RD_LAT clocks after start;
---              track: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 2, RATIO_Q_W + RATIO_Q_W/2 + 3)
---              clocks after start (rho path: product + isqrt; weight path: divider + isqrt + multiply)
+--              track: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 1 + M(HIST_W),
+--              RATIO_Q_W + RATIO_Q_W/2 + 2 + M(WEIGHT_W)) clocks after start (rho path: product +
+--              isqrt; weight path: divider + isqrt + multiply; core flat: 3 + N_BINS + BIN_RD_LAT + 29)
 --              (start in cycle c, done high in cycle c + latency; tb/test_ms_bin_pass.py asserts it).
 -- Throughput : one bin per clock; a pass takes N_BINS + pipeline latency clocks.
 -- Handshake  : start/learn sampled when busy = 0; done is a one-clock pulse; s_sum, sw, swx,
@@ -74,8 +81,20 @@ architecture rtl of ms_bin_pass is
   constant N_BINS : natural := 2 ** BIN_W;
   constant PW     : natural := SQRT_IN_W - 2 * RF;            -- H Q product bits
   constant DN_W   : natural := HIST_W + 2 * WF;               -- divider dividend bits
-  -- divider / weight-isqrt tag: last & hzero & N & SX & SY
-  constant TG_W   : natural := 2 + COUNT_W + 2 * POSSUM_W;
+  -- N, SX, SY of a bin wait beside the divider and the weight isqrt in a delay memory (not
+  -- in every pipeline stage): DLY_W bits, DLY clocks from stage A to the isqrt output
+  constant DLY_W  : natural := COUNT_W + 2 * POSSUM_W;
+  constant DLY    : natural := (RATIO_Q_W + 1) + (RATIO_Q_W / 2 + 1);  -- ms_divider + ms_isqrt
+  function clog2(n : natural) return natural is
+    variable r : natural := 0;
+  begin
+    while 2 ** r < n loop
+      r := r + 1;
+    end loop;
+    return r;
+  end function;
+  constant DP_W   : natural := clog2(DLY);                     -- delay memory address bits
+  type dly_ram_t is array (0 to 2 ** DP_W - 1) of std_logic_vector(DLY_W - 1 downto 0);
 
   type ram_t is array (0 to N_BINS - 1) of std_logic_vector(HIST_W - 1 downto 0);
   signal q_ram : ram_t;
@@ -88,7 +107,9 @@ architecture rtl of ms_bin_pass is
   -- return side
   signal ret_cnt   : unsigned(BIN_W - 1 downto 0) := (others => '0');
   signal q_rd      : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM read register
-  signal q_addr    : unsigned(BIN_W - 1 downto 0);             -- index of the next returning bin
+  signal ret_nx    : unsigned(BIN_W - 1 downto 0) := to_unsigned(1, BIN_W);  -- ret_cnt + 1
+  signal q_we      : std_logic;                                -- Q RAM write (learn)
+  signal q_addr_p  : unsigned(BIN_W - 1 downto 0);             -- Q RAM address (write or read)
   signal q_a       : unsigned(HIST_W - 1 downto 0);            -- Q of the bin in stage A
   signal va        : std_logic := '0';                        -- stage A valid (track bins)
   signal last_a    : std_logic;
@@ -97,7 +118,7 @@ architecture rtl of ms_bin_pass is
   signal sx_a      : signed(POSSUM_W - 1 downto 0);
   signal sy_a      : signed(POSSUM_W - 1 downto 0);
   -- rho path
-  signal vb        : std_logic := '0';
+  signal vb        : std_logic;
   signal last_b    : std_logic;
   signal prod_b    : unsigned(PW - 1 downto 0);
   signal sq_in     : unsigned(SQRT_IN_W - 1 downto 0);
@@ -106,14 +127,21 @@ architecture rtl of ms_bin_pass is
   signal sq_tag    : std_logic_vector(0 downto 0);
   -- weight path
   signal div_n     : unsigned(DN_W - 1 downto 0);
-  signal div_tag_i : std_logic_vector(TG_W - 1 downto 0);
+  signal div_tag_i : std_logic_vector(1 downto 0);            -- last & hzero
   signal div_ov    : std_logic;
   signal div_q     : unsigned(RATIO_Q_W - 1 downto 0);
-  signal div_tag_o : std_logic_vector(TG_W - 1 downto 0);
+  signal div_tag_o : std_logic_vector(1 downto 0);
   signal wq_ov     : std_logic;
   signal wq_r      : unsigned(RATIO_Q_W / 2 - 1 downto 0);
-  signal wq_tag    : std_logic_vector(TG_W - 1 downto 0);
-  signal vm        : std_logic := '0';
+  signal wq_tag    : std_logic_vector(0 downto 0);             -- last
+  signal dly_ram   : dly_ram_t;
+  signal dly_wp    : unsigned(DP_W - 1 downto 0) := (others => '0');
+  signal dly_rp    : unsigned(DP_W - 1 downto 0) := to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
+  signal dly_rd    : std_logic_vector(DLY_W - 1 downto 0);    -- memory read register
+  signal dly_o     : std_logic_vector(DLY_W - 1 downto 0);    -- N & SX & SY beside wq_r
+  signal sqw_in    : unsigned(RATIO_Q_W - 1 downto 0);
+  signal w_n       : unsigned(COUNT_W - 1 downto 0);
+  signal vm        : std_logic;
   signal last_m    : std_logic;
   signal wn_m      : unsigned(SW_W - 1 downto 0);
   signal wsx_m     : signed(SWX_W - 1 downto 0);
@@ -168,19 +196,22 @@ begin
 
   ---------------------------------------------------------------- Q RAM (registered read, read-first)
   -- read address: the value ret_cnt takes at this edge, i.e. the index of the bin that returns
-  -- next, so q_rd holds Q[ret_cnt] whenever a bin returns (learn writes go to ret_cnt, never
-  -- to the address being read, N_BINS >= 2)
-  q_addr <= (others => '0') when busy_r = '0' and start = '1' else
-            ret_cnt + 1 when bin_rd_valid = '1' else
-            ret_cnt;
+  -- next, so q_rd holds Q[ret_cnt] whenever a bin returns.  ret_cnt is 0 when idle (a pass
+  -- counts N_BINS returns and wraps), so the start case needs no term; ret_nx = ret_cnt + 1 is a
+  -- register, leaving one LUT between registers and the block RAM address.  Learn writes use
+  -- the same single port at ret_cnt (read data unused in learn), so the RAM is single-port
+  -- (read-before-write within the port): no write/read collision logic after the block RAM,
+  -- whose output register then holds q_a.
+  q_we     <= bin_rd_valid and learn_r;
+  q_addr_p <= ret_nx when bin_rd_valid = '1' and learn_r = '0' else ret_cnt;
 
   p_ram : process (clk)
   begin
     if rising_edge(clk) then
-      if bin_rd_valid = '1' and learn_r = '1' then
-        q_ram(to_integer(ret_cnt)) <= std_logic_vector(bin_h);
+      if q_we = '1' then
+        q_ram(to_integer(q_addr_p)) <= std_logic_vector(bin_h);
       end if;
-      q_rd <= q_ram(to_integer(q_addr));
+      q_rd <= q_ram(to_integer(q_addr_p));
     end if;
   end process;
 
@@ -190,12 +221,15 @@ begin
     if rising_edge(clk) then
       if rst = '1' then
         ret_cnt <= (others => '0');
+        ret_nx  <= to_unsigned(1, BIN_W);
         va      <= '0';
       else
         if busy_r = '0' and start = '1' then
           ret_cnt <= (others => '0');
+          ret_nx  <= to_unsigned(1, BIN_W);
         elsif bin_rd_valid = '1' then
-          ret_cnt <= ret_cnt + 1;
+          ret_cnt <= ret_nx;
+          ret_nx  <= ret_nx + 1;
         end if;
         va <= bin_rd_valid and not learn_r;
       end if;
@@ -213,18 +247,10 @@ begin
   end process;
 
   ---------------------------------------------------------------- rho path: H Q -> isqrt
-  p_prod : process (clk)
-  begin
-    if rising_edge(clk) then
-      if rst = '1' then
-        vb <= '0';
-      else
-        vb <= va;
-      end if;
-      last_b <= last_a;
-      prod_b <= resize(h_a * q_a, PW);
-    end if;
-  end process;
+  u_mult_hq : entity work.ms_mult_r4
+    generic map (A_W => HIST_W, B_W => HIST_W, B_SIGNED => false, P_W => PW, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => va, in_a => h_a, in_b => std_logic_vector(q_a),
+              in_tag(0) => last_a, out_valid => vb, unsigned(out_p) => prod_b, out_tag(0) => last_b);
 
   sq_in <= shift_left(resize(prod_b, SQRT_IN_W), 2 * RF);
 
@@ -235,44 +261,59 @@ begin
 
   ---------------------------------------------------------------- weight path: divide, isqrt, multiply
   div_n     <= shift_left(resize(q_a, DN_W), 2 * WF);
-  div_tag_i <= last_a & (nor h_a) & std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
+  div_tag_i <= last_a & (nor h_a);
 
   u_div : entity work.ms_divider
-    generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W, TAG_W => TG_W)
+    generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W, TAG_W => 2)
     port map (clk => clk, rst => rst, in_valid => va, in_n => div_n, in_d => h_a, in_tag => div_tag_i,
               out_valid => div_ov, out_q => div_q, out_tag => div_tag_o);
 
+  -- H = 0: the divider saturates (d = 0); the ratio is forced to 0 here, so w = isqrt(0) = 0
+  sqw_in <= (others => '0') when div_tag_o(0) = '1' else div_q;
+
   u_sqrt_w : entity work.ms_isqrt
-    generic map (IN_W => RATIO_Q_W, TAG_W => TG_W)
-    port map (clk => clk, rst => rst, in_valid => div_ov, in_x => div_q, in_tag => div_tag_o,
+    generic map (IN_W => RATIO_Q_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => div_ov, in_x => sqw_in, in_tag => div_tag_o(1 downto 1),
               out_valid => wq_ov, out_r => wq_r, out_tag => wq_tag);
 
-  p_mult : process (clk)
-    variable w  : unsigned(WEIGHT_W - 1 downto 0);
-    variable n  : unsigned(COUNT_W - 1 downto 0);
-    variable sx : signed(POSSUM_W - 1 downto 0);
-    variable sy : signed(POSSUM_W - 1 downto 0);
+  -- delay memory: written every clock with stage A's N, SX, SY, read DLY - 2 clocks later into
+  -- dly_rd and registered once more (dly_o, no logic after the memory), so dly_o holds the
+  -- values of the bin whose weight is in wq_r (the pipelines always flow: a fixed delay)
+  p_dly : process (clk)
   begin
     if rising_edge(clk) then
+      dly_ram(to_integer(dly_wp)) <= std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
+      dly_rd <= dly_ram(to_integer(dly_rp));
+      dly_o  <= dly_rd;
+      dly_wp <= dly_wp + 1;
+      dly_rp <= dly_rp + 1;
       if rst = '1' then
-        vm <= '0';
-      else
-        vm <= wq_ov;
+        dly_wp <= (others => '0');
+        dly_rp <= to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
       end if;
-      if wq_tag(TG_W - 2) = '1' then                         -- H = 0: weight 0
-        w := (others => '0');
-      else
-        w := wq_r;
-      end if;
-      n  := unsigned(wq_tag(2 * POSSUM_W + COUNT_W - 1 downto 2 * POSSUM_W));
-      sx := signed(wq_tag(2 * POSSUM_W - 1 downto POSSUM_W));
-      sy := signed(wq_tag(POSSUM_W - 1 downto 0));
-      last_m <= wq_tag(TG_W - 1);
-      wn_m   <= resize(w * n, SW_W);
-      wsx_m  <= resize(signed('0' & w) * sx, SWX_W);
-      wsy_m  <= resize(signed('0' & w) * sy, SWX_W);
     end if;
   end process;
+
+  -- weights w N, w SX, w SY (no mux after the isqrt: w = 0 for H = 0 comes from isqrt(0))
+  w_n  <= unsigned(dly_o(2 * POSSUM_W + COUNT_W - 1 downto 2 * POSSUM_W));
+
+  u_mult_n : entity work.ms_mult_r4
+    generic map (A_W => WEIGHT_W, B_W => COUNT_W, B_SIGNED => false, P_W => SW_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r, in_b => std_logic_vector(w_n),
+              in_tag(0) => wq_tag(0), out_valid => vm, unsigned(out_p) => wn_m,
+              out_tag(0) => last_m);
+
+  u_mult_sx : entity work.ms_mult_r4
+    generic map (A_W => WEIGHT_W, B_W => POSSUM_W, B_SIGNED => true, P_W => SWX_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r,
+              in_b => dly_o(2 * POSSUM_W - 1 downto POSSUM_W), in_tag => "0",
+              out_valid => open, signed(out_p) => wsx_m, out_tag => open);
+
+  u_mult_sy : entity work.ms_mult_r4
+    generic map (A_W => WEIGHT_W, B_W => POSSUM_W, B_SIGNED => true, P_W => SWX_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r,
+              in_b => dly_o(POSSUM_W - 1 downto 0), in_tag => "0",
+              out_valid => open, signed(out_p) => wsy_m, out_tag => open);
 
   ---------------------------------------------------------------- accumulators and done
   p_acc : process (clk)

@@ -4,7 +4,10 @@
 -- unsigned divisor d (D_W bits), bit-exact with mstrack.fixed.primitives.ms_divider_reference
 -- (and the vectorised ms_divider).  Stage 0 registers the operands and flags saturation
 -- (n >= d << Q_W); stage k = 1..Q_W decides quotient bit i = Q_W - k by comparing the partial
--- remainder with d << i and subtracting it when it is >= (restoring division).
+-- remainder with d << i and subtracting it when it is >= (restoring division).  Unless the
+-- result saturates, the remainder entering stage k is < d << (i + 1), so only its bits
+-- i + D_W .. i take part: one (D_W + 2)-bit subtraction per stage, its borrow selecting
+-- (remainder bits no later stage reads are dropped by synthesis).
 -- d = 0: the saturation test n >= 0 is always true, so q = 2**Q_W - 1 (all ones); callers
 -- must avoid d = 0 (the model raises on it).
 --
@@ -12,8 +15,8 @@
 -- Throughput : one division per clock, no back-pressure: the pipeline always flows.
 -- Handshake  : in_valid qualifies in_n/in_d/in_tag; out_valid qualifies out_q/out_tag
 --              (one out_valid pulse per in_valid, in order, LATENCY clocks later).
--- Cost       : Q_W subtractors of max(N_W, D_W + Q_W) + 1 bits and as many pipeline registers
---              for the remainder, divisor and tag.
+-- Cost       : Q_W subtractors of D_W + 2 bits and as many pipeline registers for the
+--              remainder, divisor and tag.
 -- Reset      : synchronous, active high; clears the valid pipeline only.
 library ieee;
 use ieee.std_logic_1164.all;
@@ -76,33 +79,36 @@ begin
   end process;
 
   p_data : process (clk)
-    variable dsh : unsigned(CW - 1 downto 0);
+    variable hi   : unsigned(D_W downto 0);         -- remainder bits i + D_W .. i
+    variable diff : unsigned(D_W + 1 downto 0);     -- hi - d, top bit = borrow
+    variable i    : natural;
   begin
     if rising_edge(clk) then
-      -- stage 0: register operands, saturation test n >= d << Q_W
-      dsh := shift_left(resize(in_d, CW), Q_W);
+      -- stage 0: register operands, saturation test n >= d << Q_W  <=>  (n >> Q_W) >= d
       rem_r(0) <= resize(in_n, CW);
       d_r(0)   <= in_d;
       q_r(0)   <= (others => '0');
       tag_r(0) <= in_tag;
-      if resize(in_n, CW) >= dsh then
+      if shift_right(resize(in_n, CW), Q_W) >= resize(in_d, CW) then
         sat_r(0) <= '1';
       else
         sat_r(0) <= '0';
       end if;
-      -- stage k: quotient bit Q_W - k
+      -- stage k: quotient bit i = Q_W - k.  Unless saturated, rem < d << (i + 1), so
+      -- rem >= d << i  <=>  hi = rem(i + D_W .. i) >= d, and rem - (d << i) only changes those
+      -- bits: one D_W + 2 bit subtractor whose borrow selects (saturated: q is forced anyway)
       for k in 1 to Q_W loop
-        dsh := shift_left(resize(d_r(k - 1), CW), Q_W - k);
+        i := Q_W - k;
+        hi   := rem_r(k - 1)(i + D_W downto i);
+        diff := resize(hi, D_W + 2) - resize(d_r(k - 1), D_W + 2);
         d_r(k)   <= d_r(k - 1);
         tag_r(k) <= tag_r(k - 1);
         sat_r(k) <= sat_r(k - 1);
-        if rem_r(k - 1) >= dsh then
-          rem_r(k) <= rem_r(k - 1) - dsh;
-          q_r(k)   <= q_r(k - 1);
-          q_r(k)(Q_W - k) <= '1';
-        else
-          rem_r(k) <= rem_r(k - 1);
-          q_r(k)   <= q_r(k - 1);
+        rem_r(k) <= rem_r(k - 1);
+        q_r(k)   <= q_r(k - 1);
+        if diff(D_W + 1) = '0' then
+          rem_r(k)(i + D_W downto i) <= diff(D_W downto 0);
+          q_r(k)(i) <= '1';
         end if;
       end loop;
       -- saturation folded into the last stage so that out_q is a plain register

@@ -7,7 +7,8 @@
 --   alpha_e = 2**AF - alpha_c
 --   c       = (alpha_c * c_c + alpha_e * c_e + 2**(AF-1)) >> AF        (x and y)
 --   rho_f   = floor((S_f << (RHO_OUT_FRAC - RF)) / K)   (0 for an unused feature)
--- The three divisions share one pipelined ms_divider (issued on consecutive clocks).  The
+-- The three divisions run in three iterative dividers (ms_divider_iter, one quotient bit per
+-- clock, issued on consecutive clocks; each is used once per frame).  The
 -- blend needs no multiplier: alpha_c c_c and alpha_e c_e are built by shift-and-add, one bit
 -- of alpha per clock, MSB first (acc = 2 acc + bit c), then summed and rounded in two more
 -- clocks, so every clock has at most one adder between registers (no MULT18X18D, which yosys
@@ -68,13 +69,11 @@ architecture rtl of ms_fusion is
   signal tot_r          : unsigned(RHO_SUM_W downto 0);
   signal k_r            : unsigned(HIST_W - 1 downto 0);
   signal ccx_r, ccy_r, ecx_r, ecy_r : unsigned(CENTRE_ABS_W - 1 downto 0);
-  signal div_in_valid   : std_logic := '0';
+  signal dv_rc, dv_re, dv_a : std_logic := '0';  -- issue rho_c / rho_e / alpha division
   signal div_n          : unsigned(N_W - 1 downto 0);
   signal div_d          : unsigned(D_W - 1 downto 0);
-  signal div_tag        : std_logic_vector(1 downto 0);
-  signal div_out_valid  : std_logic;
-  signal div_q          : unsigned(Q_W - 1 downto 0);
-  signal div_out_tag    : std_logic_vector(1 downto 0);
+  signal qv_rc, qv_re, qv_a : std_logic;         -- results (one-clock pulses)
+  signal q_rc, q_re, q_a : unsigned(Q_W - 1 downto 0);
   signal n_results      : unsigned(1 downto 0);
   signal a_c            : unsigned(ALPHA_W - 1 downto 0);
   -- blend: multiplier bits (shifted out MSB first), products, sums
@@ -86,15 +85,28 @@ begin
   assert Q_W >= AF + 1 report "ms_fusion: RHO_OUT_FRAC must be >= AF" severity failure;
   assert RHO_OUT_FRAC >= RF report "ms_fusion: RHO_OUT_FRAC must be >= RF" severity failure;
 
-  u_div : entity work.ms_divider
-    generic map (N_W => N_W, D_W => D_W, Q_W => Q_W, TAG_W => 2)
-    port map (clk => clk, rst => rst, in_valid => div_in_valid, in_n => div_n, in_d => div_d,
-              in_tag => div_tag, out_valid => div_out_valid, out_q => div_q, out_tag => div_out_tag);
+  -- one iterative divider per division (each used once per frame: far fewer flip-flops than a
+  -- pipeline); issued on consecutive clocks, so the results come back on consecutive clocks,
+  -- each straight into its own register
+  u_div_rc : entity work.ms_divider_iter
+    generic map (N_W => N_W, D_W => D_W, Q_W => Q_W)
+    port map (clk => clk, rst => rst, in_valid => dv_rc, in_n => div_n, in_d => div_d,
+              busy => open, out_valid => qv_rc, out_q => q_rc);
+  u_div_re : entity work.ms_divider_iter
+    generic map (N_W => N_W, D_W => D_W, Q_W => Q_W)
+    port map (clk => clk, rst => rst, in_valid => dv_re, in_n => div_n, in_d => div_d,
+              busy => open, out_valid => qv_re, out_q => q_re);
+  u_div_a : entity work.ms_divider_iter
+    generic map (N_W => N_W, D_W => D_W, Q_W => Q_W)
+    port map (clk => clk, rst => rst, in_valid => dv_a, in_n => div_n, in_d => div_d,
+              busy => open, out_valid => qv_a, out_q => q_a);
 
   p_fsm : process(clk)
   begin
     if rising_edge(clk) then
-      div_in_valid <= '0';
+      dv_rc <= '0';
+      dv_re <= '0';
+      dv_a  <= '0';
       done <= '0';
       case state is
         when S_IDLE =>
@@ -104,17 +116,15 @@ begin
             ccx_r <= c_cx; ccy_r <= c_cy; ecx_r <= e_cx; ecy_r <= e_cy;
             n_results <= (others => '0');
             -- rho_c division: (S_c << (RHO_OUT_FRAC - RF)) / K
-            div_in_valid <= '1';
+            dv_rc <= '1';
             div_n <= shift_left(resize(s_c, N_W), RHO_OUT_FRAC - RF);
             div_d <= resize(k_sum, D_W);
-            div_tag <= "01";
             state <= S_ISSUE1;
           end if;
         when S_ISSUE1 =>
-          div_in_valid <= '1';
+          dv_re <= '1';
           div_n <= shift_left(resize(se_r, N_W), RHO_OUT_FRAC - RF);
           div_d <= resize(k_r, D_W);
-          div_tag <= "10";
           state <= S_ISSUE2;
         when S_ISSUE2 =>
           -- alpha division (fused mode with tot > 0); otherwise a constant
@@ -125,24 +135,13 @@ begin
           elsif tot_r = 0 then
             a_c <= to_unsigned(ONE / 2, ALPHA_W);
           else
-            div_in_valid <= '1';
+            dv_a  <= '1';
             div_n <= shift_left(resize(sc_r, N_W), AF) + shift_right(resize(tot_r, N_W), 1);
             div_d <= resize(tot_r, D_W);
-            div_tag <= "00";
           end if;
           state <= S_WAIT;
         when S_WAIT =>
-          if div_out_valid = '1' then
-            case div_out_tag is
-              when "01" =>
-                rho_c <= (others => '0');
-                if FEATURES /= 2 then rho_c <= resize(div_q, RHO_OUT_W); end if;
-              when "10" =>
-                rho_e <= (others => '0');
-                if FEATURES /= 1 then rho_e <= resize(div_q, RHO_OUT_W); end if;
-              when others =>
-                a_c <= resize(div_q, ALPHA_W);
-            end case;
+          if (qv_rc or qv_re or qv_a) = '1' then  -- results captured below
             n_results <= n_results + 1;
             -- the last expected result: 3 if the alpha division was issued, else 2
             if (n_results = 2) or (n_results = 1 and (FEATURES /= 0 or tot_r = 0)) then
@@ -193,9 +192,24 @@ begin
           done <= '1';
           state <= S_IDLE;
       end case;
+      -- division results (they only come back in S_WAIT): straight into their registers, enabled
+      -- by the divider's out_valid alone
+      if qv_rc = '1' then
+        rho_c <= (others => '0');
+        if FEATURES /= 2 then rho_c <= resize(q_rc, RHO_OUT_W); end if;
+      end if;
+      if qv_re = '1' then
+        rho_e <= (others => '0');
+        if FEATURES /= 1 then rho_e <= resize(q_re, RHO_OUT_W); end if;
+      end if;
+      if qv_a = '1' then
+        a_c <= resize(q_a, ALPHA_W);
+      end if;
       if rst = '1' then
         state <= S_IDLE;
-        div_in_valid <= '0';
+        dv_rc <= '0';
+        dv_re <= '0';
+        dv_a  <= '0';
         done <= '0';
       end if;
     end if;

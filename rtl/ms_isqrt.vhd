@@ -5,13 +5,14 @@
 -- Stage 0 registers the input; stage k = 1..IN_W/2 brings down the next two input bits into
 -- the remainder (rem = rem * 4 + x[2i+1:2i], i = IN_W/2 - k) and tries rem - (4 * root + 1):
 -- if the trial is >= 0 the root bit is 1 and the remainder becomes the trial, else 0.
--- The remainder never exceeds 2 * root, so it is held in IN_W/2 + 3 bits.
+-- The remainder never exceeds 2 * root, so it is held in IN_W/2 + 3 bits, and stage k only
+-- subtracts over the k + 2 bits it can occupy (one subtractor, its borrow selecting).
 --
 -- Latency    : LATENCY = IN_W / 2 + 1 clocks from in_valid to out_valid (constant LATENCY below).
 -- Throughput : one root per clock, no back-pressure: the pipeline always flows.
 -- Handshake  : in_valid qualifies in_x/in_tag; out_valid qualifies out_r/out_tag
 --              (one out_valid per in_valid, in order, LATENCY clocks later).
--- Cost       : IN_W/2 subtractors of IN_W/2 + 3 bits; per stage the remaining input bits,
+-- Cost       : IN_W/2 subtractors of at most IN_W/2 + 2 bits; per stage the remaining input bits,
 --              remainder, root and tag registers.
 -- Reset      : synchronous, active high; clears the valid pipeline only.
 library ieee;
@@ -39,6 +40,11 @@ architecture rtl of ms_isqrt is
   constant R_W     : natural := IN_W / 2;
   constant LATENCY : natural := R_W + 1;                   -- clocks from in_valid to out_valid
   constant RW      : natural := R_W + 3;                   -- remainder / trial width
+  function minn(a, b : natural) return natural is
+  begin
+    if a < b then return a; end if;
+    return b;
+  end function;
 
   type x_arr_t is array (0 to R_W) of unsigned(IN_W - 1 downto 0);
   type rem_arr_t is array (0 to R_W) of unsigned(RW - 1 downto 0);
@@ -66,9 +72,10 @@ begin
   end process;
 
   p_data : process (clk)
-    variable rm    : unsigned(RW - 1 downto 0);
-    variable trial : unsigned(RW - 1 downto 0);
-    variable sub   : unsigned(RW - 1 downto 0);
+    variable rm   : unsigned(RW - 1 downto 0);
+    variable sub  : unsigned(RW - 1 downto 0);
+    variable diff : unsigned(RW downto 0);        -- rm - sub, top bit = borrow
+    variable nw   : natural;                      -- significant bits of rm in stage k
   begin
     if rising_edge(clk) then
       x_r(0)   <= in_x;
@@ -76,19 +83,24 @@ begin
       r_r(0)   <= (others => '0');
       tag_r(0) <= in_tag;
       for k in 1 to R_W loop
+        -- after stage k - 1 the root has k - 1 bits and rem <= 2 root < 2**k, so rm has
+        -- k + 2 significant bits: the trial subtraction is only that wide (bit-exact)
+        nw := minn(k + 2, RW);
         -- bring down the next two bits (top of the shifted input)
         rm  := shift_left(rem_r(k - 1), 2);
         rm(1 downto 0) := x_r(k - 1)(IN_W - 1 downto IN_W - 2);
         sub := shift_left(resize(r_r(k - 1), RW), 2);
         sub(0) := '1';
+        diff := (others => '0');
+        diff(nw downto 0) := resize(rm(nw - 1 downto 0), nw + 1) - resize(sub(nw - 1 downto 0), nw + 1);
         x_r(k)   <= shift_left(x_r(k - 1), 2);
         tag_r(k) <= tag_r(k - 1);
-        if rm >= sub then
-          trial := rm - sub;
-          rem_r(k) <= trial;
+        rem_r(k) <= (others => '0');
+        if diff(nw) = '0' then
+          rem_r(k)(nw - 1 downto 0) <= diff(nw - 1 downto 0);
           r_r(k)   <= shift_left(r_r(k - 1), 1) or to_unsigned(1, R_W);
         else
-          rem_r(k) <= rm;
+          rem_r(k)(nw - 1 downto 0) <= rm(nw - 1 downto 0);
           r_r(k)   <= shift_left(r_r(k - 1), 1);
         end if;
       end loop;

@@ -14,8 +14,8 @@
 -- the model histogram Q and returns K = sum H.
 -- A "pass" = ms_pixel_pass (window bounding box, LANES px/clock) then ms_bin_pass (one bin
 -- per clock).  Cycles per iteration: the pixel pass (sum over the window rows of the LANES
--- groups of each row's ellipse extent, + 6) + the bin pass (N_BINS + ~33) + ms_centre
--- (SHIFT_Q_W + 4) + 6 of control; docs/realtime.md, docs/performance.md.
+-- groups of each row's ellipse extent, + 6) + the bin pass (N_BINS + ~35) + ms_centre
+-- (SHIFT_Q_W + 6) + 6 of control; docs/realtime.md, docs/performance.md.
 -- Handshake: `start` pulse while `busy` = 0; `done` pulse with the results (held).
 library ieee;
 use ieee.std_logic_1164.all;

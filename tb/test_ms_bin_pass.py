@@ -37,7 +37,13 @@ def pass_latency(g: dict, learn: bool) -> int:
     if learn:
         return 2 + nb + lat
     rq = int(g["RATIO_Q_W"])
-    return 3 + nb + lat + max(int(g["SQRT_IN_W"]) // 2 + 2, rq + rq // 2 + 3)
+    return 3 + nb + lat + max(int(g["SQRT_IN_W"]) // 2 + 1 + mult_latency(int(g["HIST_W"])),
+                              rq + rq // 2 + 2 + mult_latency(int(g["WEIGHT_W"])))
+
+
+def mult_latency(a_w: int) -> int:
+    """ms_mult_r4 LATENCY: 1 + max(1, ceil(log2(ceil(A_W / 2))))."""
+    return 1 + max(1, (((a_w + 1) // 2) - 1).bit_length())
 
 
 def fixed_params(g: dict) -> FixedParams:

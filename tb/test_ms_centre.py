@@ -3,7 +3,7 @@
 Model: :func:`mstrack.fixed.blocks.ms_centre` (round_div_signed + clamp_centre) on
 region-relative coordinates.  Random sums (negative, zero Swx, Sw = 1, Sw = 0 -> lost,
 extreme values that saturate the divider, shifts that need clamping at both limits),
-started back to back (full speed, asserting the documented latency SHIFT_Q_W + 4) and
+started back to back (full speed, asserting the documented latency SHIFT_Q_W + 6) and
 with random gaps.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_centre.py``.
@@ -29,7 +29,7 @@ MAX_HALF = 63
 
 def centre_latency(g: dict) -> int:
     """Documented start -> done latency of ms_centre (header of rtl/ms_centre.vhd)."""
-    return int(g["SHIFT_Q_W"]) + 4
+    return int(g["SHIFT_Q_W"]) + 6
 
 
 def centre_cases(g: dict, rng: random.Random, n: int) -> list[dict]:

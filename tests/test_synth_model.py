@@ -29,18 +29,20 @@ def test_engine_cycles_matches_documented_worst_case():
     g = synth.CONFIGS["lanes2"].generics()
     p = synth.pixel_pass_cycles(63, 63, 2)                  # box scan, 127 x 64 + 5
     eng = synth.engine_cycles(g, [p] * 21, 512, 20)
-    assert 11 + eng + 1 + (g["RHO_OUT_FRAC"] + 8) + 3 == 182_763
+    # + 21 x 2 (bin pass, LUT multipliers) + 20 x 2 (centre: registered divider operands,
+    # iterative dividers)
+    assert 11 + eng + 1 + (g["RHO_OUT_FRAC"] + 8) + 3 == 182_763 + 21 * 2 + 20 * 2
     # stop "lost" at the first centre: one pass, one bin pass, one centre
-    assert synth.engine_cycles(g, [p], 512, 1, "lost") == p + 545 + 18 + 7
+    assert synth.engine_cycles(g, [p], 512, 1, "lost") == p + 547 + 20 + 7
     with pytest.raises(AssertionError):
         synth.engine_cycles(g, [p] * 20, 512, 20)           # n iterations need n + 1 passes
 
 
 def test_bin_pass_and_centre_latencies():
     g = synth.CONFIGS["default"].generics()
-    assert synth.bin_pass_cycles(g, 512) == 545 and synth.bin_pass_cycles(g, 16) == 49
+    assert synth.bin_pass_cycles(g, 512) == 547 and synth.bin_pass_cycles(g, 16) == 51
     assert synth.bin_pass_cycles(g, 512, learn=True) == 517
-    assert synth.centre_cycles(g) == 18
+    assert synth.centre_cycles(g) == 20
 
 
 NETLIST = """module sub_1_2 (input clk);

@@ -7,7 +7,11 @@
 --   len > 2*MAX_HALF + 1    -> lo += (len - (2*MAX_HALF+1)) / 2; len = 2*MAX_HALF + 1
 -- and then the half extents e = (len - 1) / 2 and the init centre in Q.CF:
 --   c = (2*lo + len - 1) << (CF - 1).
--- Latency: 2 clocks from in_valid to out_valid.  Throughput: 1 box per clock.
+-- Pipeline (at most one carry chain plus selection per clock): 1 lo = max(a, 1),
+-- lo + WIN_MAX, a + n, S - 1; 2 len = hi - lo and len - WIN_MAX (both candidates of hi,
+-- selected by the compare a + n > S - 1); 3 reject test, shrink (lo += (len - WIN_MAX)/2),
+-- len - 1; 4 half extent and centre 2 lo + len - 1.
+-- Latency: 4 clocks from in_valid to out_valid.  Throughput: 1 box per clock.
 -- Handshake: valid only (no back-pressure); used once per init request.
 library ieee;
 use ieee.std_logic_1164.all;
@@ -49,83 +53,126 @@ architecture rtl of ms_box_clip is
   constant WIN_MAX : integer := 2 * MAX_HALF + 1;
   subtype s_t is signed(SW - 1 downto 0);
 
-  signal v1              : std_logic := '0';
-  signal lo_x, lo_y      : s_t;
-  signal len_x, len_y    : s_t;
-  signal same_x, same_y  : std_logic;
+  -- per axis, stage 1
+  type s1_t is record
+    lo    : s_t;        -- max(a, 1)
+    lo_w  : s_t;        -- lo + WIN_MAX
+    hi_a  : s_t;        -- a + n (box end, exclusive)
+    hi_b  : s_t;        -- S - 1 (interior end, exclusive)
+    a_in  : std_logic;  -- a >= 1 (lo = a)
+  end record;
+  -- stage 2
+  type s2_t is record
+    lo    : s_t;
+    len   : s_t;        -- min(a + n, S - 1) - lo
+    dw    : s_t;        -- len - WIN_MAX
+    same  : std_logic;  -- lo = a and hi = a + n
+  end record;
+  -- stage 3
+  type s3_t is record
+    lo    : s_t;        -- start after shrinking
+    len   : s_t;        -- size after shrinking
+    lm1   : s_t;        -- len - 1
+    rej   : std_logic;  -- len < 3 (before shrinking)
+    shr   : std_logic;  -- shrunk to WIN_MAX
+    same  : std_logic;
+  end record;
+
+  function stage1(box_a : signed; box_n : unsigned; size : unsigned) return s1_t is
+    variable r : s1_t;
+    variable a : s_t;
+  begin
+    a := resize(box_a, SW);
+    if a < 1 then
+      r.lo := to_signed(1, SW);
+      r.lo_w := to_signed(1 + WIN_MAX, SW);
+      r.a_in := '0';
+    else
+      r.lo := a;
+      r.lo_w := a + WIN_MAX;
+      r.a_in := '1';
+    end if;
+    r.hi_a := a + signed(resize(box_n, SW));
+    r.hi_b := signed(resize(size, SW)) - 1;
+    return r;
+  end function;
+
+  function stage2(p : s1_t) return s2_t is
+    variable r : s2_t;
+  begin
+    r.lo := p.lo;
+    if p.hi_a > p.hi_b then
+      r.len := p.hi_b - p.lo;
+      r.dw := p.hi_b - p.lo_w;
+      r.same := '0';
+    else
+      r.len := p.hi_a - p.lo;
+      r.dw := p.hi_a - p.lo_w;
+      r.same := p.a_in;
+    end if;
+    return r;
+  end function;
+
+  function stage3(p : s2_t) return s3_t is
+    variable r : s3_t;
+  begin
+    r.rej := '1' when p.len < 3 else '0';
+    r.same := p.same;
+    if p.dw > 0 then            -- len > WIN_MAX: shrink about the centre
+      r.lo := p.lo + shift_right(p.dw, 1);
+      r.len := to_signed(WIN_MAX, SW);
+      r.lm1 := to_signed(WIN_MAX - 1, SW);
+      r.shr := '1';
+    else
+      r.lo := p.lo;
+      r.len := p.len;
+      r.lm1 := p.len - 1;
+      r.shr := '0';
+    end if;
+    return r;
+  end function;
+
+  function centre(p : s3_t) return unsigned is
+  begin
+    return shift_left(resize(unsigned(shift_left(p.lo, 1) + p.lm1), COORD_W + CF), CF - 1);
+  end function;
+
+  signal v1, v2, v3 : std_logic := '0';
+  signal x1, y1     : s1_t;
+  signal x2, y2     : s2_t;
+  signal x3, y3     : s3_t;
 begin
-  -- stage 1: clip to the interior
-  p_clip : process(clk)
-    variable a, n, s, lo, hi : s_t;
+  p_pipe : process(clk)
   begin
     if rising_edge(clk) then
-      -- x axis
-      a := resize(box_x, SW);
-      n := signed(resize(box_w, SW));
-      s := signed(resize(frame_w, SW));
-      lo := a;
-      if lo < 1 then lo := to_signed(1, SW); end if;
-      hi := a + n;
-      if hi > s - 1 then hi := s - 1; end if;
-      lo_x <= lo;
-      len_x <= hi - lo;
-      same_x <= '1' when lo = a and hi = a + n else '0';
-      -- y axis
-      a := resize(box_y, SW);
-      n := signed(resize(box_h, SW));
-      s := signed(resize(frame_h, SW));
-      lo := a;
-      if lo < 1 then lo := to_signed(1, SW); end if;
-      hi := a + n;
-      if hi > s - 1 then hi := s - 1; end if;
-      lo_y <= lo;
-      len_y <= hi - lo;
-      same_y <= '1' when lo = a and hi = a + n else '0';
+      -- stage 1: clip the start to the interior
+      x1 <= stage1(box_x, box_w, frame_w);
+      y1 <= stage1(box_y, box_h, frame_h);
+      -- stage 2: clip the end, length
+      x2 <= stage2(x1);
+      y2 <= stage2(y1);
+      -- stage 3: reject / shrink to the largest window
+      x3 <= stage3(x2);
+      y3 <= stage3(y2);
+      -- stage 4: outputs, half extents, centre
+      clip_x <= unsigned(x3.lo(COORD_W - 1 downto 0));
+      clip_w <= unsigned(x3.len(COORD_W - 1 downto 0));
+      ex <= resize(unsigned(shift_right(x3.lm1, 1)), HALF_W);
+      cx <= centre(x3);
+      clip_y <= unsigned(y3.lo(COORD_W - 1 downto 0));
+      clip_h <= unsigned(y3.len(COORD_W - 1 downto 0));
+      ey <= resize(unsigned(shift_right(y3.lm1, 1)), HALF_W);
+      cy <= centre(y3);
+      rejected <= x3.rej or y3.rej;
+      clipped <= x3.rej or y3.rej or x3.shr or y3.shr or not x3.same or not y3.same;
       v1 <= in_valid;
+      v2 <= v1;
+      v3 <= v2;
+      out_valid <= v3;
       if rst = '1' then
         v1 <= '0';
-      end if;
-    end if;
-  end process;
-
-  -- stage 2: reject / shrink to the largest window, half extents, centre
-  p_fit : process(clk)
-    variable lo, ln   : s_t;
-    variable shrunk   : boolean;
-    variable rej      : boolean;
-    variable cxv, cyv : unsigned(COORD_W + CF - 1 downto 0);
-  begin
-    if rising_edge(clk) then
-      rej := len_x < 3 or len_y < 3;
-      shrunk := false;
-      -- x
-      lo := lo_x; ln := len_x;
-      if ln > WIN_MAX then
-        lo := lo + shift_right(ln - WIN_MAX, 1);
-        ln := to_signed(WIN_MAX, SW);
-        shrunk := true;
-      end if;
-      clip_x <= unsigned(lo(COORD_W - 1 downto 0));
-      clip_w <= unsigned(ln(COORD_W - 1 downto 0));
-      ex <= resize(unsigned(shift_right(ln - 1, 1)), HALF_W);
-      cxv := shift_left(resize(unsigned(shift_left(lo, 1) + ln - 1), COORD_W + CF), CF - 1);
-      -- y
-      lo := lo_y; ln := len_y;
-      if ln > WIN_MAX then
-        lo := lo + shift_right(ln - WIN_MAX, 1);
-        ln := to_signed(WIN_MAX, SW);
-        shrunk := true;
-      end if;
-      clip_y <= unsigned(lo(COORD_W - 1 downto 0));
-      clip_h <= unsigned(ln(COORD_W - 1 downto 0));
-      ey <= resize(unsigned(shift_right(ln - 1, 1)), HALF_W);
-      cyv := shift_left(resize(unsigned(shift_left(lo, 1) + ln - 1), COORD_W + CF), CF - 1);
-      cx <= cxv;
-      cy <= cyv;
-      rejected <= '1' when rej else '0';
-      clipped <= '1' when rej or shrunk or same_x = '0' or same_y = '0' else '0';
-      out_valid <= v1;
-      if rst = '1' then
+        v2 <= '0';
+        v3 <= '0';
         out_valid <= '0';
       end if;
     end if;

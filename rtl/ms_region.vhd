@@ -6,6 +6,11 @@
 --   start = min(max(c - e - MARGIN, 1), S - 1 - n)
 -- The region is columns start .. start + n - 1 (inside the frame interior).  It also
 -- gives the region-relative limits of the window centre: lo = e, hi = n - 1 - e.
+-- Timing: stage 1 computes, per axis, the unclamped start round(c) - (e + MARGIN),
+-- t = S - 1 - (2e + 2*MARGIN + 1) (the upper start limit when the region is not cut
+-- by the frame) and both candidates of n and hi; stage 2 only compares (t < 1: n = S - 2
+-- and start = 1; else start = min(max(start, 1), t)) and selects: at most two carry
+-- chains in a clock.
 -- Latency: 2 clocks from in_valid to out_valid.  Throughput: 1 per clock.
 -- Handshake: valid only; used once per frame.
 library ieee;
@@ -43,38 +48,69 @@ end entity;
 architecture rtl of ms_region is
   constant SW : natural := COORD_W + 3;
   subtype s_t is signed(SW - 1 downto 0);
-  signal v1           : std_logic := '0';
-  signal n_x, n_y     : s_t;
-  signal st_x, st_y   : s_t;
-  signal ex1, ey1     : s_t;
-  signal smax_x, smax_y : s_t;
+  type axis_t is record
+    st   : s_t;  -- round(c) - e - MARGIN (unclamped start)
+    t    : s_t;  -- S - 1 - (2e + 2 MARGIN + 1): start limit if the box + margins fit
+    n_a  : s_t;  -- 2e + 2 MARGIN + 1 (n if it fits)
+    n_b  : s_t;  -- S - 2 (n otherwise)
+    hi_a : s_t;  -- e + 2 MARGIN (= n_a - 1 - e)
+    hi_b : s_t;  -- S - 3 - e (= n_b - 1 - e)
+  end record;
+  signal v1   : std_logic := '0';
+  signal ax, ay : axis_t;
 
   function round_pos(c : unsigned) return s_t is
   begin
     return resize(signed('0' & shift_right(c + to_unsigned(2 ** (CF - 1), c'length), CF)), SW);
   end function;
+
+  -- stage 1 of one axis
+  function prepare(c : unsigned; ev : unsigned; sv : unsigned) return axis_t is
+    variable a    : axis_t;
+    variable e, s : s_t;
+  begin
+    e := signed(resize(ev, SW));
+    s := signed(resize(sv, SW));
+    a.st   := round_pos(c) - (e + MARGIN);
+    a.t    := (s - (2 * MARGIN + 2)) - shift_left(e, 1);
+    a.n_a  := shift_left(e, 1) + (2 * MARGIN + 1);
+    a.n_b  := s - 2;
+    a.hi_a := e + 2 * MARGIN;
+    a.hi_b := (s - 3) - e;
+    return a;
+  end function;
+
+  -- stage 2 of one axis: clamped start, n, hi
+  type res_t is record
+    st, n, hi : s_t;
+  end record;
+  function finish(a : axis_t) return res_t is
+    variable r : res_t;
+  begin
+    if a.t < 1 then             -- region cut to the frame interior: n = S - 2, start = 1
+      r.st := to_signed(1, SW);
+      r.n  := a.n_b;
+      r.hi := a.hi_b;
+    else
+      if a.st > a.t then
+        r.st := a.t;
+      elsif a.st < 1 then
+        r.st := to_signed(1, SW);
+      else
+        r.st := a.st;
+      end if;
+      r.n  := a.n_a;
+      r.hi := a.hi_a;
+    end if;
+    return r;
+  end function;
 begin
-  -- stage 1: region size and the unclamped start
+  -- stage 1: unclamped start, start limit, candidates of n and hi
   p_size : process(clk)
-    variable e, n, s : s_t;
   begin
     if rising_edge(clk) then
-      e := signed(resize(ex, SW));
-      s := signed(resize(frame_w, SW));
-      n := shift_left(e, 1) + (2 * MARGIN + 1);
-      if n > s - 2 then n := s - 2; end if;
-      n_x <= n;
-      st_x <= round_pos(cx) - e - MARGIN;
-      smax_x <= s - 1 - n;
-      ex1 <= e;
-      e := signed(resize(ey, SW));
-      s := signed(resize(frame_h, SW));
-      n := shift_left(e, 1) + (2 * MARGIN + 1);
-      if n > s - 2 then n := s - 2; end if;
-      n_y <= n;
-      st_y <= round_pos(cy) - e - MARGIN;
-      smax_y <= s - 1 - n;
-      ey1 <= e;
+      ax <= prepare(cx, ex, frame_w);
+      ay <= prepare(cy, ey, frame_h);
       v1 <= in_valid;
       if rst = '1' then
         v1 <= '0';
@@ -82,23 +118,19 @@ begin
     end if;
   end process;
 
-  -- stage 2: clamp the start into the interior, limits of the window centre
+  -- stage 2: clamp the start into the interior, select n and the window centre limit
   p_clamp : process(clk)
-    variable st : s_t;
+    variable rx, ry : res_t;
   begin
     if rising_edge(clk) then
-      st := st_x;
-      if st < 1 then st := to_signed(1, SW); end if;
-      if st > smax_x then st := smax_x; end if;
-      reg_x <= unsigned(st(COORD_W - 1 downto 0));
-      reg_w <= unsigned(n_x(REGION_W - 1 downto 0));
-      hi_x <= unsigned(resize(n_x - 1 - ex1, REGION_W));
-      st := st_y;
-      if st < 1 then st := to_signed(1, SW); end if;
-      if st > smax_y then st := smax_y; end if;
-      reg_y <= unsigned(st(COORD_W - 1 downto 0));
-      reg_h <= unsigned(n_y(REGION_W - 1 downto 0));
-      hi_y <= unsigned(resize(n_y - 1 - ey1, REGION_W));
+      rx := finish(ax);
+      ry := finish(ay);
+      reg_x <= unsigned(rx.st(COORD_W - 1 downto 0));
+      reg_w <= unsigned(rx.n(REGION_W - 1 downto 0));
+      hi_x  <= unsigned(resize(rx.hi, REGION_W));
+      reg_y <= unsigned(ry.st(COORD_W - 1 downto 0));
+      reg_h <= unsigned(ry.n(REGION_W - 1 downto 0));
+      hi_y  <= unsigned(resize(ry.hi, REGION_W));
       out_valid <= v1;
       if rst = '1' then
         out_valid <= '0';

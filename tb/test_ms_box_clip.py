@@ -18,6 +18,11 @@ from mstrack.fixed.vhdl_pkg import core_generics
 from mstrack.params import TrackerParams
 
 
+#: clocks from in_valid to out_valid (the headers of rtl/ms_box_clip.vhd and rtl/ms_region.vhd)
+BOX_CLIP_LAT = 4
+REGION_LAT = 2
+
+
 def _g():
     return json.loads(os.environ["MSTRACK_GENERICS"])
 
@@ -45,10 +50,13 @@ async def box_clip_random(dut):
         dut.in_valid.value = 1
         await RisingEdge(dut.clk)
         dut.in_valid.value = 0
+        lat = 0
         while True:
             await RisingEdge(dut.clk)
+            lat += 1
             if int(dut.out_valid.value):
                 break
+        assert lat == BOX_CLIP_LAT, f"latency {lat} != {BOX_CLIP_LAT}"
         box, clipped = ms_box_clip(x, y, w, h, fw, fh, fp.max_half)
         ctx = f"case {n}: box {(x, y, w, h)} frame {fw}x{fh}"
         assert int(dut.rejected.value) == int(box is None), ctx
@@ -82,10 +90,13 @@ async def region_random(dut):
         dut.in_valid.value = 1
         await RisingEdge(dut.clk)
         dut.in_valid.value = 0
+        lat = 0
         while True:
             await RisingEdge(dut.clk)
+            lat += 1
             if int(dut.out_valid.value):
                 break
+        assert lat == REGION_LAT, f"latency {lat} != {REGION_LAT}"
         reg = ms_region((cx, cy), ex, ey, fw, fh, fp)
         got = tuple(int(getattr(dut, s).value) for s in ("reg_x", "reg_y", "reg_w", "reg_h", "hi_x", "hi_y"))
         exp = (reg.x, reg.y, reg.w, reg.h, reg.hi[0] - reg.x, reg.hi[1] - reg.y)

@@ -20,11 +20,15 @@
 -- dx walks down from XR[i-1] (one clock per step: TA[dx] - TA[dx-1] = 4 h^2 (2 dx - 1))
 -- while dx > 0 and R < 0.  The down walk takes ex - XR[max(ex, ey)] steps in all.
 --
--- Latency (start -> done), n = max(ex, ey), X = 2 ex - XR[n] (walk clocks):
--- flat n + 5 + X clocks; Epanechnikov 2 (n + 1) + KVAL_W + 5 + X clocks (set-up 4: w^2 and
--- h^2, D = w^2 h^2 and the steps, R = D - 1: each multiplier output goes into a register;
--- issue 1 or 2 per entry, divider KVAL_W + 1, write register 1).  At most 194 (flat) /
--- 268 (Epanechnikov, KVAL_W 9) clocks for HALF_W = 6.  Speed is irrelevant (once per target).
+-- w^2, h^2 and D = w^2 h^2 come from shift-and-add multiplications (no multiplier block:
+-- a MULT18X18D between two registers limits Fmax to ~144 MHz): w^2 and h^2 together in
+-- HALF_W + 1 clocks, D in 2 (HALF_W + 1) clocks.
+--
+-- Latency (start -> done), n = max(ex, ey), X = 2 ex - XR[n] (walk clocks), S = 3 (HALF_W + 1) + 3
+-- (set-up: S_SETUP1, w^2 and h^2, S_DINIT, D, S_SETUP2):
+-- flat n + S + 2 + X clocks; Epanechnikov 2 (n + 1) + KVAL_W + S + 2 + X clocks (issue 1 or 2
+-- per entry, divider KVAL_W + 1, write register 1).  At most 215 (flat) / 289 (Epanechnikov,
+-- KVAL_W 9) clocks for HALF_W = 6.  Speed is irrelevant (once per target).
 -- Handshake: `start` pulse, ignored while busy; `done` pulse.
 -- Model: mstrack.fixed.blocks.ms_kernel(w, h, kernel, KERNEL_BITS): .ex .ey .D .TA .TB .KA .KB
 -- (XR[i] = max dx with ms_kernel.inside in row |dy| = i).
@@ -68,7 +72,7 @@ architecture rtl of ms_kernel_tables is
   constant N_W  : natural := 2 * HALF_W + 2 + KERNEL_BITS;  -- (4 i^2) << KERNEL_BITS
   constant TAG_W : natural := 2 * HALF_W + 1;         -- [sel | XR[i] | i], sel = 0 KA, 1 KB
 
-  type state_t is (S_IDLE, S_SETUP1, S_SETUP2, S_SETUP3, S_XUP, S_ISSUE, S_WAIT);
+  type state_t is (S_IDLE, S_SETUP1, S_SQ, S_DINIT, S_DMUL, S_SETUP2, S_XUP, S_ISSUE, S_WAIT);
   signal state : state_t := S_IDLE;
 
   signal wl, hl         : unsigned(WW - 1 downto 0) := (others => '0');
@@ -76,6 +80,13 @@ architecture rtl of ms_kernel_tables is
   signal ex_r, ey_r     : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal n_last         : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal d_r            : unsigned(KD_W - 1 downto 0) := (others => '0');
+  -- shift-and-add multiplications: w^2, h^2 (multiplicands mcw, mch, multipliers mpw, mph),
+  -- then D = w^2 h^2 (multiplicand mcd = w^2 << j, multiplier mpd = h^2 >> j)
+  signal mcw, mch       : unsigned(SQ_W - 1 downto 0) := (others => '0');
+  signal mpw, mph       : unsigned(WW - 1 downto 0) := (others => '0');
+  signal mcd            : unsigned(KD_W - 1 downto 0) := (others => '0');
+  signal mpd            : unsigned(SQ_W - 1 downto 0) := (others => '0');
+  signal cnt            : natural range 0 to SQ_W := 0;
   -- issue side
   signal i_iss          : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal sel            : std_logic := '0';
@@ -87,6 +98,8 @@ architecture rtl of ms_kernel_tables is
   -- XR walk: xr = dx, xres = D - 1 - TA[xr] - TB[i_iss] (signed), xstp = TA[xr+1] - TA[xr]
   -- (S_XUP) / TA[xr] - TA[xr-1] (S_ISSUE), tbw_stp = TB[i_iss+1] - TB[i_iss]
   signal xr             : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal xr_nz          : std_logic := '0';           -- xr /= 0 (registered with xr)
+  signal xup_last       : std_logic := '0';           -- S_XUP: this step is the last (xr + 1 = ex)
   signal xres           : signed(T_W downto 0) := (others => '0');
   signal xstp, tbw_stp  : unsigned(T_W - 1 downto 0) := (others => '0');
   signal walk           : std_logic;                  -- dx = xr is outside row i_iss: step down
@@ -105,7 +118,7 @@ architecture rtl of ms_kernel_tables is
   signal dv_out_tag     : std_logic_vector(TAG_W - 1 downto 0) := (others => '0');
 begin
   -- walk only before KA of an entry is issued (sel = 0); at sel = 1 the test is already false
-  walk <= '1' when xr /= 0 and xres(T_W) = '1' else '0';
+  walk <= xr_nz and xres(T_W);
 
   dv_in_valid <= '1' when state = S_ISSUE and walk = '0' and KERNEL_EPAN = 1 else '0';
   dv_in_n     <= shift_left(sq4, KERNEL_BITS);
@@ -125,7 +138,6 @@ begin
     variable wr_i : unsigned(HALF_W - 1 downto 0);
     variable wr_x : unsigned(HALF_W - 1 downto 0);
     variable e_x, e_y : unsigned(HALF_W - 1 downto 0);
-    variable dd       : unsigned(KD_W - 1 downto 0);
   begin
     if rising_edge(clk) then
       we_r   <= '0';
@@ -144,8 +156,13 @@ begin
         end if;
 
       elsif state = S_SETUP1 then
-        w2   <= wl * wl;
-        h2   <= hl * hl;
+        w2   <= (others => '0');
+        h2   <= (others => '0');
+        mcw  <= resize(wl, SQ_W);
+        mch  <= resize(hl, SQ_W);
+        mpw  <= wl;
+        mph  <= hl;
+        cnt  <= 0;
         e_x  := resize(shift_right(wl - 1, 1), HALF_W);
         e_y  := resize(shift_right(hl - 1, 1), HALF_W);
         ex_r <= e_x;
@@ -155,11 +172,45 @@ begin
         else
           n_last <= e_y;
         end if;
-        state <= S_SETUP2;
+        state <= S_SQ;
+
+      elsif state = S_SQ then            -- w^2, h^2: WW shift-and-add steps
+        if mpw(0) = '1' then
+          w2 <= w2 + mcw;
+        end if;
+        if mph(0) = '1' then
+          h2 <= h2 + mch;
+        end if;
+        mcw <= shift_left(mcw, 1);
+        mch <= shift_left(mch, 1);
+        mpw <= shift_right(mpw, 1);
+        mph <= shift_right(mph, 1);
+        if cnt = WW - 1 then
+          state <= S_DINIT;
+        else
+          cnt <= cnt + 1;
+        end if;
+
+      elsif state = S_DINIT then
+        d_r   <= (others => '0');
+        mcd   <= resize(w2, KD_W);
+        mpd   <= h2;
+        cnt   <= 0;
+        state <= S_DMUL;
+
+      elsif state = S_DMUL then          -- D = w^2 h^2: SQ_W shift-and-add steps (mod 2**KD_W, D < 2**KD_W)
+        if mpd(0) = '1' then
+          d_r <= d_r + mcd;
+        end if;
+        mcd <= shift_left(mcd, 1);
+        mpd <= shift_right(mpd, 1);
+        if cnt = SQ_W - 1 then
+          state <= S_SETUP2;
+        else
+          cnt <= cnt + 1;
+        end if;
 
       elsif state = S_SETUP2 then
-        dd       := resize(w2 * h2, KD_W);
-        d_r      <= dd;
         ta_acc   <= (others => '0');
         tb_acc   <= (others => '0');
         ta_stp   <= resize(shift_left(resize(h2, T_W), 2), T_W);
@@ -169,12 +220,15 @@ begin
         sq4      <= (others => '0');
         sq4_step <= to_unsigned(4, N_W);
         xr       <= (others => '0');
+        xr_nz    <= '0';
+        if ex_r = 1 then
+          xup_last <= '1';
+        else
+          xup_last <= '0';
+        end if;
         xstp     <= resize(shift_left(resize(h2, T_W), 2), T_W);
         tbw_stp  <= resize(shift_left(resize(w2, T_W), 2), T_W);
-        state    <= S_SETUP3;
-
-      elsif state = S_SETUP3 then        -- R = D - 1 from the D register (not the multiplier)
-        xres <= signed(resize(d_r, T_W + 1)) - 1;
+        xres     <= signed(resize(d_r, T_W + 1)) - 1;
         if ex_r = 0 then
           state <= S_ISSUE;
         else
@@ -184,7 +238,13 @@ begin
       elsif state = S_XUP then           -- xr = 0 .. ex by additions
         xres <= xres - signed(resize(xstp, T_W + 1));
         xr   <= xr + 1;
-        if xr + 1 = ex_r then
+        xr_nz <= '1';
+        if resize(xr, HALF_W + 1) + 2 = resize(ex_r, HALF_W + 1) then
+          xup_last <= '1';
+        else
+          xup_last <= '0';
+        end if;
+        if xup_last = '1' then
           state <= S_ISSUE;               -- xstp stays TA[ex] - TA[ex-1]: the down step
         else
           xstp <= xstp + shift_left(resize(h2, T_W), 3);
@@ -195,6 +255,9 @@ begin
           xres <= xres + signed(resize(xstp, T_W + 1));
           xstp <= xstp - shift_left(resize(h2, T_W), 3);
           xr   <= xr - 1;
+          if xr = 1 then
+            xr_nz <= '0';
+          end if;
         elsif KERNEL_EPAN = 1 then
           sel <= not sel;
           if sel = '1' then

@@ -22,8 +22,9 @@
 --   G(dy) = floor((win_x + XR[|dy|]) / LANES) - floor((win_x - XR[|dy|]) / LANES) + 1.
 -- Throughput: LANES pixels per clock, no stall.  Handshake: `start` is a pulse,
 -- accepted only when idle (after `done` of the previous pass) and ready = '1';
--- the bin read port is used only between passes.  ex, ey and the kernel tables
--- must be stable during a pass.
+-- the bin read port is used only between passes (from the cycle of `done` on), a
+-- bin at most once in 3 clocks (ms_histogram).  ex, ey and the kernel tables must
+-- be stable during a pass.
 -- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
 library ieee;
 use ieee.std_logic_1164.all;

@@ -50,6 +50,7 @@ class TB:
         self.epan = int(self.g["KERNEL_EPAN"])
         self.kb = int(self.g["KERNEL_BITS"])
         self.kval_w = int(self.g["KVAL_W"])
+        self.half_w = int(self.g["HALF_W"])
         self.writes: list[tuple[int, int, int, int, int, int]] = []
         dut.rst.value = Immediate(1)
         dut.start.value = Immediate(0)
@@ -92,7 +93,8 @@ class TB:
         n_last = max(ker.ex, ker.ey)
         xr = model_xr(ker, n_last + 1)
         walk = 2 * ker.ex - xr[n_last]  # set-up walk to TA[ex] + the down steps
-        exp_n = (2 * (n_last + 1) + self.kval_w + 5 if self.epan else n_last + 5) + walk
+        setup = 3 * (self.half_w + 1) + 3   # S_SETUP1, w^2/h^2 (HALF_W + 1), S_DINIT, D (2 HALF_W + 2), S_SETUP2
+        exp_n = (2 * (n_last + 1) + self.kval_w + setup + 2 if self.epan else n_last + setup + 2) + walk
         assert n == exp_n, f"{w}x{h}: done after {n} clocks, documented {exp_n}"
         assert [a for a, *_ in self.writes] == list(range(n_last + 1)), f"{w}x{h}: addresses {self.writes}"
         got_xr = [x for *_, x in self.writes]
@@ -131,8 +133,8 @@ async def tables(dut):
         n = await tb.check(w, h)
         worst = max(worst, n)
         dut._log.debug("%dx%d: %d clocks", w, h, n)
-    # documented bound (rtl/ms_kernel_tables.vhd header): n + 5 + 2 ex (+ n + 2 + KVAL_W when Epanechnikov)
-    bound = 3 * tb.max_half + 5 + (tb.max_half + 2 + tb.kval_w if tb.epan else 0)
+    # documented bound (rtl/ms_kernel_tables.vhd header): n + S + 2 + 2 ex (+ n + 2 + KVAL_W when Epanechnikov)
+    bound = 3 * tb.max_half + 3 * (tb.half_w + 1) + 5 + (tb.max_half + 2 + tb.kval_w if tb.epan else 0)
     assert worst <= bound, f"latency {worst} > bound {bound}"
     dut._log.info("%d sizes OK, worst latency %d clocks (bound %d)", len(sizes), worst, bound)
 

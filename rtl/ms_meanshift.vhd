@@ -109,8 +109,10 @@ architecture rtl of ms_meanshift is
   signal s0               : unsigned(RHO_SUM_W - 1 downto 0);
   signal first            : std_logic;
   signal it               : unsigned(ITER_W - 1 downto 0);
-  signal dxs, dys         : sc_t;
+  signal dxs, dys         : sc_t := (others => '0');
   signal sqx, sqy         : unsigned(2 * SCW - 1 downto 0);
+  signal shift2           : unsigned(2 * SCW - 1 downto 0);
+  signal shift_small      : std_logic;
 
   -- sub-block handshakes
   constant BIN_RD_LAT : natural := 3;                             -- ms_pixel_pass bin read latency
@@ -171,10 +173,26 @@ begin
 
   busy <= '0' when state = S_IDLE else '1';
 
+  -- shift2 = dxs^2 + dys^2 < EPS2, free running in three register stages (square | sum |
+  -- compare): dxs / dys are written in S_CENTRE_WAIT and read back in S_DECIDE after a whole
+  -- pixel pass and bin pass (>= N_BINS clocks), so shift_small has long settled by then.
+  p_shift : process(clk)
+  begin
+    if rising_edge(clk) then
+      sqx <= unsigned(dxs * dxs);
+      sqy <= unsigned(dys * dys);
+      shift2 <= sqx + sqy;
+      if shift2 < EPS2 then
+        shift_small <= '1';
+      else
+        shift_small <= '0';
+      end if;
+    end if;
+  end process;
+
   p_ctrl : process(clk)
     variable cx, cy   : sc_t;
     variable lo, hi   : sc_t;
-    variable shift2   : unsigned(2 * SCW - 1 downto 0);
     variable stop_now : boolean;
   begin
     if rising_edge(clk) then
@@ -194,20 +212,32 @@ begin
           end if;
 
         when S_CLAMP =>                       -- c0 = clamp(start), window at round(c0)
-          cx := c_in_x;
+          -- the two bound compares and round(c_in) side by side (one carry chain deep), then
+          -- a select: round(lo) = ex / ey and round(hi) = hi_x / hi_y exactly (integer bounds)
           lo := signed(resize(shift_left(resize(lo_x, CENTRE_W), CF), SCW));
           hi := signed(resize(shift_left(resize(hi_x, CENTRE_W), CF), SCW));
-          if cx < lo then cx := lo; end if;
-          if cx > hi then cx := hi; end if;
-          cy := c_in_y;
+          if c_in_x < lo and not (lo_x > hi_x) then                   -- clamped to lo
+            c0x <= unsigned(lo(CENTRE_W - 1 downto 0));
+            win_x <= lo_x;
+          elsif c_in_x < lo or c_in_x > hi then                       -- clamped to hi
+            c0x <= unsigned(hi(CENTRE_W - 1 downto 0));
+            win_x <= hi_x;
+          else
+            c0x <= unsigned(c_in_x(CENTRE_W - 1 downto 0));
+            win_x <= round_c(unsigned(c_in_x(CENTRE_W - 1 downto 0)));
+          end if;
           lo := signed(resize(shift_left(resize(lo_y, CENTRE_W), CF), SCW));
           hi := signed(resize(shift_left(resize(hi_y, CENTRE_W), CF), SCW));
-          if cy < lo then cy := lo; end if;
-          if cy > hi then cy := hi; end if;
-          c0x <= unsigned(cx(CENTRE_W - 1 downto 0));
-          c0y <= unsigned(cy(CENTRE_W - 1 downto 0));
-          win_x <= round_c(unsigned(cx(CENTRE_W - 1 downto 0)));
-          win_y <= round_c(unsigned(cy(CENTRE_W - 1 downto 0)));
+          if c_in_y < lo and not (lo_y > hi_y) then
+            c0y <= unsigned(lo(CENTRE_W - 1 downto 0));
+            win_y <= lo_y;
+          elsif c_in_y < lo or c_in_y > hi then
+            c0y <= unsigned(hi(CENTRE_W - 1 downto 0));
+            win_y <= hi_y;
+          else
+            c0y <= unsigned(c_in_y(CENTRE_W - 1 downto 0));
+            win_y <= round_c(unsigned(c_in_y(CENTRE_W - 1 downto 0)));
+          end if;
           state <= S_PASS;
 
         when S_PASS =>                        -- (the histogram clears itself after reset)
@@ -260,9 +290,7 @@ begin
             end if;
           end if;
 
-        when S_DIFF =>                        -- squares of the shift components
-          sqx <= unsigned(dxs * dxs);
-          sqy <= unsigned(dys * dys);
+        when S_DIFF =>                        -- (shift_small settles during the pass)
           state <= S_DECIDE;
 
         when S_DECIDE =>
@@ -270,14 +298,13 @@ begin
             res_stop <= STOP_RHO;
             state <= S_FINISH;
           else
-            shift2 := sqx + sqy;
             c0x <= c1x;
             c0y <= c1y;
             s0 <= bp_s;
             win0_x <= win_x;
             win0_y <= win_y;
             stop_now := true;
-            if shift2 < EPS2 then
+            if shift_small = '1' then
               res_stop <= STOP_SHIFT;
             elsif it = MAX_ITER then
               res_stop <= STOP_MAX_ITER;

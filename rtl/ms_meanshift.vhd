@@ -110,9 +110,10 @@ architecture rtl of ms_meanshift is
   signal first            : std_logic;
   signal it               : unsigned(ITER_W - 1 downto 0);
   signal dxs, dys         : sc_t := (others => '0');
-  signal sqx, sqy         : unsigned(2 * SCW - 1 downto 0);
+  signal sqx, sqy         : unsigned(2 * SCW - 1 downto 0) := (others => '0');
   signal shift2           : unsigned(2 * SCW - 1 downto 0);
   signal shift_small      : std_logic;
+  signal rho_fell         : std_logic;
 
   -- sub-block handshakes
   constant BIN_RD_LAT : natural := 3;                             -- ms_pixel_pass bin read latency
@@ -280,8 +281,8 @@ begin
             else
               c1x <= ce_cx;
               c1y <= ce_cy;
-              -- shift components now (c0 is stable), squared in S_DIFF, summed in S_DECIDE:
-              -- three short register stages instead of one long path, no extra clock
+              -- shift components now (c0 is stable), squared and compared during the pass
+              -- (p_shift); S_DIFF registers the rho compare for S_DECIDE
               dxs <= signed(resize(ce_cx, SCW)) - signed(resize(c0x, SCW));
               dys <= signed(resize(ce_cy, SCW)) - signed(resize(c0y, SCW));
               win_x <= round_c(ce_cx);
@@ -291,10 +292,11 @@ begin
           end if;
 
         when S_DIFF =>                        -- (shift_small settles during the pass)
+          rho_fell <= '1' when bp_s < s0 else '0';
           state <= S_DECIDE;
 
         when S_DECIDE =>
-          if bp_s < s0 then                   -- rho fell: keep c0, S0
+          if rho_fell = '1' then              -- S1 < S0: keep c0, S0
             res_stop <= STOP_RHO;
             state <= S_FINISH;
           else

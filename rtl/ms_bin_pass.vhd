@@ -35,6 +35,7 @@
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
+use work.ms_pkg.all;
 
 entity ms_bin_pass is
   generic (
@@ -85,14 +86,6 @@ architecture rtl of ms_bin_pass is
   -- in every pipeline stage): DLY_W bits, DLY clocks from stage A to the isqrt output
   constant DLY_W  : natural := COUNT_W + 2 * POSSUM_W;
   constant DLY    : natural := (RATIO_Q_W + 1) + (RATIO_Q_W / 2 + 1);  -- ms_divider + ms_isqrt
-  function clog2(n : natural) return natural is
-    variable r : natural := 0;
-  begin
-    while 2 ** r < n loop
-      r := r + 1;
-    end loop;
-    return r;
-  end function;
   constant DP_W   : natural := clog2(DLY);                     -- delay memory address bits
   type dly_ram_t is array (0 to 2 ** DP_W - 1) of std_logic_vector(DLY_W - 1 downto 0);
 

@@ -19,6 +19,7 @@
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
+use work.ms_pkg.all;
 
 entity ms_mult_r4 is
   generic (
@@ -42,24 +43,11 @@ entity ms_mult_r4 is
 end entity;
 
 architecture rtl of ms_mult_r4 is
-  function clog2(n : natural) return natural is
-    variable r : natural := 0;
-  begin
-    while 2 ** r < n loop
-      r := r + 1;
-    end loop;
-    return r;
-  end function;
-  function maxn(a, b : natural) return natural is
-  begin
-    if a > b then return a; end if;
-    return b;
-  end function;
   constant ND      : natural := (A_W + 1) / 2;               -- radix-4 digits of a
-  constant NLEV    : natural := maxn(1, clog2(ND));          -- adder tree levels
+  constant NLEV    : natural := max(1, clog2(ND));          -- adder tree levels
   constant NDP     : natural := 2 ** NLEV;                   -- digits padded to a power of two
   constant LATENCY : natural := 1 + NLEV;                    -- in_valid -> out_valid
-  constant BX_W    : natural := maxn(P_W, B_W);              -- b extended
+  constant BX_W    : natural := max(P_W, B_W);              -- b extended
 
   subtype p_t is unsigned(P_W - 1 downto 0);
   type p_arr_t is array (0 to NDP - 1) of p_t;

@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: setup demo test test-sim test-synth test-sim-only test-synth-only eval results clean synth
+.PHONY: setup demo test test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
 
 setup:
 	bash tools/setup.sh
@@ -32,6 +32,19 @@ test-sim-only:
 
 test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m synth -s -p no:cacheprovider $(ARGS)
+
+# The tests against the newest PyPI versions (not in CI): a separate venv, installed without the
+# lock, so drift in numpy/OpenCV/cocotb/... is seen before it reaches the lock.
+LATEST_VENV ?= .venv-latest
+test-latest:
+	SETUP_LATEST=1 VENV=$(LATEST_VENV) bash tools/setup.sh
+	$(MAKE) --no-print-directory VENV=$(LATEST_VENV) -j2 -Oline test-sim-only test-synth-only
+
+# Rewrite requirements.lock from the latest venv (run after `make test-latest` passes).
+lock:
+	{ sed -n '1,2p' requirements.lock; $(LATEST_VENV)/bin/python -m pip freeze --exclude-editable \
+	  | grep -v '^#'; echo "setuptools==$$($(LATEST_VENV)/bin/python -m pip index versions setuptools 2>/dev/null \
+	  | sed -n 's/^setuptools (\(.*\))/\1/p')"; } > requirements.lock.new && mv requirements.lock.new requirements.lock
 
 eval: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval $(ARGS)

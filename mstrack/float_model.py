@@ -49,7 +49,7 @@ def edge_magnitude(frame: np.ndarray) -> np.ndarray:
     frame: (H, W, 3) uint8 BGR.  Returns (H, W) float32 in [0, 2040]; the
     1-pixel frame border has no full 3x3 neighbourhood and gets |G| = 0.
     """
-    grey = frame.astype(np.float32) @ np.asarray(GREY_WEIGHTS_BGR, np.float32)
+    grey = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0])
     gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
     mag = np.abs(gx) + np.abs(gy)
@@ -87,11 +87,12 @@ _GREY_W = tuple(np.float32(w) for w in GREY_WEIGHTS_BGR)
 
 
 def grey_area(frame: np.ndarray, x0: int, x1: int, y0: int, y1: int) -> np.ndarray:
-    """Float32 grey of ``frame[y0:y1, x0:x1]``, bit-identical to :func:`edge_magnitude`'s.
+    """Float32 grey of ``frame[y0:y1, x0:x1]``: (B wb + G wg) + R wr, element-wise in float32.
 
-    The whole-frame product ``frame @ weights`` rounds (B wb + G wg) + R wr in
-    float32; element-wise numpy does the same on any sub-array (the BLAS
-    product does not on a 1-px wide one).
+    Every path (whole frame, search area, numba kernel) computes the grey with
+    these operations in this order, so they agree bit for bit by construction.
+    No BLAS product is used: a matrix product's rounding depends on the BLAS
+    kernel (numpy 2.4 / OpenBLAS 0.3.31 rounds ``frame @ weights`` differently).
     """
     b, g, r = cv2.split(frame[y0:y1, x0:x1])
     wb, wg, wr = _GREY_W

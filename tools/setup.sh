@@ -4,9 +4,11 @@
 #   1. apt packages listed in APT_PACKAGES that are missing (as root only;
 #      'apt-get update' runs once, and only when something is missing);
 #   2. the virtualenv .venv (python3 -m venv) if missing;
-#   3. 'pip install -e .[EXTRAS]' when pyproject.toml (or the extras) changed
-#      since the last install, or the package is not importable; the hash is
-#      kept in .venv/.stamp.
+#   3. 'pip install -e .[EXTRAS]' constrained to the pinned versions of
+#      requirements.lock (PIP_CONSTRAINT, so the build back end is pinned too)
+#      when pyproject.toml, the lock (or the extras) changed since the last
+#      install, or the package is not importable; the hash is kept in .venv/.stamp.
+#      SETUP_LATEST=1 installs without the lock (make test-latest: newest versions).
 #
 # Safe to run repeatedly: a second run does nothing and takes about a second.
 # Environment: PYTHON (default python3), VENV (default .venv), SETUP_NO_APT=1 to skip apt.
@@ -85,12 +87,23 @@ fi
 
 # --- 3. pip ---------------------------------------------------------------------
 extras=$(IFS=,; echo "${PIP_EXTRAS[*]}")
-want=$( { cat pyproject.toml; echo "extras=$extras"; } | sha256sum | cut -d' ' -f1)
+if [ -n "${SETUP_LATEST:-}" ]; then
+    lock_note="newest versions, no lock"
+    want=$( { cat pyproject.toml; echo "extras=$extras latest"; } | sha256sum | cut -d' ' -f1)
+else
+    lock_note="pinned by requirements.lock"
+    want=$( { cat pyproject.toml requirements.lock; echo "extras=$extras"; } | sha256sum | cut -d' ' -f1)
+fi
 have=$(cat "$VENV/.stamp" 2>/dev/null || true)
 if [ "$want" != "$have" ] || ! "$VENV/bin/python" -c 'import mstrack, cv2, numpy, matplotlib, tqdm, pytest' 2>/dev/null \
    || [ ! -x "$VENV/bin/mstrack" ]; then
-    log "pip install -e .[$extras]"
-    "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e ".[$extras]"
+    log "pip install -e .[$extras] ($lock_note)"
+    if [ -n "${SETUP_LATEST:-}" ]; then
+        "$VENV/bin/python" -m pip install -q --disable-pip-version-check --upgrade --upgrade-strategy eager -e ".[$extras]"
+    else
+        PIP_CONSTRAINT="$PWD/requirements.lock" \
+            "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e ".[$extras]"
+    fi
     echo "$want" > "$VENV/.stamp"
 fi
 log "ok ($VENV ready)"

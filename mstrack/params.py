@@ -5,11 +5,37 @@ The fixed-point widths live in :class:`mstrack.fixed.formats.FixedParams`.
 """
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, fields, replace
 from typing import Any, Literal
 
 Features = Literal["fused", "colour", "edge"]
 Kernel = Literal["flat", "epanechnikov"]
+
+
+class ParamTypeError(TypeError, ValueError):
+    """A parameter of the wrong type (e.g. ``max_iter=1.5``); both a TypeError and a ValueError."""
+
+
+def check_param_types(obj: Any) -> None:
+    """Check the ``int`` / ``float`` fields of the frozen dataclass ``obj`` (shared by every layer).
+
+    ``int`` fields take a Python or numpy integer (not bool, not float); ``float`` fields a real,
+    finite number (not bool).  Numpy scalars are converted to ``int`` / ``float`` in place.
+    Raises :class:`ParamTypeError` naming the field.
+    """
+    for f in fields(obj):
+        kind = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", "")
+        v = getattr(obj, f.name)
+        if kind == "int":
+            if isinstance(v, bool) or not isinstance(v, numbers.Integral):
+                raise ParamTypeError(f"{f.name} must be an integer, got {v!r} ({type(v).__name__})")
+            object.__setattr__(obj, f.name, int(v))
+        elif kind == "float":
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+                raise ParamTypeError(f"{f.name} must be a finite real number, got {v!r} ({type(v).__name__})")
+            object.__setattr__(obj, f.name, float(v))
 
 
 @dataclass(frozen=True)
@@ -48,6 +74,7 @@ class TrackerParams:
     eps2: float = 1.0
 
     def __post_init__(self) -> None:
+        check_param_types(self)
         if self.features not in ("fused", "colour", "edge"):
             raise ValueError(f"features must be 'fused', 'colour' or 'edge', got {self.features!r}")
         if self.kernel not in ("flat", "epanechnikov"):

@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from ..params import TrackerParams
+from ..params import TrackerParams, check_param_types
 from .primitives import bits_for
 
 
@@ -54,6 +54,7 @@ class FixedParams:
     rho_out_frac: int = 16
 
     def __post_init__(self) -> None:
+        check_param_types(self)
         if not 1 <= self.max_half <= 255:
             raise ValueError("max_half must be in 1..255")
         if not 0 <= self.margin <= 255:

@@ -5,6 +5,8 @@ Documented behaviour for bad input (tested in tests/test_bad_input.py):
 * ``None``, non-array, empty, wrong ndim, wrong channel count, non-uint8
   frames raise :class:`FrameError` (a ``ValueError``); the tracker state is
   untouched, so tracking can go on with the next frame.
+* ndarray subclasses (``np.matrix``, masked arrays) are read as plain arrays (a uint8
+  ``np.matrix`` is a grey frame).
 * grey (2-D, or H x W x 1) uint8 frames are accepted and replicated into
   B = G = R (the colour histogram then only uses the grey diagonal).
 * BGRA frames: the alpha channel is dropped.
@@ -43,6 +45,8 @@ def check_frame(frame: object, expect_shape: tuple[int, int] | None = None) -> n
         raise FrameError("frame is None (unreadable or corrupt image?)")
     if not isinstance(frame, np.ndarray):
         raise FrameError(f"frame must be a numpy array, got {type(frame).__name__}")
+    if type(frame) is not np.ndarray:  # a subclass (np.matrix, masked array): its plain data
+        frame = np.asarray(frame).view(np.ndarray)
     if frame.dtype != np.uint8:
         raise FrameError(f"frame must be uint8 (8-bit BGR as OpenCV gives it), got dtype {frame.dtype}")
     if frame.ndim == 3 and frame.shape[2] == 1:

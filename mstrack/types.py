@@ -15,9 +15,12 @@ OTB ground truth is 1-based; the data readers subtract 1 from x and y.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, asdict
 from enum import Enum
 from typing import Any
+
+import numpy as np
 
 
 @dataclass(frozen=True)
@@ -35,13 +38,20 @@ class Box:
         if isinstance(box, Box):
             b = box
         else:
+            # an ordered sequence / 1-D array of 4 real numbers only: not a string or bytes ("5599"
+            # would iterate as 4 digits), not a set or dict (no order), not bools or numeric strings
+            if isinstance(box, (str, bytes, bytearray, memoryview, set, frozenset, dict)) \
+                    or not hasattr(box, "__len__") or not hasattr(box, "__getitem__"):
+                raise ValueError(f"box must be a sequence of 4 numbers (x, y, w, h), got {box!r}")
             try:
-                vals = [float(v) for v in box]
-            except (TypeError, ValueError) as exc:
-                raise ValueError(f"box must be 4 numbers (x, y, w, h), got {box!r}") from exc
-            if len(vals) != 4:
-                raise ValueError(f"box must be 4 numbers (x, y, w, h), got {len(vals)} values")
-            b = cls(*vals)
+                items = list(box)
+            except TypeError as exc:
+                raise ValueError(f"box must be a sequence of 4 numbers (x, y, w, h), got {box!r}") from exc
+            if len(items) != 4:
+                raise ValueError(f"box must be 4 numbers (x, y, w, h), got {len(items)} values")
+            if not all(isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) for v in items):
+                raise ValueError(f"box must be 4 real numbers (x, y, w, h), got {box!r}")
+            b = cls(*(float(v) for v in items))
         if not all(math.isfinite(v) for v in (b.x, b.y, b.w, b.h)):
             raise ValueError(f"box has a non-finite value: {b}")
         return b

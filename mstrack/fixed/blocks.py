@@ -95,7 +95,11 @@ def ms_box_clip(x: int, y: int, w: int, h: int, frame_w: int, frame_h: int,
 
 
 def round_box(x: float, y: float, w: float, h: float) -> tuple[int, int, int, int]:
-    """Float box -> integer box: edges rounded half up (x0 = floor(x + .5), x1 = floor(x + w + .5))."""
+    """Float box -> integer box: edges rounded half up (x0 = floor(x + .5), x1 = floor(x + w + .5)).
+
+    Raises ValueError if an edge is not finite (e.g. x + w overflows for x = w = 1e308)."""
+    if not all(np.isfinite(v) for v in (x + 0.5, y + 0.5, x + w + 0.5, y + h + 0.5)):
+        raise ValueError(f"box ({x:g}, {y:g}, {w:g}, {h:g}) is out of range (an edge is not finite)")
     x0 = int(np.floor(x + 0.5))
     y0 = int(np.floor(y + 0.5))
     return x0, y0, int(np.floor(x + w + 0.5)) - x0, int(np.floor(y + h + 0.5)) - y0

@@ -264,10 +264,13 @@ def table(results: list[Agreement]) -> str:
 
 
 def write_table(md: str, path: Path = RESULTS_MD, command: str = "", section: str = "table") -> Path:
-    """Replace the marked ``section`` of ``path`` (append the markers at the end if absent)."""
+    """Replace the marked ``section`` of ``path`` (append the markers at the end if absent).
+
+    The section gets the command and a ``Tools:`` line (numpy, OpenCV, numba versions)."""
     BEGIN = BEGIN_MARK.format(section=section)
     END = END_MARK.format(section=section)
-    block = f"{BEGIN}\n\nCommand: `{command}`\n\n{md}\n\n{END}"
+    from .versions import PYTHON_TOOLS, tools_line
+    block = f"{BEGIN}\n\nCommand: `{command}`\n\n{tools_line(PYTHON_TOOLS)}\n\n{md}\n\n{END}"
     text = path.read_text() if path.is_file() else "# Fixed-point model vs float reference\n\n"
     if BEGIN in text and END in text:
         head, rest = text.split(BEGIN, 1)

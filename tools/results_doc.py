@@ -1,7 +1,8 @@
 """Compose docs/results.md from the float and fixed evaluation reports (run by `make results`).
 
 Copies report.md/json and the plots of out/eval_float and out/eval_fixed into docs/results/
-and writes docs/results.md: the overall tables of both runs, side by side with their commands.
+and writes docs/results.md: the overall tables of both runs, side by side with their commands
+and the "Tools:" line of each report (the numpy / OpenCV / numba versions that produced it).
 """
 from __future__ import annotations
 
@@ -24,6 +25,12 @@ def command(md: str) -> str:
     return next(line for line in md.splitlines() if line.startswith("Command:"))
 
 
+def tools(md: str) -> str:
+    """The report's "Tools: ..." line (mstrack.versions.tools_line), which names what produced it."""
+    return next((line for line in md.splitlines() if line.startswith("Tools:")),
+                "Tools: not recorded in this report (made before `mstrack eval` recorded them).")
+
+
 def main() -> int:
     out = ["# Results on real video", "",
            "OTB one-pass evaluation (init on frame 0 with the ground truth, no re-init) of mstrack "
@@ -43,7 +50,7 @@ def main() -> int:
             shutil.copy(run / f, dst / f)
         md = rep.read_text()
         out += [f"## {'Float reference and OpenCV baselines' if name == 'float' else 'Fixed-point model (= the RTL core)'}",
-                "", command(md), "", section(md, "Overall"), "",
+                "", command(md), "", tools(md), "", section(md, "Overall"), "",
                 f"Per sequence and per attribute: [results/{name}/report.md](results/{name}/report.md). "
                 f"Machine-readable: `results/{name}/report.json`.", "",
                 f"![success {name}](results/{name}/success.png) ![precision {name}](results/{name}/precision.png)", ""]

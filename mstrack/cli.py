@@ -2,6 +2,15 @@
 
 Built-in commands: ``eval``, ``track``, ``bench``, ``demo``.
 
+Errors are one line (``mstrack <command>: error: ...``, exit 1; set
+``MSTRACK_TRACEBACK=1`` for the traceback).  Bad input (README.md, "Bad
+input"): an ``--out`` that is a file, lies under a file or is not writable is
+refused before anything is run or written; ``--max-frames`` must be >= 1;
+``track`` names the unreadable image file, warns when a video decodes fewer
+frames than its container announces (``source`` in results.json); ``eval``
+records a sequence that fails (corrupt frame, invalid frame-0 box) as failed in
+the report and goes on with the others.
+
 Extension point
 ---------------
 Each command is one ``register(subparsers)`` function that adds its parser
@@ -46,6 +55,35 @@ CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_
 
 
 # --------------------------------------------------------------------------- helpers
+
+def _positive_int(s: str) -> int:
+    try:
+        v = int(s)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(f"wants a positive integer, got {s!r}") from exc
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"wants a positive integer (>= 1), got {s!r}")
+    return v
+
+
+def check_out_dir(path: str | Path, option: str = "--out") -> Path:
+    """Create the output folder ``path`` if needed and check that files can be written in it.
+
+    Raises :class:`DataError` (one line, nothing written or removed) if ``path`` is a file, lies
+    under a file, or cannot be created or written."""
+    p = Path(path)
+    for q in (p, *p.parents):
+        if q.exists() and not q.is_dir():
+            raise DataError(f"{option} {'is' if q == p else 'lies under'} a file, not a folder", q)
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+        import tempfile
+        with tempfile.NamedTemporaryFile(dir=p, prefix=".mstrack-write-test-"):
+            pass
+    except OSError as exc:
+        raise DataError(f"{option} folder cannot be created or written ({exc.strerror or exc})", p) from exc
+    return p
+
 
 def _csv_list(s: str | None) -> list[str] | None:
     return [t.strip() for t in s.split(",") if t.strip()] if s else None
@@ -135,7 +173,8 @@ class _Display:
 
 def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, out_dir: Path, fps: float = 30.0,
                  gt: np.ndarray | None = None, show: bool = False, max_frames: int | None = None,
-                 progress: bool = False) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+                 progress: bool = False, source: VideoSource | None = None
+                 ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Track through ``frames`` and write results.csv, results.json and an overlay video.
 
     Parameters
@@ -152,13 +191,19 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
     show : bool
         Also display frames (only with a display).
     max_frames : int, optional
+        At least 1.
+    source : VideoSource, optional
+        The source ``frames`` come from: unreadable images are then named
+        (``frame_errors`` in results.json) and a video that decoded fewer
+        frames than its container announces is reported (``source``).
 
     Returns
     -------
     rows : list of dict
         One per frame with the :data:`CSV_FIELDS`.
     info : dict
-        ``video`` (path written), ``fps`` (update() calls per second), ``frames``.
+        ``video`` (path written), ``fps`` (update() calls per second), ``frames``,
+        ``source`` (``kind``, ``frames_decoded``, ``truncated``; with ``source``).
 
     Notes
     -----
@@ -169,6 +214,8 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
 
     from .evaluate import frame_error_types, result_status, to_box
 
+    if max_frames is not None and max_frames < 1:
+        raise ValueError(f"max_frames must be >= 1, got {max_frames}")
     bad_frame = frame_error_types()
     out_dir.mkdir(parents=True, exist_ok=True)
     rows: list[dict[str, Any]] = []
@@ -183,7 +230,10 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
                 break
             if i == 0:
                 if frame is None:
-                    raise DataError("frame 0 is unreadable", out_dir)
+                    err = source.errors.get(0) if source is not None else None
+                    if err is not None:
+                        raise DataError(f"frame 0 is unreadable ({err.reason})", err.path)
+                    raise DataError("frame 0 is unreadable", getattr(source, "path", out_dir))
                 res = tracker.init(frame, box)
                 b = to_box(res) if res is not None else box
                 row = _row(0, res, b, result_status(res) if res is not None else Status.INIT.value)
@@ -225,7 +275,12 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
         w = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
         w.writeheader()
         w.writerows(rows)
-    info = {"frames": len(rows), "video": str(video_path), "fps": n_upd / t_upd if t_upd > 0 else math.nan}
+    info: dict[str, Any] = {"frames": len(rows), "video": str(video_path),
+                            "fps": n_upd / t_upd if t_upd > 0 else math.nan}
+    if source is not None:
+        info["source"] = {"path": str(source.path), "kind": source.kind, "frames_decoded": source.decoded,
+                          "truncated": source.truncated}
+        info["frame_errors"] = {str(i): str(e) for i, e in source.errors.items() if i < len(rows)}
     clean = [{k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in r.items()} for r in rows]
     (out_dir / "results.json").write_text(json.dumps({"init_box": list(box.as_tuple()), **info,
                                                       "box_convention": "0-based x,y,w,h; cx,cy pixel-index centre",
@@ -243,15 +298,21 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     unknown = [n for n in names if n not in tracker_names()]
     if unknown:
         raise ValueError(f"unknown tracker(s) {', '.join(unknown)}; known: {', '.join(tracker_names())}")
+    check_out_dir(args.out)
     seqs = load_dataset(args.dataset, _csv_list(args.sequences))
     ev = evaluate(seqs, names, args.out, model=args.model, force=args.force, quiet=args.quiet,
                   max_frames=args.max_frames)
+    for s, per in ev.failed.items():
+        for t, reason in per.items():
+            _warn(f"{t} on {s} failed, sequence left out of the scores: {reason}")
     paths = write_report(ev, args.out, command=args.command_line)
     order = sorted(ev.trackers, key=lambda t: -ev.overall[t].auc)
     _print_table(["tracker", "AUC", "P@20", "fps"],
                  [[t, _fmt(ev.overall[t].auc), _fmt(ev.overall[t].precision20), _fmt(ev.fps[t], 1)] for t in order])
+    if ev.failed:
+        print(f"{len(ev.failed)} of {len(seqs)} sequences failed: {', '.join(ev.failed)} (see the report)")
     print(f"report: {paths['md']}")
-    return 0
+    return 0 if ev.sequences else 1
 
 
 def register_eval(sub: argparse._SubParsersAction) -> None:
@@ -262,7 +323,7 @@ def register_eval(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", choices=("float", "fixed"), default="float", help="mstrack model")
     p.add_argument("--out", default="out/eval", help="report folder (default out/eval)")
     p.add_argument("--sequences", help="comma-separated sequence names (default: all)")
-    p.add_argument("--max-frames", type=int, help="use at most N frames per sequence")
+    p.add_argument("--max-frames", type=_positive_int, help="use at most N frames per sequence (N >= 1)")
     p.add_argument("--force", action="store_true", help="ignore cached per-sequence results")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(func=_cmd_eval)
@@ -283,11 +344,18 @@ def _cmd_track(args: argparse.Namespace) -> int:
     if box is None:
         raise ValueError("--box x,y,w,h is required unless SOURCE is a sequence folder with ground truth")
     out = Path(args.out) if args.out else Path("out/track") / Path(args.source).resolve().name
+    check_out_dir(out)
     tracker = make_tracker(args.tracker, args.model)
     rows, info = track_frames(tracker, src.frames(on_bad="none"), box, out, fps=src.fps, gt=gt, show=args.show,
-                              max_frames=args.max_frames, progress=not args.quiet and sys.stderr.isatty())
+                              max_frames=args.max_frames, progress=not args.quiet and sys.stderr.isatty(),
+                              source=src)
+    for i, err in info["frame_errors"].items():
+        _warn(f"frame {i}: {err}")
+    if src.truncated:
+        _warn(f"{src.path}: {src.truncated}")
     n_err = sum(r["status"] == Status.ERROR.value for r in rows)
-    print(f"{len(rows)} frames, {n_err} error frames, {_fmt(info['fps'], 1)} fps (update only)")
+    print(f"{len(rows)} frames, {n_err} error frames, {_fmt(info['fps'], 1)} fps (update only)"
+          + (f"; VIDEO TRUNCATED: {src.truncated}" if src.truncated else ""))
     print(f"wrote {out / 'results.csv'}, {out / 'results.json'}, {info['video']}")
     return 0
 
@@ -300,7 +368,7 @@ def register_track(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", choices=("float", "fixed"), default="float")
     p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"tracker name (default {DEFAULT_TRACKER})")
     p.add_argument("--out", help="output folder (default out/track/<source name>)")
-    p.add_argument("--max-frames", type=int, help="stop after N frames")
+    p.add_argument("--max-frames", type=_positive_int, help="stop after N frames (N >= 1)")
     p.add_argument("--show", action="store_true", help="display frames (needs a display)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_track)
@@ -351,12 +419,12 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                      *[_fmt(all_fps[r[0]] / all_fps["opencv-camshift"], 4) for r in runs[:-1]]])
     _print_table(header, rows)
     if args.write_docs:
-        import cv2
+        from .versions import PYTHON_TOOLS, tools_line
         md = ["# mstrack speed benchmark", "",
               f"Command: `{args.command_line}`", "",
               f"Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M UTC}; machine: {platform.machine()}, "
-              f"{os.cpu_count()} cores, Python {platform.python_version()}, numpy {np.__version__}, "
-              f"OpenCV {cv2.__version__}.", "",
+              f"{os.cpu_count()} cores, Python {platform.python_version()}.", "",
+              tools_line(PYTHON_TOOLS), "",
               "fps = update() calls per second on frames preloaded in memory (init excluded).", "",
               "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         md += ["| " + " | ".join(r) + " |" for r in rows]
@@ -501,7 +569,7 @@ def main(argv: list[str] | None = None) -> int:
     args.command_line = "mstrack " + shlex.join(argv)
     try:
         return int(args.func(args) or 0)
-    except (DataError, ValueError, ImportError, RuntimeError) as exc:
+    except (DataError, ValueError, ImportError, RuntimeError, OSError) as exc:
         if os.environ.get("MSTRACK_TRACEBACK"):
             raise
         print(f"mstrack {args.command}: error: {exc}", file=sys.stderr)

@@ -11,6 +11,19 @@ identical channels).
 Ground-truth / image count mismatch: a sequence is cut to the shorter of the
 two, with a :class:`DataWarning`; pass ``strict=True`` to get a
 :class:`DataError` instead.
+
+Bad input (each raises :class:`DataError` naming the file, unless said otherwise):
+
+* a blank line in the middle of a ground-truth file is a missing annotation
+  for that frame (a NaN row, as OTB writes them), so later rows keep their
+  frame; blank lines at the end of the file are ignored;
+* ``meta.json`` must be a JSON object; ``fps`` a positive number,
+  ``gt_coordinate_base`` a number, ``attributes`` a list of strings and
+  ``name`` a plain name (no ``/``, ``\\``, ``.`` or ``..``: it names cache files);
+* :func:`load_dataset` refuses two sequences with the same name (the same
+  name twice in ``names``, or two folders whose meta.json give one name);
+* a video (:class:`VideoSource`) that decodes fewer frames than its container
+  announces sets :attr:`VideoSource.truncated` (a message) after iterating.
 """
 from __future__ import annotations
 
@@ -38,10 +51,13 @@ class DataError(ValueError):
     ----------
     path : Path
         The offending file or folder.
+    reason : str
+        The message without the path.
     """
 
     def __init__(self, message: str, path: str | Path) -> None:
         self.path = Path(path)
+        self.reason = message
         super().__init__(f"{message}: {self.path}")
 
 
@@ -130,7 +146,9 @@ def parse_gt(path: str | Path) -> np.ndarray:
 
     Values may be separated by commas, tabs or spaces; ``NaN`` is accepted.
     Lines of 8 values (VOT polygons ``x1,y1,...,x4,y4``) become their
-    axis-aligned min/max box.  Blank lines are skipped.
+    axis-aligned min/max box.  A blank line is a missing annotation (a NaN
+    row, so later lines keep their frame number); blank lines at the end of
+    the file are dropped.
 
     Returns
     -------
@@ -141,9 +159,13 @@ def parse_gt(path: str | Path) -> np.ndarray:
     if not p.is_file():
         raise DataError("ground-truth file not found", p)
     rows: list[list[float]] = []
-    for lineno, line in enumerate(p.read_text().splitlines(), start=1):
+    lines = p.read_text().splitlines()
+    while lines and not lines[-1].strip():
+        lines.pop()
+    for lineno, line in enumerate(lines, start=1):
         s = line.strip()
         if not s:
+            rows.append([float("nan")] * 4)
             continue
         try:
             vals = [float(t) for t in re.split(r"[,\s;]+", s) if t]
@@ -157,8 +179,8 @@ def parse_gt(path: str | Path) -> np.ndarray:
             rows.append([x0, y0, xs.max() - x0, ys.max() - y0])
         else:
             raise DataError(f"line {lineno}: expected 4 or 8 values, got {len(vals)}", p)
-    if not rows:
-        raise DataError("ground-truth file is empty", p)
+    if not rows or not np.isfinite(np.asarray(rows)).any():
+        raise DataError("ground-truth file is empty" if not rows else "ground-truth file has no box", p)
     return np.asarray(rows, dtype=np.float64)
 
 
@@ -200,6 +222,25 @@ def _find_image_dir(d: Path) -> Path:
     return d
 
 
+def _meta_number(meta: dict[str, Any], key: str, path: Path, default: float | None,
+                 positive: bool = False) -> float | None:
+    """``meta[key]`` as a finite float (``default`` if absent or null); DataError naming meta.json if not."""
+    v = meta.get(key)
+    if v is None:
+        return default
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) or (positive and v <= 0):
+        raise DataError(f"meta.json {key!r} must be a {'positive ' if positive else ''}number, got {v!r}", path)
+    return float(v)
+
+
+def _meta_name(meta: dict[str, Any], default: str, path: Path) -> str:
+    """The sequence name: a plain file name (it names cache and result files)."""
+    v = meta.get("name", default)
+    if not isinstance(v, str) or not v.strip() or v in (".", "..") or "/" in v or "\\" in v or "\0" in v:
+        raise DataError(f"meta.json 'name' must be a plain name (no '/', '\\', '.' or '..'), got {v!r}", path)
+    return v
+
+
 def load_sequence(path: str | Path, strict: bool = False) -> Sequence:
     """Load an OTB or VOT sequence folder.
 
@@ -231,11 +272,18 @@ def load_sequence(path: str | Path, strict: bool = False) -> Sequence:
             meta = json.loads((d / "meta.json").read_text())
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise DataError(f"invalid meta.json ({exc})", d / "meta.json") from exc
+        if not isinstance(meta, dict):
+            raise DataError(f"meta.json must be a JSON object, got {type(meta).__name__}", d / "meta.json")
+        attrs = meta.get("attributes", [])
+        if not isinstance(attrs, list) or not all(isinstance(a, str) for a in attrs):
+            raise DataError(f"meta.json 'attributes' must be a list of strings, got {attrs!r}", d / "meta.json")
     gt_file = next((d / g for g in GT_NAMES if (d / g).is_file()), None)
     if gt_file is None:
         raise DataError(f"no ground truth ({' or '.join(GT_NAMES)})", d)
     fmt = meta.get("format", "vot" if gt_file.name == "groundtruth.txt" else "otb")
-    base = float(meta.get("gt_coordinate_base", 0 if fmt == "vot" else 1))
+    base = _meta_number(meta, "gt_coordinate_base", d / "meta.json", 0.0 if fmt == "vot" else 1.0)
+    fps = _meta_number(meta, "fps", d / "meta.json", None, positive=True)
+    name = _meta_name(meta, d.name, d / "meta.json")
     img_dir = _find_image_dir(d)
     files = list_images(img_dir)
     if not files:
@@ -249,13 +297,12 @@ def load_sequence(path: str | Path, strict: bool = False) -> Sequence:
         n = min(len(gt), len(files))
         warnings.warn(f"{d}: {msg}; using the first {n} frames", DataWarning, stacklevel=2)
         gt, files = gt[:n], files[:n]
-    fps = meta.get("fps")
     return Sequence(
-        name=str(meta.get("name", d.name)),
+        name=name,
         img_files=files,
         gt=gt,
         attributes=[normalise_attribute(a) for a in meta.get("attributes", [])],
-        fps=float(fps) if fps else None,
+        fps=fps,
         meta=meta,
         path=d,
     )
@@ -276,13 +323,23 @@ def load_dataset(path: str | Path, names: list[str] | None = None, strict: bool 
     if not d.is_dir():
         raise DataError("dataset folder not found", d)
     if names:
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise DataError(f"sequence {', '.join(twice)} given more than once", d)
         missing = [n for n in names if not _is_sequence_dir(d / n)]
         if missing:
             raise DataError(f"no sequence named {', '.join(missing)}", d)
-        return [load_sequence(d / n, strict=strict) for n in names]
-    seqs = [load_sequence(p, strict=strict) for p in sorted(d.iterdir()) if _is_sequence_dir(p)]
+        seqs = [load_sequence(d / n, strict=strict) for n in names]
+    else:
+        seqs = [load_sequence(p, strict=strict) for p in sorted(d.iterdir()) if _is_sequence_dir(p)]
     if not seqs:
         raise DataError("no sequence folders (with groundtruth_rect.txt / groundtruth.txt)", d)
+    seen: dict[str, Path] = {}
+    for s in seqs:
+        if s.name in seen:
+            raise DataError(f"two sequences named {s.name!r} ({seen[s.name].name}/ and {s.path.name}/; "
+                            "see their meta.json 'name')", d)
+        seen[s.name] = s.path
     return seqs
 
 
@@ -302,6 +359,14 @@ class VideoSource:
     fps : float
         Frame rate from the container, the meta.json hint, or 30.
     sequence : Sequence or None
+    decoded : int
+        Frames yielded by the last :meth:`frames` iteration so far.
+    truncated : str or None
+        Set when a video ended before the frame count of its container (cut
+        or garbled file): e.g. "decoded 7 of 15 frames ...".
+    errors : dict
+        Frame index -> :class:`DataError` of each unreadable image met by
+        :meth:`frames` (``on_bad`` "none" or "skip").
 
     Raises
     ------
@@ -314,6 +379,9 @@ class VideoSource:
         self.path = Path(path)
         self.sequence: Sequence | None = None
         self._files: list[Path] = []
+        self.decoded = 0
+        self.truncated: str | None = None
+        self.errors: dict[int, DataError] = {}
         if self.path.is_dir():
             if _is_sequence_dir(self.path):
                 self.kind = "sequence"
@@ -359,31 +427,45 @@ class VideoSource:
         ----------
         on_bad : {"raise", "none", "skip"}
             For an unreadable image in a folder: raise :class:`DataError`,
-            yield ``None`` in its place, or skip it.  (A video simply ends
-            at its first undecodable frame.)
+            yield ``None`` in its place, or skip it (the error is kept in
+            :attr:`errors`).  A video ends at its first undecodable frame; if
+            that is before the container's frame count, :attr:`truncated`
+            says so (``mstrack track`` warns and records it in results.json).
         """
         if on_bad not in ("raise", "none", "skip"):
             raise ValueError(f"on_bad must be raise, none or skip, not {on_bad!r}")
+        self.decoded, self.truncated, self.errors = 0, None, {}
         if self.kind == "video":
             cap = cv2.VideoCapture(str(self.path))
             try:
+                expected = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
                 while True:
                     ok, frame = cap.read()
                     if not ok or frame is None:
+                        if expected > self.decoded:
+                            self.truncated = (f"decoded {self.decoded} of {expected} frames (the container "
+                                              f"announces {expected}; the file is cut or corrupt after frame "
+                                              f"{self.decoded - 1})")
                         return
                     if frame.ndim == 2:
                         frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
+                    self.decoded += 1
                     yield frame
             finally:
                 cap.release()
-        for f in self._files:
+        for i, f in enumerate(self._files):
             try:
-                yield read_image(f)
-            except DataError:
+                img = read_image(f)
+            except DataError as exc:
                 if on_bad == "raise":
                     raise
+                self.errors[i] = exc
                 if on_bad == "none":
+                    self.decoded += 1
                     yield None
+                continue
+            self.decoded += 1
+            yield img
 
     def __iter__(self) -> Iterator[np.ndarray | None]:
         return self.frames()

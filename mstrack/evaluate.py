@@ -5,7 +5,16 @@ on every following frame; frame 0 counts in the scores with the box the
 tracker reports from ``init`` (as in OTB).  Speed is measured on ``update()``
 only (frame decoding excluded).  Per-sequence results are cached as
 ``<out>/results/<label>/<sequence>.json`` and reused unless ``force``, or
-the frame count, model or tracker code (:func:`tracker_fingerprint`) changed.
+the frame count, model, tracker code (:func:`tracker_fingerprint`), tracker
+parameters (:func:`params_key`) or the sequence's content
+(:func:`sequence_digest`: ground truth and the frame files' names, sizes and
+modification times) changed, so one ``--out`` folder can serve several
+datasets whose sequences share a name without mixing their results.
+
+A sequence that cannot be run (unreadable frame, invalid frame-0 box, tracker
+error) is recorded in :attr:`Evaluation.failed` with the reason and left out
+of every tracker's scores; the other sequences go on and keep their cached
+runs (a failed run is not cached, so it is retried next time).
 
 Aggregates (:class:`Evaluation`): per sequence, per attribute and overall,
 the latter two frame-weighted (the per-frame values of all sequences are
@@ -32,7 +41,7 @@ from .data import DataError, Sequence
 from .metrics import Scores, concat_scores, score, valid_gt
 from .types import Box, Status
 
-CACHE_VERSION = 1
+CACHE_VERSION = 2
 MODELS = ("float", "fixed")
 
 
@@ -205,6 +214,30 @@ def run_sequence(tracker: Any, seq: Sequence, max_frames: int | None = None, lab
     return SequenceRun(label, seq.name, boxes, status, total, model)
 
 
+def sequence_digest(seq: Sequence, n_frames: int) -> str:
+    """Short hash of what a run of the first ``n_frames`` of ``seq`` depends on in the data.
+
+    The ground truth (0-based, as loaded) and, per frame file, its name, size and modification
+    time (not its path: a moved dataset keeps its cache).  Part of the cache key."""
+    import hashlib
+
+    h = hashlib.sha1(np.ascontiguousarray(seq.gt[:n_frames], dtype=np.float64).tobytes())
+    for f in seq.img_files[:n_frames]:
+        try:
+            st = Path(f).stat()
+            h.update(f"{Path(f).name}:{st.st_size}:{st.st_mtime_ns};".encode())
+        except OSError:
+            h.update(f"{Path(f).name}:missing;".encode())
+    return h.hexdigest()[:16]
+
+
+def params_key(tracker: Any) -> str:
+    """The parameters of a tracker object as a string (``repr`` of its ``params`` and, for the
+    fixed model, ``impl.fixed``); "" for trackers without them.  Part of the cache key."""
+    parts = [getattr(tracker, "params", None), getattr(getattr(tracker, "impl", None), "fixed", None)]
+    return "; ".join(repr(p) for p in parts if p is not None)
+
+
 def tracker_fingerprint(name: str) -> str:
     """Short hash of the code behind tracker ``name``, stored with cached runs.
 
@@ -232,16 +265,22 @@ def tracker_fingerprint(name: str) -> str:
 
 
 def cache_path(out_dir: str | Path, label: str, seq_name: str) -> Path:
-    """``<out>/results/<label>/<seq>.json``."""
+    """``<out>/results/<label>/<seq>.json``; ValueError if a name is not a plain file name."""
+    for what, v in (("tracker label", label), ("sequence name", seq_name)):
+        if not v or v in (".", "..") or any(c in v for c in "/\\\0"):
+            raise ValueError(f"{what} {v!r} cannot name a cache file (no '/', '\\', '.' or '..')")
     return Path(out_dir) / "results" / label / f"{seq_name}.json"
 
 
-def load_cached(path: Path, n_frames: int, model: str, fingerprint: str | None = None) -> SequenceRun | None:
-    """A cached run if it exists and matches (frame count, model, code fingerprint, cache version); else None."""
+def load_cached(path: Path, n_frames: int, model: str, fingerprint: str | None = None,
+                content: str | None = None, params: str | None = None) -> SequenceRun | None:
+    """A cached run if it exists and matches (frame count, model, code fingerprint, sequence content
+    digest, tracker parameters, cache version); else None."""
     try:
         d = json.loads(path.read_text())
         if d.get("version") != CACHE_VERSION or d.get("n_frames") != n_frames or d.get("model") != model \
-                or d.get("fingerprint") != fingerprint:
+                or d.get("fingerprint") != fingerprint or d.get("content") != content \
+                or d.get("params") != params:
             return None
         return SequenceRun.from_json(d)
     except (OSError, ValueError, KeyError, TypeError):
@@ -267,6 +306,9 @@ class Evaluation:
         ``[label]`` -> frame-weighted :class:`~mstrack.metrics.Scores`.
     fps : dict
         ``[label]`` -> total updates / total update time.
+    failed : dict
+        Sequence name -> {label: reason} of the runs that failed; those sequences are
+        not in :attr:`sequences` nor in any score.
     """
 
     trackers: list[str]
@@ -278,15 +320,22 @@ class Evaluation:
     overall: dict[str, Scores] = field(default_factory=dict)
     fps: dict[str, float] = field(default_factory=dict)
     seq_frames: dict[str, int] = field(default_factory=dict)
+    failed: dict[str, dict[str, str]] = field(default_factory=dict)
 
 
-def aggregate(runs: dict[str, dict[str, SequenceRun]], sequences: list[Sequence]) -> Evaluation:
-    """Score runs against the sequences' ground truth and aggregate them."""
+def aggregate(runs: dict[str, dict[str, SequenceRun]], sequences: list[Sequence],
+              failed: dict[str, dict[str, str]] | None = None) -> Evaluation:
+    """Score runs against the sequences' ground truth and aggregate them.
+
+    Sequences named in ``failed`` (name -> {label: reason}) are left out of every score."""
+    failed = dict(failed or {})
+    sequences = [s for s in sequences if s.name not in failed]
+    runs = {label: {n: r for n, r in per.items() if n not in failed} for label, per in runs.items()}
     attrs: dict[str, list[str]] = {}
     for s in sequences:
         for a in dict.fromkeys(s.attributes):
             attrs.setdefault(a, []).append(s.name)
-    ev = Evaluation(list(runs), [s.name for s in sequences], dict(sorted(attrs.items())), runs)
+    ev = Evaluation(list(runs), [s.name for s in sequences], dict(sorted(attrs.items())), runs, failed=failed)
     by_name = {s.name: s for s in sequences}
     for label, per in runs.items():
         ev.per_sequence[label] = {name: score(r.boxes, by_name[name].gt[:r.n_frames]) for name, r in per.items()}
@@ -322,10 +371,23 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
         Use at most this many frames of each sequence.
     factory : callable
         ``factory(name, model) -> tracker``; defaults to :func:`make_tracker`.
+
+    A run that raises :class:`DataError`, ``RuntimeError`` or ``ValueError`` (unreadable frame,
+    invalid frame-0 box, tracker error) is recorded in ``Evaluation.failed`` and the evaluation
+    goes on; ValueError for ``max_frames < 1`` or two sequences with the same name.
     """
+    if max_frames is not None and (isinstance(max_frames, bool) or not isinstance(max_frames, int)
+                                   or max_frames < 1):
+        raise ValueError(f"max_frames must be a positive integer, got {max_frames!r}")
+    seen: set[str] = set()
+    for s in sequences:
+        if s.name in seen:
+            raise ValueError(f"two sequences named {s.name!r}")
+        seen.add(s.name)
     progress = not quiet and sys.stderr.isatty()
     names = list(trackers)
-    runs: dict[str, dict[str, SequenceRun]] = {}
+    runs: dict[str, dict[str, SequenceRun]] = {label: {} for label in dict.fromkeys(run_label(t, model) for t in names)}
+    failed: dict[str, dict[str, str]] = {}
     jobs = [(t, s) for t in names for s in sequences]
     for name, seq in tqdm(jobs, desc="eval", disable=not progress, unit="seq"):
         label = run_label(name, model)
@@ -333,10 +395,16 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
         n = len(seq) if max_frames is None else min(len(seq), max_frames)
         path = cache_path(out_dir, label, seq.name)
         fp = tracker_fingerprint(name) if name in TRACKERS else None
-        run = None if force else load_cached(path, n, m, fp)
+        tracker = factory(name, model)
+        key = {"fingerprint": fp, "content": sequence_digest(seq, n), "params": params_key(tracker)}
+        run = None if force else load_cached(path, n, m, **key)
         if run is None:
-            run = run_sequence(factory(name, model), seq, n, label=label, model=m, progress=progress)
+            try:
+                run = run_sequence(tracker, seq, n, label=label, model=m, progress=progress)
+            except (DataError, RuntimeError, ValueError) as exc:
+                failed.setdefault(seq.name, {})[label] = str(exc)
+                continue
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps({**run.to_json(), "fingerprint": fp}) + "\n")
-        runs.setdefault(label, {})[seq.name] = run
-    return aggregate(runs, sequences)
+            path.write_text(json.dumps({**run.to_json(), **key}) + "\n")
+        runs[label][seq.name] = run
+    return aggregate(runs, sequences, failed)

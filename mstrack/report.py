@@ -3,8 +3,11 @@
 ``write_report(ev, out)`` writes:
 
 * ``report.md``: overall table (tracker, AUC, precision@20, fps), per-sequence
-  AUC table, per-attribute AUC table;
-* ``report.json``: the same numbers plus all curves, machine readable;
+  AUC table, per-attribute AUC table, the failed runs with their reasons; a
+  ``Tools:`` line names the numpy / OpenCV / numba versions
+  (:func:`mstrack.versions.tools_line`);
+* ``report.json``: the same numbers plus all curves, ``failed`` and
+  ``tools``, machine readable;
 * ``success.png`` / ``precision.png``: overall OTB-style plots, legend
   entries ``name [AUC]`` / ``name [P@20]`` sorted best first.
 """
@@ -17,6 +20,7 @@ from typing import Any
 
 from .evaluate import Evaluation
 from .metrics import CE_THRESHOLDS, IOU_THRESHOLDS, PRECISION_AT, Scores
+from .versions import PYTHON_TOOLS, tool_versions, tools_line
 
 
 def _f(v: float, nd: int = 3) -> str:
@@ -47,6 +51,8 @@ def report_dict(ev: Evaluation) -> dict[str, Any]:
                              for s, sc in ev.per_sequence[t].items()} for t in ev.trackers},
         "per_attribute": {t: {a: _scores_json(sc) for a, sc in ev.per_attribute[t].items()}
                           for t in ev.trackers},
+        "failed": ev.failed,
+        "tools": {k: tool_versions()[k] for k in PYTHON_TOOLS},
     }
 
 
@@ -67,6 +73,10 @@ def report_markdown(ev: Evaluation, title: str = "mstrack evaluation", command: 
            "overall and per-attribute numbers are frame-weighted; fps counts update() only.", ""]
     if command:
         out += ["Command: `" + command + "`", ""]
+    out += [tools_line(PYTHON_TOOLS), ""]
+    if ev.failed:
+        out += [f"**{len(ev.failed)} sequence(s) failed** and are left out of every score below "
+                "(see \"Failed runs\").", ""]
     out += ["## Overall", "", _table(["tracker", "AUC", f"P@{PRECISION_AT}", "fps"],
             [[t, _f(ev.overall[t].auc), _f(ev.overall[t].precision20), _f(ev.fps[t], 1)] for t in order]), ""]
     out += ["## AUC per sequence", "", _table(
@@ -78,6 +88,10 @@ def report_markdown(ev: Evaluation, title: str = "mstrack evaluation", command: 
             ["attribute", "sequences", *order],
             [[a, str(len(seqs)), *(_f(ev.per_attribute[t][a].auc) for t in order)]
              for a, seqs in ev.attributes.items()]), ""]
+    if ev.failed:
+        out += ["## Failed runs", "", _table(
+            ["sequence", "tracker", "reason"],
+            [[s, t, r.replace("|", "\\|").replace("\n", " ")] for s, per in ev.failed.items() for t, r in per.items()]), ""]
     return "\n".join(out)
 
 

@@ -187,3 +187,79 @@ def test_data_reader_errors(tmp_path):
         seq.frame(0)                             # unreadable image
     with pytest.raises(data.DataError):
         data.load_sequence(tmp_path / "missing")
+
+
+# ----------------------------------------------------------------------------- issue 9: boxes and parameters
+@pytest.mark.parametrize("box", ["5599", b"5599", bytearray(b"5599"), {1.0, 2.0, 30.0, 40.0},
+                                 {"x": 1, "y": 2, "w": 3, "h": 4}, (True, 10, 20, 20), ("10", "10", "20", "20"),
+                                 (10, 10, 20, None), iter((10, 10, 20, 20))])
+def test_box_must_be_four_real_numbers(box):
+    """Strings and bytes iterate as digits, a set has no order: none of them is a box."""
+    from mstrack.types import Box
+    with pytest.raises(ValueError, match="box must be"):
+        Box.of(box)
+
+
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("box", ["5599", b"5599", {10, 11, 20, 21}])
+def test_tracker_refuses_non_numeric_box(model, box, scene):
+    with pytest.raises(ValueError, match="box must be"):
+        Tracker(model=model).init(scene[0], box)
+
+
+def test_box_accepts_numpy_and_python_numbers():
+    from mstrack.types import Box
+    assert Box.of(np.array([1, 2, 3, 4], np.int32)) == Box.of((1.0, 2, np.float32(3), np.int64(4))) == Box(1, 2, 3, 4)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_huge_box_is_a_value_error(model, scene):
+    """1e308 boxes: x + w overflows to inf (the fixed model raised OverflowError)."""
+    with pytest.raises(ValueError) as ei:
+        Tracker(model=model).init(scene[0], (1e308, 1e308, 1e308, 1e308))
+    assert not isinstance(ei.value, OverflowError)
+
+
+PARAM_CASES = [({"max_iter": 1.5}, "max_iter must be an integer"), ({"colour_bits": 3.5}, "colour_bits must be an integer"),
+               ({"max_iter": True}, "max_iter must be an integer"), ({"edge_shift": 5.0}, "edge_shift must be an integer"),
+               ({"colour_bits": "3"}, "colour_bits must be an integer"), ({"eps2": float("nan")}, "eps2 must be a finite"),
+               ({"eps2": float("inf")}, "eps2 must be a finite"), ({"eps2": "1"}, "eps2 must be a finite"),
+               ({"eps2": False}, "eps2 must be a finite")]
+
+
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("kw,msg", PARAM_CASES)
+def test_param_types_checked_in_both_models(model, kw, msg):
+    """Same check, same message, at construction, in both models (one shared class)."""
+    from mstrack.params import ParamTypeError
+    with pytest.raises(ParamTypeError, match=msg) as ei:
+        Tracker(model=model, **kw)
+    assert isinstance(ei.value, TypeError) and isinstance(ei.value, ValueError)
+
+
+@pytest.mark.parametrize("kw", [{"max_half": 63.0}, {"margin": True}, {"centre_frac": 8.5}, {"rho_frac": None}])
+def test_fixed_param_types_checked(kw):
+    from mstrack.fixed import FixedParams
+    from mstrack.params import ParamTypeError
+    with pytest.raises(ParamTypeError, match=next(iter(kw))):
+        FixedParams(**kw)
+
+
+def test_numpy_integer_params_are_accepted_as_int(scene):
+    from mstrack.params import TrackerParams
+    tp = TrackerParams(colour_bits=np.int64(3), max_iter=np.int32(20), eps2=np.float32(1.0))
+    assert type(tp.colour_bits) is int and type(tp.max_iter) is int and type(tp.eps2) is float
+    assert tp == TrackerParams()
+
+
+@pytest.mark.filterwarnings("ignore::PendingDeprecationWarning")
+@pytest.mark.parametrize("model", MODELS)
+def test_np_matrix_frames_are_grey_frames(model, scene):
+    """np.matrix is an ndarray subclass that cannot be 3-D: read as a plain 2-D (grey) array."""
+    f0, f1, _, box = scene
+    g0, g1 = (cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) for f in (f0, f1))
+    ref = Tracker(model=model)
+    ref.init(g0, box)
+    trk = Tracker(model=model)
+    assert trk.init(np.matrix(g0), box).status == Status.INIT
+    assert trk.update(np.matrix(g1)).box == ref.update(g1).box

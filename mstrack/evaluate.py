@@ -45,11 +45,11 @@ CACHE_VERSION = 2
 MODELS = ("float", "fixed")
 
 
-def _mstrack(features: str, kernel: str) -> Callable[[str], Any]:
+def _mstrack(features: str | None, kernel: str, preset: str = "paper") -> Callable[[str], Any]:
     def make(model: str = "float") -> Any:
         from .tracker import Tracker  # imported late: written separately, may be absent
-        return Tracker(model=model, features=features, kernel=kernel)
-    make.__doc__ = f"mstrack.Tracker(features={features!r}, kernel={kernel!r})"
+        return Tracker(model=model, features=features, kernel=kernel, preset=preset)
+    make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r})"
     return make
 
 
@@ -62,6 +62,7 @@ def _baseline(fn: Callable[[], Any]) -> Callable[[str], Any]:
 
 #: Tracker name -> factory ``f(model) -> tracker``.  Add entries here.
 TRACKERS: dict[str, Callable[[str], Any]] = {
+    "mstrack-v2": _mstrack(None, "flat", "v2"),
     "mstrack-fused-flat": _mstrack("fused", "flat"),
     "mstrack-colour-flat": _mstrack("colour", "flat"),
     "mstrack-edge-flat": _mstrack("edge", "flat"),
@@ -252,7 +253,7 @@ def tracker_fingerprint(name: str) -> str:
 
     pkg = Path(__file__).resolve().parent
     if uses_model(name):
-        files = [pkg / f"{m}.py" for m in ("tracker", "float_model", "params", "frames", "types")]
+        files = [pkg / f"{m}.py" for m in ("tracker", "float_model", "float_v2", "params", "frames", "types")]
         files += sorted((pkg / "fixed").glob("*.py"))
         extra = ""
     else:

@@ -11,6 +11,7 @@ from dataclasses import dataclass, fields, replace
 from typing import Any, Literal
 
 Features = Literal["fused", "colour", "edge"]
+Preset = Literal["paper", "v2"]
 Kernel = Literal["flat", "epanechnikov"]
 
 
@@ -63,17 +64,67 @@ class TrackerParams:
         Maximum mean-shift iterations per feature per frame (paper: 20).
     eps2 : float
         Stop when the squared shift of one iteration is below eps2 (px^2).
+    preset : {"paper", "v2"}
+        "paper": the paper's algorithm (fixed-size window, colour + edge
+        fusion), bit for bit as before; "v2": tracker v2 (docs/algorithm.md,
+        "Tracker v2"; float model only for now).  ``features`` defaults to
+        "fused" for the paper and "colour" for v2.
+
+    The remaining fields are tracker v2's (ignored by the paper preset):
+
+    pad : float
+        The mean-shift window is the box grown by ``pad`` x its size (0.25:
+        each half-size x 1.25); the ring it adds shows the target growing.
+    bg_ring : float
+        Background ring for the background-weighted model: the box grown by
+        ``bg_ring`` x its size on each side, less the box.
+    max_window : int
+        Largest window extent in (decimated) pixels; a larger target is tracked
+        on every 2nd / 4th / 8th pixel.
+    scale_gain, scale_step, scale_reg : float
+        Scale update per frame: s = clamp(1 + gain (clamp(est, 1 - step,
+        1 + step) - 1) - reg (w / w0 - 1), 1 - step, 1 + step), est =
+        sqrt(spread / spread at init).  scale_gain = 0 keeps the init size.
+    conf_lost, conf_uncertain, conf_reacquire : float
+        Confidence thresholds: below conf_lost the target is lost (ok False,
+        nothing learnt, wide search from the next frame on); below
+        conf_uncertain the result is uncertain (ok False, nothing learnt); a
+        wide search re-acquires the target at conf_reacquire or above.
+    ref_rate : float
+        Rate of the running references of rho and share (confident frames).
+    search_step : float
+        Wide search start points: the last centre +- search_step window
+        sizes in x and y (8 points).
+    search_iter : int
+        Mean-shift iterations from each start point of the wide search.
     """
 
-    features: Features = "fused"
+    features: Features = None  # type: ignore[assignment]  # resolved per preset
     kernel: Kernel = "flat"
     colour_bits: int = 3
     edge_bins_log2: int = 4
     edge_shift: int = 5
     max_iter: int = 20
     eps2: float = 1.0
+    preset: Preset = "paper"
+    pad: float = 0.25
+    bg_ring: float = 0.6
+    max_window: int = 127
+    scale_gain: float = 0.3
+    scale_step: float = 0.1
+    scale_reg: float = 0.1
+    conf_lost: float = 0.4
+    conf_uncertain: float = 0.5
+    conf_reacquire: float = 0.5
+    ref_rate: float = 0.02
+    search_step: float = 1.0
+    search_iter: int = 5
 
     def __post_init__(self) -> None:
+        if self.preset not in ("paper", "v2"):
+            raise ValueError(f"preset must be 'paper' or 'v2', got {self.preset!r}")
+        if self.features is None:
+            object.__setattr__(self, "features", "fused" if self.preset == "paper" else "colour")
         check_param_types(self)
         if self.features not in ("fused", "colour", "edge"):
             raise ValueError(f"features must be 'fused', 'colour' or 'edge', got {self.features!r}")
@@ -89,6 +140,21 @@ class TrackerParams:
             raise ValueError("max_iter must be >= 1")
         if not self.eps2 > 0:
             raise ValueError("eps2 must be > 0")
+        if self.preset == "v2":
+            if self.features != "colour":
+                raise ValueError("preset 'v2' tracks on colour only (features='colour')")
+            for name, lo, hi in (("pad", 0.0, 2.0), ("bg_ring", 0.05, 4.0), ("scale_gain", 0.0, 1.0),
+                                 ("scale_step", 0.0, 0.5), ("scale_reg", 0.0, 1.0), ("conf_lost", 0.0, 1.0),
+                                 ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
+                                 ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0)):
+                if not lo <= getattr(self, name) <= hi:
+                    raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
+            if not self.conf_lost <= self.conf_uncertain:
+                raise ValueError("conf_lost must be <= conf_uncertain")
+            if not 7 <= self.max_window <= 1023:
+                raise ValueError("max_window must be in 7..1023")
+            if self.search_iter < 1:
+                raise ValueError("search_iter must be >= 1")
 
     @property
     def n_colour_bins(self) -> int:

@@ -36,9 +36,15 @@ class Tracker:
         if model == "float":
             if rest:
                 raise TypeError(f"unknown parameters for the float model: {sorted(rest)}")
-            from .float_model import FloatTracker
-            self._impl: Any = FloatTracker(tp)
+            if tp.preset == "v2":
+                from .float_v2 import FloatTrackerV2
+                self._impl: Any = FloatTrackerV2(tp)
+            else:
+                from .float_model import FloatTracker
+                self._impl = FloatTracker(tp)
         elif model == "fixed":
+            if tp.preset == "v2":
+                raise ValueError("preset 'v2' has no fixed-point model yet (model='float' only)")
             from .fixed import FixedParams, FixedTracker
             fp, rest = FixedParams.split(rest)
             if rest:

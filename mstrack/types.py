@@ -81,7 +81,10 @@ class Status(str, Enum):
 
     OK = "ok"                  # tracked normally
     INIT = "init"              # the frame the target was initialised on
-    LOST = "lost"              # no model bin present in the window (all weights 0)
+    LOST = "lost"              # the target is not where the tracker looks (v2: confidence below
+                               # the loss threshold; paper preset: all weights 0); box kept
+    UNCERTAIN = "uncertain"    # v2: confidence low, position reported but not trusted
+    REACQUIRED = "reacquired"  # v2: the wide search found the target again after a loss
     CLIPPED = "clipped"        # init box clipped to the frame / to the maximum window
     ERROR = "error"            # frame rejected (bad frame); position kept from the previous frame
 
@@ -122,7 +125,13 @@ class TrackResult:
     iter_e: int
     status: Status
     message: str = ""
+    confidence: float = 1.0
     extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        """True when the box can be trusted: not lost, uncertain or a rejected frame."""
+        return self.status in (Status.OK, Status.INIT, Status.CLIPPED, Status.REACQUIRED)
 
     def to_dict(self) -> dict[str, Any]:
         d = asdict(self)

@@ -1,0 +1,265 @@
+"""Tracker v2, float reference (docs/algorithm.md, "Tracker v2").
+
+Mean shift on a background-weighted colour model (CBWH, Ning et al. 2012),
+in a window padded around the target, with
+
+* scale from the spread of the target-coloured pixels (calibrated on the
+  init frame, bounded step, pulled toward the init size),
+* decimation (every D-th pixel, D a power of two) for targets larger than
+  the window memory,
+* a confidence = min(1, rho / rho_ref) * min(1, share / share_ref) from the
+  Bhattacharyya coefficient and the share of target-coloured pixels in the
+  box, against their running references,
+* loss (confidence below a threshold: the box is kept, nothing is learnt)
+  and re-acquisition by a wider search from several start points.
+
+Every step is a pass over the window's pixels or over the bins, so the
+fixed-point model and the RTL can do the same in integers.
+
+Coordinates are pixel-index (pixel (i, j) at (i, j)).  With decimation D the
+tracker works on the image of the pixels with x % D == 0 and y % D == 0
+(``bins[::D, ::D]``), in which pixel (i, j) is frame pixel (D i, D j).  The
+window of half-sizes (hx, hy) around (cx, cy) holds the pixels with
+d2 = ((x - cx) / hx)^2 + ((y - cy) / hy)^2 < 1.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .float_model import check_frame, clip_box, colour_bins
+from .params import TrackerParams
+from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
+
+
+@dataclass
+class PassV2:
+    """Sums of one pass over a window (one pixel pass + one bin pass in the hardware).
+
+    rho: Bhattacharyya coefficient of the window histogram p against q;
+    sw, swx, swy: sums of the mean-shift weights sqrt(q_u / p_u), and of the
+    weights times x, y; nt, st2: count and sum of d2 of the target-coloured
+    pixels (t_u = 1) in the window; n_in, nt_in: pixels, and target-coloured
+    pixels, in the inner window d2 < 1 / (1 + pad)^2 (the box itself).
+    """
+
+    rho: float
+    sw: float
+    swx: float
+    swy: float
+    nt: float
+    st2: float
+    n_in: int
+    nt_in: int
+
+    @property
+    def share(self) -> float:
+        """Share of target-coloured pixels in the box (inner window)."""
+        return self.nt_in / self.n_in if self.n_in else 0.0
+
+    @property
+    def spread(self) -> float:
+        """Mean d2 of the target-coloured pixels in the window (0 if none)."""
+        return self.st2 / self.nt if self.nt else 0.0
+
+
+def window_pixels(cx: float, cy: float, hx: float, hy: float, width: int,
+                  height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Columns, rows (int) and d2 of the pixels with d2 < 1 inside a width x height image."""
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    xs = np.arange(x0, x1 + 1, dtype=np.float64)
+    ys = np.arange(y0, y1 + 1, dtype=np.float64)
+    d2 = ((xs[None, :] - cx) / hx) ** 2 + ((ys[:, None] - cy) / hy) ** 2
+    yy, xx = np.nonzero(d2 < 1.0)
+    return (xx + x0).astype(np.intp), (yy + y0).astype(np.intp), d2[yy, xx]
+
+
+def background_model(bins: np.ndarray, n_bins: int, cx: float, cy: float, w: float, h: float,
+                     ring: float, kernel: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Target model of a w x h box at (cx, cy): (q, q', t).
+
+    q: kernel-weighted histogram of the box ellipse (sums to 1).  o: histogram
+    of the background ring, the pixels of the box grown by ``ring`` x its size
+    on each side that are outside the box.  CBWH (Ning et al. 2012):
+    v_u = min(o* / o_u, 1), o* the smallest non-zero o_u (v_u = 1 where o_u = 0);
+    q'_u = v_u q_u / sum(v q).  t_u = 1 where q_u > o_u (target-coloured bin).
+    """
+    height, width = bins.shape
+    xs, ys, d2 = window_pixels(cx, cy, w / 2.0, h / 2.0, width, height)
+    k = np.ones_like(d2) if kernel == "flat" else 1.0 - d2
+    q = np.bincount(bins[ys, xs], weights=k, minlength=n_bins)
+    q /= q.sum()
+    gx, gy = ring * w, ring * h
+    x0, x1 = max(0, math.ceil(cx - w / 2 - gx)), min(width - 1, math.floor(cx + w / 2 + gx))
+    y0, y1 = max(0, math.ceil(cy - h / 2 - gy)), min(height - 1, math.floor(cy + h / 2 + gy))
+    yy, xx = np.mgrid[y0:y1 + 1, x0:x1 + 1]
+    outside = (np.abs(xx - cx) > w / 2.0) | (np.abs(yy - cy) > h / 2.0)
+    o = np.bincount(bins[yy[outside], xx[outside]], minlength=n_bins).astype(np.float64)
+    if o.sum() == 0:  # box fills the frame: no background seen
+        return q, q.copy(), (q > 0).astype(np.float64)
+    o /= o.sum()
+    v = np.ones(n_bins)
+    nz = o > 0
+    v[nz] = np.minimum(o[nz].min() / o[nz], 1.0)
+    qb = q * v
+    return q, qb / qb.sum(), (q > o).astype(np.float64)
+
+
+def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: tuple[float, float],
+                hx: float, hy: float, inner2: float, kernel: str) -> PassV2:
+    """One pass over the window at ``c``: histogram, rho, weights and their sums (:class:`PassV2`)."""
+    height, width = bins.shape
+    xs, ys, d2 = window_pixels(c[0], c[1], hx, hy, width, height)
+    b = bins[ys, xs]
+    k = np.ones_like(d2) if kernel == "flat" else 1.0 - d2
+    p = np.bincount(b, weights=k, minlength=n_bins)
+    s = p.sum()
+    if s > 0:
+        p /= s
+    rho = float(np.sqrt(p * q).sum())
+    wb = np.zeros(n_bins)
+    nz = p > 0
+    wb[nz] = np.sqrt(q[nz] / p[nz])
+    w = wb[b]
+    tp = t[b]
+    inner = d2 < inner2
+    return PassV2(rho=rho, sw=float(w.sum()), swx=float((w * xs).sum()), swy=float((w * ys).sum()),
+                  nt=float(tp.sum()), st2=float((tp * d2).sum()), n_in=int(inner.sum()),
+                  nt_in=int(tp[inner].sum()))
+
+
+class FloatTrackerV2:
+    """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2")."""
+
+    def __init__(self, params: TrackerParams | None = None) -> None:
+        self.params = params or TrackerParams(preset="v2")
+        self._shape: tuple[int, int] | None = None
+
+    # ------------------------------------------------------------------ helpers
+    def decimation(self, w: float, h: float) -> int:
+        """D: the smallest power of two with max(w, h) (1 + pad) / D <= max_window."""
+        p = self.params
+        d = 1
+        while max(w, h) * (1.0 + p.pad) / d > p.max_window and d < 8:
+            d *= 2
+        return d
+
+    def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
+        return colour_bins(frame[::d, ::d], self.params.colour_bits)
+
+    def _track(self, bins: np.ndarray, start: tuple[float, float], hx: float, hy: float,
+               max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
+        """Mean shift from ``start`` (decimated coordinates): centre, pass at the centre, iterations."""
+        p = self.params
+        height, width = bins.shape
+        inner2 = 1.0 / (1.0 + p.pad) ** 2
+
+        def clamp(c: tuple[float, float]) -> tuple[float, float]:
+            return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
+
+        c0 = clamp(start)
+        p0 = window_pass(bins, p.n_colour_bins, self._qb, self._t, c0, hx, hy, inner2, p.kernel)
+        it = 0
+        for it in range(1, max_iter + 1):
+            if p0.sw <= 0:
+                break
+            c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
+            p1 = window_pass(bins, p.n_colour_bins, self._qb, self._t, c1, hx, hy, inner2, p.kernel)
+            if p1.rho < p0.rho:
+                break
+            s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
+            c0, p0 = c1, p1
+            if s2 < p.eps2:
+                break
+        return c0, p0, it
+
+    def _confidence(self, ps: PassV2) -> float:
+        cr = min(1.0, ps.rho / self._rho_ref) if self._rho_ref > 0 else 0.0
+        cs = min(1.0, ps.share / self._share_ref) if self._share_ref > 0 else 0.0
+        return cr * cs
+
+    # ------------------------------------------------------------------ API
+    def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
+        frame = check_frame(frame)
+        height, width = frame.shape[:2]
+        box, clipped = clip_box(Box.of(box), width, height)
+        p = self.params
+        self._shape = (height, width)
+        cx, cy = box_centre_index(box)
+        self._size = self._size0 = (box.w, box.h)
+        self._centre = (cx, cy)
+        d = self.decimation(box.w, box.h)
+        bins = self._bins(frame, d)
+        self._q, self._qb, self._t = background_model(bins, p.n_colour_bins, cx / d, cy / d, box.w / d,
+                                                      box.h / d, p.bg_ring, p.kernel)
+        pad = 1.0 + p.pad
+        ps = window_pass(bins, p.n_colour_bins, self._qb, self._t, (cx / d, cy / d), pad * box.w / 2 / d,
+                         pad * box.h / 2 / d, 1.0 / pad ** 2, p.kernel)
+        # references: rho and share are learnt from the first tracked frames (start at the init values)
+        self._rho_ref = ps.rho
+        self._share_ref = ps.share
+        self._spread_ref = ps.spread if ps.spread > 0 else 0.5 / pad ** 2
+        self._lost = False
+        return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
+                           iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
+                           message="init box clipped to the frame" if clipped else "",
+                           confidence=1.0, extra={"decimation": d, "share": ps.share})
+
+    def update(self, frame: np.ndarray) -> TrackResult:
+        if self._shape is None:
+            raise RuntimeError("update() called before init()")
+        frame = check_frame(frame, self._shape)
+        p = self.params
+        w, h = self._size
+        d = self.decimation(w, h)
+        bins = self._bins(frame, d)
+        pad = 1.0 + p.pad
+        hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
+        start = (self._centre[0] / d, self._centre[1] / d)
+        c, ps, it = self._track(bins, start, hx, hy, p.max_iter)
+        conf = self._confidence(ps)
+        searched = 0
+        if self._lost:
+            # wide search: mean shift from start points around the last centre, best confidence wins
+            for sy in (-1, 0, 1):
+                for sx in (-1, 0, 1):
+                    if sx == 0 and sy == 0:
+                        continue
+                    s0 = (start[0] + sx * p.search_step * 2 * hx, start[1] + sy * p.search_step * 2 * hy)
+                    c2, ps2, _ = self._track(bins, s0, hx, hy, p.search_iter)
+                    searched += 1
+                    conf2 = self._confidence(ps2)
+                    if conf2 > conf:
+                        c, ps, conf = c2, ps2, conf2
+        if conf < (p.conf_reacquire if self._lost else p.conf_lost):
+            status = Status.LOST
+        elif self._lost:
+            status = Status.REACQUIRED
+        elif conf < p.conf_uncertain:
+            status = Status.UNCERTAIN
+        else:
+            status = Status.OK
+        self._lost = status == Status.LOST
+        self._centre = (c[0] * d, c[1] * d)  # lost: the search's best candidate (not trusted: ok False)
+        if status == Status.OK:
+            a = p.ref_rate
+            self._rho_ref += a * (ps.rho - self._rho_ref)
+            self._share_ref += a * (ps.share - self._share_ref)
+        # scale: every frame (a lost or uncertain target changes size too), from the spread
+        if p.scale_gain > 0 and ps.nt > 0:
+            est = math.sqrt(ps.spread / self._spread_ref)
+            est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
+            s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / self._size0[0] - 1.0)
+            s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
+            self._size = (min(max(w * s, 3.0), float(self._shape[1])),
+                          min(max(h * s, 3.0), float(self._shape[0])))
+        box = box_from_centre_index(*self._centre, *self._size)
+        return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
+                           iter_c=it, iter_e=0, status=status, confidence=conf,
+                           extra={"decimation": d, "share": ps.share, "spread": ps.spread,
+                                  "searched": searched})

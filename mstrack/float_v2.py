@@ -216,7 +216,8 @@ class FloatTrackerV2:
         frame = check_frame(frame, self._shape)
         p = self.params
         w, h = self._size
-        d = self.decimation(w, h)
+        # lost: the whole search runs at twice the decimation (a region 2x wider in the same memory)
+        d = self.decimation(w, h) * (2 if self._lost else 1)
         bins = self._bins(frame, d)
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d

@@ -108,7 +108,7 @@ class TrackerParams:
     eps2: float = 1.0
     preset: Preset = "paper"
     pad: float = 0.25
-    bg_ring: float = 0.6
+    bg_ring: float = 0.625
     max_window: int = 127
     scale_gain: float = 0.3
     scale_step: float = 0.1
@@ -116,7 +116,7 @@ class TrackerParams:
     conf_lost: float = 0.4
     conf_uncertain: float = 0.5
     conf_reacquire: float = 0.5
-    ref_rate: float = 0.02
+    ref_rate: float = 0.015625
     search_step: float = 1.0
     search_iter: int = 5
 

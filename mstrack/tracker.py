@@ -43,13 +43,15 @@ class Tracker:
                 from .float_model import FloatTracker
                 self._impl = FloatTracker(tp)
         elif model == "fixed":
-            if tp.preset == "v2":
-                raise ValueError("preset 'v2' has no fixed-point model yet (model='float' only)")
             from .fixed import FixedParams, FixedTracker
             fp, rest = FixedParams.split(rest)
             if rest:
                 raise TypeError(f"unknown parameters: {sorted(rest)}")
-            self._impl = FixedTracker(tp, fp)
+            if tp.preset == "v2":
+                from .fixed.tracker_v2 import FixedTrackerV2
+                self._impl = FixedTrackerV2(tp, fp)
+            else:
+                self._impl = FixedTracker(tp, fp)
         else:
             raise ValueError(f"model must be 'float' or 'fixed', got {model!r}")
         self.model = model

@@ -1,0 +1,209 @@
+"""Blocks of tracker v2 in integers, one function per (future) RTL entity of the same name.
+
+docs/fixed_point.md ("Tracker v2") gives format, range and rounding of each
+signal; docs/algorithm.md ("Tracker v2") the float algorithm these follow.
+Ratios and fractions are Q.16 (``ONE = 2**16`` is 1.0) unless said otherwise.
+Sizes are Q.8 px (``w8 = round(w * 256)``).  All shifts of signed values are
+arithmetic (floor).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..params import TrackerParams
+from .blocks import ms_kernel
+from .primitives import ms_divider, ms_isqrt
+
+ONE = 1 << 16          # Q.16 one
+SIZE_FRAC = 8          # box sizes w8, h8 are Q.8 px
+BG_FRAC = 8            # CBWH factors v_u are Q.8 (2**8 = 1)
+QN_BITS = 16           # the normalised model Qn sums to about 2**16
+PAD_FRAC = 4           # pad, bg_ring, search_step are multiples of 1/16
+MAX_DECIMATION = 8
+
+
+def q16(x: float) -> int:
+    """A parameter in [0, 1+] as Q.16, rounded to nearest."""
+    return int(round(x * ONE))
+
+
+def sixteenths(x: float, name: str) -> int:
+    """A parameter that must be a multiple of 1/16 (pad, bg_ring, search_step), as an integer."""
+    n = int(round(x * 16))
+    if abs(n - x * 16) > 1e-9:
+        raise ValueError(f"{name} = {x} is not a multiple of 1/16 (the fixed-point model needs it)")
+    return n
+
+
+def rate_shift(rate: float) -> int:
+    """ref_rate = 2**-k -> k (the running references update with a shift)."""
+    k = int(round(-np.log2(rate))) if rate > 0 else 0
+    if rate <= 0 or abs(2.0 ** -k - rate) > 1e-12:
+        raise ValueError(f"ref_rate = {rate} must be a power of two 2**-k for the fixed-point model")
+    return k
+
+
+# ----------------------------------------------------------------------------- geometry
+def ms_decimation(w8: int, h8: int, pad16: int, max_window: int) -> int:
+    """D: the smallest power of two (<= 8) with (1 + pad) max(w, h) / D <= max_window.
+
+    Exact: (16 + pad16) max(w8, h8) <= max_window D 2**(4 + 8).
+    """
+    d = 1
+    m = (16 + pad16) * max(w8, h8)
+    while m > max_window * d << (PAD_FRAC + SIZE_FRAC) and d < MAX_DECIMATION:
+        d *= 2
+    return d
+
+
+def ms_window_size(s8: int, pad16: int, d: int, limit: int) -> int:
+    """Window diameter in decimated px: round((1 + pad) s / D) (half up), in 3 .. limit."""
+    sh = PAD_FRAC + SIZE_FRAC + (d.bit_length() - 1)
+    n = ((16 + pad16) * s8 + (1 << (sh - 1))) >> sh
+    return max(3, min(n, limit))
+
+
+def ms_box_size(s8: int, d: int, limit: int) -> int:
+    """Box diameter in decimated px: round(s / D) (half up), in 3 .. limit."""
+    sh = SIZE_FRAC + (d.bit_length() - 1)
+    return max(3, min((s8 + (1 << (sh - 1))) >> sh, limit))
+
+
+# ----------------------------------------------------------------------------- target model
+@dataclass
+class ModelV2:
+    """Target model of v2 (per target: what a multi-target core keeps per target).
+
+    Qn: background-weighted histogram normalised to about 2**16 (sum of Q v,
+    scaled); T: 1 for target-coloured bins (q_u > o_u); Q, O: the raw box and
+    ring counts (for traces and tests).
+    """
+
+    Qn: np.ndarray
+    T: np.ndarray
+    Q: np.ndarray
+    O: np.ndarray
+
+
+def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: int,
+                n_bins: int) -> ModelV2:
+    """CBWH target model of the box of diameters (wb, hb) decimated px centred on pixel (cx, cy).
+
+    Box: the pixels of the ellipse (2dx/wb)^2 + (2dy/hb)^2 < 1 (exact integer
+    test of :class:`ms_kernel`, flat) -> counts Q.  Ring: the pixels of the
+    rectangle grown by g = (ring16 * n) >> 4 on each side (n = wb, hb), clipped
+    to the image, that lie outside the box's rectangle (|dx| > ex or
+    |dy| > ey) -> counts O.  o* = the smallest non-zero O;
+    v_u = min(floor(o* 2**8 / O_u), 2**8) (2**8 where O_u = 0);
+    Qn_u = floor(Q_u v_u 2**16 / sum(Q v));  T_u = 1 where Q_u sum(O) > O_u sum(Q)
+    (q_u > o_u, exact); without any ring pixel: v = 1 and T_u = (Q_u > 0).
+    """
+    height, width = bins.shape
+    ker = ms_kernel(wb, hb, "flat", 8)
+    ex, ey = ker.ex, ker.ey
+    box = bins[cy - ey: cy + ey + 1, cx - ex: cx + ex + 1]
+    Q = np.bincount(box[ker.inside], minlength=n_bins).astype(np.int64)
+    gx, gy = (ring16 * wb) >> PAD_FRAC, (ring16 * hb) >> PAD_FRAC
+    x0, x1 = max(0, cx - ex - gx), min(width - 1, cx + ex + gx)
+    y0, y1 = max(0, cy - ey - gy), min(height - 1, cy + ey + gy)
+    yy, xx = np.mgrid[y0:y1 + 1, x0:x1 + 1]
+    outside = (np.abs(xx - cx) > ex) | (np.abs(yy - cy) > ey)
+    O = np.bincount(bins[yy[outside], xx[outside]], minlength=n_bins).astype(np.int64)
+    nq, no = int(Q.sum()), int(O.sum())
+    one_v = 1 << BG_FRAC
+    if no == 0:
+        v = np.full(n_bins, one_v, np.int64)
+        T = (Q > 0).astype(np.int64)
+    else:
+        omin = int(O[O > 0].min())
+        v = np.full(n_bins, one_v, np.int64)
+        nz = O > 0
+        v[nz] = np.minimum(ms_divider(omin << BG_FRAC, O[nz], BG_FRAC + 1), one_v)
+        T = (Q * no > O * nq).astype(np.int64)
+    qv = Q * v
+    tot = int(qv.sum())
+    Qn = np.zeros(n_bins, np.int64)
+    nz = qv > 0
+    Qn[nz] = ms_divider(qv[nz] << QN_BITS, tot, QN_BITS + 1)
+    return ModelV2(Qn=Qn, T=T, Q=Q, O=O)
+
+
+def ms_model_scale(Qn: np.ndarray, K: int) -> np.ndarray:
+    """The model at a window of K pixels: Qw_u = (Qn_u K) >> 16 (so sum Qw ~ K, like H)."""
+    return (Qn * K) >> QN_BITS
+
+
+# ----------------------------------------------------------------------------- per-pass statistics
+@dataclass
+class TargetStats:
+    """Target-coloured pixel statistics of one window (accumulated in the pixel pass).
+
+    nt: count of pixels with T = 1; st2: their sum of d2q = KA[|dx|] + KB[|dy|]
+    (d2 in Q.KB); n_in / nt_in: pixels / target-coloured pixels of the inner
+    window d2q (16 + pad16)^2 < 2**(KB + 8) (the box inside the padded window).
+    """
+
+    nt: int
+    st2: int
+    n_in: int
+    nt_in: int
+
+
+def ms_target_stats(bins: np.ndarray, T: np.ndarray, win: tuple[int, int], ker: ms_kernel, kb: int,
+                    pad16: int) -> TargetStats:
+    """Statistics of the window at integer centre ``win`` (within ``bins``' coordinates)."""
+    ex, ey = ker.ex, ker.ey
+    b = bins[win[1] - ey: win[1] + ey + 1, win[0] - ex: win[0] + ex + 1][ker.inside]
+    adx = np.abs(ker._dx_in)
+    ady = np.abs(ker._dy_in)
+    d2q = ker.KA[adx] + ker.KB[ady]
+    t = T[b]
+    inner = d2q * (16 + pad16) ** 2 < (1 << (kb + 8))
+    return TargetStats(nt=int(t.sum()), st2=int((t * d2q).sum()), n_in=int(inner.sum()),
+                       nt_in=int(t[inner].sum()))
+
+
+# ----------------------------------------------------------------------------- confidence, scale
+def ms_share(st: TargetStats) -> int:
+    """share = floor(nt_in 2**16 / n_in) (Q.16; 0 when n_in = 0)."""
+    return int(ms_divider(st.nt_in << 16, st.n_in, 17)) if st.n_in else 0
+
+
+def ms_spread(st: TargetStats) -> int:
+    """spread = floor(st2 2**16 / nt): mean d2q of the target-coloured pixels, Q.(KB + 16); 0 if nt = 0."""
+    return int(ms_divider(st.st2 << 16, st.nt, 40)) if st.nt else 0
+
+
+def ms_confidence(rho: int, share: int, rho_ref: int, share_ref: int) -> int:
+    """conf = (min(1, rho / rho_ref) min(1, share / share_ref)) in Q.16, each ratio floored."""
+    def ratio(x: int, ref: int) -> int:
+        return min(ONE, int(ms_divider(x << 16, ref, 34))) if ref > 0 else 0
+    return (ratio(rho, rho_ref) * ratio(share, share_ref)) >> 16
+
+
+def ms_ref_update(ref: int, x: int, k: int) -> int:
+    """Running reference: ref + ((x - ref) >> k) (arithmetic shift = floor)."""
+    return ref + ((x - ref) >> k)
+
+
+def ms_scale(spread: int, spread_ref: int, w8: int, w0_8: int, tp: TrackerParams) -> int:
+    """Scale factor s (Q.16) of one frame (float: FloatTrackerV2.update).
+
+    est = isqrt(floor(spread 2**16 / spread_ref) 2**16) (Q.16, floored), clamped to
+    [1 - step, 1 + step]; s = 1 + ((gain (est - 1)) >> 16) - ((reg (w / w0 - 1)) >> 16)
+    with w / w0 = floor(w8 2**16 / w0_8); clamped to [1 - step, 1 + step].  gain,
+    reg, step in Q.16 (rounded).
+    """
+    lo, hi = ONE - q16(tp.scale_step), ONE + q16(tp.scale_step)
+    r = int(ms_divider(spread << 16, spread_ref, 40))
+    est = min(max(int(ms_isqrt(r << 16)), lo), hi)
+    wr = int(ms_divider(w8 << 16, w0_8, 40))
+    s = ONE + ((q16(tp.scale_gain) * (est - ONE)) >> 16) - ((q16(tp.scale_reg) * (wr - ONE)) >> 16)
+    return min(max(s, lo), hi)
+
+
+def ms_resize(s8: int, s: int, frame_size: int) -> int:
+    """New size (Q.8): (s8 s) >> 16, clamped to [3, frame_size] px."""
+    return min(max((s8 * s) >> 16, 3 << SIZE_FRAC), frame_size << SIZE_FRAC)

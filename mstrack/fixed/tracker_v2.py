@@ -1,0 +1,215 @@
+"""Fixed-point tracker v2: the executable specification of core v2 (float: mstrack/float_v2.py).
+
+Per frame (all integer; blocks in :mod:`mstrack.fixed.blocks_v2` and :mod:`mstrack.fixed.blocks`):
+
+1. D = ms_decimation(w8, h8) (x2 while lost); the tracker works on the
+   decimated image ``frame[::D, ::D]`` and its colour bins.
+2. Window diameters wd, hd = round((1 + pad) (w, h) / D); flat kernel tables
+   (:class:`ms_kernel`); the model at this window, Qw = ms_model_scale(Qn, K).
+3. Region = window box + MARGIN decimated px per side (+ the search offset
+   while lost), captured; mean shift (:func:`ms_meanshift`, the paper's
+   loop) from the last centre; while lost also from 8 start points at
+   +-search_step window diameters (search_iter iterations each).
+4. rho = ms_rho_out(S, K); share and spread from :func:`ms_target_stats` at
+   the final centre; confidence; status; the best start point wins while lost.
+5. References (rho_ref, share_ref) follow confident frames by a shift;
+   the size changes by ms_scale every frame.
+
+Raw integers of each frame are in ``TrackResult.extra`` (:data:`RESULT_FIELDS_V2`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..frames import check_frame
+from ..params import TrackerParams
+from ..types import Box, Status, TrackResult
+from .blocks import (STOP_CODES, Region, ms_box_clip, ms_colour_bin, ms_kernel, ms_meanshift, ms_region,
+                     ms_rho_out, ms_round_centre, round_box)
+from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_model_scale,
+                        ms_ref_update, ms_resize, ms_scale, ms_share, ms_spread, ms_target_stats,
+                        ms_window_size, ms_box_size, q16, rate_shift, sixteenths)
+from .formats import FixedParams, widths
+
+# Integer fields of one v2 result (what result word v2 will carry).
+RESULT_FIELDS_V2 = ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "decimation")
+STATUS_CODES_V2 = {Status.OK: 0, Status.UNCERTAIN: 1, Status.LOST: 2, Status.REACQUIRED: 3,
+                   Status.INIT: 4, Status.CLIPPED: 5, Status.ERROR: 6}
+
+
+class FixedTrackerV2:
+    """Bit-accurate model of tracker v2.  Use through :class:`mstrack.Tracker` (model="fixed", preset="v2")."""
+
+    def __init__(self, params: TrackerParams | None = None, fixed: FixedParams | None = None) -> None:
+        self.params = params or TrackerParams(preset="v2")
+        if self.params.preset != "v2":
+            raise ValueError("FixedTrackerV2 needs preset='v2'")
+        self.fixed = fixed or FixedParams()
+        p = self.params
+        self.pad16 = sixteenths(p.pad, "pad")
+        self.ring16 = sixteenths(p.bg_ring, "bg_ring")
+        self.step16 = sixteenths(p.search_step, "search_step")
+        self.ref_k = rate_shift(p.ref_rate)
+        if p.kernel != "flat":
+            raise ValueError("the fixed-point v2 model has the flat kernel only")
+        if p.max_window > 2 * self.fixed.max_half + 1:
+            raise ValueError(f"max_window {p.max_window} > 2 max_half + 1 = {2 * self.fixed.max_half + 1}")
+        self.widths = widths(p, self.fixed)
+        self._shape: tuple[int, int] | None = None
+
+    # ------------------------------------------------------------------ helpers
+    def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
+        return ms_colour_bin(frame[::d, ::d], self.params.colour_bits)
+
+    def _geometry(self, d: int, dims: tuple[int, int]) -> tuple[int, int]:
+        """Window diameters (decimated px), limited to the decimated frame's interior."""
+        p = self.params
+        hd_, wd_ = dims
+        wd = ms_window_size(self.w8, self.pad16, d, min(p.max_window, wd_ - 2))
+        hd = ms_window_size(self.h8, self.pad16, d, min(p.max_window, hd_ - 2))
+        return wd, hd
+
+    def _run(self, bins: np.ndarray, Qw: np.ndarray, ker: ms_kernel, start8: tuple[int, int],
+             reg: Region, max_iter: int):
+        """Mean shift from ``start8`` (Q.CF, decimated px) in region ``reg``; (c8, S, iters, stop, stats)."""
+        fx, p = self.fixed, self.params
+        cf = fx.centre_frac
+        sub = bins[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
+        tp = p.with_(max_iter=max_iter)
+        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_colour_bins, self.widths.shift_q)
+        win = (ms_round_centre(r.c8[0], cf), ms_round_centre(r.c8[1], cf))
+        st = ms_target_stats(bins, self.model.T, win, ker, fx.kernel_bits, self.pad16)
+        return r.c8, r.S, r.iterations, r.stop, st
+
+    def _box(self) -> Box:
+        s = float(1 << self.fixed.centre_frac)
+        cx, cy = self.c8[0] / s, self.c8[1] / s
+        w, h = self.w8 / 256.0, self.h8 / 256.0
+        return Box(cx + 0.5 - w / 2.0, cy + 0.5 - h / 2.0, w, h)
+
+    # ------------------------------------------------------------------ API
+    def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
+        """Round the float box to integers (edges half up) and initialise as the hardware does."""
+        b = Box.of(box)
+        if b.w <= 0 or b.h <= 0:
+            raise ValueError(f"box must have positive width and height, got {b}")
+        frame = check_frame(frame)
+        fh, fw = frame.shape[:2]
+        if fw >= (1 << self.fixed.coord_bits) or fh >= (1 << self.fixed.coord_bits):
+            raise ValueError(f"frame {fw}x{fh} larger than coord_bits={self.fixed.coord_bits} allows")
+        x, y, w, h = round_box(*b.as_tuple())
+        ib, clipped = ms_box_clip(x, y, w, h, fw, fh, 4095)  # no shrink: large targets are decimated
+        if ib is None:
+            raise ValueError(f"box ({x}, {y}, {w}, {h}) leaves less than 3x3 px inside the "
+                             f"interior of the {fw}x{fh} frame")
+        p, fx = self.params, self.fixed
+        cf = fx.centre_frac
+        self._shape = (fh, fw)
+        self.w8, self.h8 = ib.w << SIZE_FRAC, ib.h << SIZE_FRAC
+        self.w0_8 = self.w8
+        self.c8 = ((2 * ib.x + ib.w - 1) << (cf - 1), (2 * ib.y + ib.h - 1) << (cf - 1))
+        d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window)
+        bins = self._bins(frame, d)
+        hd_, wd_ = bins.shape
+        sh = d.bit_length() - 1
+        cd = (ms_round_centre(self.c8[0] >> sh, cf), ms_round_centre(self.c8[1] >> sh, cf))
+        wb = ms_box_size(self.w8, d, wd_ - 2)
+        hb = ms_box_size(self.h8, d, hd_ - 2)
+        # keep the box inside the decimated interior
+        cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
+              min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
+        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_colour_bins)
+        wd, hd = self._geometry(d, bins.shape)
+        ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+        Qw = ms_model_scale(self.model.Qn, ker.K)
+        start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
+        # one pass at the init centre (no iteration) gives the references
+        _, S, _, _, st = self._ref_pass(bins, Qw, ker, start8)
+        self.rho_ref = ms_rho_out(S, ker.K, fx)
+        self.share_ref = ms_share(st)
+        sp = ms_spread(st)
+        self.spread_ref = sp if sp > 0 else ((128 << (fx.kernel_bits + 16)) // (16 + self.pad16) ** 2)
+        self.lost = False
+        raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
+               "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
+               "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref}
+        return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
+                           rho_c=self.rho_ref / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=0,
+                           iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
+                           message="init box clipped" if clipped else "", confidence=1.0, extra=raw)
+
+    def _ref_pass(self, bins, Qw, ker, start8):
+        """The pass at the (clamped) init centre without moving: S and the target statistics."""
+        fx, p = self.fixed, self.params
+        cf = fx.centre_frac
+        hd_, wd_ = bins.shape
+        reg = ms_region(start8, ker.ex, ker.ey, wd_, hd_, fx)
+        from .blocks import clamp_centre, ms_bin_pass, ms_histogram
+        c8 = clamp_centre(start8, reg, cf)
+        win = (ms_round_centre(c8[0], cf), ms_round_centre(c8[1], cf))
+        sub = bins[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
+        hist = ms_histogram(sub, reg, win, ker, p.n_colour_bins)
+        S = ms_bin_pass(Qw, hist, fx).S
+        st = ms_target_stats(bins, self.model.T, win, ker, fx.kernel_bits, self.pad16)
+        return c8, S, 0, "shift", st
+
+    def update(self, frame: np.ndarray) -> TrackResult:
+        """Track one frame.  Bad frames raise FrameError and leave the state unchanged."""
+        if self._shape is None:
+            raise RuntimeError("update() called before init()")
+        frame = check_frame(frame, self._shape)
+        p, fx = self.params, self.fixed
+        cf = fx.centre_frac
+        d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
+        sh = d.bit_length() - 1
+        bins = self._bins(frame, d)
+        wd, hd = self._geometry(d, bins.shape)
+        ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+        Qw = ms_model_scale(self.model.Qn, ker.K)
+        start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
+        # one region per frame: the window box + MARGIN, + the search offsets while lost
+        ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
+        margin = fx.margin + (max(ox, oy) if self.lost else 0)
+        reg = ms_region(start8, ker.ex, ker.ey, bins.shape[1], bins.shape[0], fx.with_(margin=min(margin, 255)))
+        c8d, S, it, stop, st = self._run(bins, Qw, ker, start8, reg, p.max_iter)
+        rho = ms_rho_out(S, ker.K, fx)
+        share = ms_share(st)
+        conf = ms_confidence(rho, share, self.rho_ref, self.share_ref)
+        searched = 0
+        if self.lost:
+            for sy in (-1, 0, 1):
+                for sx in (-1, 0, 1):
+                    if sx == 0 and sy == 0:
+                        continue
+                    s8 = (max(start8[0] + (sx * ox << cf), 0), max(start8[1] + (sy * oy << cf), 0))
+                    c2, S2, _, _, st2 = self._run(bins, Qw, ker, s8, reg, p.search_iter)
+                    searched += 1
+                    rho2, share2 = ms_rho_out(S2, ker.K, fx), ms_share(st2)
+                    conf2 = ms_confidence(rho2, share2, self.rho_ref, self.share_ref)
+                    if conf2 > conf:
+                        c8d, S, st, rho, share, conf = c2, S2, st2, rho2, share2, conf2
+        if conf < q16(p.conf_reacquire if self.lost else p.conf_lost):
+            status = Status.LOST
+        elif self.lost:
+            status = Status.REACQUIRED
+        elif conf < q16(p.conf_uncertain):
+            status = Status.UNCERTAIN
+        else:
+            status = Status.OK
+        self.lost = status == Status.LOST
+        self.c8 = (c8d[0] << sh, c8d[1] << sh)
+        if status == Status.OK:
+            self.rho_ref = ms_ref_update(self.rho_ref, rho, self.ref_k)
+            self.share_ref = ms_ref_update(self.share_ref, share, self.ref_k)
+        spread = ms_spread(st)
+        if p.scale_gain > 0 and st.nt > 0:
+            s = ms_scale(spread, self.spread_ref, self.w8, self.w0_8, p)
+            fh, fw = self._shape
+            self.w8 = ms_resize(self.w8, s, fw)
+            self.h8 = ms_resize(self.h8, s, fh)
+        raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": rho,
+               "confidence": conf, "status": STATUS_CODES_V2[status], "iter": it, "decimation": d,
+               "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched}
+        return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
+                           rho_c=rho / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=it, iter_e=0,
+                           status=status, confidence=conf / 65536.0, extra=raw)

@@ -1,0 +1,259 @@
+"""Tracker v2 in fixed point: each block against its exact definition, and the tracker against float v2.
+
+Exact definitions use Python integers and fractions.Fraction (no floats), so a
+rounding or width slip in mstrack/fixed/blocks_v2.py shows as a mismatch.
+"""
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mstrack import Tracker
+from mstrack.fixed.blocks import ms_kernel
+from mstrack.fixed.blocks_v2 import (ONE, ms_bg_model, ms_box_size, ms_confidence, ms_decimation,
+                                     ms_model_scale, ms_ref_update, ms_resize, ms_scale, ms_share, ms_spread,
+                                     ms_target_stats, ms_window_size, rate_shift, sixteenths, TargetStats)
+from mstrack.float_v2 import FloatTrackerV2
+from mstrack.params import TrackerParams
+
+SEQ_ROOT = Path(__file__).resolve().parents[2] / "shared" / "data" / "sequences"
+V2 = TrackerParams(preset="v2")
+
+
+def floor_frac(x: Fraction) -> int:
+    return math.floor(x)
+
+
+# ----------------------------------------------------------------------------- geometry
+def test_decimation_exhaustive():
+    """D is the smallest power of two <= 8 with (1 + pad) max(w, h) / D <= max_window (exact)."""
+    for pad16 in (0, 4, 8):
+        for s8 in range(3 << 8, 1200 << 8, 37):
+            want = next((d for d in (1, 2, 4, 8) if Fraction(16 + pad16, 16) * Fraction(s8, 256) / d <= 127), 8)
+            assert ms_decimation(s8, 3 << 8, pad16, 127) == want, (pad16, s8)
+            assert ms_decimation(3 << 8, s8, pad16, 127) == want
+
+
+def test_decimation_matches_float():
+    flt = FloatTrackerV2(V2)
+    for s in np.linspace(3, 1000, 997):
+        s8 = int(round(s * 256))
+        assert ms_decimation(s8, s8, 4, 127) == flt.decimation(s8 / 256, s8 / 256)
+
+
+def test_window_and_box_size_round_half_up():
+    for d in (1, 2, 4, 8):
+        for s8 in range(3 << 8, 1100 << 8, 53):
+            exact = Fraction(20, 16) * Fraction(s8, 256) / d
+            assert ms_window_size(s8, 4, d, 10 ** 6) == max(3, floor_frac(exact + Fraction(1, 2)))
+            assert ms_box_size(s8, d, 10 ** 6) == max(3, floor_frac(Fraction(s8, 256 * d) + Fraction(1, 2)))
+    assert ms_window_size(1000 << 8, 4, 1, 127) == 127
+
+
+def test_parameter_representation():
+    assert sixteenths(0.25, "pad") == 4 and sixteenths(0.625, "bg_ring") == 10
+    with pytest.raises(ValueError, match="1/16"):
+        sixteenths(0.6, "bg_ring")
+    assert rate_shift(1 / 64) == 6
+    with pytest.raises(ValueError, match="power of two"):
+        rate_shift(0.02)
+    with pytest.raises(ValueError, match="1/16"):
+        Tracker(model="fixed", preset="v2", bg_ring=0.6)
+
+
+# ----------------------------------------------------------------------------- model
+def _bg_model_exact(bins, cx, cy, wb, hb, ring16, n_bins):
+    ker = ms_kernel(wb, hb, "flat", 8)
+    ex, ey = ker.ex, ker.ey
+    Q = [0] * n_bins
+    for dy in range(-ey, ey + 1):
+        for dx in range(-ex, ex + 1):
+            if Fraction(2 * dx, wb) ** 2 + Fraction(2 * dy, hb) ** 2 < 1:
+                Q[bins[cy + dy, cx + dx]] += 1
+    gx, gy = ring16 * wb // 16, ring16 * hb // 16
+    H, W = bins.shape
+    O = [0] * n_bins
+    for y in range(max(0, cy - ey - gy), min(H - 1, cy + ey + gy) + 1):
+        for x in range(max(0, cx - ex - gx), min(W - 1, cx + ex + gx) + 1):
+            if abs(x - cx) > ex or abs(y - cy) > ey:
+                O[bins[y, x]] += 1
+    nq, no = sum(Q), sum(O)
+    omin = min(o for o in O if o > 0)
+    v = [min(floor_frac(Fraction(omin * 256, o)), 256) if o else 256 for o in O]
+    tot = sum(q * vv for q, vv in zip(Q, v))
+    Qn = [floor_frac(Fraction(q * vv * ONE, tot)) for q, vv in zip(Q, v)]
+    T = [int(Fraction(q, nq) > Fraction(o, no)) for q, o in zip(Q, O)]
+    return Q, O, Qn, T
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_bg_model_against_exact_definition(seed):
+    rng = np.random.default_rng(seed)
+    n_bins = 64
+    H, W = 60, 80
+    bins = rng.integers(0, n_bins, (H, W))
+    bins[20:40, 30:50] = rng.integers(0, 8, (20, 20))  # a "target" of few colours
+    wb, hb = int(rng.integers(3, 30)), int(rng.integers(3, 25))
+    cx, cy = int(rng.integers(wb // 2 + 1, W - wb // 2 - 1)), int(rng.integers(hb // 2 + 1, H - hb // 2 - 1))
+    m = ms_bg_model(bins, cx, cy, wb, hb, 10, n_bins)
+    Q, O, Qn, T = _bg_model_exact(bins, cx, cy, wb, hb, 10, n_bins)
+    assert m.Q.tolist() == Q and m.O.tolist() == O and m.Qn.tolist() == Qn and m.T.tolist() == T
+    assert ONE - n_bins <= m.Qn.sum() <= ONE
+
+
+def test_bg_model_without_background():
+    bins = np.zeros((9, 9), np.int64)
+    bins[4, 4] = 3
+    m = ms_bg_model(bins, 4, 4, 9, 9, 10, 8)  # the ring falls outside the image
+    assert m.O.sum() == 0 and m.T.tolist() == [1, 0, 0, 1, 0, 0, 0, 0]
+    assert m.Qn[3] == (1 << 16) // m.Q.sum()
+
+
+def test_model_scale():
+    rng = np.random.default_rng(1)
+    Qn = rng.integers(0, 1 << 16, 512)
+    for K in (3, 100, 16129):
+        assert ms_model_scale(Qn, K).tolist() == [q * K >> 16 for q in Qn.tolist()]
+
+
+@pytest.mark.parametrize("wd,hd,pad16", [(3, 3, 4), (17, 31, 4), (127, 127, 4), (40, 9, 0), (25, 64, 8)])
+def test_target_stats_brute_force(wd, hd, pad16):
+    rng = np.random.default_rng(wd * hd)
+    ker = ms_kernel(wd, hd, "flat", 8)
+    bins = rng.integers(0, 16, (hd + 4, wd + 4))
+    T = rng.integers(0, 2, 16)
+    win = (ker.ex + 2, ker.ey + 2)
+    nt = st2 = n_in = nt_in = 0
+    for dy in range(-ker.ey, ker.ey + 1):
+        for dx in range(-ker.ex, ker.ex + 1):
+            if 4 * dx * dx * hd * hd + 4 * dy * dy * wd * wd >= wd * wd * hd * hd:
+                continue
+            d2q = (4 * dx * dx * 256) // (wd * wd) + (4 * dy * dy * 256) // (hd * hd)
+            t = int(T[bins[win[1] + dy, win[0] + dx]])
+            inner = Fraction(d2q, 256) < Fraction(256, (16 + pad16) ** 2)
+            nt += t
+            st2 += t * d2q
+            n_in += inner
+            nt_in += t * inner
+    assert ms_target_stats(bins, T, win, ker, 8, pad16) == TargetStats(nt, st2, n_in, nt_in)
+
+
+# ----------------------------------------------------------------------------- confidence, scale
+def test_share_spread_confidence_random():
+    rng = np.random.default_rng(7)
+    for _ in range(3000):
+        n_in = int(rng.integers(1, 16130))
+        st = TargetStats(nt=int(rng.integers(1, 16130)), st2=int(rng.integers(0, 16129 * 512)), n_in=n_in,
+                         nt_in=int(rng.integers(0, n_in + 1)))
+        assert ms_share(st) == floor_frac(Fraction(st.nt_in * ONE, st.n_in))
+        assert ms_spread(st) == floor_frac(Fraction(st.st2 * ONE, st.nt))
+        rho, share = int(rng.integers(0, ONE + 1)), int(rng.integers(0, ONE + 1))
+        rr, sr = int(rng.integers(1, ONE + 1)), int(rng.integers(1, ONE + 1))
+        want = (min(ONE, floor_frac(Fraction(rho * ONE, rr))) * min(ONE, floor_frac(Fraction(share * ONE, sr)))) >> 16
+        assert ms_confidence(rho, share, rr, sr) == want
+        assert 0 <= want <= ONE
+    assert ms_share(TargetStats(0, 0, 0, 0)) == 0 and ms_spread(TargetStats(0, 0, 0, 0)) == 0
+    assert ms_confidence(5, 5, 0, 0) == 0
+
+
+def test_ref_update_floor():
+    for ref, x in ((1000, 2000), (2000, 1000), (5, 6), (6, 5), (0, ONE)):
+        assert ms_ref_update(ref, x, 6) == ref + math.floor(Fraction(x - ref, 64))
+
+
+def test_scale_against_exact_definition():
+    rng = np.random.default_rng(3)
+    g, r, st = round(0.3 * ONE), round(0.1 * ONE), round(0.1 * ONE)
+    for _ in range(3000):
+        spread, ref = int(rng.integers(0, 1 << 30)), int(rng.integers(1, 1 << 30))
+        w8, w0 = int(rng.integers(3 << 8, 4000 << 8)), int(rng.integers(3 << 8, 4000 << 8))
+        ratio = min(floor_frac(Fraction(spread * ONE, ref)), (1 << 40) - 1)
+        est = min(max(math.isqrt(ratio << 16), ONE - st), ONE + st)
+        wr = min(floor_frac(Fraction(w8 * ONE, w0)), (1 << 40) - 1)
+        s = ONE + math.floor(Fraction(g * (est - ONE), ONE)) - math.floor(Fraction(r * (wr - ONE), ONE))
+        assert ms_scale(spread, ref, w8, w0, V2) == min(max(s, ONE - st), ONE + st)
+    assert ms_resize(10 << 8, ONE - 6554, 640) == ((10 << 8) * (ONE - 6554)) >> 16
+    assert ms_resize(3 << 8, ONE // 2, 640) == 3 << 8
+    assert ms_resize(600 << 8, 2 * ONE, 640) == 640 << 8
+
+
+# ----------------------------------------------------------------------------- tracker
+def _scene(n: int = 30):
+    """A red square on a textured green/blue background moving right and growing."""
+    rng = np.random.default_rng(0)
+    frames, boxes = [], []
+    for i in range(n):
+        f = np.zeros((120, 160, 3), np.uint8)
+        f[..., 0] = rng.integers(100, 200, (120, 160))
+        f[..., 1] = rng.integers(60, 140, (120, 160))
+        s = 20 + i // 2
+        x, y = 30 + 2 * i, 50 - i // 4
+        f[y:y + s, x:x + s] = (30, 30, 220)
+        frames.append(f)
+        boxes.append((x, y, s, s))
+    return frames, boxes
+
+
+def test_fixed_v2_tracks_a_growing_target_like_float():
+    frames, boxes = _scene()
+    for model in ("float", "fixed"):
+        trk = Tracker(model=model, preset="v2")
+        trk.init(frames[0], boxes[0])
+        for f in frames[1:]:
+            r = trk.update(f)
+        x, y, s, _ = boxes[-1]
+        assert abs(r.box.x + r.box.w / 2 - (x + s / 2)) < 5, (model, r.box)  # box lags the growth
+        assert r.box.w > 22, (model, r.box)       # followed the growth (init 20 px, truth 34 px)
+        assert r.ok and r.confidence > 0.5
+
+
+def test_fixed_v2_results_are_integers_and_deterministic():
+    frames, boxes = _scene(8)
+    runs = []
+    for _ in range(2):
+        trk = Tracker(model="fixed", preset="v2")
+        trk.init(frames[0], boxes[0])
+        runs.append([trk.update(f).extra for f in frames[1:]])
+    assert runs[0] == runs[1]
+    for e in runs[0]:
+        for k in ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "decimation"):
+            assert isinstance(e[k], int), k
+
+
+def test_fixed_v2_large_target_is_decimated_not_shrunk():
+    rng = np.random.default_rng(2)
+    f = rng.integers(0, 120, (400, 640, 3)).astype(np.uint8)
+    f[50:350, 100:400] = (40, 200, 60)
+    trk = Tracker(model="fixed", preset="v2")
+    r0 = trk.init(f, (100, 50, 300, 300))
+    r = trk.update(f)
+    assert r0.box.w == 300 and r.extra["decimation"] == 4  # 1.25 * 300 / 4 = 94 <= 127 < 188
+    assert abs(r.box.w - 300) < 10 and abs(r.box.x - 100) < 3
+
+
+@pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (../shared absent)")
+def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
+    """Issue target: the fixed model (= hardware) within 0.01 AUC of float v2, whole dev set."""
+    from mstrack.data import load_dataset
+    from mstrack.metrics import iou, valid_gt, IOU_THRESHOLDS
+
+    res = {}
+    for model in ("float", "fixed"):
+        ious = []
+        for seq in load_dataset(SEQ_ROOT):
+            trk = Tracker(model=model, preset="v2")
+            boxes = []
+            for i, fr in enumerate(seq.frames()):
+                r = trk.init(fr, seq.init_box()) if i == 0 else trk.update(fr)
+                boxes.append(r.box.as_tuple())
+            gt = seq.gt[:len(boxes)]
+            ious.append(iou(np.array(boxes), gt)[valid_gt(gt)])
+        io = np.concatenate(ious)
+        res[model] = float(np.mean([(io > t).mean() for t in IOU_THRESHOLDS]))
+    # measured 2026-11-23: float 0.549, fixed 0.555
+    assert abs(res["fixed"] - res["float"]) <= 0.01, res
+    assert res["fixed"] >= 0.50, res

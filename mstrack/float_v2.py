@@ -222,7 +222,8 @@ class FloatTrackerV2:
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
         start = (self._centre[0] / d, self._centre[1] / d)
-        c, ps, it = self._track(bins, start, hx, hy, p.max_iter)
+        # lost: every start point (this one included) runs search_iter iterations
+        c, ps, it = self._track(bins, start, hx, hy, p.search_iter if self._lost else p.max_iter)
         conf = self._confidence(ps)
         searched = 0
         if self._lost:

@@ -257,3 +257,17 @@ def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
     # measured 2026-11-23: float 0.549, fixed 0.555
     assert abs(res["fixed"] - res["float"]) <= 0.01, res
     assert res["fixed"] >= 0.50, res
+
+
+def test_v2_budget_section_is_current():
+    """docs/fixed_point.md's v2 budget table is generated (python -m mstrack.synth --v2-budget --write)."""
+    from mstrack.synth import render_v2_budget
+    doc = Path(__file__).resolve().parents[1] / "docs" / "fixed_point.md"
+    text = doc.read_text()
+    assert render_v2_budget(text) == text, "stale: run python -m mstrack.synth --v2-budget --write"
+
+
+def test_v2_worst_frames_fit_1080p60_blanking_with_lanes_4():
+    from mstrack.synth import v2_cycle_budget
+    rows = v2_cycle_budget(4)
+    assert len(rows) == 3 and all(r["clocks"] <= 99000 for r in rows), rows

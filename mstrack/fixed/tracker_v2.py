@@ -171,7 +171,7 @@ class FixedTrackerV2:
         ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
         reg = ms_region(start8, ker.ex, ker.ey, bins.shape[1], bins.shape[0], fx.with_(margin=min(margin, 255)))
-        c8d, S, it, stop, st = self._run(bins, Qw, ker, start8, reg, p.max_iter)
+        c8d, S, it, stop, st = self._run(bins, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter)
         rho = ms_rho_out(S, ker.K, fx)
         share = ms_share(st)
         conf = ms_confidence(rho, share, self.rho_ref, self.share_ref)

@@ -41,7 +41,7 @@ from .data import DataError, Sequence
 from .metrics import Scores, concat_scores, score, valid_gt
 from .types import Box, Status
 
-CACHE_VERSION = 2
+CACHE_VERSION = 3
 MODELS = ("float", "fixed")
 
 
@@ -115,6 +115,16 @@ def to_box(result: Any) -> Box:
     return Box.of(result)
 
 
+#: statuses under which a tracker vouches for its box (``TrackResult.ok``)
+OK_STATUSES = frozenset(s.value for s in (Status.OK, Status.INIT, Status.CLIPPED, Status.REACQUIRED))
+
+
+def result_confidence(result: Any) -> float:
+    """``result.confidence`` as a float, NaN if the tracker gives none."""
+    c = getattr(result, "confidence", None)
+    return float(c) if c is not None else float("nan")
+
+
 def result_status(result: Any) -> str:
     """Status string of a tracker's return value ("ok" if it has none)."""
     st = getattr(result, "status", Status.OK)
@@ -145,6 +155,9 @@ class SequenceRun:
     update_time : float
         Total seconds spent in ``update()`` (N - 1 calls).
     model : str
+    confidence : list of float, length N
+        ``TrackResult.confidence`` per frame (NaN for trackers without one, and for
+        rejected frames).
     """
 
     tracker: str
@@ -153,6 +166,12 @@ class SequenceRun:
     status: list[str]
     update_time: float
     model: str = "float"
+    confidence: list[float] = field(default_factory=list)
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Per frame: the tracker vouches for its box (status ok, init, clipped or reacquired)."""
+        return np.array([s in OK_STATUSES for s in self.status], dtype=bool)
 
     @property
     def n_frames(self) -> int:
@@ -167,12 +186,14 @@ class SequenceRun:
     def to_json(self) -> dict[str, Any]:
         return {"version": CACHE_VERSION, "tracker": self.tracker, "sequence": self.sequence,
                 "model": self.model, "n_frames": self.n_frames, "fps": self.fps,
-                "update_time_s": self.update_time, "boxes": self.boxes.tolist(), "status": self.status}
+                "update_time_s": self.update_time, "boxes": self.boxes.tolist(), "status": self.status,
+                "confidence": [None if c != c else round(float(c), 6) for c in self.confidence]}
 
     @classmethod
     def from_json(cls, d: dict[str, Any]) -> "SequenceRun":
         return cls(d["tracker"], d["sequence"], np.asarray(d["boxes"], dtype=np.float64).reshape(-1, 4),
-                   list(d["status"]), float(d["update_time_s"]), d.get("model", "float"))
+                   list(d["status"]), float(d["update_time_s"]), d.get("model", "float"),
+                   [float("nan") if c is None else float(c) for c in d.get("confidence", [])])
 
 
 def run_sequence(tracker: Any, seq: Sequence, max_frames: int | None = None, label: str = "tracker",
@@ -189,11 +210,13 @@ def run_sequence(tracker: Any, seq: Sequence, max_frames: int | None = None, lab
     bad_frame = frame_error_types()
     boxes = np.empty((n, 4), np.float64)
     status: list[str] = []
+    conf: list[float] = []
     where = f"{label} on {seq.name}"
     try:
         res = tracker.init(seq.frame(0), seq.init_box())
         boxes[0] = to_box(res).as_tuple() if res is not None else seq.gt[0]
         status.append(result_status(res) if res is not None else Status.INIT.value)
+        conf.append(result_confidence(res))
         total = 0.0
         for i in tqdm(range(1, n), desc=where, leave=False, disable=not progress, unit="f"):
             frame = seq.frame(i)
@@ -204,15 +227,17 @@ def run_sequence(tracker: Any, seq: Sequence, max_frames: int | None = None, lab
                 total += time.perf_counter() - t0
                 boxes[i] = boxes[i - 1]
                 status.append(Status.ERROR.value)
+                conf.append(float("nan"))
                 continue
             total += time.perf_counter() - t0
             boxes[i] = to_box(res).as_tuple()
             status.append(result_status(res))
+            conf.append(result_confidence(res))
     except DataError:
         raise
     except Exception as exc:
         raise RuntimeError(f"{where}, frame {len(status)}: {type(exc).__name__}: {exc}") from exc
-    return SequenceRun(label, seq.name, boxes, status, total, model)
+    return SequenceRun(label, seq.name, boxes, status, total, model, conf)
 
 
 def sequence_digest(seq: Sequence, n_frames: int) -> str:

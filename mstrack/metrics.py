@@ -198,3 +198,28 @@ def concat_scores(parts: list[Scores]) -> Scores:
         return score_frames(np.zeros(0), np.zeros(0))
     return score_frames(np.concatenate([s.ious for s in parts]),
                         np.concatenate([s.errors for s in parts]))
+
+
+@dataclass
+class LossDetection:
+    """How well a tracker's ``ok`` flag tells when it is off the target (issue 10's loss signal).
+
+    off: frames with IoU = 0 (off the target); recall: share of them with ok False.
+    on: frames with IoU >= 0.5 (on the target); false_alarm: share of them with ok False.
+    """
+
+    off: int
+    recall: float
+    on: int
+    false_alarm: float
+
+
+def loss_detection(ious: np.ndarray, ok: np.ndarray) -> LossDetection:
+    """Per-frame loss recall and false-alarm rate from IoUs and the tracker's ok flags (same length;
+    pass only frames with valid ground truth)."""
+    ious, ok = np.asarray(ious, dtype=np.float64), np.asarray(ok, dtype=bool)
+    if ious.shape != ok.shape:
+        raise ValueError(f"ious {ious.shape} and ok {ok.shape} differ in shape")
+    off, on = ious == 0, ious >= 0.5
+    return LossDetection(int(off.sum()), float((off & ~ok).sum() / off.sum()) if off.any() else float("nan"),
+                         int(on.sum()), float((on & ~ok).sum() / on.sum()) if on.any() else float("nan"))

@@ -31,7 +31,100 @@ def tools(md: str) -> str:
                 "Tools: not recorded in this report (made before `mstrack eval` recorded them).")
 
 
-def main() -> int:
+LOSS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-fused-flat", "float"),
+                 ("mstrack-fused-flat", "fixed"), ("mstrack-colour-flat", "float"))
+
+
+def loss_section(seq_root: Path) -> list[str]:
+    """Issue 10's loss signal: per tracker, off-target frames (IoU = 0) flagged not ok (recall) and
+    on-target frames (IoU >= 0.5) flagged not ok (false alarms), from the cached runs; and the
+    confidence-vs-IoU plot of v2 (docs/results/v2_confidence.png)."""
+    import json
+
+    import numpy as np
+
+    sys.path.insert(0, str(REPO))
+    from mstrack.data import load_dataset
+    from mstrack.evaluate import SequenceRun
+    from mstrack.metrics import iou, loss_detection, valid_gt
+
+    seqs = {s.name: s for s in load_dataset(seq_root)}
+    rows, per_seq, conf_io = [], {}, {}
+    for name, model in LOSS_TRACKERS:
+        label = name if model == "float" else f"{name}@fixed"
+        ious, oks = [], []
+        for sname, seq in seqs.items():
+            f = RUNS[model] / "results" / label / f"{sname}.json"
+            if not f.is_file():
+                return [f"(loss table: {f} missing; run `make results`)"]
+            run = SequenceRun.from_json(json.loads(f.read_text()))
+            gt = seq.gt[:run.n_frames]
+            v = valid_gt(gt)
+            v[0] = False  # the init frame says nothing about loss detection
+            io = iou(run.boxes, gt)[v]
+            ok = run.ok[v]
+            ious.append(io)
+            oks.append(ok)
+            ld = loss_detection(io, ok)
+            per_seq.setdefault(sname, {})[label] = ld
+            if name == "mstrack-v2":
+                c = np.asarray(run.confidence, dtype=np.float64)[v]
+                conf_io.setdefault(model, []).append((c, io))
+        ld = loss_detection(np.concatenate(ious), np.concatenate(oks))
+        rows.append(f"| {label} | {ld.off} | {ld.recall:.2f} | {ld.on} | {ld.false_alarm:.3f} |")
+    out = ["## Loss detection (issue 10)", "",
+           "Per frame, frames with valid ground truth after the init frame: *recall* = share of "
+           "off-target frames (IoU = 0) whose result is not `ok`; *false alarms* = share of on-target "
+           "frames (IoU >= 0.5) whose result is not `ok` (`TrackResult.ok`: status ok, init, clipped or "
+           "reacquired).  Target: recall >= 0.6 at false alarms <= 0.05.  From the cached runs of the "
+           "two commands above.", "",
+           "| tracker | off-target frames | recall | on-target frames | false alarms |", "|---|---:|---:|---:|---:|"]
+    out += rows
+    labels = [n if m == "float" else f"{n}@fixed" for n, m in LOSS_TRACKERS[:2]]
+    out += ["", "Per sequence (v2): off-target frames / recall, on-target frames / false alarms:", "",
+            "| sequence | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
+    for sname, d in per_seq.items():
+        cells = []
+        for lab in labels:
+            ld = d[lab]
+            rec = "-" if ld.off == 0 else f"{ld.recall:.2f}"
+            fa = "-" if ld.on == 0 else f"{ld.false_alarm:.2f}"
+            cells.append(f"{ld.off} / {rec}, {ld.on} / {fa}")
+        out.append(f"| {sname} | " + " | ".join(cells) + " |")
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(6, 4))
+        edges = np.linspace(0, 1, 11)
+        for model, parts in conf_io.items():
+            c = np.concatenate([p[0] for p in parts])
+            io = np.concatenate([p[1] for p in parts])
+            good = np.isfinite(c)
+            c, io = c[good], io[good]
+            idx = np.clip(np.digitize(c, edges) - 1, 0, 9)
+            mids = [(edges[i] + edges[i + 1]) / 2 for i in range(10) if (idx == i).any()]
+            mean = [io[idx == i].mean() for i in range(10) if (idx == i).any()]
+            off = [(io[idx == i] == 0).mean() for i in range(10) if (idx == i).any()]
+            ax.plot(mids, mean, "o-", label=f"v2 {model}: mean IoU")
+            ax.plot(mids, off, "x--", label=f"v2 {model}: share IoU = 0")
+        ax.set_xlabel("confidence (bins of 0.1)")
+        ax.set_ylabel("IoU / share of frames")
+        ax.set_ylim(0, 1)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title("Tracker v2: confidence against IoU (dev set)")
+        fig.tight_layout()
+        fig.savefig(DOCS / "results" / "v2_confidence.png", dpi=100)
+        plt.close(fig)
+        out += ["", "![confidence vs IoU](results/v2_confidence.png)"]
+    except ImportError:
+        pass
+    return out + [""]
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = [] if argv is None else argv
     out = ["# Results on real video", "",
            "OTB one-pass evaluation (init on frame 0 with the ground truth, no re-init) of mstrack "
            "(float reference and bit-accurate fixed-point model = the hardware) and four OpenCV "
@@ -54,8 +147,15 @@ def main() -> int:
                 f"Per sequence and per attribute: [results/{name}/report.md](results/{name}/report.md). "
                 f"Machine-readable: `results/{name}/report.json`.", "",
                 f"![success {name}](results/{name}/success.png) ![precision {name}](results/{name}/precision.png)", ""]
+    seq_root = Path(argv[0]) if argv else REPO.parent / "shared" / "data" / "sequences"
+    out += loss_section(seq_root) if seq_root.is_dir() else [f"(loss table: {seq_root} not found)", ""]
     out += ["## Reading the numbers", "",
-            "* **Fusion does not pay on this set.** In the run above, colour alone beats the fused "
+            "* **Tracker v2** (`preset=\"v2\"`, docs/algorithm.md \"Tracker v2\"; fixed-point model "
+            "docs/fixed_point.md \"Tracker v2\") is the background-weighted colour tracker with scale, "
+            "decimation, confidence and a wide search.  It is the best mstrack tracker on this set in "
+            "both layers and beats CSRT's overall AUC; its mean over sequences and its loss signal are "
+            "below the issue's targets (the numbers above; docs/results.md is regenerated by `make results`).",
+            "* **Fusion does not pay on this set (paper preset).** In the run above, colour alone beats the fused "
             "tracker. The 16-bin gradient-magnitude histogram discriminates poorly (edge alone is the "
             "weakest mstrack variant): the background next to a target often has an edge histogram much "
             "like the target's. rho_e then stays near 1, and alpha_e = rho_e / (rho_c + rho_e) gives the "
@@ -73,4 +173,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

@@ -5,7 +5,7 @@ drawn by :func:`mstrack.synthetic.render_scene` (the red/yellow checkerboard tar
 ``make_scene`` at a given box per frame, optionally hidden by a background-textured patch),
 then bad input, then a floor on the real sequences.
 
-Figures in comments were measured on 2026-11-21 (seeds 0..2); the assertions are floors or
+Figures in comments were measured on 2026-11-23 (seeds 0..2); the assertions are floors or
 bounds with a margin, never the measured values themselves.
 """
 from __future__ import annotations
@@ -573,8 +573,8 @@ def test_never_nan(kernel, scene):
 
 # ============================================================================ real data
 #: Overall frame-weighted OTB AUC (frame 0 included) of v2 float over the 10 sequences of
-#: ../shared/data/sequences; measured 2026-11-21: v2 0.551, paper float fused/flat 0.366 (same
-#: run, 15 s for both on 2 shared cores).  Floor 0.50.
+#: ../shared/data/sequences; measured 2026-11-23: v2 0.551, paper float fused/flat 0.366 (same
+#: run; 8 .. 15 s for both on 2 shared cores).  Floor 0.50.
 V2_AUC_FLOOR = 0.50
 
 

@@ -51,7 +51,13 @@ VTEST_CANDIDATES = (
     "/usr/share/opencv4/samples/data/vtest.avi",
     "/usr/local/share/opencv4/samples/data/vtest.avi",
 )
-CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_c", "status")
+CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_c", "confidence", "status")
+#: Decimals of ``confidence`` in results.csv / results.json (0..1; NaN / null for trackers without one).
+CONFIDENCE_DECIMALS = 4
+#: Overlays of frames narrower than this are upscaled (nearest neighbour, integer factor) so that the
+#: status banner stays legible (Girl, 128x96, becomes 384x288).
+OVERLAY_MIN_WIDTH = 320
+PRESETS = ("paper", "v2")
 
 
 # --------------------------------------------------------------------------- helpers
@@ -108,33 +114,111 @@ def _print_table(header: list[str], rows: list[list[str]], file: Any = None) -> 
         print("  ".join(str(c).ljust(w[i]) for i, c in enumerate(r)), file=file)
 
 
-def _row(i: int, res: Any, box: Box, status: str) -> dict[str, Any]:
+def reports_confidence(tracker: Any) -> bool:
+    """True if ``tracker`` computes a confidence (mstrack tracker v2, ``preset="v2"``); the paper
+    preset and the OpenCV baselines leave ``confidence`` empty (NaN in the CSV, null in the JSON)."""
+    return getattr(getattr(tracker, "params", None), "preset", None) == "v2"
+
+
+def _row(i: int, res: Any, box: Box, status: str, confidence: bool = False) -> dict[str, Any]:
     cx, cy = getattr(res, "centre", None) or box_centre_index(box)
     g = lambda k: float(getattr(res, k, math.nan))  # noqa: E731
+    conf = round(g("confidence"), CONFIDENCE_DECIMALS) if confidence and res is not None else math.nan
     return {"frame": i, "x": box.x, "y": box.y, "w": box.w, "h": box.h, "cx": float(cx), "cy": float(cy),
-            "rho_c": g("rho_c"), "rho_e": g("rho_e"), "alpha_c": g("alpha_c"), "status": status}
+            "rho_c": g("rho_c"), "rho_e": g("rho_e"), "alpha_c": g("alpha_c"), "confidence": conf,
+            "status": status}
+
+
+#: Box colour per status (BGR): trusted green, re-acquired cyan, uncertain orange, lost / error red.
+STATUS_COLOURS = {Status.OK.value: (0, 220, 0), Status.INIT.value: (0, 220, 0), Status.CLIPPED.value: (0, 220, 0),
+                  Status.REACQUIRED.value: (255, 220, 0), Status.UNCERTAIN.value: (0, 165, 255),
+                  Status.LOST.value: (0, 0, 255), Status.ERROR.value: (0, 0, 255)}
+GT_COLOUR = (255, 255, 255)
+_FONT = 0  # cv2.FONT_HERSHEY_SIMPLEX
+
+
+def overlay_scale(width: int) -> int:
+    """Integer upscale factor of the overlay of a frame ``width`` px wide (1 from OVERLAY_MIN_WIDTH up)."""
+    return max(1, math.ceil(OVERLAY_MIN_WIDTH / max(int(width), 1)))
+
+
+def overlay_lines(row: dict[str, Any], width: int, font_scale: float = 0.45) -> list[str]:
+    """The banner text of ``row``, wrapped to lines that fit ``width`` px (at ``font_scale``).
+
+    The first line starts with the frame number, the status and the confidence (when known), so
+    they are never wrapped away; rho_c, rho_e and alpha_c follow when finite (only the rho of the
+    feature in use when one feature drives the result, alpha_c 1 or 0)."""
+    import cv2
+
+    tokens = [f"#{row['frame']}", str(row["status"]).upper()]
+    conf = row.get("confidence", math.nan)
+    if conf is not None and math.isfinite(conf):
+        tokens.append(f"conf {conf:.2f}")
+    a = row.get("alpha_c")
+    single = a is not None and a in (0.0, 1.0)  # one feature (colour or edge, v2): no fusion to show
+    for key, label, show in (("rho_c", "rho_c", not single or a == 1.0), ("rho_e", "rho_e", not single or a == 0.0),
+                             ("alpha_c", "a_c", not single)):
+        v = row.get(key)
+        if show and v is not None and math.isfinite(v):
+            tokens.append(f"{label} {v:.2f}")
+    lines: list[str] = []
+    for tok in tokens:
+        cand = f"{lines[-1]}  {tok}" if lines else tok
+        if lines and cv2.getTextSize(cand, _FONT, font_scale, 1)[0][0] <= width - 8:
+            lines[-1] = cand
+        else:
+            lines.append(tok)
+    return lines
+
+
+def _text_block(img: np.ndarray, lines: list[tuple[str, tuple[int, int, int] | None]], top: bool,
+                font_scale: float) -> None:
+    """Lines of white text on a half-transparent black band at the top or bottom of ``img``; a line
+    with a colour gets a short swatch line of that colour before its text (legend)."""
+    import cv2
+
+    (_, th), base = cv2.getTextSize("Ag", _FONT, font_scale, 1)
+    step = th + base + 4
+    sw = 3 * th  # swatch length
+    widths = [cv2.getTextSize(t, _FONT, font_scale, 1)[0][0] + (sw + 6 if c else 0) for t, c in lines]
+    bw = min(img.shape[1], max(widths) + 8)
+    bh = min(img.shape[0], step * len(lines) + 4)
+    y0 = 0 if top else img.shape[0] - bh
+    roi = img[y0:y0 + bh, 0:bw]
+    roi[:] = (roi * 0.35).astype(np.uint8)
+    for i, (text, colour) in enumerate(lines):
+        yb = y0 + 4 + th + i * step
+        x = 4
+        if colour is not None:
+            cv2.line(img, (x, yb - th // 2), (x + sw, yb - th // 2), colour, 2)
+            x += sw + 6
+        cv2.putText(img, text, (x, yb), _FONT, font_scale, (255, 255, 255), 1, cv2.LINE_AA)
 
 
 def draw_overlay(frame: np.ndarray, row: dict[str, Any], gt: np.ndarray | None = None) -> np.ndarray:
-    """Draw the tracked box (green; red when not ok), its centre, rho values and optional GT (white)."""
+    """Overlay of one frame: the tracked box coloured by status (:data:`STATUS_COLOURS`), its centre,
+    a banner at the top (frame, status, confidence, rho values; wrapped to the width) and, when the
+    ground truth ``gt`` is drawn (white), a legend at the bottom (ground truth vs tracker).
+
+    Frames narrower than :data:`OVERLAY_MIN_WIDTH` are upscaled by :func:`overlay_scale` first (the
+    returned image is then larger than ``frame``) so that the text stays readable."""
     import cv2
 
-    img = frame.copy()
-    if gt is not None and np.isfinite(gt).all():
+    k = overlay_scale(frame.shape[1])
+    img = cv2.resize(frame, (frame.shape[1] * k, frame.shape[0] * k), interpolation=cv2.INTER_NEAREST) \
+        if k > 1 else frame.copy()
+    s = lambda v: int(round(v * k))  # noqa: E731
+    fs = 0.45 if img.shape[1] >= 400 else 0.4
+    have_gt = gt is not None and np.isfinite(gt).all()
+    if have_gt:
         x, y, w, h = gt
-        cv2.rectangle(img, (int(round(x)), int(round(y))), (int(round(x + w)) - 1, int(round(y + h)) - 1),
-                      (255, 255, 255), 1)
-    ok = row["status"] in (Status.OK.value, Status.INIT.value, Status.CLIPPED.value)
-    col = (0, 220, 0) if ok else (0, 0, 255)
-    p0 = (int(round(row["x"])), int(round(row["y"])))
-    p1 = (int(round(row["x"] + row["w"])) - 1, int(round(row["y"] + row["h"])) - 1)
-    cv2.rectangle(img, p0, p1, col, 2)
-    cv2.circle(img, (int(round(row["cx"])), int(round(row["cy"]))), 3, (0, 0, 255), -1)
-    txt = f"#{row['frame']} rho_c={_fmt(row['rho_c'], 2)} rho_e={_fmt(row['rho_e'], 2)} " \
-          f"a_c={_fmt(row['alpha_c'], 2)} {row['status']}"
-    (tw, th), base = cv2.getTextSize(txt, cv2.FONT_HERSHEY_SIMPLEX, 0.45, 1)
-    cv2.rectangle(img, (0, 0), (tw + 8, th + base + 8), (0, 0, 0), -1)
-    cv2.putText(img, txt, (4, th + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+        cv2.rectangle(img, (s(x), s(y)), (s(x + w) - 1, s(y + h) - 1), GT_COLOUR, 1)
+    col = STATUS_COLOURS.get(row["status"], (0, 0, 255))
+    cv2.rectangle(img, (s(row["x"]), s(row["y"])), (s(row["x"] + row["w"]) - 1, s(row["y"] + row["h"]) - 1), col, 2)
+    cv2.circle(img, (s(row["cx"] + 0.5 - 0.5 / k), s(row["cy"] + 0.5 - 0.5 / k)), 3, col, -1)  # pixel centre
+    _text_block(img, [(t, None) for t in overlay_lines(row, img.shape[1], fs)], True, fs)
+    if have_gt:
+        _text_block(img, [("ground truth", GT_COLOUR), ("tracker", col)], False, fs)
     return img
 
 
@@ -208,7 +292,11 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
     Notes
     -----
     A ``FrameError`` from ``update`` (or an unreadable frame) is recorded as
-    status "error" with the previous box, and tracking goes on.
+    status "error" with the previous box, and tracking goes on.  ``status`` is
+    a :class:`~mstrack.types.Status` value (v2 adds "uncertain" and
+    "reacquired"); ``confidence`` (0..1, :data:`CONFIDENCE_DECIMALS` decimals)
+    is filled for tracker v2 only (:func:`reports_confidence`).  The overlay
+    video is upscaled for frames narrower than :data:`OVERLAY_MIN_WIDTH`.
     """
     from tqdm import tqdm
 
@@ -217,6 +305,7 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
     if max_frames is not None and max_frames < 1:
         raise ValueError(f"max_frames must be >= 1, got {max_frames}")
     bad_frame = frame_error_types()
+    conf = reports_confidence(tracker)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows: list[dict[str, Any]] = []
     writer = None
@@ -236,9 +325,8 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
                     raise DataError("frame 0 is unreadable", getattr(source, "path", out_dir))
                 res = tracker.init(frame, box)
                 b = to_box(res) if res is not None else box
-                row = _row(0, res, b, result_status(res) if res is not None else Status.INIT.value)
+                row = _row(0, res, b, result_status(res) if res is not None else Status.INIT.value, conf)
                 size = (frame.shape[1], frame.shape[0])
-                writer, video_path = open_video_writer(out_dir / "overlay.mp4", fps, size)
             else:
                 prev = rows[-1]
                 res, st = None, Status.ERROR.value
@@ -256,7 +344,7 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
                     row = _row(i, None, b, Status.ERROR.value)
                     row.update(cx=prev["cx"], cy=prev["cy"])
                 else:
-                    row = _row(i, res, to_box(res), st)
+                    row = _row(i, res, to_box(res), st, conf)
             rows.append(row)
             if frame is None or frame.ndim != 3 or (frame.shape[1], frame.shape[0]) != size:
                 import cv2
@@ -265,6 +353,8 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
             else:
                 canvas = frame
             img = draw_overlay(canvas, row, None if gt is None or i >= len(gt) else gt[i])
+            if writer is None:  # the overlay may be larger than the frame (small frames are upscaled)
+                writer, video_path = open_video_writer(out_dir / "overlay.mp4", fps, (img.shape[1], img.shape[0]))
             writer.write(img)
             display.show(img)
     finally:
@@ -286,6 +376,29 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
                                                       "box_convention": "0-based x,y,w,h; cx,cy pixel-index centre",
                                                       "frames_data": clean}, indent=1) + "\n")
     return rows, info
+
+
+def resolve_tracker(tracker: str | None, preset: str | None) -> str:
+    """Tracker name from ``--tracker`` and ``--preset`` (track, demo).
+
+    ``--preset v2`` runs ``mstrack-v2`` (colour only, so it takes no other ``--tracker``);
+    ``--preset paper`` (the default) runs ``--tracker`` or :data:`DEFAULT_TRACKER`."""
+    v2 = "mstrack-v2"
+    if preset == "v2":
+        if tracker not in (None, v2):
+            raise ValueError(f"--preset v2 runs {v2}; leave out --tracker {tracker} (or use --preset paper)")
+        return v2
+    if preset == "paper" and tracker == v2:
+        raise ValueError(f"--tracker {v2} is the v2 preset; leave out --preset paper")
+    return tracker or DEFAULT_TRACKER
+
+
+def _add_preset_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--tracker", default=None,
+                   help=f"tracker name (default {DEFAULT_TRACKER}; mstrack-v2 with --preset v2)")
+    p.add_argument("--preset", choices=PRESETS, default=None,
+                   help="mstrack algorithm: paper (default; the paper's fixed-size colour + edge fusion) or "
+                        "v2 (tracker v2: scale, confidence, loss and re-acquisition; float model only for now)")
 
 
 # --------------------------------------------------------------------------- eval
@@ -345,7 +458,7 @@ def _cmd_track(args: argparse.Namespace) -> int:
         raise ValueError("--box x,y,w,h is required unless SOURCE is a sequence folder with ground truth")
     out = Path(args.out) if args.out else Path("out/track") / Path(args.source).resolve().name
     check_out_dir(out)
-    tracker = make_tracker(args.tracker, args.model)
+    tracker = make_tracker(resolve_tracker(args.tracker, args.preset), args.model)
     rows, info = track_frames(tracker, src.frames(on_bad="none"), box, out, fps=src.fps, gt=gt, show=args.show,
                               max_frames=args.max_frames, progress=not args.quiet and sys.stderr.isatty(),
                               source=src)
@@ -366,7 +479,7 @@ def register_track(sub: argparse._SubParsersAction) -> None:
     p.add_argument("source", metavar="SOURCE", help="video file, image folder or OTB/VOT sequence folder")
     p.add_argument("--box", type=_parse_box, help="initial box x,y,w,h, 0-based pixels (default: frame 0 GT)")
     p.add_argument("--model", choices=("float", "fixed"), default="float")
-    p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"tracker name (default {DEFAULT_TRACKER})")
+    _add_preset_options(p)
     p.add_argument("--out", help="output folder (default out/track/<source name>)")
     p.add_argument("--max-frames", type=_positive_int, help="stop after N frames (N >= 1)")
     p.add_argument("--show", action="store_true", help="display frames (needs a display)")
@@ -471,11 +584,12 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .synthetic import make_scene
 
     out = Path(args.out)
-    label = run_label(args.tracker, args.model)
+    name = resolve_tracker(args.tracker, args.preset)
+    label = run_label(name, args.model)
     summary: dict[str, Any] = {"tracker": label}
     # (a) synthetic scene with exact ground truth
     frames, gt = make_scene(args.synthetic_frames, 320, 240, seed=1)
-    rows, info = track_frames(make_tracker(args.tracker, args.model), frames, Box.of(gt[0]), out / "synthetic",
+    rows, info = track_frames(make_tracker(name, args.model), frames, Box.of(gt[0]), out / "synthetic",
                               fps=25.0, gt=gt)
     pred = np.array([[r["x"], r["y"], r["w"], r["h"]] for r in rows])
     sc = score(pred, gt[:len(pred)])
@@ -490,13 +604,15 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         summary["vtest"] = None
     else:
         src = VideoSource(vt)
-        rows, info = track_frames(make_tracker(args.tracker, args.model), src.frames(), Box.of(args.box), out / "vtest",
+        rows, info = track_frames(make_tracker(name, args.model), src.frames(), Box.of(args.box), out / "vtest",
                                   fps=src.fps, max_frames=args.frames)
         rho = np.array([r["rho_c"] for r in rows[1:]], dtype=float)
+        conf = np.array([r["confidence"] for r in rows[1:]], dtype=float)
         st = {s: sum(r["status"] == s for r in rows) for s in dict.fromkeys(r["status"] for r in rows)}
         summary["vtest"] = {"source": str(vt), "box": list(Box.of(args.box).as_tuple()), "frames": len(rows),
                             "fps": info["fps"], "status": st, "video": info["video"],
-                            "mean_rho_c": float(np.nanmean(rho)) if np.isfinite(rho).any() else None}
+                            "mean_rho_c": float(np.nanmean(rho)) if np.isfinite(rho).any() else None,
+                            "mean_confidence": float(np.nanmean(conf)) if np.isfinite(conf).any() else None}
         print(f"[demo] {vt.name}, {len(rows)} frames from box {Box.of(args.box).as_tuple()}: status {st}, "
               f"{_fmt(info['fps'], 1)} fps -> {info['video']}")
     out.mkdir(parents=True, exist_ok=True)
@@ -510,7 +626,7 @@ def register_demo(sub: argparse._SubParsersAction) -> None:
                        description="Default job: needs no dataset. Writes overlays and results to --out.")
     p.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
     p.add_argument("--model", choices=("float", "fixed"), default="float", help="mstrack model")
-    p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"tracker name (default {DEFAULT_TRACKER})")
+    _add_preset_options(p)
     p.add_argument("--frames", type=int, default=200, help="vtest.avi frames to track (default 200)")
     p.add_argument("--synthetic-frames", type=int, default=120, help="synthetic scene length (default 120)")
     p.add_argument("--video", help="video to use instead of vtest.avi (then also give --box)")

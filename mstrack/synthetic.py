@@ -3,7 +3,9 @@
 :func:`make_scene` renders a textured, coloured target (a red/yellow
 checkerboard with noise, so it has both a distinctive colour histogram and
 internal edges) moving smoothly over a textured blue-green background.  The
-scene is deterministic for a given seed.  Boxes follow :mod:`mstrack.types`
+scene is deterministic for a given seed.  :func:`render_scene` draws the same
+kind of target at any given box per frame (size changes, jumps) with optional
+full occlusion by a background-textured patch.  Boxes follow :mod:`mstrack.types`
 (0-based ``x, y, w, h``).
 """
 from __future__ import annotations
@@ -83,6 +85,74 @@ def make_scene(n_frames: int = 100, width: int = 320, height: int = 240, seed: i
         frames[i] = np.clip(f, 0, 255).astype(np.uint8)
     gt = np.stack([xs, ys, np.full(n_frames, tw), np.full(n_frames, th)], axis=1).astype(np.float64)
     return frames, gt
+
+
+def target_texture(rng: np.random.Generator, tw: int, th: int) -> np.ndarray:
+    """The red/yellow textured checkerboard of :func:`make_scene`, float32 (th, tw, 3) BGR."""
+    yy, xx = np.mgrid[0:th, 0:tw]
+    cell = max(4, min(tw, th) // 6)
+    check = ((yy // cell + xx // cell) % 2).astype(bool)
+    tgt = np.empty((th, tw, 3), np.float32)
+    tgt[check] = (30, 40, 210)     # red
+    tgt[~check] = (40, 200, 230)   # yellow/orange
+    tgt += _texture(rng, th, tw, 4, np.float32(-20), np.float32(20))
+    return tgt
+
+
+def background_texture(rng: np.random.Generator, width: int, height: int) -> np.ndarray:
+    """The blue/green/grey background of :func:`make_scene`, float32 (height, width, 3) BGR."""
+    bg = _texture(rng, height, width, 24, np.array([90, 80, 40], np.float32), np.array([200, 170, 110], np.float32))
+    bg += _texture(rng, height, width, 3, np.float32(-25), np.float32(25))
+    return bg
+
+
+def render_scene(boxes: np.ndarray, width: int, height: int, seed: int = 0, noise: float = 4.0,
+                 hidden: np.ndarray | None = None) -> np.ndarray:
+    """Frames of the :func:`make_scene` target drawn at given boxes (size and place per frame).
+
+    Parameters
+    ----------
+    boxes : ndarray, shape (N, 4)
+        Target box per frame, 0-based ``(x, y, w, h)``, rounded to whole pixels; the target
+        texture (made once at the largest size) is resized to each box, so a growing box shows a
+        growing target.  Parts outside the frame are cut.
+    width, height : int
+        Frame size.
+    seed : int
+        Random seed (background, target texture, noise).
+    noise : float
+        Standard deviation of per-frame sensor noise (grey levels).
+    hidden : ndarray of bool, shape (N,), optional
+        Frames where the target is fully occluded by a patch of background texture (a piece of
+        the background from elsewhere in the scene, so the patch has background colours only).
+
+    Returns
+    -------
+    ndarray, shape (N, height, width, 3), uint8 BGR.
+    """
+    b = np.rint(np.asarray(boxes, dtype=np.float64)).astype(int).reshape(-1, 4)
+    n = len(b)
+    if n < 1 or width < 32 or height < 32 or (b[:, 2:] < 1).any():
+        raise ValueError("need >= 1 box of positive size and a frame of at least 32 x 32")
+    rng = np.random.default_rng(seed)
+    bg = background_texture(rng, width, height)
+    tw, th = int(b[:, 2].max()), int(b[:, 3].max())
+    tgt = target_texture(rng, tw, th)
+    # the occluder: a background-textured patch (the background rolled by half the frame)
+    cover = np.roll(bg, (height // 2, width // 2), axis=(0, 1))
+    frames = np.empty((n, height, width, 3), np.uint8)
+    for i, (x, y, w, h) in enumerate(b):
+        f = bg.copy()
+        x0, y0, x1, y1 = max(x, 0), max(y, 0), min(x + w, width), min(y + h, height)
+        if x1 > x0 and y1 > y0:
+            if hidden is not None and hidden[i]:
+                f[y0:y1, x0:x1] = cover[y0:y1, x0:x1]
+            else:
+                t = tgt if (w, h) == (tw, th) else cv2.resize(tgt, (int(w), int(h)), interpolation=cv2.INTER_AREA)
+                f[y0:y1, x0:x1] = t[y0 - y:y1 - y, x0 - x:x1 - x]
+        f += rng.normal(0.0, noise, f.shape).astype(np.float32)
+        frames[i] = np.clip(f, 0, 255).astype(np.uint8)
+    return frames
 
 
 def write_video(frames: np.ndarray, path: str | Path, fps: float = 25.0) -> Path:

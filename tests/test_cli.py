@@ -2,6 +2,7 @@
 import csv
 import importlib.util
 import json
+import math
 import textwrap
 
 import cv2
@@ -223,3 +224,151 @@ def test_default_parser_has_builtin_and_listed_extension_commands(capsys):
     assert {"eval", "track", "bench", "demo"} <= set(sub.choices)
     assert "not found" not in capsys.readouterr().err    # every listed extension module loads
     assert len(sub.choices) >= 4 + len(cli.EXTENSIONS)
+
+
+# ----------------------------------------------------------------------------- tracker v2 outputs
+V2_STATUSES = {"init", "clipped", "ok", "uncertain", "lost", "reacquired", "error"}
+
+
+def _video_size(path):
+    cap = cv2.VideoCapture(str(path))
+    ok, f = cap.read()
+    cap.release()
+    assert ok
+    return f.shape[1], f.shape[0]
+
+
+@pytest.fixture(scope="module")
+def occluded_small_seq(tmp_path_factory):
+    """128x96 (Girl's size) sequence, a 24x24 target moving right, hidden by background in frames
+    10..17 (v2: LOST there, REACQUIRED on frame 18 or 19)."""
+    from mstrack.synthetic import render_scene
+    n = 30
+    t = np.arange(n)
+    gt = np.stack([30 + t, np.full(n, 36), np.full(n, 24), np.full(n, 24)], axis=1).astype(float)
+    frames = render_scene(gt, 128, 96, seed=5, hidden=(t >= 10) & (t < 18))
+    return write_otb_sequence(frames, gt, tmp_path_factory.mktemp("small") / "occl"), gt
+
+
+@needs_tracker
+def test_track_v2_writes_confidence_and_statuses(occluded_small_seq, tmp_path):
+    seq, gt = occluded_small_seq
+    out = tmp_path / "v2"
+    assert cli.main(["track", str(seq), "--preset", "v2", "--out", str(out), "--quiet"]) == 0
+    with open(out / "results.csv") as fh:
+        header = fh.readline().strip().split(",")
+    assert header == list(cli.CSV_FIELDS) and "confidence" in header
+    rows = _read_csv(out / "results.csv")
+    assert len(rows) == 30 and {r["status"] for r in rows} <= V2_STATUSES
+    conf = [float(r["confidence"]) for r in rows]
+    assert conf[0] == 1.0 and all(0.0 <= c <= 1.0 for c in conf)
+    assert all(len(r["confidence"].partition(".")[2]) <= cli.CONFIDENCE_DECIMALS for r in rows)
+    st = [r["status"] for r in rows]
+    assert "lost" in st[10:18] and "reacquired" in st[18:21], st
+    assert all(c < 0.5 for c, s in zip(conf, st) if s in ("lost", "uncertain"))
+    data = json.loads((out / "results.json").read_text())
+    assert [d["status"] for d in data["frames_data"]] == st
+    assert [d["confidence"] for d in data["frames_data"]] == pytest.approx(conf)
+    # Girl-sized frames: the overlay is upscaled x3 so the banner is legible
+    assert _video_size(next(out.glob("overlay.*"))) == (384, 288)
+    assert _count_frames(next(out.glob("overlay.*"))) == 30
+
+
+@needs_tracker
+def test_track_paper_leaves_confidence_empty(occluded_small_seq, tmp_path):
+    out = tmp_path / "paper"
+    assert cli.main(["track", str(occluded_small_seq[0]), "--preset", "paper", "--out", str(out), "--quiet",
+                     "--max-frames", "4"]) == 0
+    rows = _read_csv(out / "results.csv")
+    assert len(rows) == 4 and all(r["confidence"] == "nan" for r in rows)
+    assert all(d["confidence"] is None for d in json.loads((out / "results.json").read_text())["frames_data"])
+
+
+@pytest.mark.parametrize("tracker,preset,want", [(None, None, cli.DEFAULT_TRACKER), (None, "paper", cli.DEFAULT_TRACKER),
+                                                 (None, "v2", "mstrack-v2"), ("mstrack-v2", "v2", "mstrack-v2"),
+                                                 ("mstrack-v2", None, "mstrack-v2"),
+                                                 ("opencv-kcf", None, "opencv-kcf"), ("opencv-kcf", "paper", "opencv-kcf")])
+def test_resolve_tracker(tracker, preset, want):
+    assert cli.resolve_tracker(tracker, preset) == want
+
+
+@pytest.mark.parametrize("args,msg", [(["--preset", "v2", "--tracker", "opencv-meanshift"], "--preset v2 runs mstrack-v2"),
+                                      (["--preset", "paper", "--tracker", "mstrack-v2"], "is the v2 preset")])
+def test_track_preset_conflicts(occluded_small_seq, tmp_path, capsys, args, msg):
+    out = tmp_path / "x"
+    assert cli.main(["track", str(occluded_small_seq[0]), "--out", str(out), "--quiet", *args]) == 1
+    assert msg in capsys.readouterr().err
+    assert not (out / "results.csv").exists()
+
+
+def test_preset_choices(capsys):
+    with pytest.raises(SystemExit) as ei:
+        cli.build_parser().parse_args(["track", "x", "--preset", "v3"])
+    assert ei.value.code == 2 and "invalid choice" in capsys.readouterr().err
+    for cmd in ("track", "demo"):
+        args = cli.build_parser().parse_args([cmd, "x"] if cmd == "track" else [cmd])
+        assert args.preset is None and args.tracker is None     # -> paper, DEFAULT_TRACKER
+
+
+def _row(status="ok", confidence=0.8765, alpha_c=1.0, rho_e=0.0, frame=123):
+    return {"frame": frame, "x": 40.0, "y": 30.0, "w": 30.0, "h": 40.0, "cx": 54.5, "cy": 49.5, "rho_c": 0.91,
+            "rho_e": rho_e, "alpha_c": alpha_c, "confidence": confidence, "status": status}
+
+
+@pytest.mark.parametrize("width", [128, 320, 768])
+@pytest.mark.parametrize("status", ["ok", "uncertain", "reacquired", "lost"])
+def test_overlay_banner_fits_and_leads_with_status(width, status):
+    k = cli.overlay_scale(width)
+    assert width * k >= cli.OVERLAY_MIN_WIDTH and (k == 1 or width * (k - 1) < cli.OVERLAY_MIN_WIDTH)
+    for row in (_row(status), _row(status, confidence=float("nan"), alpha_c=0.55, rho_e=0.7)):
+        lines = cli.overlay_lines(row, width * k, 0.4)
+        assert lines[0].startswith(f"#123  {status.upper()}")
+        if math.isfinite(row["confidence"]):
+            assert "conf 0.88" in lines[0]
+        else:
+            assert "conf" not in " ".join(lines) and "a_c 0.55" in " ".join(lines)
+        for ln in lines:
+            assert cv2.getTextSize(ln, cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)[0][0] <= width * k - 8, ln
+    # one feature (v2, colour only): rho_e and alpha_c are not shown
+    assert "rho_e" not in " ".join(cli.overlay_lines(_row(), 2000)) and "a_c" not in " ".join(cli.overlay_lines(_row(), 2000))
+
+
+def test_overlay_small_frame_upscaled_with_legend():
+    rng = np.random.default_rng(0)
+    frame = rng.integers(60, 200, (96, 128, 3), dtype=np.uint8)
+    gt = np.array([42.0, 32.0, 30.0, 40.0])
+    with_gt = cli.draw_overlay(frame, _row("uncertain"), gt)
+    no_gt = cli.draw_overlay(frame, _row("uncertain"))
+    assert with_gt.shape == no_gt.shape == (288, 384, 3)
+    assert frame.shape == (96, 128, 3)                            # the input is not drawn on
+    big = cv2.resize(frame, (384, 288), interpolation=cv2.INTER_NEAREST)
+    dark = lambda a: (a * 0.35).astype(np.uint8)  # noqa: E731  (the bands' background)
+    # banner at the top: a darkened band (its top margin) with white text
+    assert (no_gt[:3, :100] == dark(big[:3, :100])).all() and (no_gt[:20, :100] > 230).all(axis=2).any()
+    # legend at the bottom only where ground truth is drawn
+    assert (no_gt[-12:, :60] == big[-12:, :60]).all()
+    assert (with_gt[-3:, :60] == dark(big[-3:, :60])).all() and (with_gt[-40:, :100] > 230).all(axis=2).any()
+    # the tracker box in the status colour, the ground truth in white (scaled x3)
+    assert tuple(with_gt[30 * 3 + 60, 40 * 3]) == cli.STATUS_COLOURS["uncertain"]
+    assert tuple(with_gt[32 * 3 + 60, 42 * 3 + 30 * 3 - 1]) == cli.GT_COLOUR
+
+
+def test_overlay_large_frame_not_scaled():
+    frame = np.full((240, 400, 3), 128, np.uint8)
+    img = cli.draw_overlay(frame, _row("lost"))
+    assert img.shape == frame.shape
+    assert tuple(img[30 + 20, 40]) == cli.STATUS_COLOURS["lost"]
+
+
+@needs_tracker
+def test_demo_with_v2_preset(tmp_path, capsys):
+    out = tmp_path / "demo"
+    assert cli.main(["demo", "--out", str(out), "--preset", "v2", "--synthetic-frames", "20", "--frames", "5"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["tracker"] == "mstrack-v2"
+    assert summary["synthetic"]["frames"] == 20 and summary["synthetic"]["auc"] > 0.6
+    rows = _read_csv(out / "synthetic" / "results.csv")
+    assert all(0.0 <= float(r["confidence"]) <= 1.0 for r in rows)
+    if summary["vtest"] is not None:
+        assert summary["vtest"]["frames"] == 5 and 0.0 <= summary["vtest"]["mean_confidence"] <= 1.0
+    assert "mstrack-v2" in capsys.readouterr().out

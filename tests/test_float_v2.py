@@ -262,8 +262,8 @@ def test_v2_params_validated():
         TrackerParams(preset="v2", conf_lost=0.6, conf_uncertain=0.5)
     with pytest.raises(ValueError, match="preset"):
         TrackerParams(preset="v3")
-    with pytest.raises(ValueError, match="no fixed-point model"):
-        Tracker(model="fixed", preset="v2")
+    with pytest.raises(ValueError, match="flat kernel only"):
+        Tracker(model="fixed", preset="v2", kernel="epanechnikov")
     assert TrackerParams().preset == "paper" and TrackerParams().features == "fused"
 
 

@@ -57,17 +57,8 @@ def make_scene(n_frames: int = 100, width: int = 320, height: int = 240, seed: i
     rng = np.random.default_rng(seed)
     side = min(64, min(width, height) // 3)
     tw, th = target_size if target_size is not None else (side, side)
-    # background: blue/green/grey, large blobs + fine grain (BGR order)
-    bg = _texture(rng, height, width, 24, np.array([90, 80, 40], np.float32), np.array([200, 170, 110], np.float32))
-    bg += _texture(rng, height, width, 3, np.float32(-25), np.float32(25))
-    # target: red/yellow checkerboard with texture (BGR)
-    yy, xx = np.mgrid[0:th, 0:tw]
-    cell = max(4, min(tw, th) // 6)
-    check = ((yy // cell + xx // cell) % 2).astype(bool)
-    tgt = np.empty((th, tw, 3), np.float32)
-    tgt[check] = (30, 40, 210)     # red
-    tgt[~check] = (40, 200, 230)   # yellow/orange
-    tgt += _texture(rng, th, tw, 4, np.float32(-20), np.float32(20))
+    bg = background_texture(rng, width, height)  # blue/green/grey, large blobs + fine grain (BGR)
+    tgt = target_texture(rng, tw, th)  # red/yellow checkerboard with texture (BGR)
     # smooth Lissajous trajectory inside the frame (max speed about 3 px/frame)
     mx, my = (width - tw) / 2.0, (height - th) / 2.0
     ax, ay = 0.8 * mx, 0.8 * my

@@ -459,18 +459,7 @@ def scene():
     return f0, f1, f2, box
 
 
-W, H = 160, 120
-BAD_FRAMES = {
-    "none": None,
-    "list": [[0, 0, 0]],
-    "float32": np.zeros((H, W, 3), np.float32),
-    "uint16": np.zeros((H, W, 3), np.uint16),
-    "1d": np.zeros(W * 3, np.uint8),
-    "2ch": np.zeros((H, W, 2), np.uint8),
-    "4d": np.zeros((H, W, 3, 1), np.uint8),
-    "empty": np.zeros((0, 0, 3), np.uint8),
-    "tiny": np.zeros((2, 2, 3), np.uint8),
-}
+from test_bad_input import BAD_FRAMES, H, W  # noqa: E402  (the same bad frames as the paper preset)
 
 
 @pytest.mark.parametrize("name", sorted(BAD_FRAMES))

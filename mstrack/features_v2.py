@@ -1,0 +1,327 @@
+"""Experimental feature and fusion variants of tracker v2 (issue 10, item 5).
+
+Used by ``tools/v2_features.py`` to measure, on the dev sequences, whether an
+edge feature helps tracker v2 (:mod:`mstrack.float_v2`) and how to fuse it.
+Nothing here changes :class:`~mstrack.float_v2.FloatTrackerV2`; the pieces
+it is built from (:func:`~mstrack.float_v2.window_pixels`,
+:func:`~mstrack.float_v2.background_model`,
+:func:`~mstrack.float_v2.window_pass`) are reused as they are.
+
+Features (bin images on the decimated grid, see :mod:`mstrack.float_v2`):
+
+* ``colour``: :func:`~mstrack.float_model.colour_bins` (3 bits/channel, 512 bins).
+* ``orient`` (T): orientation of the 3x3 Sobel gradient of the grey image,
+  quantised to 8 octants in hardware form (no atan): bin = 4 [Gx < 0] +
+  2 [Gy < 0] + [|Gy| > |Gx|] for pixels with |Gx| + |Gy| >= T, bin 8 for the
+  flatter ones (9 bins).
+* ``mag``: the paper's 16-bin magnitude histogram,
+  min(15, floor((|Gx| + |Gy|) / 32)) (:func:`~mstrack.float_model.edge_bins`).
+* ``joint`` (T, b): colour at b bits/channel x orient(T): 2**(3b) x 9 bins,
+  one feature.
+
+The Sobel runs on the full-resolution frame (as a streaming line-buffer
+Sobel would) and is then decimated with the colour bins.
+
+:class:`MultiFeatureV2` is FloatTrackerV2 with a list of features: the first
+("main") feature plays the colour feature's role everywhere (confidence,
+scale, loss and the wide search); an optional second feature runs its own
+mean shift from the same start and the two centres are fused by a rule
+(``fusion``):
+
+* ``rho``: alpha_f = rho_f / (rho_main + rho_second) (the paper's rule);
+* ``disc``: alpha_f proportional to max(d_f, 0), d_f = rho_f - rho_bg_f,
+  rho_bg_f the Bhattacharyya coefficient of the feature's background-ring
+  histogram (init box's ring in the init frame) against its target model;
+  main feature alone if both d_f <= 0;
+* ``disc_frame``: as ``disc`` with rho_bg_f re-measured every frame on the
+  ring around the box just found (used for the next frame; one more pass per
+  feature over the ring);
+* ``wta``: winner takes all by d_f (the second feature only where it
+  discriminates better);
+* ``tie``: main feature unless its confidence is below ``conf_uncertain``,
+  then ``disc``.
+
+With a single feature ``colour`` the class reproduces FloatTrackerV2
+(checked by the tool before it reports).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .float_model import check_frame, clip_box, colour_bins, edge_bins, grey_area
+from .float_v2 import PassV2, background_model, window_pass
+from .params import TrackerParams
+from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
+
+FUSIONS = ("rho", "disc", "disc_frame", "wta", "tie")
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A per-pixel feature: ``kind`` in colour / orient / mag / joint; ``T`` the |G| threshold
+    of orient / joint; ``bits`` the colour bits per channel of colour / joint."""
+
+    kind: str
+    T: int = 64
+    bits: int = 3
+
+    @property
+    def n_bins(self) -> int:
+        if self.kind == "colour":
+            return 1 << (3 * self.bits)
+        if self.kind == "orient":
+            return 9
+        if self.kind == "mag":
+            return 16
+        if self.kind == "joint":
+            return (1 << (3 * self.bits)) * 9
+        raise ValueError(self.kind)
+
+    @property
+    def label(self) -> str:
+        if self.kind == "colour":
+            return f"colour{self.bits}b"
+        if self.kind == "orient":
+            return f"orient(T={self.T})"
+        if self.kind == "mag":
+            return "mag16"
+        return f"colour{self.bits}b x orient(T={self.T})"
+
+
+def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gx, Gy (float32) of the 3x3 Sobel on the grey image; 0 on the 1-px frame border."""
+    grey = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0])
+    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
+    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
+    for g in (gx, gy):
+        g[0, :] = g[-1, :] = 0
+        g[:, 0] = g[:, -1] = 0
+    return gx, gy
+
+
+def orientation_bins(gx: np.ndarray, gy: np.ndarray, T: float) -> np.ndarray:
+    """Octant 4 [Gx < 0] + 2 [Gy < 0] + [|Gy| > |Gx|] where |Gx| + |Gy| >= T, else 8 (flat)."""
+    ax, ay = np.abs(gx), np.abs(gy)
+    octant = (gx < 0).astype(np.intp) * 4 + (gy < 0) * 2 + (ay > ax)
+    return np.where(ax + ay >= T, octant, 8)
+
+
+class _FrameFeatures:
+    """Feature images of one frame (the Sobel computed once, shared)."""
+
+    def __init__(self, frame: np.ndarray) -> None:
+        self.frame = frame
+        self._g: tuple[np.ndarray, np.ndarray] | None = None
+
+    def grad(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._g is None:
+            self._g = sobel(self.frame)
+        return self._g
+
+    def bins(self, f: Feature, d: int) -> np.ndarray:
+        if f.kind == "colour":
+            return colour_bins(self.frame[::d, ::d], f.bits)
+        if f.kind == "mag":
+            return edge_bins(self.frame, 16, 5)[::d, ::d]
+        gx, gy = self.grad()
+        o = orientation_bins(gx[::d, ::d], gy[::d, ::d], f.T)
+        if f.kind == "orient":
+            return o
+        return colour_bins(self.frame[::d, ::d], f.bits) * 9 + o
+
+
+def ring_histogram(bins: np.ndarray, n_bins: int, cx: float, cy: float, w: float, h: float,
+                   ring: float) -> np.ndarray:
+    """Normalised histogram of the background ring of :func:`~mstrack.float_v2.background_model`."""
+    height, width = bins.shape
+    gx, gy = ring * w, ring * h
+    x0, x1 = max(0, math.ceil(cx - w / 2 - gx)), min(width - 1, math.floor(cx + w / 2 + gx))
+    y0, y1 = max(0, math.ceil(cy - h / 2 - gy)), min(height - 1, math.floor(cy + h / 2 + gy))
+    yy, xx = np.mgrid[y0:y1 + 1, x0:x1 + 1]
+    outside = (np.abs(xx - cx) > w / 2.0) | (np.abs(yy - cy) > h / 2.0)
+    o = np.bincount(bins[yy[outside], xx[outside]], minlength=n_bins).astype(np.float64)
+    s = o.sum()
+    return o / s if s > 0 else o
+
+
+class MultiFeatureV2:
+    """Tracker v2 with a main feature and an optional second feature fused by ``fusion``.
+
+    ``final_pass``: after fusion, confidence and scale come from a main-feature pass at the fused
+    centre (one more pass per frame) instead of the main feature's pass at its own centre.
+    """
+
+    def __init__(self, features: list[Feature], fusion: str = "rho", params: TrackerParams | None = None,
+                 final_pass: bool = False) -> None:
+        if not 1 <= len(features) <= 2:
+            raise ValueError("one or two features")
+        if fusion not in FUSIONS:
+            raise ValueError(f"fusion must be one of {FUSIONS}")
+        self.features = list(features)
+        self.fusion = fusion
+        self.final_pass = final_pass
+        self.params = params or TrackerParams(preset="v2")
+        self._shape: tuple[int, int] | None = None
+
+    # same as FloatTrackerV2.decimation
+    def decimation(self, w: float, h: float) -> int:
+        p = self.params
+        d = 1
+        while max(w, h) * (1.0 + p.pad) / d > p.max_window and d < 8:
+            d *= 2
+        return d
+
+    def _track(self, k: int, bins: np.ndarray, start: tuple[float, float], hx: float, hy: float,
+               max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
+        """FloatTrackerV2._track for feature k (same steps, same stopping rules)."""
+        p = self.params
+        n, qb, t = self.features[k].n_bins, self._qb[k], self._t[k]
+        height, width = bins.shape
+        inner2 = 1.0 / (1.0 + p.pad) ** 2
+
+        def clamp(c: tuple[float, float]) -> tuple[float, float]:
+            return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
+
+        c0 = clamp(start)
+        p0 = window_pass(bins, n, qb, t, c0, hx, hy, inner2, p.kernel)
+        it = 0
+        for it in range(1, max_iter + 1):
+            if p0.sw <= 0:
+                break
+            c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
+            p1 = window_pass(bins, n, qb, t, c1, hx, hy, inner2, p.kernel)
+            if p1.rho < p0.rho:
+                break
+            s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
+            c0, p0 = c1, p1
+            if s2 < p.eps2:
+                break
+        return c0, p0, it
+
+    def _confidence(self, ps: PassV2) -> float:
+        cr = min(1.0, ps.rho / self._rho_ref) if self._rho_ref > 0 else 0.0
+        cs = min(1.0, ps.share / self._share_ref) if self._share_ref > 0 else 0.0
+        return cr * cs
+
+    def _rho_bg(self, k: int, bins: np.ndarray, cx: float, cy: float, w: float, h: float) -> float:
+        o = ring_histogram(bins, self.features[k].n_bins, cx, cy, w, h, self.params.bg_ring)
+        return float(np.sqrt(o * self._qb[k]).sum())
+
+    def _alphas(self, rho: list[float], conf: float) -> tuple[float, float]:
+        if self.fusion == "rho":
+            s = rho[0] + rho[1]
+            a = rho[0] / s if s > 0 else 0.5
+            return a, 1.0 - a
+        if self.fusion == "tie" and conf >= self.params.conf_uncertain:
+            return 1.0, 0.0
+        d = [max(rho[k] - self._rbg[k], 0.0) for k in range(2)]
+        if self.fusion == "wta":
+            return (1.0, 0.0) if d[0] >= d[1] else (0.0, 1.0)
+        s = d[0] + d[1]
+        if s <= 0:
+            return 1.0, 0.0
+        return d[0] / s, d[1] / s
+
+    # ------------------------------------------------------------------ API
+    def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
+        frame = check_frame(frame)
+        height, width = frame.shape[:2]
+        box, clipped = clip_box(Box.of(box), width, height)
+        p = self.params
+        self._shape = (height, width)
+        cx, cy = box_centre_index(box)
+        self._size = self._size0 = (box.w, box.h)
+        self._centre = (cx, cy)
+        d = self.decimation(box.w, box.h)
+        ff = _FrameFeatures(frame)
+        self._qb, self._t, self._rbg = [], [], []
+        pad = 1.0 + p.pad
+        for k, f in enumerate(self.features):
+            bins = ff.bins(f, d)
+            _, qb, t = background_model(bins, f.n_bins, cx / d, cy / d, box.w / d, box.h / d, p.bg_ring,
+                                        p.kernel)
+            self._qb.append(qb)
+            self._t.append(t)
+            self._rbg.append(self._rho_bg(k, bins, cx / d, cy / d, box.w / d, box.h / d))
+            if k == 0:
+                ps = window_pass(bins, f.n_bins, qb, t, (cx / d, cy / d), pad * box.w / 2 / d,
+                                 pad * box.h / 2 / d, 1.0 / pad ** 2, p.kernel)
+        self._rho_ref = ps.rho
+        self._share_ref = ps.share
+        self._spread_ref = ps.spread if ps.spread > 0 else 0.5 / pad ** 2
+        self._lost = False
+        return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
+                           iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
+                           confidence=1.0, extra={"decimation": d})
+
+    def update(self, frame: np.ndarray) -> TrackResult:
+        if self._shape is None:
+            raise RuntimeError("update() called before init()")
+        frame = check_frame(frame, self._shape)
+        p = self.params
+        w, h = self._size
+        d = self.decimation(w, h)
+        ff = _FrameFeatures(frame)
+        bins = [ff.bins(f, d) for f in self.features]
+        pad = 1.0 + p.pad
+        hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
+        inner2 = 1.0 / pad ** 2
+        start = (self._centre[0] / d, self._centre[1] / d)
+        c, ps, it = self._track(0, bins[0], start, hx, hy, p.max_iter)
+        conf = self._confidence(ps)
+        ac, ae, it_e, rho_e = 1.0, 0.0, 0, 0.0
+        if len(self.features) == 2:
+            ce, pse, it_e = self._track(1, bins[1], start, hx, hy, p.max_iter)
+            rho_e = pse.rho
+            ac, ae = self._alphas([ps.rho, pse.rho], conf)
+            if ae > 0:
+                c = (ac * c[0] + ae * ce[0], ac * c[1] + ae * ce[1])
+                if self.final_pass:
+                    ps = window_pass(bins[0], self.features[0].n_bins, self._qb[0], self._t[0], c, hx, hy,
+                                     inner2, p.kernel)
+                    conf = self._confidence(ps)
+        searched = 0
+        if self._lost:
+            for sy in (-1, 0, 1):
+                for sx in (-1, 0, 1):
+                    if sx == 0 and sy == 0:
+                        continue
+                    s0 = (start[0] + sx * p.search_step * 2 * hx, start[1] + sy * p.search_step * 2 * hy)
+                    c2, ps2, _ = self._track(0, bins[0], s0, hx, hy, p.search_iter)
+                    searched += 1
+                    conf2 = self._confidence(ps2)
+                    if conf2 > conf:
+                        c, ps, conf = c2, ps2, conf2
+        if conf < (p.conf_reacquire if self._lost else p.conf_lost):
+            status = Status.LOST
+        elif self._lost:
+            status = Status.REACQUIRED
+        elif conf < p.conf_uncertain:
+            status = Status.UNCERTAIN
+        else:
+            status = Status.OK
+        self._lost = status == Status.LOST
+        self._centre = (c[0] * d, c[1] * d)
+        if status == Status.OK:
+            a = p.ref_rate
+            self._rho_ref += a * (ps.rho - self._rho_ref)
+            self._share_ref += a * (ps.share - self._share_ref)
+        if p.scale_gain > 0 and ps.nt > 0:
+            est = math.sqrt(ps.spread / self._spread_ref)
+            est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
+            s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / self._size0[0] - 1.0)
+            s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
+            self._size = (min(max(w * s, 3.0), float(self._shape[1])),
+                          min(max(h * s, 3.0), float(self._shape[0])))
+        if self.fusion == "disc_frame" and len(self.features) == 2 and status == Status.OK:
+            # background rho re-measured on the ring around the box just found (for the next frame)
+            for k in range(2):
+                self._rbg[k] = self._rho_bg(k, bins[k], c[0], c[1], w / d, h / d)
+        box = box_from_centre_index(*self._centre, *self._size)
+        return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=rho_e, alpha_c=ac, alpha_e=ae,
+                           iter_c=it, iter_e=it_e, status=status, confidence=conf,
+                           extra={"decimation": d, "searched": searched})

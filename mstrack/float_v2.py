@@ -133,6 +133,38 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
                   nt_in=int(tp[inner].sum()))
 
 
+class LazyBins:
+    """Colour bins of an image, computed on the first request for a rectangle and kept.
+
+    Indexing ``bins[ys, xs]`` (integer arrays) computes the bins of the bounding box of the
+    request (grown by ``margin`` px and united with what is already there); the values never
+    depend on which rectangles were asked for, so results equal those of the whole image.
+    """
+
+    def __init__(self, image: np.ndarray, bits: int, margin: int) -> None:
+        self.image, self.bits, self.margin = image, bits, margin
+        self.shape = image.shape[:2]
+        self.values = np.empty(self.shape, np.intp)
+        self.box: tuple[int, int, int, int] | None = None  # y0, y1, x0, x1 (half-open)
+
+    def _ensure(self, y0: int, y1: int, x0: int, x1: int) -> None:
+        b = self.box
+        if b is not None and y0 >= b[0] and y1 <= b[1] and x0 >= b[2] and x1 <= b[3]:
+            return
+        m = self.margin
+        ny0, ny1, nx0, nx1 = max(0, y0 - m), min(self.shape[0], y1 + m), max(0, x0 - m), min(self.shape[1], x1 + m)
+        if b is not None:
+            ny0, ny1, nx0, nx1 = min(ny0, b[0]), max(ny1, b[1]), min(nx0, b[2]), max(nx1, b[3])
+        self.values[ny0:ny1, nx0:nx1] = colour_bins(self.image[ny0:ny1, nx0:nx1], self.bits)
+        self.box = (ny0, ny1, nx0, nx1)
+
+    def __getitem__(self, key: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        ys, xs = key
+        if len(ys):
+            self._ensure(int(ys.min()), int(ys.max()) + 1, int(xs.min()), int(xs.max()) + 1)
+        return self.values[ys, xs]
+
+
 class FloatTrackerV2:
     """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2")."""
 
@@ -151,6 +183,10 @@ class FloatTrackerV2:
 
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
         return colour_bins(frame[::d, ::d], self.params.colour_bits)
+
+    def _lazy_bins(self, frame: np.ndarray, d: int, w: float, h: float) -> LazyBins:
+        """Bins computed around the windows the frame's mean shift visits (same values)."""
+        return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8)
 
     def _track(self, bins: np.ndarray, start: tuple[float, float], hx: float, hy: float,
                max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
@@ -218,7 +254,7 @@ class FloatTrackerV2:
         w, h = self._size
         # lost: the whole search runs at twice the decimation (a region 2x wider in the same memory)
         d = self.decimation(w, h) * (2 if self._lost else 1)
-        bins = self._bins(frame, d)
+        bins = self._lazy_bins(frame, d, w, h)
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
         start = (self._centre[0] / d, self._centre[1] / d)

@@ -25,11 +25,13 @@ d2 = ((x - cx) / hx)^2 + ((y - cy) / hy)^2 < 1.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from .float_model import check_frame, clip_box, colour_bins
+from . import float_model as _fm
+from .float_model import _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3, check_frame, clip_box, colour_bins
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -133,6 +135,91 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
                   nt_in=int(tp[inner].sum()))
 
 
+# ----------------------------------------------------------------------------- numba kernel
+# window_pass compiled with numba (float_model's "numba kernels" helpers): the same IEEE double
+# operations in the same order, so every pass, and so every result, is bit-identical to numpy.
+# The window's pixels are found row by row as in window_pixels (d2 = ax + by, ax = ((x - cx) / hx)
+# * ((x - cx) / hx), numpy's ``** 2`` on a float64 array, row-major order = np.nonzero's); the bins
+# come from the (decimated) frame's pixels in the scan (_nb_scan, the same integers as
+# colour_bins); the histogram is bincount's sequential sum; p.sum(), sqrt(p q).sum(), w.sum(),
+# (w x).sum(), (w y).sum() and (t d2).sum() are numpy's pairwise sums (_nb_sum, _nb_sum3); nt,
+# n_in and nt_in are counts (t is 0 / 1), exact in any order.  The mean-shift loop, its shift
+# test and everything per frame stay in Python (the same code for both paths).
+
+@_jit
+def _nb_window_pass(frame, bits, bins, cx, cy, hx, hy, width, height, inner2, flat, q, t,
+                    ibuf, fbuf, ax, cnt, dbuf):
+    """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
+    the decimated frame): (n, rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
+    nb = q.shape[0]
+    B, X, Y = ibuf[0], ibuf[1], ibuf[2]
+    h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
+    cnt = cnt[:, :nb]
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
+        h[:] = 0.0
+        n = 0
+    else:
+        n = _nb_scan(cx, cy, hx, hy, width, height, frame, bits, bins, 0, 0, flat, B, X, Y, h, ax, cnt)
+    rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
+    for u in range(nb):
+        wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
+    sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+    nt = n_in = nt_in = 0
+    for i in range(n):
+        ty = (Y[i] - cy) / hy
+        d2 = ax[X[i] - x0] + ty * ty  # ax: _nb_scan's column terms of this window
+        tv = t[B[i]]
+        dbuf[i] = tv * d2
+        if tv != 0.0:
+            nt += 1
+        if d2 < inner2:
+            n_in += 1
+            if tv != 0.0:
+                nt_in += 1
+    st2 = _nb_sum(dbuf, n)
+    return n, rho, sw, swx, swy, float(nt), st2, n_in, nt_in
+
+
+def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
+    """Work buffers of :func:`_nb_window_pass` for windows of half-sizes up to hx, hy.
+
+    int32 bins and coordinates (3, box px); float64 histogram, normalised
+    histogram, weights (3, bins); d2 column terms (box width); int32 counts
+    (4 interleaved tables, 1 beyond 2**16 bins); float64 t d2 (box px).
+    """
+    box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
+    return (np.empty((3, box_w * box_h), np.int32), np.empty((3, n_bins)), np.empty(box_w),
+            np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
+
+
+def _buffers_fit(bufs: tuple[np.ndarray, ...], hx: float, hy: float, n_bins: int) -> bool:
+    box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
+    return bufs[2].shape[0] >= box_w and bufs[0].shape[1] >= box_w * box_h and bufs[1].shape[1] >= n_bins
+
+
+_NO_BINS = np.zeros((1, 1), np.int32)
+
+
+def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray, c: tuple[float, float],
+                      hx: float, hy: float, inner2: float, kernel: str,
+                      bufs: tuple[np.ndarray, ...] | None = None) -> PassV2:
+    """:func:`window_pass` on ``colour_bins(frame, bits)`` by the numba kernel (bit-identical).
+
+    ``frame``: (H, W, 3) uint8, e.g. the decimated view ``frame[::D, ::D]``.
+    """
+    height, width = frame.shape[:2]
+    if bufs is None or not _buffers_fit(bufs, hx, hy, q.shape[0]):
+        bufs = _nb_buffers_v2(hx, hy, q.shape[0])
+    _, rho, sw, swx, swy, nt, st2, n_in, nt_in = _nb_window_pass(
+        frame, bits, _NO_BINS, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
+        kernel == "flat", q, t, *bufs)
+    return PassV2(rho=rho, sw=sw, swx=swx, swy=swy, nt=nt, st2=st2, n_in=n_in, nt_in=nt_in)
+
+
 class LazyBins:
     """Colour bins of an image, computed on the first request for a rectangle and kept.
 
@@ -166,11 +253,33 @@ class LazyBins:
 
 
 class FloatTrackerV2:
-    """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2")."""
+    """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2").
 
-    def __init__(self, params: TrackerParams | None = None) -> None:
+    ``path`` picks how the window passes of :meth:`update` are computed, with the
+    same results bit for bit: "numpy" (:func:`window_pass` on :class:`LazyBins`),
+    "numba" (:func:`window_pass_numba`), or "auto": numba when it is installed and
+    passes its self-check (:func:`_numba_ready`; MSTRACK_NUMBA=0 disables it), else numpy.
+    """
+
+    PATHS = ("auto", "numba", "numpy")
+
+    def __init__(self, params: TrackerParams | None = None, path: str = "auto") -> None:
+        if path not in self.PATHS:
+            raise ValueError(f"path must be one of {self.PATHS}, got {path!r}")
         self.params = params or TrackerParams(preset="v2")
+        self.path = path
         self._shape: tuple[int, int] | None = None
+        self._bufs: tuple[np.ndarray, ...] | None = None
+
+    def active_path(self) -> str:
+        """The path :meth:`update` runs now: "numpy" or "numba"."""
+        if self.path == "numpy":
+            return "numpy"
+        if _numba_ready():
+            return "numba"
+        if self.path == "numba":
+            raise RuntimeError("path='numba' but numba is not installed or failed its self-check")
+        return "numpy"
 
     # ------------------------------------------------------------------ helpers
     def decimation(self, w: float, h: float) -> int:
@@ -188,24 +297,36 @@ class FloatTrackerV2:
         """Bins computed around the windows the frame's mean shift visits (same values)."""
         return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8)
 
-    def _track(self, bins: np.ndarray, start: tuple[float, float], hx: float, hy: float,
-               max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
-        """Mean shift from ``start`` (decimated coordinates): centre, pass at the centre, iterations."""
+    def _window_pass(self, src: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
+                     inner2: float) -> PassV2:
+        """:func:`window_pass` on bins (numpy path) or by the numba kernel on a decimated frame."""
         p = self.params
-        height, width = bins.shape
+        if isinstance(src, np.ndarray) and src.ndim == 3:
+            return window_pass_numba(src, p.colour_bits, self._qb, self._t, c, hx, hy, inner2, p.kernel,
+                                     self._bufs)
+        return window_pass(src, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+
+    def _track(self, bins: np.ndarray | LazyBins, start: tuple[float, float], hx: float, hy: float,
+               max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
+        """Mean shift from ``start`` (decimated coordinates): centre, pass at the centre, iterations.
+
+        ``bins``: the decimated image's bins, or (numba path) the decimated frame itself.
+        """
+        p = self.params
+        height, width = bins.shape[:2]
         inner2 = 1.0 / (1.0 + p.pad) ** 2
 
         def clamp(c: tuple[float, float]) -> tuple[float, float]:
             return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
 
         c0 = clamp(start)
-        p0 = window_pass(bins, p.n_colour_bins, self._qb, self._t, c0, hx, hy, inner2, p.kernel)
+        p0 = self._window_pass(bins, c0, hx, hy, inner2)
         it = 0
         for it in range(1, max_iter + 1):
             if p0.sw <= 0:
                 break
             c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
-            p1 = window_pass(bins, p.n_colour_bins, self._qb, self._t, c1, hx, hy, inner2, p.kernel)
+            p1 = self._window_pass(bins, c1, hx, hy, inner2)
             if p1.rho < p0.rho:
                 break
             s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
@@ -225,6 +346,8 @@ class FloatTrackerV2:
         height, width = frame.shape[:2]
         box, clipped = clip_box(Box.of(box), width, height)
         p = self.params
+        self.active_path()  # numba: compile / self-check here, not in update()
+        self._bufs = None
         self._shape = (height, width)
         cx, cy = box_centre_index(box)
         self._size = self._size0 = (box.w, box.h)
@@ -254,9 +377,14 @@ class FloatTrackerV2:
         w, h = self._size
         # lost: the whole search runs at twice the decimation (a region 2x wider in the same memory)
         d = self.decimation(w, h) * (2 if self._lost else 1)
-        bins = self._lazy_bins(frame, d, w, h)
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
+        if self.active_path() == "numba":
+            bins: np.ndarray | LazyBins = frame[::d, ::d]  # the kernel bins the pixels it visits
+            if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_colour_bins):
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_colour_bins)  # room to grow
+        else:
+            bins = self._lazy_bins(frame, d, w, h)
         start = (self._centre[0] / d, self._centre[1] / d)
         # lost: every start point (this one included) runs search_iter iterations
         c, ps, it = self._track(bins, start, hx, hy, p.search_iter if self._lost else p.max_iter)
@@ -301,3 +429,53 @@ class FloatTrackerV2:
                            iter_c=it, iter_e=0, status=status, confidence=conf,
                            extra={"decimation": d, "share": ps.share, "spread": ps.spread,
                                   "searched": searched})
+
+
+_NUMBA_OK: bool | None = None
+
+
+def _numba_ready() -> bool:
+    """Compile (or load) the v2 numba kernel and check it against numpy; False: use numpy.
+
+    Needs float_model's kernels to pass their own self-check (the pairwise sums
+    and the scan are theirs); MSTRACK_NUMBA=0 in the environment skips numba.
+    """
+    global _NUMBA_OK
+    if _NUMBA_OK is None:
+        _NUMBA_OK = False
+        if _fm._numba_ready():
+            try:
+                _NUMBA_OK = _numba_self_check()
+            except Exception as exc:  # noqa: BLE001 - any failure means: use numpy
+                warnings.warn(f"mstrack: numba v2 kernel disabled ({exc!r}); using numpy", RuntimeWarning)
+            else:
+                if not _NUMBA_OK:
+                    warnings.warn("mstrack: numba v2 kernel disagrees with numpy here; using numpy",
+                                  RuntimeWarning)
+    return _NUMBA_OK
+
+
+def _numba_self_check() -> bool:
+    """window_pass_numba == window_pass on random frames: decimated views, both kernels, windows
+    across the frame borders, tiny and empty windows, zeros in q."""
+    rng = np.random.default_rng(0)
+    frame = np.ascontiguousarray(rng.integers(0, 256, (45, 61, 3), dtype=np.uint8))
+    inner2 = 1.0 / 1.25 ** 2
+    for bits in (2, 3):
+        nb = 1 << (3 * bits)
+        q = rng.random(nb)
+        q[rng.random(nb) < 0.3] = 0.0
+        q /= q.sum()
+        t = (rng.random(nb) < 0.5).astype(np.float64)
+        for d in (1, 2):
+            src = frame[::d, ::d]
+            bins = colour_bins(src, bits)
+            height, width = bins.shape
+            for c, hx, hy in (((width / 2.0 + 0.3, height / 2.0 - 0.2), 9.4, 7.1), ((0.0, 0.0), 12.5, 5.0),
+                              ((width - 1.0, height - 1.0), 3.3, 20.25), ((5.5, 3.5), 0.3, 0.4),
+                              ((7.25, 9.75), 80.0, 60.0)):
+                for kernel in ("flat", "epanechnikov"):
+                    if window_pass_numba(src, bits, q, t, c, hx, hy, inner2, kernel) != \
+                            window_pass(bins, nb, q, t, c, hx, hy, inner2, kernel):
+                        return False
+    return True

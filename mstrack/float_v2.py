@@ -31,7 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import float_model as _fm
-from .float_model import _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3, check_frame, clip_box, colour_bins
+from .float_model import (_SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3, check_frame, clip_box,
+                          colour_bins)
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -147,41 +148,113 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
 # test and everything per frame stay in Python (the same code for both paths).
 
 @_jit
-def _nb_window_pass(frame, bits, bins, cx, cy, hx, hy, width, height, inner2, flat, q, t,
-                    ibuf, fbuf, ax, cnt, dbuf):
-    """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
-    the decimated frame): (n, rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
+def _nb_box(cx, cy, hx, hy, width, height):
+    """The window's bounding box x0, x1, y0, y1 (inclusive) in the image, as :func:`window_pixels`."""
+    return (max(0, math.ceil(cx - hx)), min(width - 1, math.floor(cx + hx)),
+            max(0, math.ceil(cy - hy)), min(height - 1, math.floor(cy + hy)))
+
+
+@_jit
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, nobins):
+    """The mean-shift part of :func:`window_pass` at (cx, cy): (rho, sw, swx, swy).
+
+    Pixels, bins and histogram by float_model's ``_nb_scan`` on the colour bins of
+    ``frame``'s pixels; the window's pixels stay in ``ibuf`` (B, X, Y)."""
     nb = q.shape[0]
-    B, X, Y = ibuf[0], ibuf[1], ibuf[2]
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
-    cnt = cnt[:, :nb]
-    x0 = max(0, math.ceil(cx - hx))
-    x1 = min(width - 1, math.floor(cx + hx))
-    y0 = max(0, math.ceil(cy - hy))
-    y1 = min(height - 1, math.floor(cy + hy))
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
         h[:] = 0.0
         n = 0
     else:
-        n = _nb_scan(cx, cy, hx, hy, width, height, frame, bits, bins, 0, 0, flat, B, X, Y, h, ax, cnt)
+        n = _nb_scan(cx, cy, hx, hy, width, height, frame, bits, nobins, 0, 0, flat, ibuf[0], ibuf[1], ibuf[2],
+                     h, ax, cnt[:, :nb])
     rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
     for u in range(nb):
         wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
-    sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
-    nt = n_in = nt_in = 0
-    for i in range(n):
-        ty = (Y[i] - cy) / hy
-        d2 = ax[X[i] - x0] + ty * ty  # ax: _nb_scan's column terms of this window
-        tv = t[B[i]]
-        dbuf[i] = tv * d2
-        if tv != 0.0:
-            nt += 1
-        if d2 < inner2:
-            n_in += 1
-            if tv != 0.0:
-                nt_in += 1
-    st2 = _nb_sum(dbuf, n)
-    return n, rho, sw, swx, swy, float(nt), st2, n_in, nt_in
+    sw, swx, swy = _nb_sum3(wb, ibuf[0], ibuf[1], ibuf[2], n)
+    return rho, sw, swx, swy
+
+
+@_jit
+def _nb_stats(frame, bits, cx, cy, hx, hy, width, height, t, inner2, ax, td):
+    """The target statistics of :func:`window_pass` at (cx, cy): (nt, st2, n_in, nt_in).
+
+    The window's pixels in row-major order as ``_nb_scan`` finds them (d2 = ax + by;
+    each row's inside pixels one run), td = t[b] d2 per pixel, st2 its pairwise sum."""
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
+    if x1 < x0 or y1 < y0:
+        return 0.0, 0.0, 0, 0
+    nx = x1 - x0 + 1
+    for j in range(nx):
+        v = (x0 + j - cx) / hx
+        ax[j] = v * v
+    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    n = nt = n_in = nt_in = 0
+    for y in range(y0, y1 + 1):
+        v = (y - cy) / hy
+        by = v * v
+        px = frame[y, x0:x1 + 1]
+        for j in range(nx):
+            d2 = ax[j] + by
+            if d2 < 1.0:
+                b = (((np.uint32(px[j, 2]) >> s) << s2) | ((np.uint32(px[j, 1]) >> s) << s1)
+                     | (np.uint32(px[j, 0]) >> s))
+                tv = t[b]
+                td[n] = tv * d2
+                n += 1
+                if d2 < inner2:
+                    n_in += 1
+                    if tv != 0.0:
+                        nt_in += 1
+                if tv != 0.0:
+                    nt += 1
+    return float(nt), _nb_sum(td, n), n_in, nt_in
+
+
+@_jit
+def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
+                    ibuf, fbuf, ax, cnt, td, nobins):
+    """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
+    the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
+    rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, nobins)
+    nt, st2, n_in, nt_in = _nb_stats(frame, bits, cx, cy, hx, hy, width, height, t, inner2, ax, td)
+    return rho, sw, swx, swy, nt, st2, n_in, nt_in
+
+
+@_jit
+def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, t, max_iter, eps2,
+              ibuf, fbuf, ax, cnt, td, nobins):
+    """FloatTrackerV2._track's mean shift from (sx, sy) after ``it0`` iterations.
+
+    Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
+    iterations, ``pass`` the :func:`_nb_window_pass` tuple at c0 (the target
+    statistics of that window only); 1 the shift test c0 -> c1 is left to Python
+    (|s2 - eps2| tiny: Python's ``dx ** 2`` is libm's pow, which may round
+    differently from dx * dx), ``pass`` then holds rho at c0 and c1 only.
+    """
+    c0x = min(max(sx, 0.0), width - 1.0)
+    c0y = min(max(sy, 0.0), height - 1.0)
+    rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, ibuf, fbuf, ax,
+                                     cnt, nobins)
+    it = it0
+    for it in range(it0 + 1, max_iter + 1):
+        if sw0 <= 0:
+            break
+        c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
+        c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
+        rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, ibuf, fbuf,
+                                         ax, cnt, nobins)
+        if rho1 < rho0:
+            break
+        s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
+        if abs(s2 - eps2) <= _SHIFT2_BAND * eps2:
+            return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0)
+        c0x, c0y, rho0, sw0, swx0, swy0 = c1x, c1y, rho1, sw1, swx1, swy1
+        if s2 < eps2:
+            break
+    nt, st2, n_in, nt_in = _nb_stats(frame, bits, c0x, c0y, hx, hy, width, height, t, inner2, ax, td)
+    return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in)
 
 
 def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
@@ -196,12 +269,12 @@ def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
             np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
 
 
+_NO_BINS = np.zeros((1, 1), np.int32)  # _nb_scan's bins argument (unused: bins from the pixels)
+
+
 def _buffers_fit(bufs: tuple[np.ndarray, ...], hx: float, hy: float, n_bins: int) -> bool:
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
     return bufs[2].shape[0] >= box_w and bufs[0].shape[1] >= box_w * box_h and bufs[1].shape[1] >= n_bins
-
-
-_NO_BINS = np.zeros((1, 1), np.int32)
 
 
 def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray, c: tuple[float, float],
@@ -214,10 +287,8 @@ def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray
     height, width = frame.shape[:2]
     if bufs is None or not _buffers_fit(bufs, hx, hy, q.shape[0]):
         bufs = _nb_buffers_v2(hx, hy, q.shape[0])
-    _, rho, sw, swx, swy, nt, st2, n_in, nt_in = _nb_window_pass(
-        frame, bits, _NO_BINS, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
-        kernel == "flat", q, t, *bufs)
-    return PassV2(rho=rho, sw=sw, swx=swx, swy=swy, nt=nt, st2=st2, n_in=n_in, nt_in=nt_in)
+    return PassV2(*_nb_window_pass(frame, bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height,
+                                   float(inner2), kernel == "flat", q, t, *bufs, _NO_BINS))
 
 
 class LazyBins:
@@ -270,11 +341,14 @@ class FloatTrackerV2:
         self.path = path
         self._shape: tuple[int, int] | None = None
         self._bufs: tuple[np.ndarray, ...] | None = None
+        self._use_numba = False
 
     def active_path(self) -> str:
         """The path :meth:`update` runs now: "numpy" or "numba"."""
         if self.path == "numpy":
             return "numpy"
+        if self._use_numba:  # (the self-check's own run)
+            return "numba"
         if _numba_ready():
             return "numba"
         if self.path == "numba":
@@ -297,36 +371,33 @@ class FloatTrackerV2:
         """Bins computed around the windows the frame's mean shift visits (same values)."""
         return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8)
 
-    def _window_pass(self, src: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
-                     inner2: float) -> PassV2:
-        """:func:`window_pass` on bins (numpy path) or by the numba kernel on a decimated frame."""
-        p = self.params
-        if isinstance(src, np.ndarray) and src.ndim == 3:
-            return window_pass_numba(src, p.colour_bits, self._qb, self._t, c, hx, hy, inner2, p.kernel,
-                                     self._bufs)
-        return window_pass(src, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
-
     def _track(self, bins: np.ndarray | LazyBins, start: tuple[float, float], hx: float, hy: float,
                max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
         """Mean shift from ``start`` (decimated coordinates): centre, pass at the centre, iterations.
 
-        ``bins``: the decimated image's bins, or (numba path) the decimated frame itself.
+        ``bins``: the decimated image's bins (numpy path), or the decimated frame
+        itself (numba path, :meth:`_track_numba`: the same loop in the kernel).
         """
         p = self.params
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            return self._track_numba(bins, start, hx, hy, max_iter)
         height, width = bins.shape[:2]
         inner2 = 1.0 / (1.0 + p.pad) ** 2
 
         def clamp(c: tuple[float, float]) -> tuple[float, float]:
             return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
 
+        def window(c: tuple[float, float]) -> PassV2:
+            return window_pass(bins, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+
         c0 = clamp(start)
-        p0 = self._window_pass(bins, c0, hx, hy, inner2)
+        p0 = window(c0)
         it = 0
         for it in range(1, max_iter + 1):
             if p0.sw <= 0:
                 break
             c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
-            p1 = self._window_pass(bins, c1, hx, hy, inner2)
+            p1 = window(c1)
             if p1.rho < p0.rho:
                 break
             s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
@@ -334,6 +405,28 @@ class FloatTrackerV2:
             if s2 < p.eps2:
                 break
         return c0, p0, it
+
+    def _track_numba(self, frame: np.ndarray, start: tuple[float, float], hx: float, hy: float,
+                     max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
+        """:meth:`_track` by :func:`_nb_track` on the decimated frame (same results bit for bit)."""
+        p = self.params
+        height, width = frame.shape[:2]
+        inner2 = 1.0 / (1.0 + p.pad) ** 2
+        flat = p.kernel == "flat"
+        eps2 = float(p.eps2)
+        sx, sy, it0 = float(start[0]), float(start[1]), 0
+        while True:
+            code, it, c0x, c0y, c1x, c1y, r = _nb_track(frame, p.colour_bits, sx, sy, it0, hx, hy, width, height,
+                                                        inner2, flat, self._qb, self._t, int(max_iter), eps2,
+                                                        *self._bufs, _NO_BINS)
+            if code == 0:
+                return (c0x, c0y), PassV2(*r), it
+            # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
+            if (c1x - c0x) ** 2 + (c1y - c0y) ** 2 < p.eps2:
+                c = (c1x, c1y)
+                return c, window_pass_numba(frame, p.colour_bits, self._qb, self._t, c, hx, hy, inner2,
+                                            p.kernel, self._bufs), it
+            sx, sy, it0 = c1x, c1y, it  # go on from c1 (its pass is recomputed: the same numbers)
 
     def _confidence(self, ps: PassV2) -> float:
         cr = min(1.0, ps.rho / self._rho_ref) if self._rho_ref > 0 else 0.0
@@ -478,4 +571,19 @@ def _numba_self_check() -> bool:
                     if window_pass_numba(src, bits, q, t, c, hx, hy, inner2, kernel) != \
                             window_pass(bins, nb, q, t, c, hx, hy, inner2, kernel):
                         return False
+    # the whole tracker (compiles _nb_track): a block moving on noise, both kernels, lost and found
+    frames = []
+    for i in range(6):
+        f = rng.integers(0, 256, (48, 64, 3), dtype=np.uint8)
+        if i != 3:  # frame 3: the target is gone
+            f[10 + i:26 + i, 12 + 2 * i:30 + 2 * i] = (20, 40, 230)
+        frames.append(f)
+    for kernel in ("flat", "epanechnikov"):
+        runs = []
+        for path in ("numpy", "numba"):
+            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel), path=path)
+            trk._use_numba = path == "numba"  # (the self-check runs inside active_path)
+            runs.append([trk.init(frames[0], (12, 10, 18, 16))] + [trk.update(f) for f in frames[1:]])
+        if runs[0] != runs[1]:
+            return False
     return True

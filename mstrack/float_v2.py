@@ -155,11 +155,12 @@ def _nb_box(cx, cy, hx, hy, width, height):
 
 
 @_jit
-def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, nobins):
-    """The mean-shift part of :func:`window_pass` at (cx, cy): (rho, sw, swx, swy).
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, nobins):
+    """The mean-shift part of :func:`window_pass` at (cx, cy): (n, rho, sw, swx, swy).
 
     Pixels, bins and histogram by float_model's ``_nb_scan`` on the colour bins of
-    ``frame``'s pixels; the window's pixels stay in ``ibuf`` (B, X, Y)."""
+    ``frame``'s pixels; the window's pixels stay in B, X, Y (n of them) and its
+    column terms of d2 in ``ax``, for :func:`_nb_stats`."""
     nb = q.shape[0]
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
@@ -167,48 +168,37 @@ def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax
         h[:] = 0.0
         n = 0
     else:
-        n = _nb_scan(cx, cy, hx, hy, width, height, frame, bits, nobins, 0, 0, flat, ibuf[0], ibuf[1], ibuf[2],
-                     h, ax, cnt[:, :nb])
+        n = _nb_scan(cx, cy, hx, hy, width, height, frame, bits, nobins, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
     rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
     for u in range(nb):
         wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
-    sw, swx, swy = _nb_sum3(wb, ibuf[0], ibuf[1], ibuf[2], n)
-    return rho, sw, swx, swy
+    sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+    return n, rho, sw, swx, swy
 
 
 @_jit
-def _nb_stats(frame, bits, cx, cy, hx, hy, width, height, t, inner2, ax, td):
-    """The target statistics of :func:`window_pass` at (cx, cy): (nt, st2, n_in, nt_in).
+def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
+    """The target statistics of :func:`window_pass` at (cx, cy) from :func:`_nb_pass`'s pixels
+    (B, X, Y, ax of that window): (nt, st2, n_in, nt_in).
 
-    The window's pixels in row-major order as ``_nb_scan`` finds them (d2 = ax + by;
-    each row's inside pixels one run), td = t[b] d2 per pixel, st2 its pairwise sum."""
-    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
-    if x1 < x0 or y1 < y0:
-        return 0.0, 0.0, 0, 0
-    nx = x1 - x0 + 1
-    for j in range(nx):
-        v = (x0 + j - cx) / hx
-        ax[j] = v * v
-    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
-    n = nt = n_in = nt_in = 0
-    for y in range(y0, y1 + 1):
-        v = (y - cy) / hy
-        by = v * v
-        px = frame[y, x0:x1 + 1]
-        for j in range(nx):
-            d2 = ax[j] + by
-            if d2 < 1.0:
-                b = (((np.uint32(px[j, 2]) >> s) << s2) | ((np.uint32(px[j, 1]) >> s) << s1)
-                     | (np.uint32(px[j, 0]) >> s))
-                tv = t[b]
-                td[n] = tv * d2
-                n += 1
-                if d2 < inner2:
-                    n_in += 1
-                    if tv != 0.0:
-                        nt_in += 1
-                if tv != 0.0:
-                    nt += 1
+    d2 = ax + by as the scan found the pixels (by once per row: the pixels are in
+    row-major order); td = t[b] d2 per pixel, st2 its pairwise sum."""
+    x0 = max(0, math.ceil(cx - hx))
+    nt = n_in = nt_in = 0
+    y, by = -1, 0.0
+    for i in range(n):
+        if Y[i] != y:
+            y = Y[i]
+            v = (y - cy) / hy
+            by = v * v
+        d2 = ax[X[i] - x0] + by
+        tv = t[B[i]]
+        td[i] = tv * d2
+        inner = d2 < inner2
+        n_in += inner
+        if tv != 0.0:
+            nt += 1
+            nt_in += inner
     return float(nt), _nb_sum(td, n), n_in, nt_in
 
 
@@ -217,8 +207,9 @@ def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q,
                     ibuf, fbuf, ax, cnt, td, nobins):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
     the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
-    rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, nobins)
-    nt, st2, n_in, nt_in = _nb_stats(frame, bits, cx, cy, hx, hy, width, height, t, inner2, ax, td)
+    n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
+                                    ibuf[2], fbuf, ax[0], cnt, nobins)
+    nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
     return rho, sw, swx, swy, nt, st2, n_in, nt_in
 
 
@@ -229,43 +220,47 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
 
     Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
     iterations, ``pass`` the :func:`_nb_window_pass` tuple at c0 (the target
-    statistics of that window only); 1 the shift test c0 -> c1 is left to Python
-    (|s2 - eps2| tiny: Python's ``dx ** 2`` is libm's pow, which may round
-    differently from dx * dx), ``pass`` then holds rho at c0 and c1 only.
+    statistics of that window only, from its pixels kept in the other half of the
+    buffers); 1 the shift test c0 -> c1 is left to Python (|s2 - eps2| tiny:
+    Python's ``dx ** 2`` is libm's pow, which may round differently from dx * dx),
+    ``pass`` then holds rho at c0 and c1 only.
     """
+    B0, X0, Y0, B1, X1, Y1, ax0, ax1 = ibuf[0], ibuf[1], ibuf[2], ibuf[3], ibuf[4], ibuf[5], ax[0], ax[1]
     c0x = min(max(sx, 0.0), width - 1.0)
     c0y = min(max(sy, 0.0), height - 1.0)
-    rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, ibuf, fbuf, ax,
-                                     cnt, nobins)
+    n0, rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, B0, X0, Y0, fbuf,
+                                         ax0, cnt, nobins)
     it = it0
     for it in range(it0 + 1, max_iter + 1):
         if sw0 <= 0:
             break
         c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
         c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
-        rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, ibuf, fbuf,
-                                         ax, cnt, nobins)
+        n1, rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, B1, X1, Y1,
+                                             fbuf, ax1, cnt, nobins)
         if rho1 < rho0:
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
         if abs(s2 - eps2) <= _SHIFT2_BAND * eps2:
             return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0)
-        c0x, c0y, rho0, sw0, swx0, swy0 = c1x, c1y, rho1, sw1, swx1, swy1
+        c0x, c0y, n0, rho0, sw0, swx0, swy0 = c1x, c1y, n1, rho1, sw1, swx1, swy1
+        B0, X0, Y0, ax0, B1, X1, Y1, ax1 = B1, X1, Y1, ax1, B0, X0, Y0, ax0
         if s2 < eps2:
             break
-    nt, st2, n_in, nt_in = _nb_stats(frame, bits, c0x, c0y, hx, hy, width, height, t, inner2, ax, td)
+    nt, st2, n_in, nt_in = _nb_stats(n0, B0, X0, Y0, ax0, c0x, c0y, hx, hy, t, inner2, td)
     return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in)
 
 
 def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
-    """Work buffers of :func:`_nb_window_pass` for windows of half-sizes up to hx, hy.
+    """Work buffers of :func:`_nb_track` for windows of half-sizes up to hx, hy.
 
-    int32 bins and coordinates (3, box px); float64 histogram, normalised
-    histogram, weights (3, bins); d2 column terms (box width); int32 counts
-    (4 interleaved tables, 1 beyond 2**16 bins); float64 t d2 (box px).
+    int32 bins and coordinates of two windows (6, box px); float64 histogram,
+    normalised histogram, weights (3, bins); d2 column terms of two windows
+    (2, box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins);
+    float64 t d2 (box px).
     """
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
-    return (np.empty((3, box_w * box_h), np.int32), np.empty((3, n_bins)), np.empty(box_w),
+    return (np.empty((6, box_w * box_h), np.int32), np.empty((3, n_bins)), np.empty((2, box_w)),
             np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
 
 
@@ -274,7 +269,7 @@ _NO_BINS = np.zeros((1, 1), np.int32)  # _nb_scan's bins argument (unused: bins 
 
 def _buffers_fit(bufs: tuple[np.ndarray, ...], hx: float, hy: float, n_bins: int) -> bool:
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
-    return bufs[2].shape[0] >= box_w and bufs[0].shape[1] >= box_w * box_h and bufs[1].shape[1] >= n_bins
+    return bufs[2].shape[1] >= box_w and bufs[0].shape[1] >= box_w * box_h and bufs[1].shape[1] >= n_bins
 
 
 def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray, c: tuple[float, float],

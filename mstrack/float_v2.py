@@ -155,12 +155,39 @@ def _nb_box(cx, cy, hx, hy, width, height):
 
 
 @_jit
-def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, nobins):
+def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1):
+    """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once.
+
+    rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
+    to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
+    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    for y in range(y0, y1 + 1):
+        lo, hi = rows[0, y], rows[1, y]
+        if lo <= x0 and x1 < hi:
+            continue
+        if lo >= hi:  # nothing yet in this row
+            a, b = x0, x1 + 1
+            lo, hi = x0, x0
+        else:
+            a, b = min(x0, lo), max(x1 + 1, hi)
+        px, row = frame[y], cache[y]
+        for x in range(a, lo):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        for x in range(hi, b):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        rows[0, y], rows[1, y] = a, b
+
+
+@_jit
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, cache, rows):
     """The mean-shift part of :func:`window_pass` at (cx, cy): (n, rho, sw, swx, swy).
 
-    Pixels, bins and histogram by float_model's ``_nb_scan`` on the colour bins of
-    ``frame``'s pixels; the window's pixels stay in B, X, Y (n of them) and its
-    column terms of d2 in ``ax``, for :func:`_nb_stats`."""
+    Pixels and histogram by float_model's ``_nb_scan`` on the colour bins of
+    ``frame``'s pixels (:func:`_nb_bins`, computed once per frame in ``cache``);
+    the window's pixels stay in B, X, Y (n of them) and its column terms of d2 in
+    ``ax``, for :func:`_nb_stats`."""
     nb = q.shape[0]
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
@@ -168,7 +195,8 @@ def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf,
         h[:] = 0.0
         n = 0
     else:
-        n = _nb_scan(cx, cy, hx, hy, width, height, frame, bits, nobins, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
+        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1)
+        n = _nb_scan(cx, cy, hx, hy, width, height, frame, 0, cache, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
     rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
     for u in range(nb):
         wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
@@ -204,18 +232,18 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
 
 @_jit
 def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
-                    ibuf, fbuf, ax, cnt, td, nobins):
+                    ibuf, fbuf, ax, cnt, td, cache, rows):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
     the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
     n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
-                                    ibuf[2], fbuf, ax[0], cnt, nobins)
+                                    ibuf[2], fbuf, ax[0], cnt, cache, rows)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
     return rho, sw, swx, swy, nt, st2, n_in, nt_in
 
 
 @_jit
 def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, t, max_iter, eps2,
-              ibuf, fbuf, ax, cnt, td, nobins):
+              ibuf, fbuf, ax, cnt, td, cache, rows):
     """FloatTrackerV2._track's mean shift from (sx, sy) after ``it0`` iterations.
 
     Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
@@ -229,7 +257,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
     c0x = min(max(sx, 0.0), width - 1.0)
     c0y = min(max(sy, 0.0), height - 1.0)
     n0, rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, B0, X0, Y0, fbuf,
-                                         ax0, cnt, nobins)
+                                         ax0, cnt, cache, rows)
     it = it0
     for it in range(it0 + 1, max_iter + 1):
         if sw0 <= 0:
@@ -237,7 +265,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
         c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
         c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
         n1, rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, B1, X1, Y1,
-                                             fbuf, ax1, cnt, nobins)
+                                             fbuf, ax1, cnt, cache, rows)
         if rho1 < rho0:
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
@@ -264,7 +292,10 @@ def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
             np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
 
 
-_NO_BINS = np.zeros((1, 1), np.int32)  # _nb_scan's bins argument (unused: bins from the pixels)
+def _bins_cache(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """An empty bins cache of :func:`_nb_bins` for a height x width image: (bins, rows)."""
+    rows = np.zeros((2, height), np.int32)
+    return np.empty((height, width), np.int32), rows
 
 
 def _buffers_fit(bufs: tuple[np.ndarray, ...], hx: float, hy: float, n_bins: int) -> bool:
@@ -283,7 +314,7 @@ def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray
     if bufs is None or not _buffers_fit(bufs, hx, hy, q.shape[0]):
         bufs = _nb_buffers_v2(hx, hy, q.shape[0])
     return PassV2(*_nb_window_pass(frame, bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height,
-                                   float(inner2), kernel == "flat", q, t, *bufs, _NO_BINS))
+                                   float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width)))
 
 
 class LazyBins:
@@ -336,6 +367,7 @@ class FloatTrackerV2:
         self.path = path
         self._shape: tuple[int, int] | None = None
         self._bufs: tuple[np.ndarray, ...] | None = None
+        self._cache: tuple[np.ndarray, np.ndarray] | None = None
         self._use_numba = False
 
     def active_path(self) -> str:
@@ -413,7 +445,7 @@ class FloatTrackerV2:
         while True:
             code, it, c0x, c0y, c1x, c1y, r = _nb_track(frame, p.colour_bits, sx, sy, it0, hx, hy, width, height,
                                                         inner2, flat, self._qb, self._t, int(max_iter), eps2,
-                                                        *self._bufs, _NO_BINS)
+                                                        *self._bufs, *self._cache)
             if code == 0:
                 return (c0x, c0y), PassV2(*r), it
             # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
@@ -435,7 +467,7 @@ class FloatTrackerV2:
         box, clipped = clip_box(Box.of(box), width, height)
         p = self.params
         self.active_path()  # numba: compile / self-check here, not in update()
-        self._bufs = None
+        self._bufs = self._cache = None
         self._shape = (height, width)
         cx, cy = box_centre_index(box)
         self._size = self._size0 = (box.w, box.h)
@@ -471,6 +503,10 @@ class FloatTrackerV2:
             bins: np.ndarray | LazyBins = frame[::d, ::d]  # the kernel bins the pixels it visits
             if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_colour_bins):
                 self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_colour_bins)  # room to grow
+            if self._cache is None:
+                self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
+            else:
+                self._cache[1][:] = 0  # a new frame: no bins yet
         else:
             bins = self._lazy_bins(frame, d, w, h)
         start = (self._centre[0] / d, self._centre[1] / d)

@@ -215,6 +215,7 @@ def test_shift_test_near_eps2_is_decided_in_python(monkeypatch):
 
     monkeypatch.setattr(v2, "_nb_track", spy)
     trk._bufs = v2._nb_buffers_v2(hx, hy, 512)
+    trk._cache = v2._bins_cache(*frames[1].shape[:2])
     for eps2 in (s2, float(np.nextafter(s2, np.inf))):  # go on, stop at c1
         trk.params = TrackerParams(preset="v2", eps2=eps2)
         want = trk._track(bins, start, hx, hy, 10)

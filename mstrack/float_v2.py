@@ -136,16 +136,18 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
                   nt_in=int(tp[inner].sum()))
 
 
-# ----------------------------------------------------------------------------- numba kernel
-# window_pass compiled with numba (float_model's "numba kernels" helpers): the same IEEE double
-# operations in the same order, so every pass, and so every result, is bit-identical to numpy.
-# The window's pixels are found row by row as in window_pixels (d2 = ax + by, ax = ((x - cx) / hx)
-# * ((x - cx) / hx), numpy's ``** 2`` on a float64 array, row-major order = np.nonzero's); the bins
-# come from the (decimated) frame's pixels in the scan (_nb_scan, the same integers as
-# colour_bins); the histogram is bincount's sequential sum; p.sum(), sqrt(p q).sum(), w.sum(),
-# (w x).sum(), (w y).sum() and (t d2).sum() are numpy's pairwise sums (_nb_sum, _nb_sum3); nt,
-# n_in and nt_in are counts (t is 0 / 1), exact in any order.  The mean-shift loop, its shift
-# test and everything per frame stay in Python (the same code for both paths).
+# ----------------------------------------------------------------------------- numba kernels
+# FloatTrackerV2._track (mean shift + window_pass) compiled with numba, with float_model's
+# "numba kernels" helpers: the same IEEE double operations in the same order, so every pass, and
+# so every result, is bit-identical to numpy.  The window's pixels are found row by row as in
+# window_pixels (d2 = ax + by, ax = ((x - cx) / hx) * ((x - cx) / hx) as numpy's ``** 2`` on a
+# float64 array, row-major order = np.nonzero's) by float_model's _nb_scan, on colour bins
+# computed once per frame from the (decimated) frame's pixels (_nb_bins: colour_bins' integers);
+# the histogram is bincount's sequential sum; p.sum(), sqrt(p q).sum(), w.sum(), (w x).sum(),
+# (w y).sum() and (t d2).sum() are numpy's pairwise sums (_nb_sum, _nb_sum3); nt, n_in, nt_in are
+# counts (t is 0 / 1), exact in any order, computed for the final window only.  The one Python
+# float operation of the loop, s2 = dx ** 2 + dy ** 2 (libm pow), is left to Python when s2 is
+# within rounding of eps2.  init() and everything per frame run the same Python for both paths.
 
 @_jit
 def _nb_box(cx, cy, hx, hy, width, height):
@@ -352,10 +354,12 @@ class LazyBins:
 class FloatTrackerV2:
     """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2").
 
-    ``path`` picks how the window passes of :meth:`update` are computed, with the
-    same results bit for bit: "numpy" (:func:`window_pass` on :class:`LazyBins`),
-    "numba" (:func:`window_pass_numba`), or "auto": numba when it is installed and
-    passes its self-check (:func:`_numba_ready`; MSTRACK_NUMBA=0 disables it), else numpy.
+    ``path`` picks how the mean shift of :meth:`update` is computed, with the same
+    results bit for bit: "numpy" (:meth:`_track`, :func:`window_pass` on
+    :class:`LazyBins`), "numba" (:meth:`_track_numba`, one :func:`_nb_track` call
+    per start point), or "auto": numba when it is installed and passes its
+    self-check (:func:`_numba_ready`; MSTRACK_NUMBA=0 disables it), else numpy.
+    :meth:`init` runs numpy in both.
     """
 
     PATHS = ("auto", "numba", "numpy")
@@ -580,8 +584,8 @@ def _numba_ready() -> bool:
 
 
 def _numba_self_check() -> bool:
-    """window_pass_numba == window_pass on random frames: decimated views, both kernels, windows
-    across the frame borders, tiny and empty windows, zeros in q."""
+    """window_pass_numba == window_pass on random frames (decimated views, both kernels, windows
+    across the frame borders, tiny and empty windows, zeros in q), and the tracker both ways."""
     rng = np.random.default_rng(0)
     frame = np.ascontiguousarray(rng.integers(0, 256, (45, 61, 3), dtype=np.uint8))
     inner2 = 1.0 / 1.25 ** 2

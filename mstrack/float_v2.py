@@ -211,24 +211,30 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
     """The target statistics of :func:`window_pass` at (cx, cy) from :func:`_nb_pass`'s pixels
     (B, X, Y, ax of that window): (nt, st2, n_in, nt_in).
 
-    d2 = ax + by as the scan found the pixels (by once per row: the pixels are in
-    row-major order); td = t[b] d2 per pixel, st2 its pairwise sum."""
+    d2 = ax + by as the scan found the pixels (row-major, each row's pixels one run
+    of consecutive columns); td = t[b] d2 per pixel, st2 its pairwise sum."""
     x0 = max(0, math.ceil(cx - hx))
     nt = n_in = nt_in = 0
-    y, by = -1, 0.0
-    for i in range(n):
-        if Y[i] != y:
-            y = Y[i]
-            v = (y - cy) / hy
-            by = v * v
-        d2 = ax[X[i] - x0] + by
-        tv = t[B[i]]
-        td[i] = tv * d2
-        inner = d2 < inner2
-        n_in += inner
-        if tv != 0.0:
-            nt += 1
-            nt_in += inner
+    i = 0
+    while i < n:
+        y = Y[i]
+        v = (y - cy) / hy
+        by = v * v
+        j = i + 1
+        while j < n and Y[j] == y:
+            j += 1
+        xa = X[i] - x0
+        axr, b, tdr = ax[xa:xa + j - i], B[i:j], td[i:j]
+        for k in range(j - i):
+            d2 = axr[k] + by
+            tv = t[b[k]]
+            tdr[k] = tv * d2
+            inner = d2 < inner2
+            target = tv != 0.0
+            n_in += inner  # (no branches: t is as often 0 as 1)
+            nt += target
+            nt_in += inner & target
+        i = j
     return float(nt), _nb_sum(td, n), n_in, nt_in
 
 

@@ -25,11 +25,14 @@ d2 = ((x - cx) / hx)^2 + ((y - cy) / hy)^2 < 1.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from .float_model import check_frame, clip_box, colour_bins
+from . import float_model as _fm
+from .float_model import (_SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3, check_frame, clip_box,
+                          colour_bins)
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -133,12 +136,261 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
                   nt_in=int(tp[inner].sum()))
 
 
-class FloatTrackerV2:
-    """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2")."""
+# ----------------------------------------------------------------------------- numba kernels
+# FloatTrackerV2._track (mean shift + window_pass) compiled with numba, with float_model's
+# "numba kernels" helpers: the same IEEE double operations in the same order, so every pass, and
+# so every result, is bit-identical to numpy.  The window's pixels are found row by row as in
+# window_pixels (d2 = ax + by, ax = ((x - cx) / hx) * ((x - cx) / hx) as numpy's ``** 2`` on a
+# float64 array, row-major order = np.nonzero's) by float_model's _nb_scan, on colour bins
+# computed once per frame from the (decimated) frame's pixels (_nb_bins: colour_bins' integers);
+# the histogram is bincount's sequential sum; p.sum(), sqrt(p q).sum(), w.sum(), (w x).sum(),
+# (w y).sum() and (t d2).sum() are numpy's pairwise sums (_nb_sum, _nb_sum3); nt, n_in, nt_in are
+# counts (t is 0 / 1), exact in any order, computed for the final window only.  The one Python
+# float operation of the loop, s2 = dx ** 2 + dy ** 2 (libm pow), is left to Python when s2 is
+# within rounding of eps2.  init() and everything per frame run the same Python for both paths.
 
-    def __init__(self, params: TrackerParams | None = None) -> None:
+@_jit
+def _nb_box(cx, cy, hx, hy, width, height):
+    """The window's bounding box x0, x1, y0, y1 (inclusive) in the image, as :func:`window_pixels`."""
+    return (max(0, math.ceil(cx - hx)), min(width - 1, math.floor(cx + hx)),
+            max(0, math.ceil(cy - hy)), min(height - 1, math.floor(cy + hy)))
+
+
+@_jit
+def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1):
+    """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once.
+
+    rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
+    to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
+    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    for y in range(y0, y1 + 1):
+        lo, hi = rows[0, y], rows[1, y]
+        if lo <= x0 and x1 < hi:
+            continue
+        if lo >= hi:  # nothing yet in this row
+            a, b = x0, x1 + 1
+            lo, hi = x0, x0
+        else:
+            a, b = min(x0, lo), max(x1 + 1, hi)
+        px, row = frame[y], cache[y]
+        for x in range(a, lo):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        for x in range(hi, b):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        rows[0, y], rows[1, y] = a, b
+
+
+@_jit
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, cache, rows):
+    """The mean-shift part of :func:`window_pass` at (cx, cy): (n, rho, sw, swx, swy).
+
+    Pixels and histogram by float_model's ``_nb_scan`` on the colour bins of
+    ``frame``'s pixels (:func:`_nb_bins`, computed once per frame in ``cache``);
+    the window's pixels stay in B, X, Y (n of them) and its column terms of d2 in
+    ``ax``, for :func:`_nb_stats`."""
+    nb = q.shape[0]
+    h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
+    if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
+        h[:] = 0.0
+        n = 0
+    else:
+        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1)
+        n = _nb_scan(cx, cy, hx, hy, width, height, frame, 0, cache, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
+    rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
+    for u in range(nb):
+        wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
+    sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+    return n, rho, sw, swx, swy
+
+
+@_jit
+def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
+    """The target statistics of :func:`window_pass` at (cx, cy) from :func:`_nb_pass`'s pixels
+    (B, X, Y, ax of that window): (nt, st2, n_in, nt_in).
+
+    d2 = ax + by as the scan found the pixels (row-major, each row's pixels one run
+    of consecutive columns); td = t[b] d2 per pixel, st2 its pairwise sum."""
+    x0 = max(0, math.ceil(cx - hx))
+    nt = n_in = nt_in = 0
+    i = 0
+    while i < n:
+        y = Y[i]
+        v = (y - cy) / hy
+        by = v * v
+        j = i + 1
+        while j < n and Y[j] == y:
+            j += 1
+        xa = X[i] - x0
+        axr, b, tdr = ax[xa:xa + j - i], B[i:j], td[i:j]
+        for k in range(j - i):
+            d2 = axr[k] + by
+            tv = t[b[k]]
+            tdr[k] = tv * d2
+            inner = d2 < inner2
+            target = tv != 0.0
+            n_in += inner  # (no branches: t is as often 0 as 1)
+            nt += target
+            nt_in += inner & target
+        i = j
+    return float(nt), _nb_sum(td, n), n_in, nt_in
+
+
+@_jit
+def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
+                    ibuf, fbuf, ax, cnt, td, cache, rows):
+    """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
+    the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
+    n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
+                                    ibuf[2], fbuf, ax[0], cnt, cache, rows)
+    nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
+    return rho, sw, swx, swy, nt, st2, n_in, nt_in
+
+
+@_jit
+def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, t, max_iter, eps2,
+              ibuf, fbuf, ax, cnt, td, cache, rows):
+    """FloatTrackerV2._track's mean shift from (sx, sy) after ``it0`` iterations.
+
+    Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
+    iterations, ``pass`` the :func:`_nb_window_pass` tuple at c0 (the target
+    statistics of that window only, from its pixels kept in the other half of the
+    buffers); 1 the shift test c0 -> c1 is left to Python (|s2 - eps2| tiny:
+    Python's ``dx ** 2`` is libm's pow, which may round differently from dx * dx),
+    ``pass`` then holds rho at c0 and c1 only.
+    """
+    B0, X0, Y0, B1, X1, Y1, ax0, ax1 = ibuf[0], ibuf[1], ibuf[2], ibuf[3], ibuf[4], ibuf[5], ax[0], ax[1]
+    c0x = min(max(sx, 0.0), width - 1.0)
+    c0y = min(max(sy, 0.0), height - 1.0)
+    n0, rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, B0, X0, Y0, fbuf,
+                                         ax0, cnt, cache, rows)
+    it = it0
+    for it in range(it0 + 1, max_iter + 1):
+        if sw0 <= 0:
+            break
+        c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
+        c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
+        n1, rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, B1, X1, Y1,
+                                             fbuf, ax1, cnt, cache, rows)
+        if rho1 < rho0:
+            break
+        s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
+        if abs(s2 - eps2) <= _SHIFT2_BAND * eps2:
+            return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0)
+        c0x, c0y, n0, rho0, sw0, swx0, swy0 = c1x, c1y, n1, rho1, sw1, swx1, swy1
+        B0, X0, Y0, ax0, B1, X1, Y1, ax1 = B1, X1, Y1, ax1, B0, X0, Y0, ax0
+        if s2 < eps2:
+            break
+    nt, st2, n_in, nt_in = _nb_stats(n0, B0, X0, Y0, ax0, c0x, c0y, hx, hy, t, inner2, td)
+    return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in)
+
+
+def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
+    """Work buffers of :func:`_nb_track` for windows of half-sizes up to hx, hy.
+
+    int32 bins and coordinates of two windows (6, box px); float64 histogram,
+    normalised histogram, weights (3, bins); d2 column terms of two windows
+    (2, box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins);
+    float64 t d2 (box px).
+    """
+    box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
+    return (np.empty((6, box_w * box_h), np.int32), np.empty((3, n_bins)), np.empty((2, box_w)),
+            np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
+
+
+def _bins_cache(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """An empty bins cache of :func:`_nb_bins` for a height x width image: (bins, rows)."""
+    rows = np.zeros((2, height), np.int32)
+    return np.empty((height, width), np.int32), rows
+
+
+def _buffers_fit(bufs: tuple[np.ndarray, ...], hx: float, hy: float, n_bins: int) -> bool:
+    box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
+    return bufs[2].shape[1] >= box_w and bufs[0].shape[1] >= box_w * box_h and bufs[1].shape[1] >= n_bins
+
+
+def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray, c: tuple[float, float],
+                      hx: float, hy: float, inner2: float, kernel: str,
+                      bufs: tuple[np.ndarray, ...] | None = None) -> PassV2:
+    """:func:`window_pass` on ``colour_bins(frame, bits)`` by the numba kernel (bit-identical).
+
+    ``frame``: (H, W, 3) uint8, e.g. the decimated view ``frame[::D, ::D]``.
+    """
+    height, width = frame.shape[:2]
+    if bufs is None or not _buffers_fit(bufs, hx, hy, q.shape[0]):
+        bufs = _nb_buffers_v2(hx, hy, q.shape[0])
+    return PassV2(*_nb_window_pass(frame, bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height,
+                                   float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width)))
+
+
+class LazyBins:
+    """Colour bins of an image, computed on the first request for a rectangle and kept.
+
+    Indexing ``bins[ys, xs]`` (integer arrays) computes the bins of the bounding box of the
+    request (grown by ``margin`` px and united with what is already there); the values never
+    depend on which rectangles were asked for, so results equal those of the whole image.
+    """
+
+    def __init__(self, image: np.ndarray, bits: int, margin: int) -> None:
+        self.image, self.bits, self.margin = image, bits, margin
+        self.shape = image.shape[:2]
+        self.values = np.empty(self.shape, np.intp)
+        self.box: tuple[int, int, int, int] | None = None  # y0, y1, x0, x1 (half-open)
+
+    def _ensure(self, y0: int, y1: int, x0: int, x1: int) -> None:
+        b = self.box
+        if b is not None and y0 >= b[0] and y1 <= b[1] and x0 >= b[2] and x1 <= b[3]:
+            return
+        m = self.margin
+        ny0, ny1, nx0, nx1 = max(0, y0 - m), min(self.shape[0], y1 + m), max(0, x0 - m), min(self.shape[1], x1 + m)
+        if b is not None:
+            ny0, ny1, nx0, nx1 = min(ny0, b[0]), max(ny1, b[1]), min(nx0, b[2]), max(nx1, b[3])
+        self.values[ny0:ny1, nx0:nx1] = colour_bins(self.image[ny0:ny1, nx0:nx1], self.bits)
+        self.box = (ny0, ny1, nx0, nx1)
+
+    def __getitem__(self, key: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        ys, xs = key
+        if len(ys):
+            self._ensure(int(ys.min()), int(ys.max()) + 1, int(xs.min()), int(xs.max()) + 1)
+        return self.values[ys, xs]
+
+
+class FloatTrackerV2:
+    """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2").
+
+    ``path`` picks how the mean shift of :meth:`update` is computed, with the same
+    results bit for bit: "numpy" (:meth:`_track`, :func:`window_pass` on
+    :class:`LazyBins`), "numba" (:meth:`_track_numba`, one :func:`_nb_track` call
+    per start point), or "auto": numba when it is installed and passes its
+    self-check (:func:`_numba_ready`; MSTRACK_NUMBA=0 disables it), else numpy.
+    :meth:`init` runs numpy in both.
+    """
+
+    PATHS = ("auto", "numba", "numpy")
+
+    def __init__(self, params: TrackerParams | None = None, path: str = "auto") -> None:
+        if path not in self.PATHS:
+            raise ValueError(f"path must be one of {self.PATHS}, got {path!r}")
         self.params = params or TrackerParams(preset="v2")
+        self.path = path
         self._shape: tuple[int, int] | None = None
+        self._bufs: tuple[np.ndarray, ...] | None = None
+        self._cache: tuple[np.ndarray, np.ndarray] | None = None
+        self._use_numba = False
+
+    def active_path(self) -> str:
+        """The path :meth:`update` runs now: "numpy" or "numba"."""
+        if self.path == "numpy":
+            return "numpy"
+        if self._use_numba:  # (the self-check's own run)
+            return "numba"
+        if _numba_ready():
+            return "numba"
+        if self.path == "numba":
+            raise RuntimeError("path='numba' but numba is not installed or failed its self-check")
+        return "numpy"
 
     # ------------------------------------------------------------------ helpers
     def decimation(self, w: float, h: float) -> int:
@@ -152,24 +404,37 @@ class FloatTrackerV2:
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
         return colour_bins(frame[::d, ::d], self.params.colour_bits)
 
-    def _track(self, bins: np.ndarray, start: tuple[float, float], hx: float, hy: float,
+    def _lazy_bins(self, frame: np.ndarray, d: int, w: float, h: float) -> LazyBins:
+        """Bins computed around the windows the frame's mean shift visits (same values)."""
+        return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8)
+
+    def _track(self, bins: np.ndarray | LazyBins, start: tuple[float, float], hx: float, hy: float,
                max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
-        """Mean shift from ``start`` (decimated coordinates): centre, pass at the centre, iterations."""
+        """Mean shift from ``start`` (decimated coordinates): centre, pass at the centre, iterations.
+
+        ``bins``: the decimated image's bins (numpy path), or the decimated frame
+        itself (numba path, :meth:`_track_numba`: the same loop in the kernel).
+        """
         p = self.params
-        height, width = bins.shape
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            return self._track_numba(bins, start, hx, hy, max_iter)
+        height, width = bins.shape[:2]
         inner2 = 1.0 / (1.0 + p.pad) ** 2
 
         def clamp(c: tuple[float, float]) -> tuple[float, float]:
             return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
 
+        def window(c: tuple[float, float]) -> PassV2:
+            return window_pass(bins, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+
         c0 = clamp(start)
-        p0 = window_pass(bins, p.n_colour_bins, self._qb, self._t, c0, hx, hy, inner2, p.kernel)
+        p0 = window(c0)
         it = 0
         for it in range(1, max_iter + 1):
             if p0.sw <= 0:
                 break
             c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
-            p1 = window_pass(bins, p.n_colour_bins, self._qb, self._t, c1, hx, hy, inner2, p.kernel)
+            p1 = window(c1)
             if p1.rho < p0.rho:
                 break
             s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
@@ -177,6 +442,28 @@ class FloatTrackerV2:
             if s2 < p.eps2:
                 break
         return c0, p0, it
+
+    def _track_numba(self, frame: np.ndarray, start: tuple[float, float], hx: float, hy: float,
+                     max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
+        """:meth:`_track` by :func:`_nb_track` on the decimated frame (same results bit for bit)."""
+        p = self.params
+        height, width = frame.shape[:2]
+        inner2 = 1.0 / (1.0 + p.pad) ** 2
+        flat = p.kernel == "flat"
+        eps2 = float(p.eps2)
+        sx, sy, it0 = float(start[0]), float(start[1]), 0
+        while True:
+            code, it, c0x, c0y, c1x, c1y, r = _nb_track(frame, p.colour_bits, sx, sy, it0, hx, hy, width, height,
+                                                        inner2, flat, self._qb, self._t, int(max_iter), eps2,
+                                                        *self._bufs, *self._cache)
+            if code == 0:
+                return (c0x, c0y), PassV2(*r), it
+            # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
+            if (c1x - c0x) ** 2 + (c1y - c0y) ** 2 < p.eps2:
+                c = (c1x, c1y)
+                return c, window_pass_numba(frame, p.colour_bits, self._qb, self._t, c, hx, hy, inner2,
+                                            p.kernel, self._bufs), it
+            sx, sy, it0 = c1x, c1y, it  # go on from c1 (its pass is recomputed: the same numbers)
 
     def _confidence(self, ps: PassV2) -> float:
         cr = min(1.0, ps.rho / self._rho_ref) if self._rho_ref > 0 else 0.0
@@ -189,6 +476,8 @@ class FloatTrackerV2:
         height, width = frame.shape[:2]
         box, clipped = clip_box(Box.of(box), width, height)
         p = self.params
+        self.active_path()  # numba: compile / self-check here, not in update()
+        self._bufs = self._cache = None
         self._shape = (height, width)
         cx, cy = box_centre_index(box)
         self._size = self._size0 = (box.w, box.h)
@@ -218,9 +507,18 @@ class FloatTrackerV2:
         w, h = self._size
         # lost: the whole search runs at twice the decimation (a region 2x wider in the same memory)
         d = self.decimation(w, h) * (2 if self._lost else 1)
-        bins = self._bins(frame, d)
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
+        if self.active_path() == "numba":
+            bins: np.ndarray | LazyBins = frame[::d, ::d]  # the kernel bins the pixels it visits
+            if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_colour_bins):
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_colour_bins)  # room to grow
+            if self._cache is None:
+                self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
+            else:
+                self._cache[1][:] = 0  # a new frame: no bins yet
+        else:
+            bins = self._lazy_bins(frame, d, w, h)
         start = (self._centre[0] / d, self._centre[1] / d)
         # lost: every start point (this one included) runs search_iter iterations
         c, ps, it = self._track(bins, start, hx, hy, p.search_iter if self._lost else p.max_iter)
@@ -265,3 +563,68 @@ class FloatTrackerV2:
                            iter_c=it, iter_e=0, status=status, confidence=conf,
                            extra={"decimation": d, "share": ps.share, "spread": ps.spread,
                                   "searched": searched})
+
+
+_NUMBA_OK: bool | None = None
+
+
+def _numba_ready() -> bool:
+    """Compile (or load) the v2 numba kernel and check it against numpy; False: use numpy.
+
+    Needs float_model's kernels to pass their own self-check (the pairwise sums
+    and the scan are theirs); MSTRACK_NUMBA=0 in the environment skips numba.
+    """
+    global _NUMBA_OK
+    if _NUMBA_OK is None:
+        _NUMBA_OK = False
+        if _fm._numba_ready():
+            try:
+                _NUMBA_OK = _numba_self_check()
+            except Exception as exc:  # noqa: BLE001 - any failure means: use numpy
+                warnings.warn(f"mstrack: numba v2 kernel disabled ({exc!r}); using numpy", RuntimeWarning)
+            else:
+                if not _NUMBA_OK:
+                    warnings.warn("mstrack: numba v2 kernel disagrees with numpy here; using numpy",
+                                  RuntimeWarning)
+    return _NUMBA_OK
+
+
+def _numba_self_check() -> bool:
+    """window_pass_numba == window_pass on random frames (decimated views, both kernels, windows
+    across the frame borders, tiny and empty windows, zeros in q), and the tracker both ways."""
+    rng = np.random.default_rng(0)
+    frame = np.ascontiguousarray(rng.integers(0, 256, (45, 61, 3), dtype=np.uint8))
+    inner2 = 1.0 / 1.25 ** 2
+    for bits in (2, 3):
+        nb = 1 << (3 * bits)
+        q = rng.random(nb)
+        q[rng.random(nb) < 0.3] = 0.0
+        q /= q.sum()
+        t = (rng.random(nb) < 0.5).astype(np.float64)
+        for d in (1, 2):
+            src = frame[::d, ::d]
+            bins = colour_bins(src, bits)
+            height, width = bins.shape
+            for c, hx, hy in (((width / 2.0 + 0.3, height / 2.0 - 0.2), 9.4, 7.1), ((0.0, 0.0), 12.5, 5.0),
+                              ((width - 1.0, height - 1.0), 3.3, 20.25), ((5.5, 3.5), 0.3, 0.4),
+                              ((7.25, 9.75), 80.0, 60.0)):
+                for kernel in ("flat", "epanechnikov"):
+                    if window_pass_numba(src, bits, q, t, c, hx, hy, inner2, kernel) != \
+                            window_pass(bins, nb, q, t, c, hx, hy, inner2, kernel):
+                        return False
+    # the whole tracker (compiles _nb_track): a block moving on noise, both kernels, lost and found
+    frames = []
+    for i in range(6):
+        f = rng.integers(0, 256, (48, 64, 3), dtype=np.uint8)
+        if i != 3:  # frame 3: the target is gone
+            f[10 + i:26 + i, 12 + 2 * i:30 + 2 * i] = (20, 40, 230)
+        frames.append(f)
+    for kernel in ("flat", "epanechnikov"):
+        runs = []
+        for path in ("numpy", "numba"):
+            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel), path=path)
+            trk._use_numba = path == "numba"  # (the self-check runs inside active_path)
+            runs.append([trk.init(frames[0], (12, 10, 18, 16))] + [trk.update(f) for f in frames[1:]])
+        if runs[0] != runs[1]:
+            return False
+    return True

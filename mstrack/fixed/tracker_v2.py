@@ -24,8 +24,8 @@ import numpy as np
 from ..frames import check_frame
 from ..params import TrackerParams
 from ..types import Box, Status, TrackResult
-from .blocks import (STOP_CODES, Region, ms_box_clip, ms_colour_bin, ms_kernel, ms_meanshift, ms_region,
-                     ms_rho_out, ms_round_centre, round_box)
+from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_histogram,
+                     ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
 from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_model_scale,
                         ms_ref_update, ms_resize, ms_scale, ms_share, ms_spread, ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths)
@@ -69,17 +69,23 @@ class FixedTrackerV2:
         hd = ms_window_size(self.h8, self.pad16, d, min(p.max_window, hd_ - 2))
         return wd, hd
 
-    def _run(self, bins: np.ndarray, Qw: np.ndarray, ker: ms_kernel, start8: tuple[int, int],
-             reg: Region, max_iter: int):
-        """Mean shift from ``start8`` (Q.CF, decimated px) in region ``reg``; (c8, S, iters, stop, stats)."""
+    def _run(self, img: np.ndarray, Qw: np.ndarray, ker: ms_kernel, start8: tuple[int, int],
+             reg: Region, max_iter: int, sub: np.ndarray | None = None):
+        """Mean shift from ``start8`` (Q.CF, decimated px) in region ``reg`` of the decimated image
+        ``img``; (c8, S, iters, stop, stats).  ``sub``: the region's colour bins if already captured."""
         fx, p = self.fixed, self.params
         cf = fx.centre_frac
-        sub = bins[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
+        if sub is None:
+            sub = self._capture(img, reg)
         tp = p.with_(max_iter=max_iter)
         r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_colour_bins, self.widths.shift_q)
-        win = (ms_round_centre(r.c8[0], cf), ms_round_centre(r.c8[1], cf))
-        st = ms_target_stats(bins, self.model.T, win, ker, fx.kernel_bits, self.pad16)
+        win = (ms_round_centre(r.c8[0], cf) - reg.x, ms_round_centre(r.c8[1], cf) - reg.y)
+        st = ms_target_stats(sub, self.model.T, win, ker, fx.kernel_bits, self.pad16)
         return r.c8, r.S, r.iterations, r.stop, st
+
+    def _capture(self, img: np.ndarray, reg: Region) -> np.ndarray:
+        """ms_region_capture for v2: the colour bins of the region's pixels of the decimated image."""
+        return ms_colour_bin(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], self.params.colour_bits)
 
     def _box(self) -> Box:
         s = float(1 << self.fixed.centre_frac)
@@ -124,7 +130,7 @@ class FixedTrackerV2:
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one pass at the init centre (no iteration) gives the references
-        _, S, _, _, st = self._ref_pass(bins, Qw, ker, start8)
+        _, S, _, _, st = self._ref_pass(frame[::d, ::d], Qw, ker, start8)
         self.rho_ref = ms_rho_out(S, ker.K, fx)
         self.share_ref = ms_share(st)
         sp = ms_spread(st)
@@ -138,19 +144,17 @@ class FixedTrackerV2:
                            iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
                            message="init box clipped" if clipped else "", confidence=1.0, extra=raw)
 
-    def _ref_pass(self, bins, Qw, ker, start8):
+    def _ref_pass(self, img, Qw, ker, start8):
         """The pass at the (clamped) init centre without moving: S and the target statistics."""
         fx, p = self.fixed, self.params
         cf = fx.centre_frac
-        hd_, wd_ = bins.shape
-        reg = ms_region(start8, ker.ex, ker.ey, wd_, hd_, fx)
-        from .blocks import clamp_centre, ms_bin_pass, ms_histogram
+        reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx)
         c8 = clamp_centre(start8, reg, cf)
         win = (ms_round_centre(c8[0], cf), ms_round_centre(c8[1], cf))
-        sub = bins[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
+        sub = self._capture(img, reg)
         hist = ms_histogram(sub, reg, win, ker, p.n_colour_bins)
         S = ms_bin_pass(Qw, hist, fx).S
-        st = ms_target_stats(bins, self.model.T, win, ker, fx.kernel_bits, self.pad16)
+        st = ms_target_stats(sub, self.model.T, (win[0] - reg.x, win[1] - reg.y), ker, fx.kernel_bits, self.pad16)
         return c8, S, 0, "shift", st
 
     def update(self, frame: np.ndarray) -> TrackResult:
@@ -162,16 +166,17 @@ class FixedTrackerV2:
         cf = fx.centre_frac
         d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
         sh = d.bit_length() - 1
-        bins = self._bins(frame, d)
-        wd, hd = self._geometry(d, bins.shape)
+        img = frame[::d, ::d]
+        wd, hd = self._geometry(d, img.shape[:2])
         ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost
         ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
-        reg = ms_region(start8, ker.ex, ker.ey, bins.shape[1], bins.shape[0], fx.with_(margin=min(margin, 255)))
-        c8d, S, it, stop, st = self._run(bins, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter)
+        reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
+        sub = self._capture(img, reg)
+        c8d, S, it, stop, st = self._run(img, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter, sub)
         rho = ms_rho_out(S, ker.K, fx)
         share = ms_share(st)
         conf = ms_confidence(rho, share, self.rho_ref, self.share_ref)
@@ -182,7 +187,7 @@ class FixedTrackerV2:
                     if sx == 0 and sy == 0:
                         continue
                     s8 = (max(start8[0] + (sx * ox << cf), 0), max(start8[1] + (sy * oy << cf), 0))
-                    c2, S2, _, _, st2 = self._run(bins, Qw, ker, s8, reg, p.search_iter)
+                    c2, S2, _, _, st2 = self._run(img, Qw, ker, s8, reg, p.search_iter, sub)
                     searched += 1
                     rho2, share2 = ms_rho_out(S2, ker.K, fx), ms_share(st2)
                     conf2 = ms_confidence(rho2, share2, self.rho_ref, self.share_ref)

@@ -1,0 +1,262 @@
+"""Tracker v2 float: the numba path gives the numpy path's results bit for bit.
+
+Every TrackResult (box, centre, confidence, rho, status, iterations, extra: share,
+spread, decimation, searched) is compared with ``==`` frame by frame, on synthetic
+scenes (moving target, scale change, decimated large targets, occlusion / loss /
+re-acquisition, frame borders, both kernels) and on two real sequences from
+../shared/data/sequences (skipped if absent).  Single window passes are compared
+on random frames and windows, tiny and empty windows included.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from mstrack import float_model as fm
+from mstrack import float_v2 as v2
+from mstrack.data import load_dataset
+from mstrack.params import TrackerParams
+from mstrack.synthetic import make_scene
+from mstrack.types import Status
+
+SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
+# numba installed and not switched off: the self-check must pass (a failure is a test failure, not a skip)
+HAVE_NUMBA = fm._numba_njit is not None and os.environ.get("MSTRACK_NUMBA", "1") != "0"
+needs_numba = pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed or MSTRACK_NUMBA=0")
+KERNELS = ["flat", "epanechnikov"]
+
+
+def _run(path, frames, box, **params):
+    trk = v2.FloatTrackerV2(TrackerParams(preset="v2", **params), path=path)
+    assert trk.active_path() == path
+    out = [trk.init(frames[0], box)]
+    for f in frames[1:]:
+        out.append(trk.update(f))
+    return out
+
+
+def _assert_identical(frames, box, **params):
+    want = _run("numpy", frames, box, **params)
+    got = _run("numba", frames, box, **params)
+    assert len(got) == len(want)
+    for i, (g, w) in enumerate(zip(got, want)):
+        assert g == w, f"frame {i}: numba {g} != numpy {w}"
+    return want
+
+
+def _background(rng, height, width):
+    """Smooth green / blue texture with fine grain (BGR)."""
+    small = rng.integers(0, 256, (height // 16 + 2, width // 16 + 2, 3)).astype(np.float32)
+    bg = cv2.resize(small, (width, height), interpolation=cv2.INTER_CUBIC)
+    bg = bg * np.float32([0.5, 0.4, 0.15]) + np.float32([90, 80, 30])
+    return bg + rng.normal(0.0, 8.0, bg.shape).astype(np.float32)
+
+
+def _target(rng, h, w):
+    """Red / yellow checkerboard (BGR)."""
+    yy, xx = np.mgrid[0:h, 0:w]
+    cell = max(3, min(w, h) // 6)
+    check = ((yy // cell + xx // cell) % 2).astype(bool)
+    t = np.empty((h, w, 3), np.float32)
+    t[check], t[~check] = (30, 40, 210), (40, 200, 230)
+    return t + rng.normal(0.0, 6.0, t.shape).astype(np.float32)
+
+
+def _render(height, width, boxes, seed=0, occluded=()):
+    """Frames with the target at ``boxes`` (x, y, w, h; may leave the frame); frames in ``occluded``
+    have a grey occluder over the target."""
+    rng = np.random.default_rng(seed)
+    bg = _background(rng, height, width)
+    frames = []
+    for i, (x, y, w, h) in enumerate(boxes):
+        f = bg + rng.normal(0.0, 3.0, bg.shape).astype(np.float32)
+        t = _target(rng, h, w)
+        fx0, fy0, fx1, fy1 = max(x, 0), max(y, 0), min(x + w, width), min(y + h, height)
+        if fx1 > fx0 and fy1 > fy0:
+            f[fy0:fy1, fx0:fx1] = t[fy0 - y:fy1 - y, fx0 - x:fx1 - x]
+        if i in occluded:
+            f[max(y - 6, 0):max(y + h + 6, 0), max(x - 6, 0):max(x + w + 6, 0)] = 128.0
+        frames.append(np.clip(f, 0, 255).astype(np.uint8))
+    return frames
+
+
+# ----------------------------------------------------------------------------- single passes
+@needs_numba
+def test_numba_self_check_passes():
+    assert v2._numba_self_check()
+    assert v2._numba_ready()
+
+
+@needs_numba
+def test_window_pass_equal_random_windows():
+    rng = np.random.default_rng(11)
+    for _ in range(60):
+        height, width = (int(v) for v in rng.integers(4, 150, 2))
+        frame = rng.integers(0, 256, (height, width, 3), dtype=np.uint8)
+        if rng.random() < 0.5:
+            frame = cv2.GaussianBlur(frame, (5, 5), 1.5)
+        d = int(rng.choice([1, 2, 4, 8]))
+        src = frame[::d, ::d]
+        bits = int(rng.integers(1, 5))
+        nb = 1 << (3 * bits)
+        q = rng.random(nb)
+        q[rng.random(nb) < 0.4] = 0.0
+        q /= q.sum()
+        t = (rng.random(nb) < 0.5).astype(np.float64)
+        bins = fm.colour_bins(src, bits)
+        h, w = bins.shape
+        for _ in range(8):
+            c = (float(rng.uniform(0, w - 1)), float(rng.uniform(0, h - 1)))
+            if rng.random() < 0.2:
+                c = (float(rng.choice([0.0, w - 1.0])), float(rng.choice([0.0, h - 1.0])))
+            hx, hy = (float(v) for v in rng.uniform(0.05, 70.0, 2) ** rng.choice([1.0, 0.5]))
+            inner2 = float(rng.choice([1.0 / 1.25 ** 2, 0.5]))
+            for kernel in KERNELS:
+                want = v2.window_pass(bins, nb, q, t, c, hx, hy, inner2, kernel)
+                got = v2.window_pass_numba(src, bits, q, t, c, hx, hy, inner2, kernel)
+                assert got == want, (d, c, hx, hy, kernel)
+
+
+@needs_numba
+def test_window_pass_without_pixels():
+    """A window narrower than a pixel between two columns holds no pixel: rho 0, sums 0."""
+    frame = np.full((20, 20, 3), 200, np.uint8)
+    q = np.full(512, 1 / 512)
+    t = np.ones(512)
+    bins = fm.colour_bins(frame, 3)
+    for kernel in KERNELS:
+        want = v2.window_pass(bins, 512, q, t, (5.5, 7.0), 0.3, 4.0, 0.64, kernel)
+        got = v2.window_pass_numba(frame, 3, q, t, (5.5, 7.0), 0.3, 4.0, 0.64, kernel)
+        assert got == want and got.rho == 0.0 and got.n_in == 0
+
+
+# ----------------------------------------------------------------------------- trackers
+@needs_numba
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_moving_target(kernel):
+    frames, gt = make_scene(40, 320, 240, seed=3, target_size=(41, 33))
+    res = _assert_identical(list(frames), tuple(gt[0]), kernel=kernel)
+    assert sum(r.status == Status.OK for r in res) > 30
+
+
+@needs_numba
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_scale_change(kernel):
+    """The target grows from 20 to 50 px and shrinks back: the box follows (scale every frame)."""
+    sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]
+    boxes = [(60 + 2 * i - s // 2, 90 - s // 2, s, s) for i, s in enumerate(sizes)]
+    res = _assert_identical(_render(200, 280, boxes, seed=1), boxes[0], kernel=kernel)
+    widths = [r.box.w for r in res]
+    assert max(widths) > 24 and widths[-1] < max(widths) - 1
+
+
+@needs_numba
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_large_target_decimated(kernel):
+    """Targets of 300 and 430 px: decimation 4 and 8 (the kernel reads every D-th pixel)."""
+    boxes = [(100 + 3 * i, 60 + i, 300 + 4 * i, 280 + 3 * i) for i in range(8)]
+    res = _assert_identical(_render(420, 640, boxes, seed=2), boxes[0], kernel=kernel)
+    assert {r.extra["decimation"] for r in res[1:]} == {4}
+    boxes = [(60 + 2 * i, 40, 430, 330) for i in range(6)]
+    res = _assert_identical(_render(420, 640, boxes, seed=3), boxes[0], kernel=kernel)
+    assert {r.extra["decimation"] for r in res[1:]} == {8}
+
+
+@needs_numba
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_occlusion_loss_and_reacquisition(kernel):
+    """Occluded for 8 frames: lost (wide search from 9 start points at 2 D), then re-acquired."""
+    boxes = [(80 + 2 * i, 70 + (i % 7), 36, 30) for i in range(40)]
+    frames = _render(220, 320, boxes, seed=4, occluded=range(15, 23))
+    res = _assert_identical(frames, boxes[0], kernel=kernel)
+    status = [r.status for r in res]
+    assert Status.LOST in status and Status.REACQUIRED in status
+    assert any(r.extra.get("searched") == 8 for r in res)
+
+
+@needs_numba
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_frame_borders(kernel):
+    """Init box partly outside (clipped), windows clipped at every border, target leaving the frame."""
+    # enters at the top-left corner, crosses, leaves through the bottom-right corner
+    boxes = [(-12 + 9 * i, -10 + 6 * i, 34, 28) for i in range(36)]
+    res = _assert_identical(_render(180, 260, boxes, seed=5), boxes[0], kernel=kernel)
+    assert res[0].status == Status.CLIPPED
+    # along the right border, then out of the frame
+    boxes = [(230 + i, 40 + 2 * i, 30, 30) for i in range(30)]
+    _assert_identical(_render(180, 260, boxes, seed=6), boxes[0], kernel=kernel)
+
+
+@needs_numba
+def test_shift_test_near_eps2_is_decided_in_python(monkeypatch):
+    """s2 within rounding of eps2 goes back to Python (``dx ** 2`` is libm's pow, not dx * dx)."""
+    boxes = [(50, 40, 37, 29), (53, 42, 37, 29)]
+    frames = _render(150, 200, boxes, seed=7)
+    trk = v2.FloatTrackerV2(TrackerParams(preset="v2"), path="numpy")
+    trk.init(frames[0], boxes[0])
+    w, h = trk._size
+    hx, hy = 1.25 * w / 2.0, 1.25 * h / 2.0
+    start = trk._centre
+    bins = fm.colour_bins(frames[1], 3)
+    c1, _, _ = trk._track(bins, start, hx, hy, 1)
+    assert c1 != start
+    s2 = (c1[0] - start[0]) ** 2 + (c1[1] - start[1]) ** 2
+    codes = []
+    kernel = v2._nb_track
+
+    def spy(*args):
+        r = kernel(*args)
+        codes.append(r[0])
+        return r
+
+    monkeypatch.setattr(v2, "_nb_track", spy)
+    trk._bufs = v2._nb_buffers_v2(hx, hy, 512)
+    trk._cache = v2._bins_cache(*frames[1].shape[:2])
+    for eps2 in (s2, float(np.nextafter(s2, np.inf))):  # go on, stop at c1
+        trk.params = TrackerParams(preset="v2", eps2=eps2)
+        want = trk._track(bins, start, hx, hy, 10)
+        got = trk._track(frames[1], start, hx, hy, 10)
+        assert got == want
+    assert codes.count(1) == 2
+
+
+@pytest.fixture(scope="module")
+def real_sequences():
+    if not SEQ_ROOT.is_dir():
+        pytest.skip(f"real sequences not found at {SEQ_ROOT}")
+    seqs = {s.name: s for s in load_dataset(SEQ_ROOT)}
+    # Couple: loss and re-acquisition at D 1 / 2; bag_vot: decimation 2 and 4, long loss
+    names = [n for n in ("Couple", "bag_vot") if n in seqs] or sorted(seqs)[:2]
+    return {n: ([seqs[n].frame(i) for i in range(len(seqs[n]))], seqs[n].init_box()) for n in names}
+
+
+@needs_numba
+def test_real_sequences_identical(real_sequences):
+    for name, (frames, box) in real_sequences.items():
+        _assert_identical(frames, box)
+
+
+# ----------------------------------------------------------------------------- path selection
+def test_unknown_path_rejected():
+    with pytest.raises(ValueError):
+        v2.FloatTrackerV2(path="fast")
+
+
+def test_auto_path():
+    trk = v2.FloatTrackerV2()
+    assert trk.active_path() == ("numba" if HAVE_NUMBA else "numpy")
+    assert v2.FloatTrackerV2(path="numpy").active_path() == "numpy"
+
+
+def test_numba_switched_off_falls_back_to_numpy(monkeypatch):
+    monkeypatch.setenv("MSTRACK_NUMBA", "0")
+    monkeypatch.setattr(fm, "_NUMBA_OK", None)
+    monkeypatch.setattr(v2, "_NUMBA_OK", None)
+    assert not v2._numba_ready()
+    assert v2.FloatTrackerV2().active_path() == "numpy"
+    with pytest.raises(RuntimeError):
+        v2.FloatTrackerV2(path="numba").active_path()

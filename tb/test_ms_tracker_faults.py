@@ -972,16 +972,3 @@ def test_tracker_fuzz(tmp_path):
     assert s["seeds"] == int(seeds.split(":")[1]) and s["results"] > 0
     print(f"\nfuzz seeds {seeds}: {s['results']} results, {s['beats']} beats, {s['seconds']} s")
 
-
-@cocotb.test(skip=True)
-async def speed(dut):
-    b = Bench(dut, 1)
-    await b.start(48, 40)
-    t = time.time()
-    await b.idle(100_000)
-    dut._log.info(f"idle 100k cycles: {time.time() - t:.2f} s")
-    fr, gt = scene(2, 48, 40, 1)
-    t = time.time()
-    await b.frame(fr[0])
-    dut._log.info(f"frame: {time.time() - t:.2f} s")
-    b.stop()

@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: setup demo test test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
+.PHONY: setup demo test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
 
 setup:
 	bash tools/setup.sh
@@ -32,6 +32,17 @@ test-sim-only:
 
 test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m synth -s -p no:cacheprovider $(ARGS)
+
+# Constrained-random stream-fault test of the core (tb/test_ms_tracker_faults.py::fuzz): N seeds
+# from SEEDS in one GHDL simulation (CI runs 3 of them); a failure prints its seed, replay it
+# with `make test-fuzz SEEDS=<seed> N=1`.  Coverage of the fault classes / crosses in FUZZ_REPORT.
+SEEDS ?= 1
+N     ?= 200
+FUZZ_REPORT ?= build/fuzz_report.json
+test-fuzz: setup
+	mkdir -p build
+	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_FUZZ_REPORT=$(abspath $(FUZZ_REPORT)) MSTRACK_REQUIRE_TOOLS=1 \
+	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_faults.py -k test_tracker_fuzz $(ARGS)
 
 # The tests against the newest PyPI versions (not in CI): a separate venv, installed without the
 # lock, so drift in numpy/OpenCV/cocotb/... is seen before it reaches the lock.

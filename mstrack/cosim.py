@@ -11,7 +11,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from .fixed import FixedParams, FixedTracker
-from .fixed.blocks import ms_box_clip
+from .fixed.blocks import init_centre, ms_box_clip
 from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, core_generics, result_layout
 from .params import TrackerParams
 from .types import Status
@@ -88,3 +88,173 @@ class CoreConfig:
 def clip_ok(box: tuple[int, int, int, int], w: int, h: int, fp: FixedParams) -> bool:
     """True if the core accepts this init box for a w x h frame."""
     return ms_box_clip(*box, w, h, fp.max_half)[0] is not None
+
+
+# ----------------------------------------------------------------------------- stream-level model
+# Error codes of the result word (rtl/ms_stream_pkg.vhd).
+ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT, ERR_SIZE, ERR_SIZE_CHANGED = range(6)
+ERR_NAMES = ("short_line", "long_line", "no_sof", "cut", "size", "size_changed")
+MIN_FRAME = 3           # smallest frame_width / frame_height the core accepts
+
+
+def words_frame(words: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`frame_words`: (H, W) 24-bit words -> (H, W, 3) uint8 BGR."""
+    w = np.asarray(words, dtype=np.int64)
+    return np.stack([w & 0xFF, (w >> 8) & 0xFF, (w >> 16) & 0xFF], axis=-1).astype(np.uint8)
+
+
+class CoreModel:
+    """What ms_tracker outputs for an arbitrary input stream (docs/architecture.md, errors).
+
+    The fixed-point model :class:`FixedTracker` computes every tracked frame; this class adds
+    the system behaviour around it, beat by beat, as the RTL defines it: the stream checker
+    (ms_stream_check: short / long line, missing start of frame, cut frame, frame size out of
+    range), the top's frame gate (the line count that decides when an init box may be taken),
+    init boxes (clipped / rejected, taken between frames, applying to the next frame), frames of
+    another size than the target's (error ``size_changed``, state unchanged), results before
+    any init (``no_target``) and reset.
+
+    Feed it, in stream order, ``beat(data, tuser, tlast, fw, fh)`` for every accepted beat
+    (fw, fh: frame_width / frame_height at that beat), ``init(box, fw, fh)`` where an init box
+    was taken, and ``reset()``.  ``results`` holds the predicted result words (dicts of the
+    COMPARED_FIELDS) in order; ``epochs[i]`` the reset epoch of result i.
+    """
+
+    def __init__(self, tp: TrackerParams, fp: FixedParams, max_frame_w: int) -> None:
+        self.tp, self.fp, self.max_frame_w = tp, fp, max_frame_w
+        self.results: list[dict[str, int]] = []
+        self.kinds: list[str] = []          # "init", "track", "no_target", "error:<code name>"
+        self.epochs: list[int] = []
+        self.epoch = 0
+        self._reset_state()
+
+    # -- state -------------------------------------------------------------------------------
+    def _reset_state(self) -> None:
+        self.trk: FixedTracker | None = None       # target_valid
+        self.pending: tuple | None = None          # init_pending: (box, clipped)
+        self.rejected = 0
+        self.c8 = (0, 0)
+        self.box_wh = (0, 0)
+        self.tgt = (MIN_FRAME, MIN_FRAME)
+        self.count = 0
+        # ms_stream_check
+        self.sc = "wait"
+        self.W = self.H = 0
+        self.x = self.y = 0
+        self.rows: list[list[int]] = []
+        # the top's frame gate (line count)
+        self.in_frame = False
+        self.line = 0
+        self.fr_h = 0
+
+    def reset(self) -> None:
+        self._reset_state()
+        self.epoch += 1
+
+    def size_ok(self, fw: int, fh: int) -> bool:
+        return fw >= MIN_FRAME and fh >= MIN_FRAME and fw <= self.max_frame_w
+
+    # -- results -----------------------------------------------------------------------------
+    def _push(self, kind: str, **fields: int) -> None:
+        r = {"cx": self.c8[0], "cy": self.c8[1], "rho_c": 0, "rho_e": 0, "alpha_c": 0, "iter_c": 0,
+             "iter_e": 0, "stop_c": 0, "stop_e": 0, "err_code": 0,
+             "box_w": self.box_wh[0], "box_h": self.box_wh[1], "frame_count": self.count & 0xFFFF}
+        flags = fields.pop("flags", {})
+        r.update(fields)
+        r["flags"] = flags_word(rejected=self.rejected, **flags)
+        self.rejected = 0
+        self.count += 1
+        self.results.append(r)
+        self.kinds.append(kind)
+        self.epochs.append(self.epoch)
+
+    def _error(self, code: int) -> None:
+        self._push(f"error:{ERR_NAMES[code]}", err_code=code,
+                   flags={"error": 1, "no_target": int(self.trk is None)})
+
+    def init(self, box: tuple[int, int, int, int], fw: int, fh: int) -> None:
+        """An init box taken while frame_width, frame_height = fw, fh."""
+        ib, clipped = ms_box_clip(*box, fw, fh, self.fp.max_half)
+        if ib is None or not self.size_ok(fw, fh):
+            self.rejected = 1                      # the previous target (or pending init) stays
+            return
+        self.pending = (tuple(box), clipped)
+        self.trk = None
+        self.c8 = init_centre(ib, self.fp.centre_frac)
+        self.box_wh = (ib.w, ib.h)
+        self.tgt = (fw, fh)
+
+    def _frame(self, words: np.ndarray) -> None:
+        """A good frame (as far as the stream goes) reached the control."""
+        h, w = words.shape
+        if (self.pending or self.trk) and (w, h) != self.tgt:
+            self._error(ERR_SIZE_CHANGED)
+            return
+        if self.pending:
+            box, clipped = self.pending
+            trk = FixedTracker(self.tp, self.fp)
+            r = trk.init_int(words_frame(words), *box)
+            self.trk, self.pending = trk, None
+            flags = {"init": 1, "clipped": int(clipped)}
+            kind = "init"
+        elif self.trk:
+            r = self.trk.update(words_frame(words))
+            flags = {"lost": r.extra["lost"]}
+            kind = "track"
+        else:
+            self._push("no_target", flags={"no_target": 1})
+            return
+        e = r.extra
+        self.c8 = (e["cx"], e["cy"])
+        self.box_wh = (self.trk._t.box.w, self.trk._t.box.h)
+        self._push(kind, flags=flags, **{k: e[k] for k in ("cx", "cy", "rho_c", "rho_e", "alpha_c",
+                                                            "iter_c", "iter_e", "stop_c", "stop_e")})
+
+    # -- the stream --------------------------------------------------------------------------
+    def beat(self, data: int, tuser: int, tlast: int, fw: int, fh: int) -> None:
+        """One accepted beat (ms_stream_check, then the top's line count)."""
+        # the top's frame gate: in_frame says whether an init box must wait
+        was_in, line = self.in_frame, self.line
+        if tuser:
+            self.in_frame, self.fr_h, self.line = self.size_ok(fw, fh), fh, 0
+        elif was_in and tlast:
+            self.line += 1
+        if was_in and not tuser and tlast and line == self.fr_h - 1:
+            self.in_frame = False
+        # ms_stream_check: at most one error per beat (the last code set wins)
+        err = None
+        active = False
+        if tuser and not self.size_ok(fw, fh):
+            err, self.sc = ERR_SIZE, "drop"
+        elif tuser:
+            if self.sc == "frame":
+                err = ERR_CUT
+            self.W, self.H, self.x, self.y, self.rows = fw, fh, 0, 0, [[]]
+            active = True
+        elif self.sc == "frame":
+            active = True
+        elif self.sc == "wait":
+            err, self.sc = ERR_NO_SOF, "drop"
+        done = None
+        if active:
+            x_last = self.x == self.W - 1
+            if tlast and not x_last:
+                err, self.sc = ERR_SHORT_LINE, "drop"
+            elif not tlast and x_last:
+                err, self.sc = ERR_LONG_LINE, "drop"
+            else:
+                self.sc = "frame"
+                self.rows[-1].append(data)
+                if x_last:
+                    self.x, self.y = 0, self.y + 1
+                    if self.y == self.H:
+                        done = np.array(self.rows, dtype=np.int64)
+                        self.sc = "wait"
+                    else:
+                        self.rows.append([])
+                else:
+                    self.x += 1
+        if err is not None:
+            self._error(err)
+        if done is not None:
+            self._frame(done)

@@ -15,7 +15,8 @@
 -- (check 1, grey 2, sobel 5 after the grey; ms_sobel reads its line buffer
 -- with the position, which it gets one clock before the grey).  Throughput: 1 pixel/clock; never stalls (no
 -- ready): the top must back-pressure upstream itself if it needs to.
--- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height (not checked).
+-- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height; ms_stream_check drops a
+-- frame out of that range (frame_error, ERR_SIZE).
 -- Python model: mstrack.fixed.blocks ms_colour_bin and
 -- ms_edge_bin(ms_sobel(ms_grey(frame)), 2**EDGE_BINS_LOG2, EDGE_SHIFT).
 library ieee;
@@ -48,6 +49,7 @@ entity ms_frontend is
     frame_start  : out std_logic;                                       -- pulse: a frame started (delayed)
     frame_end    : out std_logic;                                       -- pulse: good frame complete, after its last ip_valid
     frame_error  : out std_logic;                                       -- pulse: protocol error (delayed), no frame_end for that frame
+    error_now    : out std_logic;                                       -- pulse: the same error, undelayed (1 clock after the bad beat)
     err_code     : out std_logic_vector(ERR_CODE_W - 1 downto 0)        -- ERR_* (ms_stream_pkg), with frame_error
   );
 end entity;
@@ -74,7 +76,7 @@ architecture rtl of ms_frontend is
   signal ev : ev_pipe_t := (others => (others => '0'));
 begin
   u_check : entity work.ms_stream_check
-    generic map (COORD_W => COORD_W, DATA_W => 24)
+    generic map (COORD_W => COORD_W, DATA_W => 24, MIN_SIZE => 3, MAX_W => MAX_FRAME_W)
     port map (
       clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
       in_valid => in_valid, in_data => in_data, in_sof => in_sof, in_eol => in_eol,
@@ -127,6 +129,7 @@ begin
       end if;
     end if;
   end process;
+  error_now   <= c_err;
   frame_start <= ev(EVT_DELAY)(EV_W - 1);
   frame_end   <= ev(EVT_DELAY)(EV_W - 2);
   frame_error <= ev(EVT_DELAY)(EV_W - 3);

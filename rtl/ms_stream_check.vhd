@@ -12,6 +12,10 @@
 --   ERR_CUT         sof while a frame is in progress: that frame is abandoned
 --                   (frame_error) AND the sof beat starts a new frame normally
 --                   (frame_start in the same clock)
+--   ERR_SIZE        sof while frame_width < MIN_SIZE, frame_height < MIN_SIZE or
+--                   frame_width > MAX_W (MAX_W = 0: no limit): no frame starts,
+--                   the beats are dropped until the next sof; a frame in progress
+--                   is abandoned and reported by this one code (it wins over CUT)
 -- After an error the beats are dropped silently until the next sof.  The beat
 -- that causes SHORT_LINE / LONG_LINE is dropped too.  A frame with an error
 -- never gets frame_end.  Codes: rtl/ms_stream_pkg.vhd.  Only one code per clock:
@@ -22,8 +26,7 @@
 -- frame's last pixel (x = W-1, y = H-1, with eol).
 -- Latency: 1 clock (all outputs registered).  Throughput: 1 beat/clock; it
 -- never stalls its input (no ready).  Reset: synchronous, control state only.
--- Requires frame_width >= 1, frame_height >= 1 (the front end needs >= 3 and
--- frame_width <= MAX_FRAME_W of ms_sobel; not checked here).
+-- Frame size: checked on each sof against MIN_SIZE (>= 1) and MAX_W (ERR_SIZE).
 -- Python model: the front end of mstrack.fixed.tracker (frames are complete
 -- arrays there); the coordinates are the array indices (column x, row y).
 library ieee;
@@ -34,7 +37,9 @@ use work.ms_stream_pkg.all;
 entity ms_stream_check is
   generic (
     COORD_W : natural := 12;  -- width of x, y and of the frame size (frames up to 2**COORD_W - 1)
-    DATA_W  : natural := 24   -- pixel width (RGB: R 23:16, G 15:8, B 7:0)
+    DATA_W  : natural := 24;  -- pixel width (RGB: R 23:16, G 15:8, B 7:0)
+    MIN_SIZE : positive := 1; -- smallest frame_width and frame_height accepted
+    MAX_W   : natural := 0    -- widest frame_width accepted (0: no limit)
   );
   port (
     clk          : in  std_logic;                               -- clock
@@ -77,6 +82,7 @@ begin
     variable cy_pre     : boolean;  -- cy = H - 2
     variable w1         : std_logic;
     variable active     : boolean;  -- the beat belongs to a frame in progress
+    variable size_bad   : boolean;  -- frame size out of range (sampled on sof)
   begin
     if rising_edge(clk) then
       px_valid    <= '0';
@@ -93,7 +99,13 @@ begin
         cx_pre  := x = pre_x;
         cy_pre  := y = pre_y;
         w1      := w_one;
-        if in_sof = '1' then
+        size_bad := frame_width < MIN_SIZE or frame_height < MIN_SIZE
+                    or (MAX_W > 0 and frame_width > MAX_W);
+        if in_sof = '1' and size_bad then
+          frame_error <= '1';
+          err_code    <= ERR_SIZE;
+          state       <= S_DROP;
+        elsif in_sof = '1' then
           if state = S_FRAME then
             frame_error <= '1';
             err_code    <= ERR_CUT;

@@ -8,24 +8,33 @@
 -- iter_c, iter_e, stop_c, stop_e, flags, err_code, box_w, box_h, frame_count).
 --
 -- Target init: a box on s_init (accepted between frames) takes effect on the next frame:
--- it is clipped (ms_box_clip: to the frame interior and to 2*MAX_HALF+1 px); a box with
--- less than 3x3 px inside is rejected (flag `rejected` in the next result; a previous
--- target stays).  The next good frame learns the model histograms (flag `init`).
+-- it is clipped (ms_box_clip: to the frame interior and to 2*MAX_HALF+1 px, for the frame
+-- size present when it is taken); a box with less than 3x3 px inside, or taken while the
+-- frame size is out of range, is rejected (flag `rejected` in the next result; a previous
+-- target stays).  The next good frame of that size learns the model histograms (flag `init`).
 -- Frames before any init give results with flag `no_target`.
 --
 -- Protocol errors (short/long line, missing start of frame, frame cut by a new start of
--- frame) give a result with flag `error` and the stream error code; that frame is not
--- tracked, the target state is unchanged, and the next good frame is tracked normally.
+-- frame, frame size out of range at a start of frame) and a good frame of another size than
+-- the target's init frame give a result with flag `error` and an error code
+-- (rtl/ms_stream_pkg.vhd); that frame is not tracked, the target state is unchanged, and the
+-- next good frame is tracked normally.  No error result is ever lost: the input is closed
+-- from the clock after the bad beat until its error result is in the FIFO.  Results are never
+-- dropped: a full result FIFO back-pressures the video input.  docs/architecture.md lists
+-- every fault and its behaviour.
 --
 -- Throughput: 1 pixel per clock while a frame streams in.  After the last pixel of a
 -- frame, s_axis_tready stays low until that frame's result is computed (both features'
 -- mean-shift loops in parallel, then fusion); see docs/performance.md for cycle counts.
--- The input is never back-pressured while a frame is streaming.
+-- The input is back-pressured while a frame is streaming only after a protocol error (until
+-- the error result is written), when the result FIFO is full, and for one clock when an init
+-- box is taken.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
 use work.ms_pkg.all;
 use work.ms_formats_pkg.all;
+use work.ms_stream_pkg.all;
 
 entity ms_tracker is
   generic (
@@ -76,7 +85,7 @@ entity ms_tracker is
   port (
     clk                  : in  std_logic;                                -- core and pixel clock
     rst                  : in  std_logic;                                -- synchronous reset
-    frame_width          : in  unsigned(COORD_W - 1 downto 0);           -- W (stable between inits)
+    frame_width          : in  unsigned(COORD_W - 1 downto 0);           -- W, sampled at each start of frame
     frame_height         : in  unsigned(COORD_W - 1 downto 0);           -- H
     -- target init (accepted between frames)
     s_init_tvalid        : in  std_logic;                                -- init box valid
@@ -138,13 +147,21 @@ architecture rtl of ms_tracker is
   signal in_frame       : std_logic := '0';
   signal line_cnt       : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal drain_cnt      : natural range 0 to DRAIN := 0;
+  signal fr_w, fr_h     : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- size of the frame in progress
+  signal size_ok        : std_logic;                      -- frame_width / frame_height in range
+  signal err_hold       : std_logic := '0';               -- an error is on its way to the FIFO: input closed
+  signal init_take      : std_logic;                      -- the init box is taken this clock
+  signal fe_err_now     : std_logic;
+  -- frame size the target was initialised for (the region is computed for it)
+  signal tgt_w, tgt_h   : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
+  signal in_fw, in_fh   : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
   -- front end
   signal ip_valid       : std_logic;
   signal ip_x, ip_y     : unsigned(COORD_W - 1 downto 0);
   signal ip_cbin        : std_logic_vector(BIN_C_W - 1 downto 0);
   signal ip_ebin        : std_logic_vector(BIN_E_W - 1 downto 0);
   signal fe_start, fe_end, fe_error : std_logic;
-  signal fe_code        : std_logic_vector(1 downto 0);
+  signal fe_code        : std_logic_vector(ERR_CODE_W - 1 downto 0);
   signal cap_we         : std_logic;
   signal cap_bank       : unsigned(clog2(LANES) - 1 downto 0);
   signal cap_addr       : unsigned(ADDR_W - 1 downto 0);
@@ -191,7 +208,7 @@ architecture rtl of ms_tracker is
   signal fifo_data      : std_logic_vector(RESULT_W - 1 downto 0);
   signal frame_count    : unsigned(FCOUNT_W - 1 downto 0) := (others => '0');
   signal err_pending    : std_logic := '0';
-  signal err_code_r     : std_logic_vector(1 downto 0);
+  signal err_code_r     : std_logic_vector(ERR_CODE_W - 1 downto 0);
   signal overflow       : std_logic := '0';
   signal init_ready     : std_logic;
 
@@ -231,7 +248,12 @@ begin
     report "ms_tracker: RESULT_W too small" severity failure;
 
   ---------------------------------------------------------------------------- video input gate
-  accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' else '0';
+  -- closed: outside T_IDLE, after a frame's last beat until its result, while an error result is
+  -- on its way to the FIFO (so that no second error can come before it: none is ever lost), and
+  -- in the clock an init box is taken (the box applies to the frame after that clock)
+  size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
+  accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
+                     and fe_err_now = '0' and init_take = '0' else '0';
   s_axis_tready <= accept;
   beat <= s_axis_tvalid and accept;
 
@@ -240,16 +262,16 @@ begin
     if rising_edge(clk) then
       if beat = '1' then
         if s_axis_tuser = '1' then
-          in_frame <= '1';
+          -- a frame size out of range: ms_stream_check drops the frame (ERR_SIZE)
+          in_frame <= size_ok;
+          fr_w <= frame_width;
+          fr_h <= frame_height;
           line_cnt <= (others => '0');
-          if s_axis_tlast = '1' and frame_height = 1 then
-            gate_closed <= '1';
-          end if;
         elsif in_frame = '1' and s_axis_tlast = '1' then
           line_cnt <= line_cnt + 1;
         end if;
         -- the frame's last beat (as far as the line count says): close until its result
-        if in_frame = '1' and s_axis_tuser = '0' and s_axis_tlast = '1' and line_cnt = frame_height - 1 then
+        if in_frame = '1' and s_axis_tuser = '0' and s_axis_tlast = '1' and line_cnt = fr_h - 1 then
           gate_closed <= '1';
           in_frame <= '0';
         end if;
@@ -283,7 +305,8 @@ begin
     port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
               in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
               ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
-              frame_start => fe_start, frame_end => fe_end, frame_error => fe_error, err_code => fe_code);
+              frame_start => fe_start, frame_end => fe_end, frame_error => fe_error,
+              error_now => fe_err_now, err_code => fe_code);
 
   reg_w_c <= resize(reg_w, COORD_W);
   reg_h_c <= resize(reg_h, COORD_W);
@@ -311,7 +334,7 @@ begin
   u_clip : entity work.ms_box_clip
     generic map (COORD_W => COORD_W, HALF_W => HALF_W, MAX_HALF => MAX_HALF, CF => CF)
     port map (clk => clk, rst => rst, in_valid => bc_valid, box_x => in_x, box_y => in_y,
-              box_w => in_w, box_h => in_h, frame_w => frame_width, frame_h => frame_height,
+              box_w => in_w, box_h => in_h, frame_w => in_fw, frame_h => in_fh,
               out_valid => bc_out_valid, rejected => bc_rejected, clipped => bc_clipped,
               clip_x => bc_x, clip_y => bc_y, clip_w => bc_w, clip_h => bc_h, ex => bc_ex,
               ey => bc_ey, cx => bc_cx, cy => bc_cy);
@@ -327,7 +350,7 @@ begin
   u_region : entity work.ms_region
     generic map (COORD_W => COORD_W, HALF_W => HALF_W, REGION_W => REGION_W, MARGIN => MARGIN, CF => CF)
     port map (clk => clk, rst => rst, in_valid => rg_valid_in, cx => c8x, cy => c8y, ex => ex_r,
-              ey => ey_r, frame_w => frame_width, frame_h => frame_height, out_valid => rg_valid,
+              ey => ey_r, frame_w => tgt_w, frame_h => tgt_h, out_valid => rg_valid,
               reg_x => rg_x, reg_y => rg_y, reg_w => rg_w, reg_h => rg_h, hi_x => rg_hi_x,
               hi_y => rg_hi_y);
 
@@ -400,6 +423,9 @@ begin
       zero_s2 := "00";
 
       -- protocol errors: one error result each (pushed when the FIFO has room)
+      if fe_err_now = '1' then
+        err_hold <= '1';
+      end if;
       if fe_error = '1' then
         if err_pending = '1' then
           overflow <= '1';
@@ -424,7 +450,15 @@ begin
 
         when T_IDLE =>
           if cap_done = '1' then                     -- a good frame is in the region RAMs
-            if init_pending = '1' or target_valid = '1' then
+            if (init_pending = '1' or target_valid = '1') and (fr_w /= tgt_w or fr_h /= tgt_h) then
+              -- not the size the target was initialised for: not tracked, state unchanged
+              res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
+                               to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
+                               zero_s2, zero_s2,
+                               flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
+                               ERR_SIZE_CHANGED, box_w, box_h, frame_count);
+              state <= T_PUSH;
+            elsif init_pending = '1' or target_valid = '1' then
               learn_run <= init_pending;
               eng_start <= '1';
               c_got <= '0';
@@ -442,23 +476,29 @@ begin
             res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
                              to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
                              zero_s2, zero_s2,
-                             flags_of('0', '0', '0', '1', '0', not target_valid, overflow),
-                             '0' & err_code_r, box_w, box_h, frame_count);
+                             flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
+                             err_code_r, box_w, box_h, frame_count);
             fifo_valid <= '1';
             frame_count <= frame_count + 1;
             overflow <= '0';
+            rejected_pending <= '0';
             if fe_error = '0' then
               err_pending <= '0';
+              if fe_err_now = '0' then
+                err_hold <= '0';
+              end if;
             end if;
-          elsif s_init_tvalid = '1' and init_ready = '1' then
+          elsif init_take = '1' then
             in_x <= s_init_x; in_y <= s_init_y; in_w <= s_init_w; in_h <= s_init_h;
+            in_fw <= frame_width; in_fh <= frame_height;
             bc_valid <= '1';
             state <= T_CLIP;
           end if;
 
         when T_CLIP =>
           if bc_out_valid = '1' then
-            if bc_rejected = '1' then
+            -- a frame size out of range when the box came: rejected too
+            if bc_rejected = '1' or in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W then
               rejected_pending <= '1';
               state <= T_IDLE;
             else
@@ -477,6 +517,8 @@ begin
             box_h <= tab_h;
             c8x <= bc_cx;
             c8y <= bc_cy;
+            tgt_w <= in_fw;
+            tgt_h <= in_fh;
             init_pending <= '1';
             init_clipped <= bc_clipped;
             target_valid <= '0';
@@ -546,8 +588,13 @@ begin
         init_pending <= '0';
         rejected_pending <= '0';
         err_pending <= '0';
+        err_hold <= '0';
         overflow <= '0';
         frame_count <= (others => '0');
+        box_w <= (others => '0');
+        box_h <= (others => '0');
+        tgt_w <= to_unsigned(3, COORD_W);
+        tgt_h <= to_unsigned(3, COORD_W);
         c8x <= (others => '0');
         c8y <= (others => '0');
         ex_r <= to_unsigned(1, HALF_W);
@@ -557,6 +604,7 @@ begin
   end process;
 
   init_ready <= '1' when state = T_IDLE and cap_done = '0' and err_pending = '0' and in_frame = '0'
-                         and gate_closed = '0' else '0';
+                         and gate_closed = '0' and err_hold = '0' and fe_err_now = '0' else '0';
+  init_take <= s_init_tvalid and init_ready;
   s_init_tready <= init_ready;
 end architecture;

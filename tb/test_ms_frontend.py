@@ -31,7 +31,7 @@ from mstrack.hdl import dut_generics
 CLK_NS = 10
 DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5}
 # error codes of rtl/ms_stream_pkg.vhd
-ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT = 0, 1, 2, 3
+ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT, ERR_SIZE = 0, 1, 2, 3, 4
 #: input beat (last one accepted in clock c) -> frame_end high in clock c + FRAME_END_LAT
 FRAME_END_LAT = 9
 
@@ -175,6 +175,16 @@ def scenario(g: dict, seed: int):
     f2 = random_frame(rng, 11, 23)
     segs.append((frame_beats(f2), [("error", ERR_CUT), ("start",), ("end",)], model_interior(f2, g), True))
     good(edge_frame(9, 16))
+    # frame size out of range at the sof (W > MAX_FRAME_W, W < 3, H < 3): one ERR_SIZE, no frame
+    mw = int(g["MAX_FRAME_W"])
+    for h, w in [(4, mw + 1), (5, 2), (2, 23)]:
+        segs.append((frame_beats(random_frame(rng, h, w)), [("error", ERR_SIZE)], [], True))
+        good(random_frame(rng, 11, 23))
+    # a frame cut by a sof of a bad size: one ERR_SIZE (no ERR_CUT), then a good frame
+    f = random_frame(rng, 11, 23)
+    bad(frame_beats(f)[:4 * 23 + 5], [("start",)], f)
+    segs.append((frame_beats(random_frame(rng, 6, 1)), [("error", ERR_SIZE)], [], True))
+    good(random_frame(rng, 11, 23))
     return segs
 
 

@@ -53,7 +53,8 @@ import cv2
 import numpy as np
 
 from .float_model import check_frame, clip_box, colour_bins, edge_bins, grey_area
-from .float_v2 import PassV2, background_model, window_pass
+from .float_v2 import (PassV2, background_model, confidence, decide_status, decimation, meanshift_v2, rescale,
+                       search_starts, window_pass)
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -167,45 +168,17 @@ class MultiFeatureV2:
         self.params = params or TrackerParams(preset="v2")
         self._shape: tuple[int, int] | None = None
 
-    # same as FloatTrackerV2.decimation
     def decimation(self, w: float, h: float) -> int:
-        p = self.params
-        d = 1
-        while max(w, h) * (1.0 + p.pad) / d > p.max_window and d < 8:
-            d *= 2
-        return d
+        return decimation(w, h, self.params)
 
     def _track(self, k: int, bins: np.ndarray, start: tuple[float, float], hx: float, hy: float,
                max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
-        """FloatTrackerV2._track for feature k (same steps, same stopping rules)."""
-        p = self.params
-        n, qb, t = self.features[k].n_bins, self._qb[k], self._t[k]
-        height, width = bins.shape
-        inner2 = 1.0 / (1.0 + p.pad) ** 2
-
-        def clamp(c: tuple[float, float]) -> tuple[float, float]:
-            return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
-
-        c0 = clamp(start)
-        p0 = window_pass(bins, n, qb, t, c0, hx, hy, inner2, p.kernel)
-        it = 0
-        for it in range(1, max_iter + 1):
-            if p0.sw <= 0:
-                break
-            c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
-            p1 = window_pass(bins, n, qb, t, c1, hx, hy, inner2, p.kernel)
-            if p1.rho < p0.rho:
-                break
-            s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
-            c0, p0 = c1, p1
-            if s2 < p.eps2:
-                break
-        return c0, p0, it
+        """FloatTrackerV2's mean shift (:func:`meanshift_v2`) for feature k."""
+        return meanshift_v2(bins, self.features[k].n_bins, self._qb[k], self._t[k], start, hx, hy,
+                            self.params, max_iter)
 
     def _confidence(self, ps: PassV2) -> float:
-        cr = min(1.0, ps.rho / self._rho_ref) if self._rho_ref > 0 else 0.0
-        cs = min(1.0, ps.share / self._share_ref) if self._share_ref > 0 else 0.0
-        return cr * cs
+        return confidence(ps, self._rho_ref, self._share_ref)
 
     def _rho_bg(self, k: int, bins: np.ndarray, cx: float, cy: float, w: float, h: float) -> float:
         o = ring_histogram(bins, self.features[k].n_bins, cx, cy, w, h, self.params.bg_ring)
@@ -264,18 +237,19 @@ class MultiFeatureV2:
         frame = check_frame(frame, self._shape)
         p = self.params
         w, h = self._size
-        d = self.decimation(w, h)
+        d = self.decimation(w, h) * (2 if self._lost else 1)  # as FloatTrackerV2: lost at 2D
         ff = _FrameFeatures(frame)
         bins = [ff.bins(f, d) for f in self.features]
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
         inner2 = 1.0 / pad ** 2
         start = (self._centre[0] / d, self._centre[1] / d)
-        c, ps, it = self._track(0, bins[0], start, hx, hy, p.max_iter)
+        n_iter = p.search_iter if self._lost else p.max_iter  # as FloatTrackerV2
+        c, ps, it = self._track(0, bins[0], start, hx, hy, n_iter)
         conf = self._confidence(ps)
         ac, ae, it_e, rho_e = 1.0, 0.0, 0, 0.0
         if len(self.features) == 2:
-            ce, pse, it_e = self._track(1, bins[1], start, hx, hy, p.max_iter)
+            ce, pse, it_e = self._track(1, bins[1], start, hx, hy, n_iter)
             rho_e = pse.rho
             ac, ae = self._alphas([ps.rho, pse.rho], conf)
             if ae > 0:
@@ -286,24 +260,13 @@ class MultiFeatureV2:
                     conf = self._confidence(ps)
         searched = 0
         if self._lost:
-            for sy in (-1, 0, 1):
-                for sx in (-1, 0, 1):
-                    if sx == 0 and sy == 0:
-                        continue
-                    s0 = (start[0] + sx * p.search_step * 2 * hx, start[1] + sy * p.search_step * 2 * hy)
-                    c2, ps2, _ = self._track(0, bins[0], s0, hx, hy, p.search_iter)
-                    searched += 1
-                    conf2 = self._confidence(ps2)
-                    if conf2 > conf:
-                        c, ps, conf = c2, ps2, conf2
-        if conf < (p.conf_reacquire if self._lost else p.conf_lost):
-            status = Status.LOST
-        elif self._lost:
-            status = Status.REACQUIRED
-        elif conf < p.conf_uncertain:
-            status = Status.UNCERTAIN
-        else:
-            status = Status.OK
+            for s0 in search_starts(start, hx, hy, p):
+                c2, ps2, _ = self._track(0, bins[0], s0, hx, hy, p.search_iter)
+                searched += 1
+                conf2 = self._confidence(ps2)
+                if conf2 > conf:
+                    c, ps, conf = c2, ps2, conf2
+        status = decide_status(conf, self._lost, p)
         self._lost = status == Status.LOST
         self._centre = (c[0] * d, c[1] * d)
         if status == Status.OK:
@@ -311,12 +274,7 @@ class MultiFeatureV2:
             self._rho_ref += a * (ps.rho - self._rho_ref)
             self._share_ref += a * (ps.share - self._share_ref)
         if p.scale_gain > 0 and ps.nt > 0:
-            est = math.sqrt(ps.spread / self._spread_ref)
-            est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
-            s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / self._size0[0] - 1.0)
-            s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
-            self._size = (min(max(w * s, 3.0), float(self._shape[1])),
-                          min(max(h * s, 3.0), float(self._shape[0])))
+            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p)
         if self.fusion == "disc_frame" and len(self.features) == 2 and status == Status.OK:
             # background rho re-measured on the ring around the box just found (for the next frame)
             for k in range(2):

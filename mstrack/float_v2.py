@@ -357,6 +357,78 @@ class LazyBins:
         return self.values[ys, xs]
 
 
+def decimation(w: float, h: float, p: TrackerParams) -> int:
+    """D: the smallest power of two (<= 8) with max(w, h) (1 + pad) / D <= max_window."""
+    d = 1
+    while max(w, h) * (1.0 + p.pad) / d > p.max_window and d < 8:
+        d *= 2
+    return d
+
+
+def meanshift_v2(bins: np.ndarray | LazyBins, n_bins: int, q: np.ndarray, t: np.ndarray,
+                 start: tuple[float, float], hx: float, hy: float, p: TrackerParams,
+                 max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
+    """Mean shift of one feature from ``start`` (decimated coordinates), the paper's loop on
+    :func:`window_pass`: stop when the weights vanish, when rho falls (keep the previous centre)
+    or when the squared step is below eps2.  Returns (centre, pass at the centre, iterations)."""
+    height, width = bins.shape[:2]
+    inner2 = 1.0 / (1.0 + p.pad) ** 2
+
+    def clamp(c: tuple[float, float]) -> tuple[float, float]:
+        return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
+
+    c0 = clamp(start)
+    p0 = window_pass(bins, n_bins, q, t, c0, hx, hy, inner2, p.kernel)
+    it = 0
+    for it in range(1, max_iter + 1):
+        if p0.sw <= 0:
+            break
+        c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
+        p1 = window_pass(bins, n_bins, q, t, c1, hx, hy, inner2, p.kernel)
+        if p1.rho < p0.rho:
+            break
+        s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
+        c0, p0 = c1, p1
+        if s2 < p.eps2:
+            break
+    return c0, p0, it
+
+
+def confidence(ps: PassV2, rho_ref: float, share_ref: float) -> float:
+    """min(1, rho / rho_ref) * min(1, share / share_ref) (0 for a zero reference)."""
+    cr = min(1.0, ps.rho / rho_ref) if rho_ref > 0 else 0.0
+    cs = min(1.0, ps.share / share_ref) if share_ref > 0 else 0.0
+    return cr * cs
+
+
+def search_starts(start: tuple[float, float], hx: float, hy: float,
+                  p: TrackerParams) -> list[tuple[float, float]]:
+    """The 8 wide-search start points: start +- search_step window diameters in x and y."""
+    return [(start[0] + sx * p.search_step * 2 * hx, start[1] + sy * p.search_step * 2 * hy)
+            for sy in (-1, 0, 1) for sx in (-1, 0, 1) if sx or sy]
+
+
+def decide_status(conf: float, was_lost: bool, p: TrackerParams) -> Status:
+    """lost / reacquired / uncertain / ok from the confidence and whether the target was lost."""
+    if conf < (p.conf_reacquire if was_lost else p.conf_lost):
+        return Status.LOST
+    if was_lost:
+        return Status.REACQUIRED
+    return Status.UNCERTAIN if conf < p.conf_uncertain else Status.OK
+
+
+def rescale(size: tuple[float, float], size0: tuple[float, float], spread: float, spread_ref: float,
+            shape: tuple[int, int], p: TrackerParams) -> tuple[float, float]:
+    """One frame's size update: est = sqrt(spread / spread_ref) clamped to 1 +- step;
+    s = clamp(1 + gain (est - 1) - reg (w / w0 - 1), 1 +- step); size s, in [3, frame]."""
+    w, h = size
+    est = math.sqrt(spread / spread_ref)
+    est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
+    s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / size0[0] - 1.0)
+    s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
+    return (min(max(w * s, 3.0), float(shape[1])), min(max(h * s, 3.0), float(shape[0])))
+
+
 class FloatTrackerV2:
     """Float reference of tracker v2.  Use through :class:`mstrack.Tracker` (preset="v2").
 
@@ -395,11 +467,7 @@ class FloatTrackerV2:
     # ------------------------------------------------------------------ helpers
     def decimation(self, w: float, h: float) -> int:
         """D: the smallest power of two with max(w, h) (1 + pad) / D <= max_window."""
-        p = self.params
-        d = 1
-        while max(w, h) * (1.0 + p.pad) / d > p.max_window and d < 8:
-            d *= 2
-        return d
+        return decimation(w, h, self.params)
 
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
         return colour_bins(frame[::d, ::d], self.params.colour_bits)
@@ -418,30 +486,7 @@ class FloatTrackerV2:
         p = self.params
         if isinstance(bins, np.ndarray) and bins.ndim == 3:
             return self._track_numba(bins, start, hx, hy, max_iter)
-        height, width = bins.shape[:2]
-        inner2 = 1.0 / (1.0 + p.pad) ** 2
-
-        def clamp(c: tuple[float, float]) -> tuple[float, float]:
-            return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
-
-        def window(c: tuple[float, float]) -> PassV2:
-            return window_pass(bins, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
-
-        c0 = clamp(start)
-        p0 = window(c0)
-        it = 0
-        for it in range(1, max_iter + 1):
-            if p0.sw <= 0:
-                break
-            c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
-            p1 = window(c1)
-            if p1.rho < p0.rho:
-                break
-            s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
-            c0, p0 = c1, p1
-            if s2 < p.eps2:
-                break
-        return c0, p0, it
+        return meanshift_v2(bins, p.n_colour_bins, self._qb, self._t, start, hx, hy, p, max_iter)
 
     def _track_numba(self, frame: np.ndarray, start: tuple[float, float], hx: float, hy: float,
                      max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
@@ -466,9 +511,7 @@ class FloatTrackerV2:
             sx, sy, it0 = c1x, c1y, it  # go on from c1 (its pass is recomputed: the same numbers)
 
     def _confidence(self, ps: PassV2) -> float:
-        cr = min(1.0, ps.rho / self._rho_ref) if self._rho_ref > 0 else 0.0
-        cs = min(1.0, ps.share / self._share_ref) if self._share_ref > 0 else 0.0
-        return cr * cs
+        return confidence(ps, self._rho_ref, self._share_ref)
 
     # ------------------------------------------------------------------ API
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
@@ -526,24 +569,13 @@ class FloatTrackerV2:
         searched = 0
         if self._lost:
             # wide search: mean shift from start points around the last centre, best confidence wins
-            for sy in (-1, 0, 1):
-                for sx in (-1, 0, 1):
-                    if sx == 0 and sy == 0:
-                        continue
-                    s0 = (start[0] + sx * p.search_step * 2 * hx, start[1] + sy * p.search_step * 2 * hy)
-                    c2, ps2, _ = self._track(bins, s0, hx, hy, p.search_iter)
-                    searched += 1
-                    conf2 = self._confidence(ps2)
-                    if conf2 > conf:
-                        c, ps, conf = c2, ps2, conf2
-        if conf < (p.conf_reacquire if self._lost else p.conf_lost):
-            status = Status.LOST
-        elif self._lost:
-            status = Status.REACQUIRED
-        elif conf < p.conf_uncertain:
-            status = Status.UNCERTAIN
-        else:
-            status = Status.OK
+            for s0 in search_starts(start, hx, hy, p):
+                c2, ps2, _ = self._track(bins, s0, hx, hy, p.search_iter)
+                searched += 1
+                conf2 = self._confidence(ps2)
+                if conf2 > conf:
+                    c, ps, conf = c2, ps2, conf2
+        status = decide_status(conf, self._lost, p)
         self._lost = status == Status.LOST
         self._centre = (c[0] * d, c[1] * d)  # lost: the search's best candidate (not trusted: ok False)
         if status == Status.OK:
@@ -552,12 +584,7 @@ class FloatTrackerV2:
             self._share_ref += a * (ps.share - self._share_ref)
         # scale: every frame (a lost or uncertain target changes size too), from the spread
         if p.scale_gain > 0 and ps.nt > 0:
-            est = math.sqrt(ps.spread / self._spread_ref)
-            est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
-            s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / self._size0[0] - 1.0)
-            s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
-            self._size = (min(max(w * s, 3.0), float(self._shape[1])),
-                          min(max(h * s, 3.0), float(self._shape[0])))
+            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p)
         box = box_from_centre_index(*self._centre, *self._size)
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=it, iter_e=0, status=status, confidence=conf,

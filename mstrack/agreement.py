@@ -180,6 +180,7 @@ def compare_sequence(seq_dir: str | Path, max_frames: int | None = None, resync:
     """
     seq = load_sequence(seq_dir)
     n = len(seq) if max_frames is None else min(len(seq), max_frames)
+    params = {"preset": "paper", **params}  # the RTL core's algorithm unless a preset is asked for
     tp_params = {k: v for k, v in params.items() if k in _tracker_fields()}
     flt = Tracker(model="float", **tp_params)
     fix = Tracker(model="fixed", **params)
@@ -307,7 +308,7 @@ def float_on_grid(seq_dir: str | Path, grid: float, max_frames: int | None = Non
     if grid:
         fm.kernel_window = snapped
     try:
-        trk = Tracker(model="float")
+        trk = Tracker(model="float", preset="paper")  # the paper's float model (kernel_window above)
         out = np.empty((n, 2))
         for i in range(n):
             frame = seq.frame(i)

@@ -42,7 +42,10 @@ from .data import DataError, VideoSource, load_dataset, open_video_writer
 from .types import Box, Status, box_centre_index
 
 DEFAULT_DATASET = "../shared/data/sequences"
-DEFAULT_TRACKER = "mstrack-fused-flat"
+#: Tracker of ``track``, ``demo`` and ``bench`` when none is given: tracker v2, the best measured
+#: (docs/results.md); ``--preset paper`` runs :data:`PAPER_TRACKER`, the RTL core's algorithm.
+DEFAULT_TRACKER = "mstrack-v2"
+PAPER_TRACKER = "mstrack-fused-flat"
 #: Default box on a person (dark jacket, blue jeans) in frame 0 of OpenCV's vtest.avi (768x576); he
 #: walks left, stands by the lamp post among other people (frames ~25-150), then walks right.
 VTEST_BOX = (500.0, 157.0, 30.0, 76.0)
@@ -52,6 +55,10 @@ VTEST_CANDIDATES = (
     "/usr/local/share/opencv4/samples/data/vtest.avi",
 )
 CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_c", "confidence", "status")
+#: Decimals of positions (x, y, w, h, cx, cy: 1e-6 px) and of rho_c, rho_e, alpha_c in results.csv /
+#: results.json: no float noise (145.96000000000004 -> 145.96); the fixed model's values (multiples
+#: of 2**-CF) are exact up to CF = 6.
+POSITION_DECIMALS = 6
 #: Decimals of ``confidence`` in results.csv / results.json (0..1; NaN / null for trackers without one).
 CONFIDENCE_DECIMALS = 4
 #: Overlays of frames narrower than this are upscaled (nearest neighbour, integer factor) so that the
@@ -124,8 +131,9 @@ def _row(i: int, res: Any, box: Box, status: str, confidence: bool = False) -> d
     cx, cy = getattr(res, "centre", None) or box_centre_index(box)
     g = lambda k: float(getattr(res, k, math.nan))  # noqa: E731
     conf = round(g("confidence"), CONFIDENCE_DECIMALS) if confidence and res is not None else math.nan
-    return {"frame": i, "x": box.x, "y": box.y, "w": box.w, "h": box.h, "cx": float(cx), "cy": float(cy),
-            "rho_c": g("rho_c"), "rho_e": g("rho_e"), "alpha_c": g("alpha_c"), "confidence": conf,
+    r = lambda v: round(float(v), POSITION_DECIMALS)  # noqa: E731  (NaN stays NaN)
+    return {"frame": i, "x": r(box.x), "y": r(box.y), "w": r(box.w), "h": r(box.h), "cx": r(cx), "cy": r(cy),
+            "rho_c": r(g("rho_c")), "rho_e": r(g("rho_e")), "alpha_c": r(g("alpha_c")), "confidence": conf,
             "status": status}
 
 
@@ -255,9 +263,27 @@ class _Display:
                 pass
 
 
+def init_box_note(given: Box, got: Box, frame_shape: tuple[int, ...], message: str = "") -> str | None:
+    """One line saying how the tracker changed the init box ``given`` into ``got`` on a frame of
+    ``frame_shape`` (H, W, ...): clipped to the frame and/or shrunk (to the model's largest
+    window by more than a pixel); None otherwise (sub-pixel rounding of the box is not reported)."""
+    hgt, wid = frame_shape[0], frame_shape[1]
+    x0, y0 = max(given.x, 0.0), max(given.y, 0.0)
+    x1, y1 = min(given.x + given.w, float(wid)), min(given.y + given.h, float(hgt))
+    clipped = (x0, y0, x1, y1) != (given.x, given.y, given.x + given.w, given.y + given.h)
+    shrunk = got.w < (x1 - x0) - 1.01 or got.h < (y1 - y0) - 1.01
+    if not (clipped or shrunk):
+        return None
+    why = " and ".join(w for w, on in ((f"clipped to the {wid}x{hgt} frame", clipped),
+                                       ("shrunk to the largest window the model tracks", shrunk)) if on)
+    f = lambda b: "(" + ", ".join(f"{v:g}" for v in (round(c, 2) for c in b)) + ")"  # noqa: E731
+    return (f"init box {f(given)} {why}: tracking {f(got)} (x, y, w, h)"
+            + (f" [{message}]" if message else ""))
+
+
 def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, out_dir: Path, fps: float = 30.0,
                  gt: np.ndarray | None = None, show: bool = False, max_frames: int | None = None,
-                 progress: bool = False, source: VideoSource | None = None
+                 progress: bool = False, source: VideoSource | None = None, warn_init: bool = False
                  ) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     """Track through ``frames`` and write results.csv, results.json and an overlay video.
 
@@ -280,6 +306,8 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
         The source ``frames`` come from: unreadable images are then named
         (``frame_errors`` in results.json) and a video that decoded fewer
         frames than its container announces is reported (``source``).
+    warn_init : bool
+        Warn on stderr when the tracker clips or shrinks the init box (:func:`init_box_note`).
 
     Returns
     -------
@@ -310,11 +338,15 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
     rows: list[dict[str, Any]] = []
     writer = None
     video_path = None
-    size = None
+    size: tuple[int, int] = (0, 0)
     display = _Display(show)
     t_upd, n_upd = 0.0, 0
+    total: int | None = len(frames) if hasattr(frames, "__len__") else len(source) if source is not None else None  # type: ignore[arg-type]
+    if total is not None and max_frames is not None:
+        total = min(total, max_frames)
     try:
-        for i, frame in enumerate(tqdm(frames, desc="track", disable=not progress, unit="f")):
+        for i, frame in enumerate(tqdm(frames, desc="track", disable=not progress, unit="f", total=total or None,
+                                       dynamic_ncols=True)):
             if max_frames is not None and i >= max_frames:
                 break
             if i == 0:
@@ -325,6 +357,9 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
                     raise DataError("frame 0 is unreadable", getattr(source, "path", out_dir))
                 res = tracker.init(frame, box)
                 b = to_box(res) if res is not None else box
+                note = init_box_note(box, b, frame.shape, getattr(res, "message", "")) if warn_init else None
+                if note:
+                    _warn(note)
                 row = _row(0, res, b, result_status(res) if res is not None else Status.INIT.value, conf)
                 size = (frame.shape[1], frame.shape[0])
             else:
@@ -379,26 +414,45 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
 
 
 def resolve_tracker(tracker: str | None, preset: str | None) -> str:
-    """Tracker name from ``--tracker`` and ``--preset`` (track, demo).
+    """Tracker name from ``--tracker`` and ``--preset`` (track, demo, bench).
 
-    ``--preset v2`` runs ``mstrack-v2`` (colour only, so it takes no other ``--tracker``);
-    ``--preset paper`` (the default) runs ``--tracker`` or :data:`DEFAULT_TRACKER`."""
+    No option: :data:`DEFAULT_TRACKER` (mstrack-v2).  ``--preset v2`` runs ``mstrack-v2`` (colour
+    only, so it takes no other ``--tracker``); ``--preset paper`` runs ``--tracker`` or
+    :data:`PAPER_TRACKER` (mstrack-fused-flat, the paper's algorithm: the RTL core's).  An unknown
+    name is refused with the list of known ones."""
+    from .evaluate import tracker_names
+
     v2 = "mstrack-v2"
+    if tracker is not None and tracker not in tracker_names():
+        raise ValueError(f"unknown tracker {tracker!r}; known: {', '.join(tracker_names())}")
     if preset == "v2":
         if tracker not in (None, v2):
             raise ValueError(f"--preset v2 runs {v2}; leave out --tracker {tracker} (or use --preset paper)")
         return v2
-    if preset == "paper" and tracker == v2:
-        raise ValueError(f"--tracker {v2} is the v2 preset; leave out --preset paper")
+    if preset == "paper":
+        if tracker == v2:
+            raise ValueError(f"--tracker {v2} is the v2 preset; leave out --preset paper")
+        return tracker or PAPER_TRACKER
     return tracker or DEFAULT_TRACKER
 
 
+def _tracker_help() -> str:
+    from .evaluate import tracker_names
+
+    return (f"tracker name: {', '.join(tracker_names())} (default {DEFAULT_TRACKER}, the best measured, "
+            "docs/results.md; with --preset paper: " + PAPER_TRACKER + ")")
+
+
+MODEL_HELP = ("mstrack model: float (the floating-point reference, default) or fixed (the bit-accurate "
+              "fixed-point model of the hardware core; slower)")
+
+
 def _add_preset_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--tracker", default=None,
-                   help=f"tracker name (default {DEFAULT_TRACKER}; mstrack-v2 with --preset v2)")
+    p.add_argument("--tracker", default=None, metavar="NAME", help=_tracker_help())
     p.add_argument("--preset", choices=PRESETS, default=None,
-                   help="mstrack algorithm: paper (default; the paper's fixed-size colour + edge fusion) or "
-                        "v2 (tracker v2: scale, confidence, loss and re-acquisition; float model only for now)")
+                   help="mstrack algorithm: v2 (default: tracker v2, scale, confidence, loss and "
+                        "re-acquisition) or paper (the paper's fixed-size colour + edge fusion, as the RTL "
+                        "core runs it today; then --tracker picks its variant)")
 
 
 # --------------------------------------------------------------------------- eval
@@ -414,7 +468,7 @@ def _cmd_eval(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
     seqs = load_dataset(args.dataset, _csv_list(args.sequences))
     ev = evaluate(seqs, names, args.out, model=args.model, force=args.force, quiet=args.quiet,
-                  max_frames=args.max_frames)
+                  max_frames=args.max_frames, jobs=args.jobs, scheduler=args.scheduler)
     for s, per in ev.failed.items():
         for t, reason in per.items():
             _warn(f"{t} on {s} failed, sequence left out of the scores: {reason}")
@@ -433,12 +487,20 @@ def register_eval(sub: argparse._SubParsersAction) -> None:
                        description="Run trackers over every sequence of DATASET_DIR (OPE) and write a report.")
     p.add_argument("dataset", metavar="DATASET_DIR", help="folder of OTB/VOT sequence folders")
     p.add_argument("--trackers", help="comma-separated tracker names (default: all registered)")
-    p.add_argument("--model", choices=("float", "fixed"), default="float", help="mstrack model")
+    p.add_argument("--model", choices=("float", "fixed"), default="float", help=MODEL_HELP)
     p.add_argument("--out", default="out/eval", help="report folder (default out/eval)")
-    p.add_argument("--sequences", help="comma-separated sequence names (default: all)")
+    p.add_argument("--sequences", help="comma-separated sequence names (default: all; case-insensitive when "
+                                       "that names one sequence)")
     p.add_argument("--max-frames", type=_positive_int, help="use at most N frames per sequence (N >= 1)")
     p.add_argument("--force", action="store_true", help="ignore cached per-sequence results")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.add_argument("--jobs", "-j", type=_positive_int, default=1, metavar="N",
+                   help="run N (tracker, sequence) runs at once in worker processes (default 1); the "
+                        "results are those of one process, only the fps differ")
+    p.add_argument("--scheduler", nargs="?", const="local", default=None, metavar="ADDRESS",
+                   help="run on Dask distributed: the scheduler at ADDRESS (tcp://host:8786; its workers "
+                        "must see DATASET_DIR at the same path), or, with no ADDRESS, a local cluster of "
+                        "--jobs workers (docs/distributed.md)")
     p.set_defaults(func=_cmd_eval)
 
 
@@ -461,7 +523,7 @@ def _cmd_track(args: argparse.Namespace) -> int:
     tracker = make_tracker(resolve_tracker(args.tracker, args.preset), args.model)
     rows, info = track_frames(tracker, src.frames(on_bad="none"), box, out, fps=src.fps, gt=gt, show=args.show,
                               max_frames=args.max_frames, progress=not args.quiet and sys.stderr.isatty(),
-                              source=src)
+                              source=src, warn_init=True)
     for i, err in info["frame_errors"].items():
         _warn(f"frame {i}: {err}")
     if src.truncated:
@@ -477,8 +539,11 @@ def register_track(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("track", help="track a target in a video, image folder or sequence folder",
                        description="Track one target and write results.csv, results.json and an overlay video.")
     p.add_argument("source", metavar="SOURCE", help="video file, image folder or OTB/VOT sequence folder")
-    p.add_argument("--box", type=_parse_box, help="initial box x,y,w,h, 0-based pixels (default: frame 0 GT)")
-    p.add_argument("--model", choices=("float", "fixed"), default="float")
+    p.add_argument("--box", type=_parse_box, metavar="X,Y,W,H",
+                   help="initial box, 0-based pixels, e.g. --box -5,10,20,20 (default: frame 0 ground truth); "
+                        "a box outside the frame is clipped, one larger than the model's window shrunk, "
+                        "with a warning")
+    p.add_argument("--model", choices=("float", "fixed"), default="float", help=MODEL_HELP)
     _add_preset_options(p)
     p.add_argument("--out", help="output folder (default out/track/<source name>)")
     p.add_argument("--max-frames", type=_positive_int, help="stop after N frames (N >= 1)")
@@ -554,7 +619,8 @@ def register_bench(sub: argparse._SubParsersAction) -> None:
                                    "Without DATASET_DIR: a synthetic 640x360 scene with a 64x64 target.")
     p.add_argument("dataset", metavar="DATASET_DIR", nargs="?", help="folder of sequences (optional)")
     p.add_argument("--sequences", help="comma-separated sequence names (default: all)")
-    p.add_argument("--model", choices=("float", "fixed", "both"), default="both")
+    p.add_argument("--model", choices=("float", "fixed", "both"), default="both",
+                   help="float reference, fixed-point model, or both (default)")
     p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"mstrack variant (default {DEFAULT_TRACKER})")
     p.add_argument("--frames", type=int, default=100, help="frames per sequence (default 100)")
     p.add_argument("--write-docs", action="store_true", help="write the table to docs/bench.md")
@@ -625,7 +691,7 @@ def register_demo(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("demo", help="run the tracker on a synthetic scene and OpenCV's vtest.avi",
                        description="Default job: needs no dataset. Writes overlays and results to --out.")
     p.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
-    p.add_argument("--model", choices=("float", "fixed"), default="float", help="mstrack model")
+    p.add_argument("--model", choices=("float", "fixed"), default="float", help=MODEL_HELP)
     _add_preset_options(p)
     p.add_argument("--frames", type=int, default=200, help="vtest.avi frames to track (default 200)")
     p.add_argument("--synthetic-frames", type=int, default=120, help="synthetic scene length (default 120)")
@@ -674,15 +740,73 @@ def build_parser(extensions: list[str] | None = None) -> argparse.ArgumentParser
     return parser
 
 
+#: Options whose value is a list of numbers that may start with "-" (``--box -5,10,20,20``).
+NUMBER_LIST_OPTIONS = ("--box",)
+
+
+def join_number_lists(argv: list[str]) -> list[str]:
+    """``["--box", "-5,10,20,20"]`` -> ``["--box=-5,10,20,20"]``: argparse would take a value that
+    starts with "-" (and is not one number) for an option; the ``--box=`` form needs no help."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a in NUMBER_LIST_OPTIONS and i + 1 < len(argv) and argv[i + 1].startswith("-") \
+                and all(_is_number(t) for t in argv[i + 1].replace(" ", "").split(",")):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
+
+
+def _is_number(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+COMPILE_NOTICE = ("mstrack: compiling the numba kernels (first run after an install or update, about 10 s; "
+                  "cached on disk afterwards)...")
+
+
+def install_compile_notice(file: Any = None) -> bool:
+    """Print :data:`COMPILE_NOTICE` once, on stderr, when numba starts its first compilation in this
+    process (a numba event listener: nothing is printed when the kernels load from numba's disk
+    cache).  False if numba is not installed."""
+    try:
+        from numba.core import event
+    except ImportError:
+        return False
+
+    class _Notice(event.Listener):
+        said = False
+
+        def on_start(self, ev: Any) -> None:
+            if not self.said:
+                self.said = True
+                print(COMPILE_NOTICE, file=file or sys.stderr, flush=True)
+
+        def on_end(self, ev: Any) -> None:
+            pass
+
+    event.register("numba:compile", _Notice())
+    return True
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mstrack`` command; returns the exit code."""
-    argv = list(sys.argv[1:] if argv is None else argv)
+    argv = join_number_lists(list(sys.argv[1:] if argv is None else argv))
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
     args.command_line = "mstrack " + shlex.join(argv)
+    install_compile_notice()
     try:
         return int(args.func(args) or 0)
     except (DataError, ValueError, ImportError, RuntimeError, OSError) as exc:

@@ -316,8 +316,10 @@ def load_dataset(path: str | Path, names: list[str] | None = None, strict: bool 
     path : str or Path
         Dataset folder, one subfolder per sequence.
     names : list of str, optional
-        Only these sequences (folder names), in this order; unknown names
-        raise :class:`DataError`.
+        Only these sequences (folder names), in this order.  A name that is
+        no folder matches the one folder whose name is the same but for case
+        (``crossing`` -> ``Crossing``); unknown or ambiguous names raise
+        :class:`DataError` listing the sequences of the dataset.
     """
     d = Path(path)
     if not d.is_dir():
@@ -326,10 +328,25 @@ def load_dataset(path: str | Path, names: list[str] | None = None, strict: bool 
         twice = sorted({n for n in names if names.count(n) > 1})
         if twice:
             raise DataError(f"sequence {', '.join(twice)} given more than once", d)
-        missing = [n for n in names if not _is_sequence_dir(d / n)]
+        avail = sorted((p.name for p in d.iterdir() if _is_sequence_dir(p)), key=str.lower)
+        resolved: list[str] = []
+        missing: list[str] = []
+        for n in names:
+            if _is_sequence_dir(d / n):
+                resolved.append(n)
+                continue
+            cands = [a for a in avail if a.lower() == n.lower()]
+            if len(cands) == 1:
+                resolved.append(cands[0])
+            else:
+                missing.append(n + (f" (ambiguous: {', '.join(cands)})" if cands else ""))
         if missing:
-            raise DataError(f"no sequence named {', '.join(missing)}", d)
-        seqs = [load_sequence(d / n, strict=strict) for n in names]
+            raise DataError(f"no sequence named {', '.join(missing)}; the sequences are: "
+                            f"{', '.join(avail) or '(none)'}", d)
+        twice = sorted({n for n in resolved if resolved.count(n) > 1})
+        if twice:
+            raise DataError(f"sequence {', '.join(twice)} given more than once", d)
+        seqs = [load_sequence(d / n, strict=strict) for n in resolved]
     else:
         seqs = [load_sequence(p, strict=strict) for p in sorted(d.iterdir()) if _is_sequence_dir(p)]
     if not seqs:

@@ -31,7 +31,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, Iterator
 
 import numpy as np
 from tqdm import tqdm
@@ -375,9 +375,79 @@ def aggregate(runs: dict[str, dict[str, SequenceRun]], sequences: list[Sequence]
     return ev
 
 
+#: Rough update() rate (frames per second, docs/results.md) of the slow trackers: parallel runs
+#: are handed out longest first (estimated frames / rate), so one long run does not finish last.
+FPS_HINT = {"opencv-csrt": 25.0, "opencv-kcf": 200.0, "mstrack-v2": 500.0}
+
+
+def _run_job(factory: Callable[[str, str], Any], name: str, model: str, seq: Sequence, n: int, label: str,
+             m: str) -> tuple[str, Any]:
+    """One (tracker, sequence) run in a worker process (``--jobs`` / Dask): ``("ok", SequenceRun)`` or
+    ``("failed", reason)`` (the reason as text: exceptions with custom arguments do not unpickle)."""
+    try:
+        return "ok", run_sequence(factory(name, model), seq, n, label=label, model=m)
+    except (DataError, RuntimeError, ValueError) as exc:
+        return "failed", str(exc)
+
+
+class _Pool:
+    """Runs :func:`_run_job` calls: in this process (jobs=1), on a local process pool (``jobs`` > 1)
+    or on a Dask cluster (``scheduler``); :meth:`results` yields ``(index, outcome)`` as runs finish."""
+
+    def __init__(self, jobs: int, scheduler: str | None) -> None:
+        self.jobs, self.scheduler = jobs, scheduler
+        self.where = ("this process" if jobs == 1 and scheduler is None else
+                      f"{jobs} processes" if scheduler is None else
+                      f"a local Dask cluster of {jobs} workers" if scheduler == "local" else
+                      f"the Dask scheduler at {scheduler}")
+
+    def results(self, calls: list[tuple[Any, ...]]) -> Iterator[tuple[int, tuple[str, Any]]]:
+        if not calls:
+            return
+        if self.scheduler is not None:
+            yield from self._dask(calls)
+        elif self.jobs == 1:
+            for i, c in enumerate(calls):
+                yield i, _run_job(*c)
+        else:
+            import concurrent.futures as cf
+            import multiprocessing as mp
+            # spawn: a fresh interpreter per worker (forking a process that runs OpenCV's thread pool
+            # can deadlock); workers import mstrack and load the numba kernels from their disk cache
+            with cf.ProcessPoolExecutor(max_workers=self.jobs, mp_context=mp.get_context("spawn")) as ex:
+                futs = {ex.submit(_run_job, *c): i for i, c in enumerate(calls)}
+                for f in cf.as_completed(futs):
+                    yield futs[f], f.result()
+
+    def _dask(self, calls: list[tuple[Any, ...]]) -> Iterator[tuple[int, tuple[str, Any]]]:
+        try:
+            from distributed import Client, LocalCluster, as_completed
+        except ImportError as exc:
+            raise ImportError("--scheduler needs Dask distributed: pip install 'dask[distributed]' "
+                              "(tools/setup.sh installs it, extra 'dist')") from exc
+        import logging
+        cluster = None
+        if self.scheduler == "local":
+            cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+            client = Client(cluster)
+        else:
+            client = Client(self.scheduler, timeout="20s")
+        try:
+            futs = {client.submit(_run_job, *c, pure=False, key=f"mstrack-run-{i}-{c[5]}-{c[3].name}"): i
+                    for i, c in enumerate(calls)}
+            for f in as_completed(list(futs)):
+                yield futs[f], f.result()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
 def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | Path, model: str = "float",
              force: bool = False, quiet: bool = False, max_frames: int | None = None,
-             factory: Callable[[str, str], Any] = make_tracker) -> Evaluation:
+             factory: Callable[[str, str], Any] = make_tracker, jobs: int = 1,
+             scheduler: str | None = None) -> Evaluation:
     """Run trackers over sequences (OPE), with result caching, and aggregate.
 
     Parameters
@@ -396,15 +466,29 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
     max_frames : int, optional
         Use at most this many frames of each sequence.
     factory : callable
-        ``factory(name, model) -> tracker``; defaults to :func:`make_tracker`.
+        ``factory(name, model) -> tracker``; defaults to :func:`make_tracker`.  With ``jobs`` > 1
+        or a ``scheduler`` it must be picklable (a module-level function).
+    jobs : int
+        Runs (tracker x sequence) in parallel: 1 runs them in this process; N > 1 on N worker
+        processes of this machine (or N workers of the local Dask cluster).  The results are
+        the same as with one process; only the timings (fps) differ.
+    scheduler : str, optional
+        Run on Dask distributed: ``"local"`` starts a ``LocalCluster`` of ``jobs`` workers on this
+        machine, anything else is the address of a running scheduler (``tcp://host:8786``) whose
+        workers see the sequences at the same paths and run the same mstrack.
 
-    A run that raises :class:`DataError`, ``RuntimeError`` or ``ValueError`` (unreadable frame,
-    invalid frame-0 box, tracker error) is recorded in ``Evaluation.failed`` and the evaluation
-    goes on; ValueError for ``max_frames < 1`` or two sequences with the same name.
+    Runs are looked up in the cache first (here, in this process); the others are handed out
+    longest first and each is written to the cache as soon as it comes back, so an interrupted
+    evaluation resumes where it stopped.  A run that raises :class:`DataError`, ``RuntimeError``
+    or ``ValueError`` (unreadable frame, invalid frame-0 box, tracker error) is recorded in
+    ``Evaluation.failed`` and the evaluation goes on; ValueError for ``max_frames < 1``, ``jobs
+    < 1`` or two sequences with the same name.
     """
     if max_frames is not None and (isinstance(max_frames, bool) or not isinstance(max_frames, int)
                                    or max_frames < 1):
         raise ValueError(f"max_frames must be a positive integer, got {max_frames!r}")
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"jobs must be a positive integer, got {jobs!r}")
     seen: set[str] = set()
     for s in sequences:
         if s.name in seen:
@@ -412,25 +496,58 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
         seen.add(s.name)
     progress = not quiet and sys.stderr.isatty()
     names = list(trackers)
-    runs: dict[str, dict[str, SequenceRun]] = {label: {} for label in dict.fromkeys(run_label(t, model) for t in names)}
-    failed: dict[str, dict[str, str]] = {}
-    jobs = [(t, s) for t in names for s in sequences]
-    for name, seq in tqdm(jobs, desc="eval", disable=not progress, unit="seq"):
+    labels = list(dict.fromkeys(run_label(t, model) for t in names))
+    done: dict[tuple[str, str], SequenceRun] = {}
+    reasons: dict[tuple[str, str], str] = {}
+    todo: list[tuple[tuple[Any, ...], Path, dict[str, Any], float]] = []
+    for name, seq in [(t, s) for t in names for s in sequences]:
         label = run_label(name, model)
         m = model if uses_model(name) else "float"
         n = len(seq) if max_frames is None else min(len(seq), max_frames)
         path = cache_path(out_dir, label, seq.name)
         fp = tracker_fingerprint(name) if name in TRACKERS else None
-        tracker = factory(name, model)
-        key = {"fingerprint": fp, "content": sequence_digest(seq, n), "params": params_key(tracker)}
+        key = {"fingerprint": fp, "content": sequence_digest(seq, n), "params": params_key(factory(name, model))}
         run = None if force else load_cached(path, n, m, **key)
-        if run is None:
-            try:
-                run = run_sequence(tracker, seq, n, label=label, model=m, progress=progress)
-            except (DataError, RuntimeError, ValueError) as exc:
-                failed.setdefault(seq.name, {})[label] = str(exc)
+        if run is not None:
+            done[label, seq.name] = run
+        else:
+            todo.append(((factory, name, model, seq, n, label, m), path, key, n / FPS_HINT.get(name, 1000.0)))
+    pool = _Pool(jobs, scheduler)
+    if jobs > 1 or scheduler is not None:
+        todo.sort(key=lambda t: -t[3])  # longest first (results do not depend on the order)
+    if progress and todo:
+        print(f"eval: {len(done)} runs cached, {len(todo)} to run on {pool.where}", file=sys.stderr)
+    # in this process the per-frame bar of each run shows; with workers, one bar over the runs
+    inner = progress and pool.where == "this process"
+    with tqdm(total=len(done) + len(todo), initial=len(done), desc="eval", disable=not progress,
+              unit="run", dynamic_ncols=True) as bar:
+        calls = [t[0] for t in todo]
+        for i, (kind, payload) in _inline(calls) if inner else pool.results(calls):
+            (_, name, _, seq, _, label, _), path, key, _ = todo[i]
+            bar.update(1)
+            if kind == "failed":
+                reasons[label, seq.name] = payload
                 continue
             path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps({**run.to_json(), **key}) + "\n")
-        runs[label][seq.name] = run
+            path.write_text(json.dumps({**payload.to_json(), **key}) + "\n")
+            done[label, seq.name] = payload
+    # the order of runs (and so of the report) is the tracker x sequence order, however they finished
+    runs: dict[str, dict[str, SequenceRun]] = {label: {} for label in labels}
+    failed: dict[str, dict[str, str]] = {}
+    for name in names:
+        for seq in sequences:
+            label = run_label(name, model)
+            if (label, seq.name) in done:
+                runs[label][seq.name] = done[label, seq.name]
+            elif (label, seq.name) in reasons:
+                failed.setdefault(seq.name, {})[label] = reasons[label, seq.name]
     return aggregate(runs, sequences, failed)
+
+
+def _inline(calls: list[tuple[Any, ...]]) -> Iterator[tuple[int, tuple[str, Any]]]:
+    """:func:`_run_job` in this process, with the per-frame progress bar of each run."""
+    for i, (factory, name, model, seq, n, label, m) in enumerate(calls):
+        try:
+            yield i, ("ok", run_sequence(factory(name, model), seq, n, label=label, model=m, progress=True))
+        except (DataError, RuntimeError, ValueError) as exc:
+            yield i, ("failed", str(exc))

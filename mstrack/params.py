@@ -14,6 +14,32 @@ Features = Literal["fused", "colour", "edge"]
 Preset = Literal["paper", "v2"]
 Kernel = Literal["flat", "epanechnikov"]
 
+#: Accepted spellings of the string parameters (case-insensitive) -> canonical value.  The
+#: canonical values are the ones stored in :class:`TrackerParams`, reports and cache keys; the
+#: short forms are the ones in tracker names (``mstrack-colour-epan``).
+ALIASES: dict[str, dict[str, str]] = {
+    "features": {"fused": "fused", "fusion": "fused", "colour": "colour", "color": "colour",
+                 "edge": "edge", "edges": "edge"},
+    "kernel": {"flat": "flat", "uniform": "flat", "epanechnikov": "epanechnikov", "epan": "epanechnikov"},
+    "preset": {"paper": "paper", "v2": "v2"},
+}
+
+
+def canonical(name: str, value: Any) -> Any:
+    """The canonical spelling of ``value`` for the string parameter ``name`` (see :data:`ALIASES`):
+    ``canonical("kernel", "Epan") == "epanechnikov"``.  Values that are not known aliases (and
+    non-strings) are returned unchanged, to be refused by the parameter check with the valid names."""
+    if isinstance(value, str):
+        return ALIASES.get(name, {}).get(value.strip().lower(), value)
+    return value
+
+
+def _choices(name: str) -> str:
+    canon = dict.fromkeys(ALIASES[name].values())
+    return ", ".join(f"'{c}'" + (f" (or {', '.join(repr(a) for a, v in ALIASES[name].items() if v == c and a != c)})"
+                                 if any(v == c and a != c for a, v in ALIASES[name].items()) else "")
+                     for c in canon)
+
 
 class ParamTypeError(TypeError, ValueError):
     """A parameter of the wrong type (e.g. ``max_iter=1.5``); both a TypeError and a ValueError."""
@@ -47,6 +73,7 @@ class TrackerParams:
     ----------
     features : {"fused", "colour", "edge"}
         Which feature(s) drive the result; "fused" runs both and blends them.
+        Aliases (:data:`ALIASES`, case-insensitive): "color", "fusion", "edges".
     kernel : {"flat", "epanechnikov"}
         Kernel profile used for the histograms: flat (1 inside d2 < 1, the
         paper's hardware) or Epanechnikov (1 - d2).  The mean-shift step uses
@@ -121,15 +148,17 @@ class TrackerParams:
     search_iter: int = 5
 
     def __post_init__(self) -> None:
+        for name in ALIASES:
+            object.__setattr__(self, name, canonical(name, getattr(self, name)))
         if self.preset not in ("paper", "v2"):
-            raise ValueError(f"preset must be 'paper' or 'v2', got {self.preset!r}")
+            raise ValueError(f"preset must be {_choices('preset')}, got {self.preset!r}")
         if self.features is None:
             object.__setattr__(self, "features", "fused" if self.preset == "paper" else "colour")
         check_param_types(self)
         if self.features not in ("fused", "colour", "edge"):
-            raise ValueError(f"features must be 'fused', 'colour' or 'edge', got {self.features!r}")
+            raise ValueError(f"features must be {_choices('features')}, got {self.features!r}")
         if self.kernel not in ("flat", "epanechnikov"):
-            raise ValueError(f"kernel must be 'flat' or 'epanechnikov', got {self.kernel!r}")
+            raise ValueError(f"kernel must be {_choices('kernel')}, got {self.kernel!r}")
         if not 1 <= self.colour_bits <= 8:
             raise ValueError("colour_bits must be in 1..8")
         if not 1 <= self.edge_bins_log2 <= 8:
@@ -142,7 +171,8 @@ class TrackerParams:
             raise ValueError("eps2 must be > 0")
         if self.preset == "v2":
             if self.features != "colour":
-                raise ValueError("preset 'v2' tracks on colour only (features='colour')")
+                raise ValueError(f"preset 'v2' tracks on colour only (features='colour'); features="
+                                 f"{self.features!r} is the paper preset: preset='paper', features={self.features!r}")
             for name, lo, hi in (("pad", 0.0, 2.0), ("bg_ring", 0.05, 4.0), ("scale_gain", 0.0, 1.0),
                                  ("scale_step", 0.0, 0.5), ("scale_reg", 0.0, 1.0), ("conf_lost", 0.0, 1.0),
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
@@ -163,6 +193,11 @@ class TrackerParams:
     @property
     def n_edge_bins(self) -> int:
         return 1 << self.edge_bins_log2
+
+    @classmethod
+    def field_names(cls) -> frozenset[str]:
+        """Names of the fields (the keyword arguments :class:`mstrack.Tracker` takes for them)."""
+        return frozenset(f.name for f in fields(cls))
 
     @classmethod
     def split(cls, kwargs: dict[str, Any]) -> tuple["TrackerParams", dict[str, Any]]:

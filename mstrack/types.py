@@ -18,14 +18,19 @@ import math
 import numbers
 from dataclasses import dataclass, field, asdict
 from enum import Enum
-from typing import Any
+from typing import Any, NamedTuple, Sequence
 
 import numpy as np
 
 
-@dataclass(frozen=True)
-class Box:
-    """Axis-aligned box ``(x, y, w, h)``, 0-based, left/top + size, in pixels."""
+class Box(NamedTuple):
+    """Axis-aligned box ``(x, y, w, h)``, 0-based, left/top + size, in pixels (floats).
+
+    A :class:`typing.NamedTuple`: it unpacks, indexes and compares like the 4-tuple
+    ``(x, y, w, h)`` (``x, y, w, h = res.box``; ``res.box[2]``; ``Box(1, 2, 3, 4) == (1, 2, 3, 4)``;
+    hashable, so it can key a dict).  For OpenCV drawing functions, which want integers, use
+    :meth:`to_cv` (``cv2.rectangle(img, res.box.to_cv(), colour)``).
+    """
 
     x: float
     y: float
@@ -33,8 +38,12 @@ class Box:
     h: float
 
     @classmethod
-    def of(cls, box: "Box | tuple[float, float, float, float] | list[float]") -> "Box":
-        """Build a Box from a Box or a 4-sequence; raises ValueError on bad shape/values."""
+    def of(cls, box: "Box | Sequence[float] | np.ndarray") -> "Box":
+        """Build a Box from a Box or an ordered 4-sequence ``(x, y, w, h)`` (tuple, list, 1-D array).
+
+        Values become Python floats.  Raises ValueError on a bad shape, a non-number (bools and
+        strings included) or a non-finite value.
+        """
         if isinstance(box, Box):
             b = box
         else:
@@ -52,17 +61,30 @@ class Box:
             if not all(isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) for v in items):
                 raise ValueError(f"box must be 4 real numbers (x, y, w, h), got {box!r}")
             b = cls(*(float(v) for v in items))
-        if not all(math.isfinite(v) for v in (b.x, b.y, b.w, b.h)):
+        if not all(math.isfinite(v) for v in b):
             raise ValueError(f"box has a non-finite value: {b}")
         return b
 
     def as_tuple(self) -> tuple[float, float, float, float]:
+        """The plain tuple ``(x, y, w, h)`` (floats, pixels)."""
         return (self.x, self.y, self.w, self.h)
 
     @property
     def centre(self) -> tuple[float, float]:
-        """Centre in continuous coordinates (x + w/2, y + h/2)."""
+        """Centre in continuous coordinates ``(x + w/2, y + h/2)``, pixels."""
         return (self.x + self.w / 2.0, self.y + self.h / 2.0)
+
+    def to_cv(self) -> tuple[int, int, int, int]:
+        """OpenCV's integer rect ``(x, y, w, h)`` (``cv::Rect``, pixels) for ``cv2.rectangle(img,
+        box.to_cv(), colour)`` and the ``cv2.Tracker`` API.
+
+        The corners are rounded to the nearest pixel edge (halves up) and the size taken between
+        them, so the rect covers the pixels the box covers most of: ``Box(0.4, 0, 10.4, 5)`` ->
+        ``(0, 0, 11, 5)``.
+        """
+        x0, y0 = math.floor(self.x + 0.5), math.floor(self.y + 0.5)
+        x1, y1 = math.floor(self.x + self.w + 0.5), math.floor(self.y + self.h + 0.5)
+        return (int(x0), int(y0), int(x1 - x0), int(y1 - y0))
 
 
 def box_centre_index(box: Box) -> tuple[float, float]:
@@ -106,13 +128,34 @@ class FeatureResult:
 
 @dataclass
 class TrackResult:
-    """Result of one frame.
+    """Result of one frame (:meth:`mstrack.Tracker.init` / :meth:`~mstrack.Tracker.update`).
 
-    box: fused box (0-based x, y, w, h); centre: fused centre, pixel-index
-    coordinates; rho_c / rho_e: colour / edge Bhattacharyya coefficients;
-    alpha_c / alpha_e: fusion weights (sum to 1); iter_c / iter_e: iterations
-    per feature; status: :class:`Status`; extra: model-specific detail (the
-    fixed model puts its raw integers here).
+    Attributes
+    ----------
+    box : Box
+        Tracked box ``(x, y, w, h)``, 0-based pixels (floats); ``box.to_cv()`` for OpenCV.
+    centre : tuple of float
+        Box centre ``(cx, cy)`` in pixel-index coordinates (pixel (i, j) at (i, j)).
+    rho_c, rho_e : float
+        Colour / edge Bhattacharyya coefficient at the result, 0..1 (NaN-free; 0 for a
+        feature that is not run).
+    alpha_c, alpha_e : float
+        Fusion weights of colour / edge, 0..1, summing to 1 (1 / 0 for colour only).
+    iter_c, iter_e : int
+        Mean-shift iterations per feature on this frame.
+    status : Status
+        Per-frame status (:class:`Status`).
+    message : str
+        Human-readable detail (why a box was clipped, ...), "" if none.
+    confidence : float
+        0..1, tracker v2's estimate that the box is on the target (``preset="v2"``: rho and
+        colour share against their running references); the paper preset has no confidence
+        and always reports 1.0.
+    extra : dict
+        Model-specific detail (the fixed model puts its raw integers here).
+
+    ``ok`` (property) is True when the box can be trusted (status ok, init, clipped or
+    reacquired): the ``ok`` of OpenCV's ``(ok, rect) = tracker.update(frame)``.
     """
 
     box: Box

@@ -117,6 +117,9 @@ def dump_vectors(seq_dir: str | Path, frames: list[int], out: str | Path, lanes:
         TrackerParams and FixedParams fields.
     """
     out = Path(out)
+    if not out.name.endswith(".gz"):
+        raise ValueError(f"the vectors are gzip-compressed JSON lines: name the --out file *.jsonl.gz, "
+                         f"not {out.name!r}")
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "wb") as raw, gzip.GzipFile(filename="", mode="wb", fileobj=raw, mtime=0) as gz:
         for rec in generate(seq_dir, frames, lanes, **params):
@@ -143,7 +146,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     """Arguments of ``python -m mstrack.vectors`` and ``mstrack vectors``."""
     ap.add_argument("seq_dir")
     ap.add_argument("--frames", type=_parse_frames, default=[0, 1], help="comma separated, e.g. 0,1,5")
-    ap.add_argument("--out", required=True)
+    ap.add_argument("--out", required=True, metavar="FILE.jsonl.gz",
+                    help="output file: gzip-compressed JSON lines (another extension is refused)")
     ap.add_argument("--lanes", type=int, default=DEFAULT_LANES)
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                     help="TrackerParams or FixedParams field (repeatable)")

@@ -156,7 +156,7 @@ def test_never_nan(model, features, kernel, scene):
     fr = _frames_black_noise()
     box = scene[3]
     for init_name in ("black", "noise"):
-        trk = Tracker(model=model, features=features, kernel=kernel)
+        trk = Tracker(model=model, preset="paper", features=features, kernel=kernel)
         trk.init(fr[init_name], box)
         for name in ("black", "noise", "white", "black"):
             r = trk.update(fr[name])
@@ -164,7 +164,7 @@ def test_never_nan(model, features, kernel, scene):
             assert all(math.isfinite(v) for v in vals), (init_name, name, r)
             assert _inside(r.box)
     # a target model learnt on a real target, then a black frame: lost, position kept
-    trk = Tracker(model=model, features=features, kernel=kernel)
+    trk = Tracker(model=model, preset="paper", features=features, kernel=kernel)
     r0 = trk.init(scene[0], box)
     r = trk.update(fr["black"])
     assert all(math.isfinite(v) for v in r.centre)

@@ -187,7 +187,7 @@ def test_bench_synthetic_writes_docs(tmp_path, capsys):
     doc = tmp_path / "bench.md"
     assert cli.main(["bench", "--frames", "4", "--model", "float", "--write-docs", "--docs-file", str(doc)]) == 0
     out = capsys.readouterr().out
-    assert "synthetic-640x360" in out and "mstrack-fused-flat/camshift" in out
+    assert "synthetic-640x360" in out and f"{cli.DEFAULT_TRACKER}/camshift" in out
     text = doc.read_text()
     assert "mstrack bench --frames 4 --model float" in text and "| synthetic-640x360 | 4 | 640x360 |" in text
 
@@ -196,7 +196,7 @@ def test_bench_synthetic_writes_docs(tmp_path, capsys):
 def test_bench_dataset_both_models(tiny_dataset, capsys):
     assert cli.main(["bench", str(tiny_dataset), "--frames", "3", "--model", "both"]) == 0
     out = capsys.readouterr().out
-    assert "mstrack-fused-flat@fixed fps" in out and "seq1" in out and out.splitlines()[-1].startswith("all")
+    assert f"{cli.DEFAULT_TRACKER}@fixed fps" in out and "seq1" in out and out.splitlines()[-1].startswith("all")
 
 
 def test_load_dataset_of_tiny(tiny_dataset):
@@ -284,7 +284,7 @@ def test_track_paper_leaves_confidence_empty(occluded_small_seq, tmp_path):
     assert all(d["confidence"] is None for d in json.loads((out / "results.json").read_text())["frames_data"])
 
 
-@pytest.mark.parametrize("tracker,preset,want", [(None, None, cli.DEFAULT_TRACKER), (None, "paper", cli.DEFAULT_TRACKER),
+@pytest.mark.parametrize("tracker,preset,want", [(None, None, cli.DEFAULT_TRACKER), (None, "paper", cli.PAPER_TRACKER),
                                                  (None, "v2", "mstrack-v2"), ("mstrack-v2", "v2", "mstrack-v2"),
                                                  ("mstrack-v2", None, "mstrack-v2"),
                                                  ("opencv-kcf", None, "opencv-kcf"), ("opencv-kcf", "paper", "opencv-kcf")])
@@ -307,7 +307,7 @@ def test_preset_choices(capsys):
     assert ei.value.code == 2 and "invalid choice" in capsys.readouterr().err
     for cmd in ("track", "demo"):
         args = cli.build_parser().parse_args([cmd, "x"] if cmd == "track" else [cmd])
-        assert args.preset is None and args.tracker is None     # -> paper, DEFAULT_TRACKER
+        assert args.preset is None and args.tracker is None     # -> DEFAULT_TRACKER (v2)
 
 
 def _row(status="ok", confidence=0.8765, alpha_c=1.0, rho_e=0.0, frame=123):

@@ -66,7 +66,7 @@ def test_fixed_finds_integer_shift(features):
 def test_result_fields_and_api_equivalence():
     f0, f1, box = shift_scene(3, -2)
     _, (_, r_direct), _ = _run([f0, f1], box)
-    trk = Tracker(model="fixed")
+    trk = Tracker(model="fixed", preset="paper")
     trk.init(f0, box)
     r_api = trk.update(f1)
     for k in RESULT_FIELDS:
@@ -129,7 +129,7 @@ def test_intermediates_fit_widths(kernel, size):
 
 def test_large_box_is_shrunk_to_max_window():
     f0 = shift_scene(0, 0, width=320, height=240)[0]
-    r = Tracker(model="fixed").init(f0, (10, 10, 200, 150))
+    r = Tracker(model="fixed", preset="paper").init(f0, (10, 10, 200, 150))
     assert r.status == Status.CLIPPED and (r.box.w, r.box.h) == (127, 127)
 
 

@@ -35,7 +35,7 @@ def _both(dx, dy, **params):
     f0, f1, box = shift_scene(dx, dy)
     out = []
     for model in ("float", "fixed"):
-        trk = Tracker(model=model, **params)
+        trk = Tracker(model=model, **{"preset": "paper", **params})  # the paper model unless asked
         trk.init(f0, box)
         out.append(trk.update(f1))
     return out

@@ -26,7 +26,7 @@ SUB_SHIFTS = [(0.5, -0.25), (2.75, 1.5), (-1.25, -3.5)]
 
 def _track(dx, dy, **params):
     f0, f1, box = shift_scene(dx, dy)
-    trk = Tracker(model="float", **params)
+    trk = Tracker(model="float", **{"preset": "paper", **params})  # the paper model unless asked
     r0 = trk.init(f0, box)
     r1 = trk.update(f1)
     err = math.hypot(r1.centre[0] - r0.centre[0] - dx, r1.centre[1] - r0.centre[1] - dy)
@@ -124,7 +124,7 @@ def _ms(bins, q, start, h, **kw):
 
 def test_stop_shift():
     f0, _, box = shift_scene(0, 0)
-    trk = Tracker(model="float", features="colour")
+    trk = Tracker(model="float", preset="paper", features="colour")
     trk.init(f0, box)
     r = trk.update(f0)
     assert r.extra["stop_c"] == "shift" and r.iter_c == 1
@@ -144,7 +144,7 @@ def test_stop_rho():
 
 def test_stop_max_iter_direct():
     f0, f1, box = shift_scene(8, 8)
-    trk = Tracker(model="float", features="colour", max_iter=1)
+    trk = Tracker(model="float", preset="paper", features="colour", max_iter=1)
     trk.init(f0, box)
     assert trk.update(f1).extra["stop_c"] == "max_iter"
 
@@ -152,7 +152,7 @@ def test_stop_max_iter_direct():
 def test_stop_lost():
     """No model bin in the window (frame of a colour absent from the target): all weights 0."""
     f0, _, box = shift_scene(0, 0)
-    trk = Tracker(model="float", features="colour")
+    trk = Tracker(model="float", preset="paper", features="colour")
     r0 = trk.init(f0, box)
     blue = np.zeros_like(f0)
     blue[..., 0] = 255
@@ -202,7 +202,7 @@ def test_auc_floor_real_sequences(name):
     from mstrack.metrics import score
 
     seq = load_sequence(SEQ_ROOT / name)
-    trk = Tracker(model="float")
+    trk = Tracker(model="float", preset="paper")
     boxes = [trk.init(seq.frame(0), seq.init_box()).box.as_tuple()]
     boxes += [trk.update(f).box.as_tuple() for f in list(seq.frames())[1:]]
     auc = score(np.asarray(boxes), seq.gt).auc

@@ -89,7 +89,7 @@ def test_trace_contents_consistent(seq_dir, tmp_path):
         assert res["iter_c"] == len(t["iter_colour"]) - 1 or res["stop_c"] != 0
     # the Tracker API gives the same centre as the vectors
     seq = load_sequence(seq_dir)
-    trk = Tracker(model="fixed")
+    trk = Tracker(model="fixed", preset="paper")  # the vectors are the RTL core's (paper preset)
     trk.init(seq.frame(0), tuple(seq.gt[0]))
     for i in range(1, 6):
         res = trk.update(seq.frame(i))

@@ -224,10 +224,41 @@ def draw_overlay(frame: np.ndarray, row: dict[str, Any], gt: np.ndarray | None =
     col = STATUS_COLOURS.get(row["status"], (0, 0, 255))
     cv2.rectangle(img, (s(row["x"]), s(row["y"])), (s(row["x"] + row["w"]) - 1, s(row["y"] + row["h"]) - 1), col, 2)
     cv2.circle(img, (s(row["cx"] + 0.5 - 0.5 / k), s(row["cy"] + 0.5 - 0.5 / k)), 3, col, -1)  # pixel centre
-    _text_block(img, [(t, None) for t in overlay_lines(row, img.shape[1], fs)], True, fs)
+    lines = overlay_lines(row, img.shape[1], fs)
+    _text_block(img, [(t, None) for t in lines], True, fs)
     if have_gt:
-        _text_block(img, [("ground truth", GT_COLOUR), ("tracker", col)], False, fs)
+        legend: list[tuple[str, tuple[int, int, int] | None]] = [("ground truth", GT_COLOUR), ("tracker", col)]
+        legend += [(t, None) for t in _wrap(overlay_note(" ".join(lines)), img.shape[1], fs)]
+        _text_block(img, legend, False, fs)
     return img
+
+
+def overlay_note(banner: str) -> str:
+    """The legend's explanation of the banner's numbers (those in ``banner`` only)."""
+    parts = []
+    if "conf " in banner:
+        parts.append("conf: confidence 0-1")
+    rho = [r for r in ("rho_c", "rho_e") if f"{r} " in banner]
+    if rho:
+        what = {"rho_c": "colour", "rho_e": "edge"}
+        parts.append(f"{'/'.join(rho)}: {'/'.join(what[r] for r in rho)} match to the target 0-1")
+    if "a_c " in banner:
+        parts.append("a_c: weight of colour")
+    return ", ".join(parts)
+
+
+def _wrap(text: str, width: int, font_scale: float) -> list[str]:
+    """``text`` cut at ", " into lines that fit ``width`` px (each piece on a line of its own if needed)."""
+    import cv2
+
+    lines: list[str] = []
+    for piece in (p for p in text.split(", ") if p):
+        cand = f"{lines[-1]}, {piece}" if lines else piece
+        if lines and cv2.getTextSize(cand, _FONT, font_scale, 1)[0][0] <= width - 8:
+            lines[-1] = cand
+        else:
+            lines.append(piece)
+    return lines
 
 
 def _warn(msg: str) -> None:
@@ -263,7 +294,7 @@ class _Display:
                 pass
 
 
-def init_box_note(given: Box, got: Box, frame_shape: tuple[int, ...], message: str = "") -> str | None:
+def init_box_note(given: Box, got: Box, frame_shape: tuple[int, ...]) -> str | None:
     """One line saying how the tracker changed the init box ``given`` into ``got`` on a frame of
     ``frame_shape`` (H, W, ...): clipped to the frame and/or shrunk (to the model's largest
     window by more than a pixel); None otherwise (sub-pixel rounding of the box is not reported)."""
@@ -277,8 +308,7 @@ def init_box_note(given: Box, got: Box, frame_shape: tuple[int, ...], message: s
     why = " and ".join(w for w, on in ((f"clipped to the {wid}x{hgt} frame", clipped),
                                        ("shrunk to the largest window the model tracks", shrunk)) if on)
     f = lambda b: "(" + ", ".join(f"{v:g}" for v in (round(c, 2) for c in b)) + ")"  # noqa: E731
-    return (f"init box {f(given)} {why}: tracking {f(got)} (x, y, w, h)"
-            + (f" [{message}]" if message else ""))
+    return f"init box {f(given)} {why}: tracking {f(got)} (x, y, w, h)"
 
 
 def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, out_dir: Path, fps: float = 30.0,
@@ -357,7 +387,7 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
                     raise DataError("frame 0 is unreadable", getattr(source, "path", out_dir))
                 res = tracker.init(frame, box)
                 b = to_box(res) if res is not None else box
-                note = init_box_note(box, b, frame.shape, getattr(res, "message", "")) if warn_init else None
+                note = init_box_note(box, b, frame.shape) if warn_init else None
                 if note:
                     _warn(note)
                 row = _row(0, res, b, result_status(res) if res is not None else Status.INIT.value, conf)

@@ -4,13 +4,17 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: setup demo test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
+.PHONY: setup demo typecheck test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
 
 setup:
 	bash tools/setup.sh
 
 demo: setup
 	$(VENV)/bin/mstrack demo $(ARGS)
+
+# mypy on the package (configuration: pyproject.toml [tool.mypy]); also run by tests/test_typing.py
+typecheck: setup
+	$(PY) -m mypy --cache-dir build/mypy_cache
 
 # `make test` = the simulation and Python tests (pytest -m "not synth") and, in parallel on the
 # second core, the ECP5 netlist build of the default core (tb/test_synth.py, marker `synth`:

@@ -140,13 +140,13 @@ def shift_scene(dx: float, dy: float, w: int = 41, h: int = 31, width: int = 160
     rng = np.random.default_rng(seed)
     small = rng.random((height // 20 + 2, width // 20 + 2, 3)).astype(np.float32)
     bg = cv2.resize(small, (width * ss, height * ss), interpolation=cv2.INTER_CUBIC)
-    bg = np.clip(bg, 0, 1) * np.float32([60, 50, 30]) + np.float32([120, 90, 40])
+    bg = np.clip(bg, 0, 1) * np.array([60, 50, 30], np.float32) + np.array([120, 90, 40], np.float32)
     yy, xx = np.mgrid[0:h * ss, 0:w * ss].astype(np.float32)
     u = (xx + 0.5) / ss - w / 2.0
     v = (yy + 0.5) / ss - h / 2.0
     inside = ((u / (w / 2.0)) ** 2 + (v / (h / 2.0)) ** 2 < 1)[..., None]
     check = ((np.floor(xx / ss / 2) + np.floor(yy / ss / 2)) % 2 == 0)[..., None]
-    tgt = np.where(check, np.float32([0, 0, 140]), np.float32([20, 240, 250]))
+    tgt = np.where(check, np.array([0, 0, 140], np.float32), np.array([20, 240, 250], np.float32))
     x0, y0 = (width - w) // 2 - 5, (height - h) // 2 - 3
     frames = []
     for sx, sy in ((0.0, 0.0), (dx, dy)):
@@ -188,6 +188,7 @@ def compare_sequence(seq_dir: str | Path, max_frames: int | None = None, resync:
     bx = np.empty((n, 4))
     t_f = t_x = 0.0
     box0 = Box.of(seq.gt[0])
+    prev: tuple[float, float] = (0.0, 0.0)   # the float tracker's centre on the previous frame
     for i in range(n):
         frame = seq.frame(i)
         t0 = time.perf_counter()
@@ -306,7 +307,7 @@ def float_on_grid(seq_dir: str | Path, grid: float, max_frames: int | None = Non
         return orig(math.floor(cx / grid + 0.5) * grid, math.floor(cy / grid + 0.5) * grid, *rest)
 
     if grid:
-        fm.kernel_window = snapped
+        fm.kernel_window = snapped  # type: ignore[assignment]  # same call signature
     try:
         trk = Tracker(model="float", preset="paper")  # the paper's float model (kernel_window above)
         out = np.empty((n, 2))

@@ -20,7 +20,7 @@ Bad frames (not uint8 BGR, or a size other than the init frame's) raise
 from __future__ import annotations
 
 import math
-from typing import Callable
+from typing import Any, Callable
 
 import cv2
 import numpy as np
@@ -71,8 +71,8 @@ def clip_box(box: Box | tuple[float, float, float, float], width: int, height: i
     return (cx0, cy0, cx1 - cx0, cy1 - cy0), (cx0, cy0, cx1, cy1) != (x0, y0, x1, y1)
 
 
-def _result(box: tuple[float, float, float, float], status: Status, iters: int = 0, message: str = "") -> TrackResult:
-    b = Box(*(float(v) for v in box))
+def _result(box: tuple[float, ...], status: Status, iters: int = 0, message: str = "") -> TrackResult:
+    b = Box.of(box)
     nan = math.nan
     return TrackResult(box=b, centre=box_centre_index(b), rho_c=nan, rho_e=nan, alpha_c=nan,
                        alpha_e=nan, iter_c=iters, iter_e=0, status=status, message=message)
@@ -83,8 +83,8 @@ class _HueTracker:
 
     def __init__(self) -> None:
         self._hist: np.ndarray | None = None
-        self._window: tuple[int, int, int, int] | None = None
-        self._box: tuple[float, float, float, float] | None = None
+        self._window: tuple[int, ...] = ()          # (x, y, w, h) integer window once initialised
+        self._box: tuple[float, ...] = ()           # (x, y, w, h) last box reported
         self._shape: tuple[int, ...] | None = None
 
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
@@ -159,8 +159,8 @@ class OpenCVTracker:
     def __init__(self, kind: str) -> None:
         self.kind = kind.upper()
         self._factory = _contrib_factory(self.kind)
-        self._trk: object | None = None
-        self._box: tuple[float, float, float, float] | None = None
+        self._trk: Any = None                       # the cv2.Tracker (KCF / CSRT) once initialised
+        self._box: tuple[float, ...] = ()           # (x, y, w, h) last box reported
         self._shape: tuple[int, ...] | None = None
 
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:

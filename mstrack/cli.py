@@ -219,6 +219,7 @@ def draw_overlay(frame: np.ndarray, row: dict[str, Any], gt: np.ndarray | None =
     fs = 0.45 if img.shape[1] >= 400 else 0.4
     have_gt = gt is not None and np.isfinite(gt).all()
     if have_gt:
+        assert gt is not None
         x, y, w, h = gt
         cv2.rectangle(img, (s(x), s(y)), (s(x + w) - 1, s(y + h) - 1), GT_COLOUR, 1)
     col = STATUS_COLOURS.get(row["status"], (0, 0, 255))
@@ -606,8 +607,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             cases.append((s.name, [s.frame(i) for i in range(n)], s.init_box()))
     else:
         from .synthetic import make_scene
-        frames, gt = make_scene(args.frames, 640, 360, seed=0)
-        cases.append(("synthetic-640x360", list(frames), Box.of(gt[0])))
+        scene, gt = make_scene(args.frames, 640, 360, seed=0)
+        cases.append(("synthetic-640x360", list(scene), Box.of(gt[0])))
     header = ["sequence", "frames", "size", *[r[0] + " fps" for r in runs],
               *[f"{r[0]}/camshift" for r in runs[:-1]]]
     rows = []

@@ -47,6 +47,7 @@ def expected_results(frames: Iterable[np.ndarray], box: tuple[int, int, int, int
             r = trk.update(frame)
             fl = flags_word(lost=r.extra["lost"])
         e = r.extra
+        assert trk._t is not None
         ib = trk._t.box
         out.append({"cx": e["cx"], "cy": e["cy"], "rho_c": e["rho_c"], "rho_e": e["rho_e"],
                     "alpha_c": e["alpha_c"], "iter_c": e["iter_c"], "iter_e": e["iter_e"],
@@ -155,13 +156,12 @@ class CoreModel:
         return fw >= MIN_FRAME and fh >= MIN_FRAME and fw <= self.max_frame_w
 
     # -- results -----------------------------------------------------------------------------
-    def _push(self, kind: str, **fields: int) -> None:
+    def _push(self, kind: str, flags: dict[str, int] | None = None, **fields: int) -> None:
         r = {"cx": self.c8[0], "cy": self.c8[1], "rho_c": 0, "rho_e": 0, "alpha_c": 0, "iter_c": 0,
              "iter_e": 0, "stop_c": 0, "stop_e": 0, "err_code": 0,
              "box_w": self.box_wh[0], "box_h": self.box_wh[1], "frame_count": self.count & 0xFFFF}
-        flags = fields.pop("flags", {})
         r.update(fields)
-        r["flags"] = flags_word(rejected=self.rejected, **flags)
+        r["flags"] = flags_word(rejected=self.rejected, **(flags or {}))
         self.rejected = 0
         self.count += 1
         self.results.append(r)
@@ -206,6 +206,7 @@ class CoreModel:
             return
         e = r.extra
         self.c8 = (e["cx"], e["cy"])
+        assert self.trk._t is not None
         self.box_wh = (self.trk._t.box.w, self.trk._t.box.h)
         self._push(kind, flags=flags, **{k: e[k] for k in ("cx", "cy", "rho_c", "rho_e", "alpha_c",
                                                             "iter_c", "iter_e", "stop_c", "stop_e")})

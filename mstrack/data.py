@@ -517,7 +517,7 @@ def open_video_writer(path: str | Path, fps: float, size: tuple[int, int]) -> tu
     tries = [(p, "mp4v"), (p.with_suffix(".avi"), "MJPG")] if p.suffix.lower() == ".mp4" \
         else [(p, "MJPG"), (p.with_suffix(".mp4"), "mp4v")]
     for out, codec in tries:
-        w = cv2.VideoWriter(str(out), cv2.VideoWriter_fourcc(*codec), float(fps), tuple(int(v) for v in size))
+        w = cv2.VideoWriter(str(out), cv2.VideoWriter.fourcc(*codec), float(fps), tuple(int(v) for v in size))
         if w.isOpened():
             return w, out
         w.release()

@@ -48,7 +48,7 @@ MODELS = ("float", "fixed")
 def _mstrack(features: str | None, kernel: str, preset: str = "paper") -> Callable[[str], Any]:
     def make(model: str = "float") -> Any:
         from .tracker import Tracker  # imported late: written separately, may be absent
-        return Tracker(model=model, features=features, kernel=kernel, preset=preset)
+        return Tracker(model=model, features=features, kernel=kernel, preset=preset)  # type: ignore[arg-type]
     make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r})"
     return make
 

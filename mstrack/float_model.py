@@ -21,6 +21,7 @@ import math
 import os
 import warnings
 from dataclasses import dataclass
+from typing import cast
 
 import cv2
 import numpy as np
@@ -111,12 +112,12 @@ def colour_bins_area(frame: np.ndarray, bits: int, x0: int, x1: int, y0: int, y1
     """``colour_bins(frame, bits)[y0:y1, x0:x1]`` from those pixels only.  (y1-y0, x1-x0) intp."""
     s = 8 - bits
     b, g, r = cv2.split(frame[y0:y1, x0:x1])
-    out = (r >> s).astype(np.intp)
+    out = (r >> s).astype(np.intp)  # type: ignore[operator]  # uint8 channels
     out <<= 2 * bits
-    t = (g >> s).astype(np.intp)
+    t = (g >> s).astype(np.intp)  # type: ignore[operator]
     t <<= bits
     out |= t
-    out |= b >> s
+    out |= b >> s  # type: ignore[operator]
     return out
 
 
@@ -150,7 +151,7 @@ def edge_bins_area(frame: np.ndarray, n_bins: int, shift: int, x0: int, x1: int,
     gx = cv2.Sobel(strip, cv2.CV_32F, 1, 0, ksize=3)
     gy = cv2.Sobel(strip, cv2.CV_32F, 0, 1, ksize=3)
     if kernels:
-        out = np.empty((y1 - y0, x1 - x0), dtype)
+        out: np.ndarray = np.empty((y1 - y0, x1 - x0), dtype)
         _nb_edge_bins(gx, gy, r0, c0, shift, n_bins - 1, out)
     else:
         mag = np.abs(gx[r0: r0 + y1 - y0, c0: c0 + x1 - x0])
@@ -285,6 +286,7 @@ class _Win:
             shape = self.inside.shape
             self._xs = np.broadcast_to(xf[self.x0:self.x1 + 1], shape)[self.inside]
             self._ys = np.broadcast_to(yf[self.y0:self.y1 + 1, None], shape)[self.inside]
+        assert self._ys is not None
         return self._xs, self._ys
 
 
@@ -322,6 +324,7 @@ class _Area:
     def window_bins(self, win: _Win) -> np.ndarray:
         """Bins of the window's inside pixels (row-major order)."""
         box = self.ensure(win.x0, win.x1 + 1, win.y0, win.y1 + 1)
+        assert self.bins is not None
         return self.bins[win.y0 - box[2]: win.y1 + 1 - box[2], win.x0 - box[0]: win.x1 + 1 - box[0]][win.inside]
 
 
@@ -393,7 +396,7 @@ def _meanshift_area(area: _Area, windows: dict, q: np.ndarray, start: tuple[floa
 try:
     from numba import njit as _numba_njit
 except ImportError:  # pragma: no cover - numba is a declared dependency
-    _numba_njit = None
+    _numba_njit = None  # type: ignore[assignment]
 
 
 def _jit(fn):
@@ -775,6 +778,7 @@ def _meanshift_numba(frame: np.ndarray, bits: int, area: _Area | None, q: np.nda
                                  hx, hy, width, height))
     while True:
         if area is not None:
+            assert area.bins is not None and area.box is not None
             bins, box = area.bins, area.box
         code, c0x, c0y, c1x, c1y, rho, it = _nb_meanshift(
             frame, bits, bins, box[0], box[2], box[1] - box[0], box[3] - box[2], q, sx, sy, it0,
@@ -782,6 +786,7 @@ def _meanshift_numba(frame: np.ndarray, bits: int, area: _Area | None, q: np.nda
         if code >= 0:
             return FeatureResult(centre=(c0x, c0y), rho=rho, iterations=it, stop=_STOPS[code])
         if code == -1:    # grow the area, then redo the step from c0 (same numbers)
+            assert area is not None
             area.ensure(*_window_box(c1x, c1y, hx, hy, width, height))
             sx, sy, it0 = c0x, c0y, it
         elif (c1x - c0x) ** 2 + (c1y - c0y) ** 2 < params.eps2:  # -2: meanshift's own test
@@ -841,11 +846,11 @@ def _numba_self_check() -> bool:
         win = _Win(24.5, 19.0, 7.5, 6.0, kernel == "flat", xf, yf)
         q = _window_histogram(bins[win.y0:win.y1 + 1, win.x0:win.x1 + 1][win.inside], win, 64)
         for start in ((21.25, 17.5), (30.0, 24.75)):
-            want = _meanshift_area(_Area(crop, width, height, 0, 0), {}, q, start, 7.5, 6.0, params, 64, xf, yf)
+            want_ms = _meanshift_area(_Area(crop, width, height, 0, 0), {}, q, start, 7.5, 6.0, params, 64, xf, yf)
             for bits, area in ((2, None), (0, _Area(crop, width, height, 0, 0))):
                 got = _meanshift_numba(frame, bits, area, q, start, 7.5, 6.0, params, width, height,
                                        _nb_buffers(7.5, 6.0, 64))
-                if got != want:
+                if got != want_ms:
                     return False
     return True
 
@@ -955,10 +960,10 @@ class FloatTracker:
             self._q_c = _window_histogram(area_c.window_bins(win), win, p.n_colour_bins) if area_c else None
             self._q_e = _window_histogram(area_e.window_bins(win), win, p.n_edge_bins) if area_e else None
         else:
-            win = kernel_window(cx, cy, hx, hy, p.kernel, width, height)
+            kwin = kernel_window(cx, cy, hx, hy, p.kernel, width, height)
             bc, be = self._feature_images(frame)
-            self._q_c = histogram(bc, win, p.n_colour_bins) if bc is not None else None
-            self._q_e = histogram(be, win, p.n_edge_bins) if be is not None else None
+            self._q_c = histogram(bc, kwin, p.n_colour_bins) if bc is not None else None
+            self._q_e = histogram(be, kwin, p.n_edge_bins) if be is not None else None
         self._shape = (height, width)
         self._centre = (cx, cy)
         self._bufs = None
@@ -976,26 +981,28 @@ class FloatTracker:
         p = self.params
         hx, hy = self._size[0] / 2.0, self._size[1] / 2.0
         path = self.active_path()
+        q_c, q_e = cast(np.ndarray, self._q_c), cast(np.ndarray, self._q_e)  # set for the features in use
         if path == "numba":
             _, area_e = self.last_areas = self._areas(frame, numba=True)
             height, width = self._shape
             if self._bufs is None:
                 self._bufs = _nb_buffers(hx, hy, max(p.n_colour_bins, p.n_edge_bins))
-            rc = _meanshift_numba(frame, p.colour_bits, None, self._q_c, self._centre, hx, hy, p,
+            rc = _meanshift_numba(frame, p.colour_bits, None, q_c, self._centre, hx, hy, p,
                                   width, height, self._bufs) if self.uses_colour else None
-            re = _meanshift_numba(frame, 0, area_e, self._q_e, self._centre, hx, hy, p,
+            re = _meanshift_numba(frame, 0, area_e, q_e, self._centre, hx, hy, p,
                                   width, height, self._bufs) if area_e else None
         elif path == "numpy":
             area_c, area_e = self.last_areas = self._areas(frame)
             windows: dict = {}
-            rc = _meanshift_area(area_c, windows, self._q_c, self._centre, hx, hy, p, p.n_colour_bins,
-                                 self._xf, self._yf) if area_c else None
-            re = _meanshift_area(area_e, windows, self._q_e, self._centre, hx, hy, p, p.n_edge_bins,
-                                 self._xf, self._yf) if area_e else None
+            xf, yf = cast(np.ndarray, self._xf), cast(np.ndarray, self._yf)  # set by init()
+            rc = _meanshift_area(area_c, windows, q_c, self._centre, hx, hy, p, p.n_colour_bins,
+                                 xf, yf) if area_c else None
+            re = _meanshift_area(area_e, windows, q_e, self._centre, hx, hy, p, p.n_edge_bins,
+                                 xf, yf) if area_e else None
         else:
             bc, be = self._feature_images(frame)
-            rc = meanshift(bc, self._q_c, self._centre, hx, hy, p, p.n_colour_bins) if bc is not None else None
-            re = meanshift(be, self._q_e, self._centre, hx, hy, p, p.n_edge_bins) if be is not None else None
+            rc = meanshift(bc, q_c, self._centre, hx, hy, p, p.n_colour_bins) if bc is not None else None
+            re = meanshift(be, q_e, self._centre, hx, hy, p, p.n_edge_bins) if be is not None else None
         centre, ac, ae = fuse(rc, re)
         lost = all(r is None or r.stop == "lost" for r in (rc, re))
         self._centre = centre

@@ -31,7 +31,7 @@ import sys
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Iterable, Iterator, Mapping, Sequence
+from typing import Any, Iterable, Iterator, Mapping, Sequence
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 RTL_DIR = REPO_ROOT / "rtl"
@@ -503,7 +503,7 @@ def fix_ghdl_pmux(verilog: str, vhdl_netlist: str, log: Path | None = None) -> t
             errors.append(f"cannot find the `when others` value of pmux {out} (select {sel}; VHDL: {d!r})")
             return m.group(0)
         count += 1
-        indent = re.match(r"\s*", m.group("body")).group(0)
+        indent = m.group("body")[:len(m.group("body")) - len(m.group("body").lstrip())]  # leading white space
         return m.group("head") + f"{indent}default: {out} <= {val};\n" + m.group("end").lstrip("\n")
 
     fixed = _PMUX_RE.sub(repl, verilog)
@@ -823,8 +823,9 @@ def synth_xilinx(
         "LUTRAM": count(lambda k: k.startswith("RAM") and not k.startswith("RAMB")),
         "SRL": count(lambda k: k.startswith("SRL")),
     }
-    res["BRAM36"] = res["RAMB36E1"] + 0.5 * res["RAMB18E1"]
-    res.update(cells=cells, seconds=secs, dir=str(d))
+    out: dict[str, Any] = {**res, "BRAM36": res["RAMB36E1"] + 0.5 * res["RAMB18E1"]}
+    out.update(cells=cells, seconds=secs, dir=str(d))
+    res = out
     (d / "result.json").write_text(json.dumps(res, indent=1))
     return res
 

@@ -634,6 +634,7 @@ def model_latencies(frames: Sequence, box: tuple[int, int, int, int], cfg: Confi
     for i, fr in enumerate(frames):
         if i == 0:
             tr.init_int(fr, *box, trace=True)
+            assert tr._t is not None and tr.last_trace is not None
             t, ker = tr.last_trace, tr._t.ker
             xr = row_extents(tr._t.box.w, tr._t.box.h, tp.kernel, fp.kernel_bits) if rows else None
             pp = pixel_pass_cycles(ker.ex, ker.ey, L, ms_round_centre(t["result"]["cx"], g["CF"]) - t["region"][0], xr)
@@ -642,7 +643,7 @@ def model_latencies(frames: Sequence, box: tuple[int, int, int, int], cfg: Confi
                         "engine_c": ec, "engine_e": ee})
             continue
         e = tr.update(fr, trace=True).extra
-        t = tr.last_trace
+        t = tr.last_trace  # type: ignore[assignment]  # set by trace=True
         eng = {}
         for f, key, nb in (("c", "iter_colour", nc), ("e", "iter_edge", ne)):
             passes = [pixel_pass_cycles(ker.ex, ker.ey, L, p["win"][0] - t["region"][0], xr) for p in t[key]]

@@ -19,7 +19,8 @@ import numpy as np
 from .data import open_video_writer
 
 
-def _texture(rng: np.random.Generator, h: int, w: int, cell: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+def _texture(rng: np.random.Generator, h: int, w: int, cell: int, lo: np.ndarray | np.floating,
+             hi: np.ndarray | np.floating) -> np.ndarray:
     """Smooth random colour texture, float32 (h, w, 3), each channel in [lo, hi]."""
     small = rng.random((max(2, h // cell), max(2, w // cell), 3), dtype=np.float32)
     t = cv2.resize(small, (w, h), interpolation=cv2.INTER_CUBIC)

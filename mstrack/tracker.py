@@ -18,7 +18,7 @@ from typing import Any, Literal
 import numpy as np
 
 from .frames import FrameError
-from .params import TrackerParams
+from .params import Preset, TrackerParams
 from .types import Box, TrackResult
 
 __all__ = ["Tracker", "TrackerMeanShift", "TrackerParams", "FrameError", "DEFAULT_PRESET"]
@@ -26,7 +26,7 @@ __all__ = ["Tracker", "TrackerMeanShift", "TrackerParams", "FrameError", "DEFAUL
 #: Preset of :class:`Tracker` / :class:`TrackerMeanShift` when none is given: tracker v2, the best
 #: measured (docs/results.md).  :class:`TrackerParams` itself defaults to "paper", the algorithm
 #: of the RTL core (the fixed-point model, test vectors and co-simulation use it).
-DEFAULT_PRESET = "v2"
+DEFAULT_PRESET: Preset = "v2"
 
 Model = Literal["float", "fixed"]
 BoxLike = Box | tuple[float, float, float, float] | list[float] | np.ndarray

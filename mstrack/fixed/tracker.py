@@ -57,6 +57,7 @@ class FixedTracker:
 
     def _box_at(self, c8: tuple[int, int]) -> Box:
         cx, cy = self._to_float(c8)
+        assert self._t is not None, "init() first"
         b = self._t.box
         return Box(cx - (b.w - 1) / 2.0, cy - (b.h - 1) / 2.0, float(b.w), float(b.h))
 
@@ -112,6 +113,7 @@ class FixedTracker:
         frame = check_frame(frame, self._shape)
         p, fx, t = self.params, self.fixed, self._t
         cf = fx.centre_frac
+        assert self._shape is not None
         fh, fw = self._shape
         reg: Region = ms_region(t.c8, t.ker.ex, t.ker.ey, fw, fh, fx)
         colour, edge = ms_region_capture(frame, reg, p)
@@ -142,6 +144,6 @@ class FixedTracker:
         one_a = float(1 << fx.alpha_frac)
         return TrackResult(
             box=self._box_at(c8), centre=self._to_float(c8), rho_c=rho_c / one_r, rho_e=rho_e / one_r,
-            alpha_c=a_c / one_a, alpha_e=a_e / one_a, iter_c=raw["iter_c"], iter_e=raw["iter_e"],
+            alpha_c=a_c / one_a, alpha_e=a_e / one_a, iter_c=int(raw["iter_c"]), iter_e=int(raw["iter_e"]),  # type: ignore[call-overload]
             status=Status.LOST if lost else Status.OK,
             extra={**raw, "stop_c_name": rc.stop if rc else None, "stop_e_name": re.stop if re else None})

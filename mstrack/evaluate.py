@@ -515,6 +515,11 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
     pool = _Pool(jobs, scheduler)
     if jobs > 1 or scheduler is not None:
         todo.sort(key=lambda t: -t[3])  # longest first (results do not depend on the order)
+        if model == "float" and any(uses_model(t[0][1]) for t in todo):
+            # compile (or load) the numba kernels here first: a first run compiles once, with the
+            # CLI's notice, and the workers of this machine then load them from numba's disk cache
+            from .float_v2 import _numba_ready
+            _numba_ready()
     if progress and todo:
         print(f"eval: {len(done)} runs cached, {len(todo)} to run on {pool.where}", file=sys.stderr)
     # in this process the per-frame bar of each run shows; with workers, one bar over the runs

@@ -27,6 +27,7 @@ Any object with ``init(frame, box)`` and ``update(frame)`` returning a
 from __future__ import annotations
 
 import json
+import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -390,12 +391,24 @@ def _run_job(factory: Callable[[str, str], Any], name: str, model: str, seq: Seq
         return "failed", str(exc)
 
 
+def _run_job_threads(cv_threads: int, *call: Any) -> tuple[str, Any]:
+    """:func:`_run_job` after limiting OpenCV's thread pool to ``cv_threads`` in this worker: N
+    workers of 2 OpenCV threads each on 2 cores would fight for them (CSRT and KCF use the pool).
+    The boxes do not depend on the thread count (checked for CSRT and KCF on real sequences)."""
+    import cv2
+    cv2.setNumThreads(cv_threads)
+    return _run_job(*call)
+
+
 class _Pool:
     """Runs :func:`_run_job` calls: in this process (jobs=1), on a local process pool (``jobs`` > 1)
     or on a Dask cluster (``scheduler``); :meth:`results` yields ``(index, outcome)`` as runs finish."""
 
     def __init__(self, jobs: int, scheduler: str | None) -> None:
         self.jobs, self.scheduler = jobs, scheduler
+        # OpenCV threads per worker: the cores shared out (local workers); one on a remote cluster,
+        # which is meant to run one single-threaded worker process per core
+        self.cv_threads = max(1, (os.cpu_count() or 1) // jobs) if scheduler in (None, "local") else 1
         self.where = ("this process" if jobs == 1 and scheduler is None else
                       f"{jobs} processes" if scheduler is None else
                       f"a local Dask cluster of {jobs} workers" if scheduler == "local" else
@@ -415,7 +428,7 @@ class _Pool:
             # spawn: a fresh interpreter per worker (forking a process that runs OpenCV's thread pool
             # can deadlock); workers import mstrack and load the numba kernels from their disk cache
             with cf.ProcessPoolExecutor(max_workers=self.jobs, mp_context=mp.get_context("spawn")) as ex:
-                futs = {ex.submit(_run_job, *c): i for i, c in enumerate(calls)}
+                futs = {ex.submit(_run_job_threads, self.cv_threads, *c): i for i, c in enumerate(calls)}
                 for f in cf.as_completed(futs):
                     yield futs[f], f.result()
 
@@ -434,7 +447,7 @@ class _Pool:
         else:
             client = Client(self.scheduler, timeout="20s")
         try:
-            futs = {client.submit(_run_job, *c, pure=False, key=f"mstrack-run-{i}-{c[5]}-{c[3].name}"): i
+            futs = {client.submit(_run_job_threads, self.cv_threads, *c, pure=False, key=f"mstrack-run-{i}-{c[5]}-{c[3].name}"): i
                     for i, c in enumerate(calls)}
             for f in as_completed(list(futs)):
                 yield futs[f], f.result()

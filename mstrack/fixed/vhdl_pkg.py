@@ -130,5 +130,94 @@ def unpack_result(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
     return out
 
 
+# ----------------------------------------------------------------------------- result word v2
+# Core v2 (issue 11) carries tracker v2's result: the box size follows the target, the status is
+# one of STATUS_V2 and the confidence is a Q1.16 number.  The model side (this layout, packing
+# FixedTrackerV2's raw integers, decoding) exists before the RTL so that core v2 is built against
+# it; docs/architecture.md ("Result word v2") lists it.
+STATUS_V2 = ("ok", "uncertain", "lost", "reacquired", "init", "clipped", "error")
+STATUS_W = 3
+CONF_W = 17                 # Q1.16, 0 .. 2**16
+DECIM_LOG2_W = 3            # log2 D: 0 .. 4 (D = 16 while lost at D = 8)
+SEARCHED_W = 4              # start points searched besides the centre while lost: 0 .. 8
+STOP_CODES_V2 = ("shift", "rho", "max_iter", "lost")
+
+
+def result_layout_v2(g: dict[str, int] | None = None) -> list[tuple[str, int, int]]:
+    """Fields of result word v2, LSB first: (name, offset, width).
+
+    ``cx, cy``: centre Q(COORD_W).CF in full-resolution pixel-index coordinates;
+    ``w8, h8``: box size Q(COORD_W).8 px; ``rho``, ``confidence``: Q1.16;
+    ``status``: index into :data:`STATUS_V2`; ``iter``, ``stop``: the winning mean shift;
+    ``decim_log2``: log2 of the decimation used in the frame; ``searched``: extra start points;
+    ``flags`` and ``err_code`` as in result word v1 (stream errors); ``frame_count``.
+    """
+    if g is None:
+        from ..params import TrackerParams
+        g = core_generics(TrackerParams(preset="v2"))
+    size_w = g["COORD_W"] + 8
+    fields_ = [("cx", g["CENTRE_ABS_W"]), ("cy", g["CENTRE_ABS_W"]), ("w8", size_w), ("h8", size_w),
+               ("rho", g["RHO_OUT_W"]), ("confidence", CONF_W), ("status", STATUS_W),
+               ("iter", g["ITER_W"]), ("stop", 2), ("decim_log2", DECIM_LOG2_W), ("searched", SEARCHED_W),
+               ("flags", len(RESULT_FLAGS)), ("err_code", ERR_CODE_W), ("frame_count", FRAME_COUNT_W)]
+    out, off = [], 0
+    for name, w in fields_:
+        out.append((name, off, w))
+        off += w
+    return out
+
+
+def result_width_v2(g: dict[str, int] | None = None) -> int:
+    """Result word v2 width: the fields rounded up to a multiple of 8 bits."""
+    name, off, w = result_layout_v2(g)[-1]
+    return -(-(off + w) // 8) * 8
+
+
+def pack_result_v2(fields: dict[str, int], g: dict[str, int] | None = None) -> int:
+    """Pack the fields of :func:`result_layout_v2` (missing ones are 0) into one word.
+
+    Raises ValueError when a value is negative or does not fit its field (the widths are the
+    specification: a value that does not fit is a model or width bug, never truncated silently).
+    """
+    word = 0
+    layout = result_layout_v2(g)
+    known = {name for name, _, _ in layout}
+    extra = set(fields) - known
+    if extra:
+        raise ValueError(f"unknown result v2 field(s): {sorted(extra)}")
+    for name, off, w in layout:
+        v = int(fields.get(name, 0))
+        if v < 0 or v >= 1 << w:
+            raise ValueError(f"result v2 field {name} = {v} does not fit in {w} bits")
+        word |= v << off
+    return word
+
+
+def unpack_result_v2(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
+    """Split a result word v2 into its fields; flags also one key each (flag_<name>)."""
+    out = {name: (word >> off) & ((1 << w) - 1) for name, off, w in result_layout_v2(g)}
+    for i, f in enumerate(RESULT_FLAGS):
+        out[f"flag_{f}"] = (out["flags"] >> i) & 1
+    return out
+
+
+def result_fields_v2(extra: dict[str, int], frame_count: int = 0) -> dict[str, int]:
+    """The result word v2 fields of one frame of FixedTrackerV2 (``TrackResult.extra``).
+
+    Flags follow the status (init, clipped, lost); a model frame has no stream error.
+    """
+    status = STATUS_V2[int(extra["status"])]
+    d = int(extra["decimation"])
+    flags = 0
+    for name in ("init", "clipped", "lost"):
+        if status == name:
+            flags |= 1 << RESULT_FLAGS.index(name)
+    return {"cx": int(extra["cx"]), "cy": int(extra["cy"]), "w8": int(extra["w8"]), "h8": int(extra["h8"]),
+            "rho": int(extra["rho"]), "confidence": int(extra["confidence"]), "status": int(extra["status"]),
+            "iter": int(extra["iter"]), "stop": int(extra.get("stop", 0)), "decim_log2": d.bit_length() - 1,
+            "searched": int(extra.get("searched", 0)), "flags": flags, "err_code": 0,
+            "frame_count": frame_count & ((1 << FRAME_COUNT_W) - 1)}
+
+
 if __name__ == "__main__":
     print(write_formats_pkg(Path(sys.argv[1]) if len(sys.argv) > 1 else PKG_PATH))

@@ -45,7 +45,8 @@ class PassV2:
     sw, swx, swy: sums of the mean-shift weights sqrt(q_u / p_u), and of the
     weights times x, y; nt, st2: count and sum of d2 of the target-coloured
     pixels (t_u = 1) in the window; n_in, nt_in: pixels, and target-coloured
-    pixels, in the inner window d2 < 1 / (1 + pad)^2 (the box itself).
+    pixels, in the inner window d2 < 1 / (1 + pad)^2 (the box itself); n: pixels
+    in the window.
     """
 
     rho: float
@@ -56,11 +57,17 @@ class PassV2:
     st2: float
     n_in: int
     nt_in: int
+    n: int
 
     @property
     def share(self) -> float:
         """Share of target-coloured pixels in the box (inner window)."""
         return self.nt_in / self.n_in if self.n_in else 0.0
+
+    @property
+    def ring_share(self) -> float:
+        """Share of target-coloured pixels in the window's ring around the box (0 if none)."""
+        return (self.nt - self.nt_in) / (self.n - self.n_in) if self.n > self.n_in else 0.0
 
     @property
     def spread(self) -> float:
@@ -133,7 +140,7 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
     inner = d2 < inner2
     return PassV2(rho=rho, sw=float(w.sum()), swx=float((w * xs).sum()), swy=float((w * ys).sum()),
                   nt=float(tp.sum()), st2=float((tp * d2).sum()), n_in=int(inner.sum()),
-                  nt_in=int(tp[inner].sum()))
+                  nt_in=int(tp[inner].sum()), n=len(b))
 
 
 # ----------------------------------------------------------------------------- numba kernels
@@ -242,11 +249,11 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
 def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
                     ibuf, fbuf, ax, cnt, td, cache, rows):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
-    the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
+    the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in, n).  Buffers: :func:`_nb_buffers_v2`."""
     n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
                                     ibuf[2], fbuf, ax[0], cnt, cache, rows)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
-    return rho, sw, swx, swy, nt, st2, n_in, nt_in
+    return rho, sw, swx, swy, nt, st2, n_in, nt_in, n
 
 
 @_jit
@@ -278,13 +285,13 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
         if abs(s2 - eps2) <= _SHIFT2_BAND * eps2:
-            return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0)
+            return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0, 0)
         c0x, c0y, n0, rho0, sw0, swx0, swy0 = c1x, c1y, n1, rho1, sw1, swx1, swy1
         B0, X0, Y0, ax0, B1, X1, Y1, ax1 = B1, X1, Y1, ax1, B0, X0, Y0, ax0
         if s2 < eps2:
             break
     nt, st2, n_in, nt_in = _nb_stats(n0, B0, X0, Y0, ax0, c0x, c0y, hx, hy, t, inner2, td)
-    return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in)
+    return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in, n0)
 
 
 def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
@@ -401,6 +408,21 @@ def confidence(ps: PassV2, rho_ref: float, share_ref: float) -> float:
     return cr * cs
 
 
+def loss_flag(ps: PassV2, rho0: float, p: TrackerParams) -> bool:
+    """The loss flag (docs/algorithm.md, "Loss flag"): the window matches the model worse than
+    at init *and* its target colours do not stand out from the ring around the box:
+    rho < loss_rho rho0 and share - ring_share < loss_contrast."""
+    return ps.rho < p.loss_rho * rho0 and ps.share - ps.ring_share < p.loss_contrast
+
+
+def report_status(searching: bool, flagged: bool, was_flagged_lost: bool) -> Status:
+    """The reported status: flagged -> lost (while the wide search runs) or uncertain; not
+    flagged -> reacquired after a reported loss, else ok."""
+    if flagged:
+        return Status.LOST if searching else Status.UNCERTAIN
+    return Status.REACQUIRED if was_flagged_lost else Status.OK
+
+
 def search_starts(start: tuple[float, float], hx: float, hy: float,
                   p: TrackerParams) -> list[tuple[float, float]]:
     """The 8 wide-search start points: start +- search_step window diameters in x and y."""
@@ -409,7 +431,9 @@ def search_starts(start: tuple[float, float], hx: float, hy: float,
 
 
 def decide_status(conf: float, was_lost: bool, p: TrackerParams) -> Status:
-    """lost / reacquired / uncertain / ok from the confidence and whether the target was lost."""
+    """The search state from the confidence and whether the tracker was searching: lost (search
+    from the next frame on) / reacquired / uncertain / ok (only ok frames teach the references).
+    FloatTrackerV2 reports :func:`report_status` (the loss flag), not this."""
     if conf < (p.conf_reacquire if was_lost else p.conf_lost):
         return Status.LOST
     if was_lost:
@@ -536,7 +560,9 @@ class FloatTrackerV2:
         self._rho_ref = ps.rho
         self._share_ref = ps.share
         self._spread_ref = ps.spread if ps.spread > 0 else 0.5 / pad ** 2
+        self._rho0 = ps.rho  # the loss flag's reference: rho at init
         self._lost = False
+        self._reported_lost = False
         return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
                            message="init box clipped to the frame" if clipped else "",
@@ -575,10 +601,13 @@ class FloatTrackerV2:
                 conf2 = self._confidence(ps2)
                 if conf2 > conf:
                     c, ps, conf = c2, ps2, conf2
-        status = decide_status(conf, self._lost, p)
-        self._lost = status == Status.LOST
-        self._centre = (c[0] * d, c[1] * d)  # lost: the search's best candidate (not trusted: ok False)
-        if status == Status.OK:
+        state = decide_status(conf, self._lost, p)  # the search state (what the tracker does next)
+        flagged = loss_flag(ps, self._rho0, p)  # what it reports (ok False when flagged)
+        status = report_status(state == Status.LOST, flagged, self._reported_lost)
+        self._lost = state == Status.LOST
+        self._reported_lost = status == Status.LOST
+        self._centre = (c[0] * d, c[1] * d)  # searching: the search's best candidate
+        if state == Status.OK:
             a = p.ref_rate
             self._rho_ref += a * (ps.rho - self._rho_ref)
             self._share_ref += a * (ps.share - self._share_ref)
@@ -589,7 +618,8 @@ class FloatTrackerV2:
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=it, iter_e=0, status=status, confidence=conf,
                            extra={"decimation": d, "share": ps.share, "spread": ps.spread,
-                                  "searched": searched})
+                                  "searched": searched, "nt": ps.nt, "n_in": ps.n_in, "nt_in": ps.nt_in,
+                                  "n": ps.n, "ring_share": ps.ring_share, "state": state.value})
 
 
 _NUMBA_OK: bool | None = None

@@ -86,10 +86,14 @@ class TrackerParams:
         1 + step) - 1) - reg (w / w0 - 1), 1 - step, 1 + step), est =
         sqrt(spread / spread at init).  scale_gain = 0 keeps the init size.
     conf_lost, conf_uncertain, conf_reacquire : float
-        Confidence thresholds: below conf_lost the target is lost (ok False,
-        nothing learnt, wide search from the next frame on); below
-        conf_uncertain the result is uncertain (ok False, nothing learnt); a
-        wide search re-acquires the target at conf_reacquire or above.
+        Search state from the confidence: below conf_lost the tracker searches
+        (wide search from the next frame on, nothing learnt); below
+        conf_uncertain nothing is learnt; a wide search ends at conf_reacquire
+        or above.
+    loss_rho, loss_contrast : float
+        Loss flag (``TrackResult.ok`` False): rho < loss_rho x rho at init and
+        contrast = share in the box - share in the window's ring < loss_contrast
+        (docs/algorithm.md, "Loss flag").
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -116,6 +120,8 @@ class TrackerParams:
     conf_lost: float = 0.4
     conf_uncertain: float = 0.5
     conf_reacquire: float = 0.5
+    loss_rho: float = 0.87
+    loss_contrast: float = 0.19
     ref_rate: float = 0.015625
     search_step: float = 1.0
     search_iter: int = 5
@@ -146,6 +152,7 @@ class TrackerParams:
             for name, lo, hi in (("pad", 0.0, 2.0), ("bg_ring", 0.05, 4.0), ("scale_gain", 0.0, 1.0),
                                  ("scale_step", 0.0, 0.5), ("scale_reg", 0.0, 1.0), ("conf_lost", 0.0, 1.0),
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
+                                 ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")

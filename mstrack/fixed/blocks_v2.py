@@ -171,6 +171,29 @@ def ms_share(st: TargetStats) -> int:
     return int(ms_divider(st.nt_in << 16, st.n_in, 17)) if st.n_in else 0
 
 
+def ms_ring_share(st: TargetStats, K: int) -> int:
+    """ring_share = floor((nt - nt_in) 2**16 / (K - n_in)) (Q.16; 0 when K <= n_in).
+
+    The share of target-coloured pixels in the window's ring around the box
+    (the K - n_in window pixels outside the inner window; flat kernel: K is the
+    window's pixel count).  nt - nt_in <= K - n_in, so the result is in
+    0 .. 2**16 (17 bits); dividend < 2**(16 + 14) for K < 2**14.
+    """
+    den = K - st.n_in
+    return int(ms_divider((st.nt - st.nt_in) << 16, den, 17)) if den > 0 else 0
+
+
+def ms_loss_flag(rho: int, rho0: int, share: int, ring_share: int, loss_rho: int, loss_contrast: int) -> bool:
+    """The loss flag: rho 2**16 < loss_rho rho0  and  share - ring_share < loss_contrast.
+
+    rho, rho0 (rho at init): Q.16 in 0 .. 2**16; share, ring_share: Q.16 in
+    0 .. 2**16; loss_rho (Q.16, 0 .. 2**17) and loss_contrast (Q.16, signed,
+    -2**16 .. 2**16) are the rounded parameters.  Exact comparisons: a 17 x 18 bit
+    product against a 33-bit shifted rho, and an 18-bit signed difference; no rounding.
+    """
+    return rho << 16 < loss_rho * rho0 and share - ring_share < loss_contrast
+
+
 def ms_spread(st: TargetStats) -> int:
     """spread = floor(st2 2**16 / nt): mean d2q of the target-coloured pixels, Q.(KB + 16); 0 if nt = 0."""
     return int(ms_divider(st.st2 << 16, st.nt, 40)) if st.nt else 0

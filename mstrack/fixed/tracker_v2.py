@@ -26,8 +26,9 @@ from ..params import TrackerParams
 from ..types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
-from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_model_scale,
-                        ms_ref_update, ms_resize, ms_scale, ms_share, ms_spread, ms_target_stats,
+from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_flag,
+                        ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+                        ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths)
 from .formats import FixedParams, widths
 
@@ -50,6 +51,7 @@ class FixedTrackerV2:
         self.ring16 = sixteenths(p.bg_ring, "bg_ring")
         self.step16 = sixteenths(p.search_step, "search_step")
         self.ref_k = rate_shift(p.ref_rate)
+        self.loss_rho16, self.loss_contrast16 = q16(p.loss_rho), q16(p.loss_contrast)
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
         if p.max_window > 2 * self.fixed.max_half + 1:
@@ -133,9 +135,11 @@ class FixedTrackerV2:
         _, S, _, _, st = self._ref_pass(frame[::d, ::d], Qw, ker, start8)
         self.rho_ref = ms_rho_out(S, ker.K, fx)
         self.share_ref = ms_share(st)
+        self.rho0 = self.rho_ref  # the loss flag's reference: rho at init
         sp = ms_spread(st)
         self.spread_ref = sp if sp > 0 else ((128 << (fx.kernel_bits + 16)) // (16 + self.pad16) ** 2)
         self.lost = False
+        self.reported_lost = False
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
                "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
                "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref}
@@ -193,17 +197,25 @@ class FixedTrackerV2:
                     conf2 = ms_confidence(rho2, share2, self.rho_ref, self.share_ref)
                     if conf2 > conf:
                         c8d, S, st, rho, share, conf = c2, S2, st2, rho2, share2, conf2
+        # search state (what the tracker does next) from the confidence
         if conf < q16(p.conf_reacquire if self.lost else p.conf_lost):
-            status = Status.LOST
+            state = Status.LOST
         elif self.lost:
-            status = Status.REACQUIRED
+            state = Status.REACQUIRED
         elif conf < q16(p.conf_uncertain):
-            status = Status.UNCERTAIN
+            state = Status.UNCERTAIN
         else:
-            status = Status.OK
-        self.lost = status == Status.LOST
+            state = Status.OK
+        # reported status from the loss flag (float: report_status)
+        ring = ms_ring_share(st, ker.K)
+        if ms_loss_flag(rho, self.rho0, share, ring, self.loss_rho16, self.loss_contrast16):
+            status = Status.LOST if state == Status.LOST else Status.UNCERTAIN
+        else:
+            status = Status.REACQUIRED if self.reported_lost else Status.OK
+        self.lost = state == Status.LOST
+        self.reported_lost = status == Status.LOST
         self.c8 = (c8d[0] << sh, c8d[1] << sh)
-        if status == Status.OK:
+        if state == Status.OK:
             self.rho_ref = ms_ref_update(self.rho_ref, rho, self.ref_k)
             self.share_ref = ms_ref_update(self.share_ref, share, self.ref_k)
         spread = ms_spread(st)
@@ -214,7 +226,9 @@ class FixedTrackerV2:
             self.h8 = ms_resize(self.h8, s, fh)
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": rho,
                "confidence": conf, "status": STATUS_CODES_V2[status], "iter": it, "decimation": d,
-               "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched}
+               "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched,
+               "nt": st.nt, "n_in": st.n_in, "nt_in": st.nt_in, "K": ker.K,
+               "ring_share": ring, "state": STATUS_CODES_V2[state]}
         return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
                            rho_c=rho / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=it, iter_e=0,
                            status=status, confidence=conf / 65536.0, extra=raw)

@@ -14,8 +14,9 @@ import pytest
 
 from mstrack import Tracker
 from mstrack.fixed.blocks import ms_kernel
-from mstrack.fixed.blocks_v2 import (ONE, ms_bg_model, ms_box_size, ms_confidence, ms_decimation,
-                                     ms_model_scale, ms_ref_update, ms_resize, ms_scale, ms_share, ms_spread,
+from mstrack.fixed.blocks_v2 import (ONE, ms_bg_model, ms_box_size, ms_confidence, ms_decimation, ms_loss_flag,
+                                     ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share,
+                                     ms_spread,
                                      ms_target_stats, ms_window_size, rate_shift, sixteenths, TargetStats)
 from mstrack.float_v2 import FloatTrackerV2
 from mstrack.params import TrackerParams
@@ -160,6 +161,78 @@ def test_share_spread_confidence_random():
     assert ms_confidence(5, 5, 0, 0) == 0
 
 
+def test_ring_share_against_exact_definition():
+    """ring_share = floor((nt - nt_in) 2**16 / (K - n_in)), 0 without ring pixels; large random
+    plus the edges (empty ring, all-target ring, one-pixel ring)."""
+    rng = np.random.default_rng(11)
+    cases = [(1, 0, 1, 0), (5, 5, 5, 5), (16129, 0, 16129, 0), (16129, 16129, 1, 0), (16129, 16128, 16128, 16128),
+             (16129, 1, 16128, 0)]
+    for _ in range(20000):
+        K = int(rng.integers(1, 16130))
+        n_in = int(rng.integers(0, K + 1))
+        nt_in = int(rng.integers(0, n_in + 1))
+        nt = nt_in + int(rng.integers(0, K - n_in + 1))
+        cases.append((K, n_in, nt, nt_in))
+    for K, n_in, nt, nt_in in cases:
+        st = TargetStats(nt=nt, st2=0, n_in=n_in, nt_in=nt_in)
+        want = floor_frac(Fraction((nt - nt_in) * ONE, K - n_in)) if K > n_in else 0
+        got = ms_ring_share(st, K)
+        assert got == want, (K, n_in, nt, nt_in)
+        assert 0 <= got <= ONE
+
+
+def test_loss_flag_against_exact_definition():
+    """flag = rho / rho0 < loss_rho / 2**16 and share - ring_share < loss_contrast / 2**16, as
+    exact rationals; large random over the full ranges plus every threshold edge."""
+    rng = np.random.default_rng(12)
+    cases = []
+    for _ in range(50000):
+        cases.append((int(rng.integers(0, ONE + 1)), int(rng.integers(0, ONE + 1)), int(rng.integers(0, ONE + 1)),
+                      int(rng.integers(0, ONE + 1)), int(rng.integers(0, 2 * ONE + 1)),
+                      int(rng.integers(-ONE, ONE + 1))))
+    lr, lc = round(0.87 * ONE), round(0.19 * ONE)
+    for rho0 in (1, 1000, 40000, ONE):  # rho exactly at and next to the threshold
+        for rho in {(lr * rho0) >> 16, ((lr * rho0) >> 16) + 1, max(((lr * rho0) >> 16) - 1, 0)}:
+            for d in (lc - 1, lc, lc + 1):
+                cases.append((rho, rho0, 30000, 30000 - d, lr, lc))
+    for rho, rho0, share, ring, loss_rho, loss_contrast in cases:
+        want = (Fraction(rho) < Fraction(loss_rho, ONE) * rho0) and (share - ring < loss_contrast)
+        assert ms_loss_flag(rho, rho0, share, ring, loss_rho, loss_contrast) == want, \
+            (rho, rho0, share, ring, loss_rho, loss_contrast)
+
+
+def test_fixed_v2_status_from_loss_flag():
+    """Each fixed-model update: the search state from the confidence (as before), the reported
+    status from ms_loss_flag on its raw integers (rho against rho at init, share, ring_share)."""
+    from mstrack.fixed.tracker_v2 import STATUS_CODES_V2
+    from mstrack.types import Status
+    frames, boxes = _scene(30)
+    for f in frames[12:18]:  # the target leaves for 6 frames
+        f[:] = frames[0][0, 0]
+    trk = Tracker(model="fixed", preset="v2")
+    r0 = trk.init(frames[0], boxes[0])
+    rho0 = r0.extra["rho"]
+    codes = {v: k for k, v in STATUS_CODES_V2.items()}
+    lr, lc = round(V2.loss_rho * ONE), round(V2.loss_contrast * ONE)
+    searching = reported_lost = False
+    seen = set()
+    for f in frames[1:]:
+        r = trk.update(f)
+        e = r.extra
+        assert ms_ring_share(TargetStats(e["nt"], 0, e["n_in"], e["nt_in"]), e["K"]) == e["ring_share"]
+        flagged = ms_loss_flag(e["rho"], rho0, e["share"], e["ring_share"], lr, lc)
+        state = codes[e["state"]]
+        if flagged:
+            want = Status.LOST if state == Status.LOST else Status.UNCERTAIN
+        else:
+            want = Status.REACQUIRED if reported_lost else Status.OK
+        assert codes[e["status"]] == want == r.status and r.ok == (not flagged)
+        assert (e["searched"] > 0) == searching
+        searching, reported_lost = state == Status.LOST, want == Status.LOST
+        seen.add(want)
+    assert {Status.OK, Status.LOST, Status.REACQUIRED} <= seen, seen
+
+
 def test_ref_update_floor():
     for ref, x in ((1000, 2000), (2000, 1000), (5, 6), (6, 5), (0, ONE)):
         assert ms_ref_update(ref, x, 6) == ref + math.floor(Fraction(x - ref, 64))
@@ -257,6 +330,28 @@ def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
     # measured 2026-11-23: float 0.549, fixed 0.555
     assert abs(res["fixed"] - res["float"]) <= 0.01, res
     assert res["fixed"] >= 0.50, res
+
+
+@pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (../shared absent)")
+def test_v2_loss_flag_on_the_dev_set():
+    """Loss signal floors, both models, whole dev set (docs/results_loss.md): recall (off-target
+    frames, IoU = 0, not ok) and false alarms (IoU >= 0.5, not ok).  Measured 2026-11-23: float
+    0.519 / 0.044, fixed 0.544 / 0.047 (issue target 0.6 / 0.05: recall not reached)."""
+    from mstrack.data import load_dataset
+    from mstrack.metrics import iou, loss_detection, valid_gt
+
+    for model in ("float", "fixed"):
+        ious, oks = [], []
+        for seq in load_dataset(SEQ_ROOT):
+            trk = Tracker(model=model, preset="v2")
+            trk.init(seq.frame(0), seq.init_box())
+            res = [trk.update(seq.frame(i)) for i in range(1, len(seq))]
+            gt = seq.gt[1:len(seq)]
+            v = valid_gt(gt)
+            ious.append(iou(np.array([r.box.as_tuple() for r in res]), gt)[v])
+            oks.append(np.array([r.ok for r in res])[v])
+        ld = loss_detection(np.concatenate(ious), np.concatenate(oks))
+        assert ld.recall >= 0.50 and ld.false_alarm <= 0.05, (model, ld)
 
 
 def test_v2_budget_section_is_current():

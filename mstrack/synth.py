@@ -880,10 +880,11 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
 # ----------------------------------------------------------------------------- tracker v2 budget
 #: per-frame v2 arithmetic after the mean shift, issued one after the other into one iterative
 #: divider (Q bits + 2 clocks each): share (17), spread (40), rho / rho_ref (34), share /
-#: share_ref (34), spread ratio (40), w / w0 (40); one isqrt of 56 bits (28 clocks); the model
+#: share_ref (34), spread ratio (40), w / w0 (40), ring share (17, the loss flag's
+#: ms_ring_share; its ms_loss_flag is one multiplier and two compares); one isqrt of 56 bits (28 clocks); the model
 #: scaling Qw = Qn K >> 16 rides in the bin pass (one multiplier, no clock); kernel tables for a
 #: new window size: 3 (HALF_W + 1) + 3 clocks (ms_kernel_tables set-up).
-V2_DIVISIONS_Q = (17, 40, 34, 34, 40, 40)
+V2_DIVISIONS_Q = (17, 40, 34, 34, 40, 40, 17)
 V2_ISQRT = 28
 
 

@@ -10,8 +10,11 @@ in a window padded around the target, with
 * a confidence = min(1, rho / rho_ref) * min(1, share / share_ref) from the
   Bhattacharyya coefficient and the share of target-coloured pixels in the
   box, against their running references,
-* loss (confidence below a threshold: the box is kept, nothing is learnt)
-  and re-acquisition by a wider search from several start points.
+* a search state from the confidence (below a threshold: nothing is
+  learnt, and a wider search from several start points runs next frame),
+* a loss flag, the reported status (``TrackResult.ok`` False): rho below
+  loss_rho x rho at init and the target colours' share in the box less
+  their share in the window's ring below loss_contrast.
 
 Every step is a pass over the window's pixels or over the bins, so the
 fixed-point model and the RTL can do the same in integers.

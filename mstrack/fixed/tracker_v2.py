@@ -11,7 +11,9 @@ Per frame (all integer; blocks in :mod:`mstrack.fixed.blocks_v2` and :mod:`mstra
    loop) from the last centre; while lost also from 8 start points at
    +-search_step window diameters (search_iter iterations each).
 4. rho = ms_rho_out(S, K); share and spread from :func:`ms_target_stats` at
-   the final centre; confidence; status; the best start point wins while lost.
+   the final centre; confidence; the best start point wins while lost; the
+   search state from the confidence; the reported status from the loss flag
+   (ms_ring_share, ms_loss_flag against rho0 = rho at init).
 5. References (rho_ref, share_ref) follow confident frames by a shift;
    the size changes by ms_scale every frame.
 

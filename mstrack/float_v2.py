@@ -411,16 +411,22 @@ def confidence(ps: PassV2, rho_ref: float, share_ref: float) -> float:
     return cr * cs
 
 
-def loss_flag(ps: PassV2, rho0: float, p: TrackerParams) -> bool:
-    """The loss flag (docs/algorithm.md, "Loss flag"): the window matches the model worse than
-    at init *and* its target colours do not stand out from the ring around the box:
-    rho < loss_rho rho0 and share - ring_share < loss_contrast."""
-    return ps.rho < p.loss_rho * rho0 and ps.share - ps.ring_share < p.loss_contrast
+def loss_filter(s: float, x: float, p: TrackerParams) -> float:
+    """One step of the loss flag's smoothing: s + loss_smooth (x - s)."""
+    return s + p.loss_smooth * (x - s)
+
+
+def loss_flag(rho_s: float, con_s: float, rho0: float, share: float, p: TrackerParams) -> bool:
+    """The loss flag (docs/algorithm.md, "v2.7a Loss flag"): no target-coloured pixel in the box
+    (share = 0), or the window matches the model worse than at init *and* its target colours do
+    not stand out from the ring around the box, both smoothed (:func:`loss_filter` of rho and of
+    contrast = share - ring_share): rho_s < loss_rho rho0 and con_s < loss_contrast."""
+    return share == 0 or (rho_s < p.loss_rho * rho0 and con_s < p.loss_contrast)
 
 
 def report_status(searching: bool, flagged: bool, was_flagged_lost: bool) -> Status:
     """The reported status: flagged -> lost (while the wide search runs) or uncertain; not
-    flagged -> reacquired after a reported loss, else ok."""
+    flagged -> reacquired on the first unflagged frame after a reported loss, else ok."""
     if flagged:
         return Status.LOST if searching else Status.UNCERTAIN
     return Status.REACQUIRED if was_flagged_lost else Status.OK
@@ -564,12 +570,13 @@ class FloatTrackerV2:
         self._share_ref = ps.share
         self._spread_ref = ps.spread if ps.spread > 0 else 0.5 / pad ** 2
         self._rho0 = ps.rho  # the loss flag's reference: rho at init
+        self._rho_s, self._con_s = ps.rho, ps.share - ps.ring_share  # its filters start at init
         self._lost = False
         self._reported_lost = False
         return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
                            message="init box clipped to the frame" if clipped else "",
-                           confidence=1.0, extra={"decimation": d, "share": ps.share})
+                           confidence=1.0, extra={"decimation": d, "share": ps.share, "ring_share": ps.ring_share})
 
     def update(self, frame: np.ndarray) -> TrackResult:
         if self._shape is None:
@@ -605,10 +612,13 @@ class FloatTrackerV2:
                 if conf2 > conf:
                     c, ps, conf = c2, ps2, conf2
         state = decide_status(conf, self._lost, p)  # the search state (what the tracker does next)
-        flagged = loss_flag(ps, self._rho0, p)  # what it reports (ok False when flagged)
+        self._rho_s = loss_filter(self._rho_s, ps.rho, p)
+        self._con_s = loss_filter(self._con_s, ps.share - ps.ring_share, p)
+        flagged = loss_flag(self._rho_s, self._con_s, self._rho0, ps.share, p)  # what it reports (ok False when flagged)
         status = report_status(state == Status.LOST, flagged, self._reported_lost)
         self._lost = state == Status.LOST
-        self._reported_lost = status == Status.LOST
+        # a loss stays reported (uncertain frames keep it) until a frame is ok again
+        self._reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self._reported_lost)
         self._centre = (c[0] * d, c[1] * d)  # searching: the search's best candidate
         if state == Status.OK:
             a = p.ref_rate
@@ -622,7 +632,8 @@ class FloatTrackerV2:
                            iter_c=it, iter_e=0, status=status, confidence=conf,
                            extra={"decimation": d, "share": ps.share, "spread": ps.spread,
                                   "searched": searched, "nt": ps.nt, "n_in": ps.n_in, "nt_in": ps.nt_in,
-                                  "n": ps.n, "ring_share": ps.ring_share, "state": state.value})
+                                  "n": ps.n, "ring_share": ps.ring_share, "state": state.value,
+                                  "rho_s": self._rho_s, "contrast_s": self._con_s})
 
 
 _NUMBA_OK: bool | None = None

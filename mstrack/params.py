@@ -90,10 +90,11 @@ class TrackerParams:
         (wide search from the next frame on, nothing learnt); below
         conf_uncertain nothing is learnt; a wide search ends at conf_reacquire
         or above.
-    loss_rho, loss_contrast : float
+    loss_rho, loss_contrast, loss_smooth : float
         Loss flag (``TrackResult.ok`` False): rho < loss_rho x rho at init and
-        contrast = share in the box - share in the window's ring < loss_contrast
-        (docs/algorithm.md, "Loss flag").
+        contrast = share in the box - share in the window's ring < loss_contrast,
+        both smoothed by s <- s + loss_smooth (x - s) (1: no smoothing; a power
+        of two for the fixed model) (docs/algorithm.md, "v2.7a Loss flag").
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -120,8 +121,9 @@ class TrackerParams:
     conf_lost: float = 0.4
     conf_uncertain: float = 0.5
     conf_reacquire: float = 0.5
-    loss_rho: float = 0.87
+    loss_rho: float = 0.88
     loss_contrast: float = 0.19
+    loss_smooth: float = 0.5
     ref_rate: float = 0.015625
     search_step: float = 1.0
     search_iter: int = 5
@@ -152,7 +154,7 @@ class TrackerParams:
             for name, lo, hi in (("pad", 0.0, 2.0), ("bg_ring", 0.05, 4.0), ("scale_gain", 0.0, 1.0),
                                  ("scale_step", 0.0, 0.5), ("scale_reg", 0.0, 1.0), ("conf_lost", 0.0, 1.0),
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
-                                 ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0),
+                                 ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")

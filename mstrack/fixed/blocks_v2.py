@@ -183,15 +183,27 @@ def ms_ring_share(st: TargetStats, K: int) -> int:
     return int(ms_divider((st.nt - st.nt_in) << 16, den, 17)) if den > 0 else 0
 
 
-def ms_loss_flag(rho: int, rho0: int, share: int, ring_share: int, loss_rho: int, loss_contrast: int) -> bool:
-    """The loss flag: rho 2**16 < loss_rho rho0  and  share - ring_share < loss_contrast.
+def ms_loss_filter(s: int, x: int, k: int) -> int:
+    """One step of the loss flag's smoothing: s + ((x - s) >> k) (arithmetic shift = floor).
 
-    rho, rho0 (rho at init): Q.16 in 0 .. 2**16; share, ring_share: Q.16 in
-    0 .. 2**16; loss_rho (Q.16, 0 .. 2**17) and loss_contrast (Q.16, signed,
-    -2**16 .. 2**16) are the rounded parameters.  Exact comparisons: a 17 x 18 bit
-    product against a 33-bit shifted rho, and an 18-bit signed difference; no rounding.
+    Used for rho (unsigned Q1.16, 0 .. 2**16) and for contrast = share - ring_share
+    (signed Q1.16, -2**16 .. 2**16); k = log2(1 / loss_smooth) (default 1).  The
+    result lies between s and x, so it keeps the range of its inputs (18 bits signed).
     """
-    return rho << 16 < loss_rho * rho0 and share - ring_share < loss_contrast
+    return s + ((x - s) >> k)
+
+
+def ms_loss_flag(rho_s: int, rho0: int, con_s: int, share: int, loss_rho: int, loss_contrast: int) -> bool:
+    """The loss flag: share = 0  or  (rho_s 2**16 < loss_rho rho0  and  con_s < loss_contrast).
+
+    rho_s (smoothed rho) and rho0 (rho at init): unsigned Q1.16 in 0 .. 2**16;
+    con_s (smoothed share - ring_share): signed Q1.16 in -2**16 .. 2**16;
+    loss_rho (unsigned Q1.16, 0 .. 2**17) and loss_contrast (signed Q1.16,
+    -2**16 .. 2**16) are the rounded parameters.  Exact comparisons: an 18 x 17 bit
+    product (< 2**34) against rho_s 2**16 (< 2**33), an 18-bit signed compare, and a
+    zero test of this frame's share (Q1.16; 0 = no target-coloured pixel in the box).
+    """
+    return share == 0 or (rho_s << 16 < loss_rho * rho0 and con_s < loss_contrast)
 
 
 def ms_spread(st: TargetStats) -> int:

@@ -28,8 +28,8 @@ from ..params import TrackerParams
 from ..types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
-from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_flag,
-                        ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,
+                        ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths)
 from .formats import FixedParams, widths
@@ -54,6 +54,7 @@ class FixedTrackerV2:
         self.step16 = sixteenths(p.search_step, "search_step")
         self.ref_k = rate_shift(p.ref_rate)
         self.loss_rho16, self.loss_contrast16 = q16(p.loss_rho), q16(p.loss_contrast)
+        self.loss_k = rate_shift(p.loss_smooth)
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
         if p.max_window > 2 * self.fixed.max_half + 1:
@@ -138,13 +139,16 @@ class FixedTrackerV2:
         self.rho_ref = ms_rho_out(S, ker.K, fx)
         self.share_ref = ms_share(st)
         self.rho0 = self.rho_ref  # the loss flag's reference: rho at init
+        self.rho_s = self.rho0    # the loss flag's filters start at the init values
+        self.con_s = self.share_ref - ms_ring_share(st, ker.K)
         sp = ms_spread(st)
         self.spread_ref = sp if sp > 0 else ((128 << (fx.kernel_bits + 16)) // (16 + self.pad16) ** 2)
         self.lost = False
         self.reported_lost = False
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
                "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
-               "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref}
+               "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref,
+               "rho_s": self.rho_s, "contrast_s": self.con_s}
         return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
                            rho_c=self.rho_ref / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=0,
                            iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
@@ -210,12 +214,14 @@ class FixedTrackerV2:
             state = Status.OK
         # reported status from the loss flag (float: report_status)
         ring = ms_ring_share(st, ker.K)
-        if ms_loss_flag(rho, self.rho0, share, ring, self.loss_rho16, self.loss_contrast16):
+        self.rho_s = ms_loss_filter(self.rho_s, rho, self.loss_k)
+        self.con_s = ms_loss_filter(self.con_s, share - ring, self.loss_k)
+        if ms_loss_flag(self.rho_s, self.rho0, self.con_s, share, self.loss_rho16, self.loss_contrast16):
             status = Status.LOST if state == Status.LOST else Status.UNCERTAIN
         else:
             status = Status.REACQUIRED if self.reported_lost else Status.OK
         self.lost = state == Status.LOST
-        self.reported_lost = status == Status.LOST
+        self.reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self.reported_lost)
         self.c8 = (c8d[0] << sh, c8d[1] << sh)
         if state == Status.OK:
             self.rho_ref = ms_ref_update(self.rho_ref, rho, self.ref_k)
@@ -230,7 +236,8 @@ class FixedTrackerV2:
                "confidence": conf, "status": STATUS_CODES_V2[status], "iter": it, "decimation": d,
                "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched,
                "nt": st.nt, "n_in": st.n_in, "nt_in": st.nt_in, "K": ker.K,
-               "ring_share": ring, "state": STATUS_CODES_V2[state]}
+               "ring_share": ring, "state": STATUS_CODES_V2[state], "rho_s": self.rho_s,
+               "contrast_s": self.con_s}
         return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
                            rho_c=rho / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=it, iter_e=0,
                            status=status, confidence=conf / 65536.0, extra=raw)

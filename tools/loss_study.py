@@ -316,7 +316,7 @@ def main_report() -> None:
     L += ["## The rule adopted", "",
           f"    rho_s      <- rho_s + {p.loss_smooth} (rho - rho_s)",
           f"    contrast_s <- contrast_s + {p.loss_smooth} (share - ring_share - contrast_s)",
-          f"    flagged = rho_s < {p.loss_rho} rho0  and  contrast_s < {p.loss_contrast}", "",
+          f"    flagged = share = 0  or  (rho_s < {p.loss_rho} rho0  and  contrast_s < {p.loss_contrast})", "",
           "rho0: rho at init; share: target-coloured share of the box; ring_share: the same in the window's "
           "ring around the box; the filters start at the init frame's values.  `ok` = not flagged.  Below, "
           "\"rho/rho0\" and \"contrast\" are the smoothed values unless said otherwise.", "",

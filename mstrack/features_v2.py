@@ -41,8 +41,9 @@ mean shift from the same start and the two centres are fused by a rule
 * ``tie``: main feature unless its confidence is below ``conf_uncertain``,
   then ``disc``.
 
-With a single feature ``colour`` the class reproduces FloatTrackerV2
-(checked by the tool before it reports).
+With a single feature ``colour`` the class reproduces FloatTrackerV2's boxes
+(checked by the tool before it reports); its status is v2's search state
+(``decide_status``), without v2's loss flag.
 """
 from __future__ import annotations
 

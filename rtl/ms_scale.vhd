@@ -213,7 +213,8 @@ begin
           end if;
 
         when S_SUM =>                                          -- ONE + (pa >> 16) - (pb >> 16), floor
-          sum_r <= to_signed(ONE, S_W) + resize(shift_right(pa, 16), S_W) - resize(shift_right(pb, 16), S_W);
+          -- (>> 16 as a slice: GHDL 2.0 writes shift_right of a signed as Verilog `>>`, a logical shift)
+          sum_r <= to_signed(ONE, S_W) + resize(pa(PA_W - 1 downto 16), S_W) - resize(pb(PB_W - 1 downto 16), S_W);
           state <= S_OUT;
 
         when S_OUT =>                                          -- clamp to [LO, HI]

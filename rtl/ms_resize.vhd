@@ -2,9 +2,10 @@
 --
 -- s8 (Q.8 px) times the scale factor s (Q.16, ms_scale) by shift-and-add, one bit of s per clock,
 -- MSB first (acc = 2 acc + bit s8: no multiplier block), then >> 16 (floor) and the clamp
--- min(max(p, 3 2**8), frame_size 2**8) in that order (as the model: a frame_size below 3 gives
--- frame_size 2**8).  Per frame the tracker resizes w8 (frame width) and h8 (frame height): two
--- instances, or one used twice.
+-- min(max(p, 3 2**8), frame_size 2**8) (as the model: a frame_size below 3 gives frame_size 2**8),
+-- as two compares side by side and a select (max then min in series: 119 MHz alone on ECP5).
+-- Per frame the tracker resizes w8 (frame width) and h8 (frame height): two instances, or one used
+-- twice.
 -- Model: mstrack.fixed.blocks_v2.ms_resize(s8, s, frame_size), bit for bit, for any s8 < 2**SIZE_W,
 -- s < 2**SCALE_W (the result is clamped to frame_size 2**8 < 2**SIZE_W).
 --
@@ -47,7 +48,8 @@ architecture rtl of ms_resize is
   signal clamp_r        : std_logic := '0';
   signal a_r            : unsigned(SIZE_W - 1 downto 0);
   signal m_r            : unsigned(SCALE_W - 1 downto 0);  -- multiplier bits, MSB first
-  signal f_r            : unsigned(COORD_W - 1 downto 0);
+  signal hi_r           : unsigned(P_W - 17 downto 0);     -- frame_size 2**8
+  signal small_r        : std_logic;                       -- frame_size < 3: the result is hi_r
   signal p_r            : unsigned(P_W - 1 downto 0);
   signal cnt            : natural range 0 to SCALE_W - 1;
   signal out_r          : unsigned(SIZE_W - 1 downto 0) := (others => '0');
@@ -57,7 +59,6 @@ begin
 
   p_main : process (clk)
     variable q  : unsigned(P_W - 17 downto 0);
-    variable hi : unsigned(P_W - 17 downto 0);
   begin
     if rising_edge(clk) then
       done_r  <= '0';
@@ -66,7 +67,8 @@ begin
         if start = '1' then
           a_r    <= s8;
           m_r    <= s;
-          f_r    <= frame_size;
+          hi_r   <= shift_left(resize(frame_size, P_W - 16), 8);
+          small_r <= '1' when frame_size < 3 else '0';
           p_r    <= (others => '0');
           cnt    <= SCALE_W - 1;
           busy_r <= '1';
@@ -83,16 +85,15 @@ begin
         else
           cnt <= cnt - 1;
         end if;
-      else                                              -- >> 16, max with 3 px, min with the frame
-        q  := p_r(P_W - 1 downto 16);
-        hi := shift_left(resize(f_r, P_W - 16), 8);
-        if q < MIN8 then
-          q := to_unsigned(MIN8, P_W - 16);
+      else                                              -- >> 16, min(max(q, 3 px), frame): two
+        q := p_r(P_W - 1 downto 16);                    -- compares side by side, then a select
+        if small_r = '1' or q > hi_r then
+          out_r <= resize(hi_r, SIZE_W);
+        elsif q < MIN8 then
+          out_r <= to_unsigned(MIN8, SIZE_W);
+        else
+          out_r <= resize(q, SIZE_W);
         end if;
-        if q > hi then
-          q := hi;
-        end if;
-        out_r  <= resize(q, SIZE_W);
         done_r <= '1';
         busy_r <= '0';
       end if;

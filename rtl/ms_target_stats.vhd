@@ -18,13 +18,14 @@
 -- pixel pass ignores KA/KB).  Entries used: |dx| <= ex, |dy| <= ey (exact there, < 2**KERNEL_BITS).
 --
 -- Pipeline (edge s samples the beat): s: |dx + l|, |dy|, mask -> s+1: bins registered, KA/KB read
--- -> s+2: T read, d2q = KA + KB -> s+3: per-lane terms (t, t d2q, in, t in) -> s+4 .. s+3+log2(LANES):
--- adder tree over the lanes (one level per clock) -> s+4+log2(LANES): accumulators; on the last beat
--- the sums go to the outputs and the accumulators restart from 0 (the next pass needs no clear).
--- Latency    : STATS_LAT = 5 + log2(LANES) clocks: if edge s samples px_valid = px_last = 1, edge
+-- -> s+2: T read, d2q = KA + KB -> s+3: T read data registered again (no logic after the block RAM)
+-- -> s+4: per-lane terms (t, t d2q, in, t in) -> s+5 .. s+4+log2(LANES): adder tree over the lanes
+-- (one level per clock) -> s+5+log2(LANES): accumulators; on the last beat the sums go to the
+-- outputs and the accumulators restart from 0 (the next pass needs no clear).
+-- Latency    : STATS_LAT = 6 + log2(LANES) clocks: if edge s samples px_valid = px_last = 1, edge
 --              s + STATS_LAT samples done = 1 (tb/test_ms_target_stats.py asserts it).  Attached to
---              ms_pixel_pass (PASS_LAT = 10), done comes log2(LANES) - 3 clocks after the pass's done
---              (LANES = 4: one clock before it), long before the bin pass that follows has ended.
+--              ms_pixel_pass (PASS_LAT = 10), done comes log2(LANES) - 2 clocks after the pass's done
+--              (LANES = 4: in the same clock), long before the bin pass that follows has ended.
 -- Throughput : LANES pixels per clock (one beat per clock, no stall, no back-pressure).
 -- Handshake  : none on the input (the tap is a stream); done is a one-clock pulse, nt/st2/n_in/nt_in
 --              are registered and held until the next pass's done.  Tables must not be written
@@ -81,7 +82,7 @@ architecture rtl of ms_target_stats is
   constant D_W     : natural := REGION_W + 1;
   constant D2Q_W   : natural := KT_W + 1;                        -- KA + KB
   constant TL      : natural := clog2(LANES) * boolean'pos(LANES > 1);  -- adder tree levels
-  constant STATS_LAT : natural := 5 + TL;
+  constant STATS_LAT : natural := 6 + TL;
   constant C_SQ    : natural := (16 + PAD16) * (16 + PAD16);
   constant IN_LIM  : natural := (2 ** (KERNEL_BITS + 8) + C_SQ - 1) / C_SQ;  -- d2q < IN_LIM: inner
   constant TS_W    : natural := D2Q_W + TL;                      -- tree: sum of t d2q
@@ -109,15 +110,16 @@ architecture rtl of ms_target_stats is
   signal bin2      : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
   signal ka2       : k_arr_t := (others => (others => '0'));
   signal kb2       : unsigned(KT_W - 1 downto 0) := (others => '0');
-  -- stage 3 (edge s + 2)
-  signal last3     : std_logic := '0';
+  -- stage 3 (edge s + 2): T read, d2q; stage 4 (edge s + 3): T read data registered again
+  signal last3, last4 : std_logic := '0';
   signal m3, t3    : std_logic_vector(LANES - 1 downto 0) := (others => '0');
-  signal d3        : q_arr_t := (others => (others => '0'));
-  -- stage 4 and the tree (edges s + 3 .. s + 3 + TL)
+  signal m4, t4    : std_logic_vector(LANES - 1 downto 0) := (others => '0');
+  signal d3, d4    : q_arr_t := (others => (others => '0'));
+  -- stage 5 and the tree (edges s + 4 .. s + 4 + TL)
   signal last_t    : std_logic_vector(0 to TL) := (others => '0');
   signal tr_st     : ts_arr_t := (others => (others => '0'));
   signal tr_nt, tr_ni, tr_nti : tc_arr_t := (others => (others => '0'));
-  -- accumulators and results (edge s + 4 + TL)
+  -- accumulators and results (edge s + 5 + TL)
   signal a_nt, a_ni, a_nti : unsigned(COUNT_W - 1 downto 0) := (others => '0');
   signal a_st      : unsigned(ST2_W - 1 downto 0) := (others => '0');
   signal done_r    : std_logic := '0';
@@ -199,11 +201,15 @@ begin
     begin
       if rising_edge(clk) then
         d3(l) <= resize(ka2(l), D2Q_W) + resize(kb2, D2Q_W);
+        -- T read data registered once more with no logic between (yosys maps T to a DP16KD
+        -- without output register: its 5.8 ns clock-to-out must reach a flip-flop directly)
+        t4(l) <= t3(l);
+        d4(l) <= d3(l);
       end if;
     end process;
   end generate;
 
-  -- stages 2, 3: flags; the bins registered once after the region RAM
+  -- stages 2 .. 4: flags; the bins registered once after the region RAM
   p_s23 : process (clk)
   begin
     if rising_edge(clk) then
@@ -212,37 +218,41 @@ begin
       last2 <= last1;
       m3    <= m2;
       last3 <= last2;
+      m4    <= m3;
+      last4 <= last3;
       if rst = '1' then
         m2    <= (others => '0');
         last2 <= '0';
         m3    <= (others => '0');
         last3 <= '0';
+        m4    <= (others => '0');
+        last4 <= '0';
       end if;
     end if;
   end process;
 
-  -- stage 4: per-lane terms (tree level 0), then one tree level per clock
+  -- stage 5: per-lane terms (tree level 0), then one tree level per clock
   p_tree : process (clk)
     variable tv, inn : std_logic;
     variable n       : natural;
   begin
     if rising_edge(clk) then
       for l in 0 to LANES - 1 loop
-        tv  := t3(l) and m3(l);
+        tv  := t4(l) and m4(l);
         inn := '0';
-        if d3(l) < IN_LIM then
-          inn := m3(l);
+        if d4(l) < IN_LIM then
+          inn := m4(l);
         end if;
         tr_nt(l)  <= (0 => tv, others => '0');
         tr_ni(l)  <= (0 => inn, others => '0');
         tr_nti(l) <= (0 => tv and inn, others => '0');
         if tv = '1' then
-          tr_st(l) <= resize(d3(l), TS_W);
+          tr_st(l) <= resize(d4(l), TS_W);
         else
           tr_st(l) <= (others => '0');
         end if;
       end loop;
-      last_t(0) <= last3;
+      last_t(0) <= last4;
       for k in 1 to TL loop
         n := LANES / 2 ** k;
         for i in 0 to n - 1 loop

@@ -8,7 +8,7 @@ exactly for every pass.  Two benches:
   rtl/ms_window_scan.vhd) on the px_* tap and the bins one clock later on ram_data, at full speed
   (one beat per clock, passes back to back) and throttled (random idle clocks between beats and
   passes); masked lanes carry random bins.  Tables from the model (ms_kernel KA/KB, T).  The
-  latency STATS_LAT = 5 + log2(LANES) (edge sampling the last beat -> edge sampling done) is
+  latency STATS_LAT = 6 + log2(LANES) (edge sampling the last beat -> edge sampling done) is
   asserted for every pass.
 * ``ms_target_stats_tb_top`` (tb/ms_target_stats_tb_top.vhd): attached as in the core, to a real
   ms_pixel_pass (flat) with its kernel tables from a real ms_kernel_tables (KERNEL_EPAN = 1:
@@ -44,8 +44,8 @@ if not SEQ_ROOT.is_dir():
 
 
 def stats_latency(lanes: int) -> int:
-    """STATS_LAT of rtl/ms_target_stats.vhd: 5 + log2(LANES)."""
-    return 5 + (lanes.bit_length() - 1)
+    """STATS_LAT of rtl/ms_target_stats.vhd: 6 + log2(LANES)."""
+    return 6 + (lanes.bit_length() - 1)
 
 
 def model_xr(ker: ms_kernel) -> list[int]:

@@ -1,7 +1,8 @@
 """cocotb test bench + pytest entry points for rtl/ms_resize.vhd.
 
 Model: :func:`mstrack.fixed.blocks_v2.ms_resize(s8, s, frame_size)` ((s8 s) >> 16 clamped to
-[3 2**8, frame_size 2**8]).  Core widths, 4-bit and 10-bit frame coordinates: edge cases (clamp to 3 px and to the frame, frame sizes below 3 px, the largest operands), 400 random
+[3 2**8, frame_size 2**8]).  Core widths, 4-bit and 10-bit frame coordinates: edge cases (clamp to
+3 px and to the frame, frame sizes below 3 px, the largest operands), 1,500 random
 cases (s near 1 and anywhere) and the arguments of every ms_resize call FixedTrackerV2 makes on the
 first 40 frames of 5 real sequences.  Back to back and with random gaps; latency SCALE_W + 2
 asserted for every item.
@@ -36,7 +37,7 @@ def resize_items(g: dict, rng: random.Random, real: bool) -> list[tuple[int, int
              (767, ONE, fm), (769, ONE - 1, fm), (min(sz_top, f_top << 8), ONE, f_top),
              (min(sz_top, (f_top << 8) + 1), ONE, f_top), (min(sz_top, fm << 8), min(sc_top, ONE + (ONE >> 3)), fm),
              (min(sz_top, 6400), 0, f_top), (min(sz_top, 6400), sc_top, f_top)]
-    for _ in range(400):
+    for _ in range(1500):
         s8 = rng.randint(0, sz_top) >> rng.randint(0, 8)
         s = min(sc_top, int(ONE * rng.uniform(0.85, 1.15))) if rng.random() < 0.6 else rng.randint(0, sc_top)
         f = rng.randint(0, f_top) if rng.random() < 0.3 else rng.randint((s8 >> 8) // 2, f_top) if (s8 >> 8) // 2 <= f_top else f_top

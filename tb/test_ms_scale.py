@@ -3,7 +3,7 @@
 Model: :func:`mstrack.fixed.blocks_v2.ms_scale(spread, spread_ref, w8, w0_8, tp)`, on its domain
 (spread_ref > 0, w0_8 >= 3 2**8, w8 < 2**SIZE_W: rtl/ms_scale.vhd).  Edge cases (spread 0, equal
 spreads, the largest and smallest ratios, ratios at the clamp limits 1 +- step and the
-RATIO_Q_W saturation point, w8 = w0_8, the smallest and largest sizes), 300 random cases and the
+RATIO_Q_W saturation point, w8 = w0_8, the smallest and largest sizes), 1,000 random cases and the
 arguments of every ms_scale call FixedTrackerV2 makes on the first 40 frames of 5 real sequences.
 Parameter sets (generics SCALE_GAIN / SCALE_REG / SCALE_STEP from TrackerParams): the v2 defaults,
 step 0.5 with gain 1 and no regulariser, gain 0 (s = 1 - reg term only), a small step.  Back to back
@@ -51,7 +51,7 @@ def scale_items(g: dict, rng: random.Random, real: bool) -> list[dict[str, int]]
     rs = (1 << g["RATIO_Q_W"]) - 1
     for r in (rs - 1, rs, rs + 1):
         cases.append((min(sp_top, (r * 64) >> 16 << 0) if False else min(sp_top, r * 64 >> 16), 64, 6400, 6400))
-    for _ in range(300):
+    for _ in range(1000):
         ref = rng.randint(1, sp_top) >> rng.randint(0, g["SPREAD_W"] - 1) or 1
         k = rng.random()
         if k < 0.5:                               # near 1

@@ -1,7 +1,7 @@
 """cocotb test bench + pytest entry points for rtl/ms_share.vhd.
 
 Model: :func:`mstrack.fixed.blocks_v2.ms_share` (floor(nt_in 2**16 / n_in), 0 when n_in = 0).
-Small COUNT_W: every (nt_in, n_in) pair, nt_in > n_in included.  Core widths: edge cases, 400 random
+Small COUNT_W: every (nt_in, n_in) pair, nt_in > n_in included.  Core widths: edge cases, 1,500 random
 pairs (nt_in <= n_in and beyond) and the (nt_in, n_in) of every ms_share call FixedTrackerV2 makes on
 the first 40 frames of 5 real sequences (tb/v2_common.py).  Back to back and with random gaps; the
 latency SHARE_W + 1 is asserted for every item.
@@ -34,7 +34,7 @@ def share_items(g: dict, rng: random.Random, real: bool) -> list[dict[str, int]]
     if cw <= 5:
         return [{"nt_in": a, "n_in": b} for a in range(top + 1) for b in range(top + 1)]
     pairs = [(0, 0), (top, 0), (0, 1), (1, 1), (top, top), (top - 1, top), (1, top), (top, 1), (2, 3)]
-    for _ in range(400):
+    for _ in range(1500):
         n = rng.randint(0, top) >> rng.randint(0, cw - 1)
         pairs.append((rng.randint(0, n) if rng.random() < 0.8 else rng.randint(0, top), n))
     if real:

@@ -3,7 +3,7 @@
 Model: :func:`mstrack.fixed.blocks_v2.ms_spread` (floor(st2 2**16 / nt), 0 when nt = 0), on its
 domain st2 < 2**(SPREAD_W - 16) nt (every mean d2q the kernel tables can give; rtl/ms_spread.vhd).
 Small widths: every (st2, nt) pair of the domain.  Core widths: edge cases (the largest window full of
-the largest d2q, a single pixel, ...), 400 random pairs and the (st2, nt) of every ms_spread call
+the largest d2q, a single pixel, ...), 1,500 random pairs and the (st2, nt) of every ms_spread call
 FixedTrackerV2 makes on the first 40 frames of 5 real sequences.  Back to back and with random gaps;
 the latency SPREAD_W + 1 is asserted for every item.
 
@@ -42,7 +42,7 @@ def spread_items(g: dict, rng: random.Random, real: bool) -> list[dict[str, int]
     else:
         pairs = [(0, 0), (stop, 0), (0, 1), (dmax, 1), (min(stop, ctop * dmax), ctop), (1, ctop), (0, ctop),
                  (min(stop, (ctop - 1) * dmax + dmax - 1), ctop)]
-        for _ in range(400):
+        for _ in range(1500):
             n = rng.randint(1, ctop) >> rng.randint(0, cw - 1)
             pairs.append((rng.randint(0, min(stop, n * dmax)), n))
         if real:

@@ -40,7 +40,11 @@ def resize_items(g: dict, rng: random.Random, real: bool) -> list[tuple[int, int
     for _ in range(1500):
         s8 = rng.randint(0, sz_top) >> rng.randint(0, 8)
         s = min(sc_top, int(ONE * rng.uniform(0.85, 1.15))) if rng.random() < 0.6 else rng.randint(0, sc_top)
-        f = rng.randint(0, f_top) if rng.random() < 0.3 else rng.randint((s8 >> 8) // 2, f_top) if (s8 >> 8) // 2 <= f_top else f_top
+        half = (s8 >> 8) // 2                  # mostly frames around the box size (clamp seldom)
+        if rng.random() < 0.3 or half > f_top:
+            f = rng.randint(0, f_top)
+        else:
+            f = rng.randint(half, f_top)
         cases.append((s8, s, f))
     if real:
         cases += record_v2_calls()["ms_resize"]

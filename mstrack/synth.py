@@ -365,6 +365,27 @@ def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
         "ms_centre": pick("SW_W", "SWX_W", "SHIFT_Q_W", "CF", "REGION_W", "CENTRE_W"),
         "ms_fusion": pick("FEATURES", "RHO_SUM_W", "HIST_W", "CENTRE_ABS_W", "AF", "ALPHA_W", "RF",
                           "RHO_OUT_FRAC", "RHO_OUT_W"),
+        **v2_scale_block_generics(cfg),
+    }
+
+
+def v2_scale_block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
+    """Generics of the v2 statistics / scale blocks (mstrack.fixed.vhdl_pkg.v2_scale_generics) for the
+    configuration's sizes, with the v2 parameters (preset "v2")."""
+    from .fixed.vhdl_pkg import v2_scale_generics
+
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    tp_kw = {k: v for k, v in cfg.tp.items() if k not in ("features", "kernel")}
+    g = v2_scale_generics(TrackerParams(preset="v2", **tp_kw), FixedParams(**cfg.fp), cfg.lanes)
+    pick = lambda *ks: {k: g[k] for k in ks}  # noqa: E731
+    return {
+        "ms_target_stats": pick("LANES", "BIN_W", "HALF_W", "REGION_W", "KERNEL_BITS", "KT_W", "PAD16", "COUNT_W",
+                                "ST2_W"),
+        "ms_share": pick("COUNT_W", "SHARE_W"),
+        "ms_spread": pick("COUNT_W", "ST2_W", "SPREAD_W"),
+        "ms_scale": pick("SPREAD_W", "SIZE_W", "SCALE_W", "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "RATIO_Q_W",
+                         "WR_Q_W"),
+        "ms_resize": pick("SIZE_W", "SCALE_W", "COORD_W"),
     }
 
 

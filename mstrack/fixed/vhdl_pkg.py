@@ -76,6 +76,56 @@ def core_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None
     return g
 
 
+def v2_scale_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None,
+                      lanes: int = DEFAULT_LANES) -> dict[str, int]:
+    """Generics of the v2 statistics and scale blocks (ms_target_stats, ms_share, ms_spread,
+    ms_scale, ms_resize), derived from the model (docs/fixed_point.md, "Tracker v2").
+
+    Worst case over all windows: the counts hold the largest window's pixels; st2 the largest window
+    times the largest d2q (2**(KB + 1) - 1, the bound docs/fixed_point.md states; inside the ellipse
+    d2q < 2**KB in fact); spread = floor(st2 2**16 / nt) <= that d2q in Q.16.  ms_scale's ratio
+    division needs only RATIO_Q_W quotient bits: every ratio r >= 2**RATIO_Q_W - 1 gives
+    isqrt(r 2**16) >= 1 + step, clamped to the same value, so saturating there is exact.  The size
+    ratio w8 2**16 / w0_8 (w0_8 >= 3 px, w8 < 2**SIZE_W) never saturates with WR_Q_W bits.
+    """
+    from .blocks_v2 import ONE, SIZE_FRAC, q16, sixteenths
+    from .primitives import ms_isqrt
+
+    tp = tp or TrackerParams(preset="v2")
+    fp = fp or FixedParams()
+    g = core_generics(tp, fp, lanes)
+    w = widths(tp, fp)
+    kb = fp.kernel_bits
+    d2q_max = (1 << (kb + 1)) - 1
+    step = q16(tp.scale_step)
+    hi = ONE + step
+    ratio_q = 1
+    while int(ms_isqrt(((1 << ratio_q) - 1) << 16)) < hi:
+        ratio_q += 1
+    size_w = fp.coord_bits + SIZE_FRAC
+    return {
+        "LANES": lanes,
+        "BIN_W": 3 * tp.colour_bits,
+        "HALF_W": g["HALF_W"],
+        "REGION_W": g["REGION_W"],
+        "KERNEL_BITS": kb,
+        "KT_W": kb + 1,
+        "PAD16": sixteenths(tp.pad, "pad"),
+        "COUNT_W": w.count,
+        "ST2_W": bits_for(w.pix_max * d2q_max),
+        "SHARE_W": bits_for(ONE),
+        "SPREAD_W": bits_for(d2q_max << 16),
+        "SIZE_W": size_w,
+        "COORD_W": fp.coord_bits,
+        "SCALE_W": bits_for(hi),
+        "SCALE_GAIN": q16(tp.scale_gain),
+        "SCALE_REG": q16(tp.scale_reg),
+        "SCALE_STEP": step,
+        "RATIO_Q_W": ratio_q,
+        "WR_Q_W": bits_for((((1 << size_w) - 1) << 16) // (3 << SIZE_FRAC)),
+    }
+
+
 def formats_pkg_text(lanes: int = DEFAULT_LANES) -> str:
     g = core_generics(lanes=lanes)
     lines = [

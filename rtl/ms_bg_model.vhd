@@ -341,8 +341,15 @@ begin
       -- stage A: |dx|, |dy|
       dx := signed('0' & px_x) - signed('0' & cx_r);
       dy := signed('0' & px_y) - signed('0' & cy_r);
-      a_adx <= resize(unsigned(abs(dx)), COORD_W);
-      a_ady <= resize(unsigned(abs(dy)), COORD_W);
+      -- |dx|, |dy| by negation, not `abs` (GHDL 2.0's Verilog writer prints `abs` as VHDL)
+      if dx < 0 then
+        dx := -dx;
+      end if;
+      if dy < 0 then
+        dy := -dy;
+      end if;
+      a_adx <= resize(unsigned(dx), COORD_W);
+      a_ady <= resize(unsigned(dy), COORD_W);
       a_bin <= px_bin;
       a_v   <= px_valid and to_sl(state = S_COUNT);
       -- stage B: box (ellipse) and ring flags

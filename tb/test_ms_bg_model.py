@@ -33,7 +33,7 @@ from mstrack.hdl import dut_generics
 DEFAULTS = {"BIN_W": 9, "HALF_W": 6, "COORD_W": 12, "RING_W": 5, "Q_W": 14, "O_W": 17, "KD_W": 29}
 CLK_NS = 10
 SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
-REAL_SEQS = ("Girl", "Couple")
+REAL_SEQS = ("Girl", "MotorRolling", "bag_vot")   # D = 1, 2 (640x360), 2 (fractional box)
 
 
 def mult_lat(a_w: int) -> int:

@@ -35,13 +35,13 @@
 --                       215 clocks at HALF_W = 6) + 2 clocks; pixels before `counting` are
 --                       ignored (the top starts the block when the init box is taken, between
 --                       frames, so this costs nothing on the stream).
---   px_last -> done   : LAT_DONE = 3 N_BINS + 60 clocks at the default widths: drain 5, pass 1
+--   px_last -> done   : LAT_DONE = 3 N_BINS + 61 clocks at the default widths: drain 6, pass 1
 --                       N_BINS + 3, pass 2 N_BINS + 30 (read 2, T products M(Q_W) = 4, T 1,
 --                       divider 18, v Q M(9) = 4, end 1), pass 3 N_BINS + 22 (read 2, divider 18,
 --                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
---                       ms_mult_r4 latency (constant LAT_DONE).  1,596 clocks at N_BINS = 512
+--                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N_BINS = 512
 --                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.synth
---                       --v2-budget: init frame 5,800 clocks, so 5,845 with this block).
+--                       --v2-budget: init frame 5,800 clocks, so 5,846 with this block).
 -- Throughput: one pixel per clock while counting; one model per init.
 -- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high
 --             until `done` (one-clock pulse); n_box, n_ring, o_min, qv_sum are stable from done
@@ -112,9 +112,10 @@ architecture rtl of ms_bg_model is
   constant DD_W    : natural := max(TOT_W, O_W);                      -- divider divisor
   constant G_W     : natural := max(COORD_W, RING_W + HALF_W + 1) + 1; -- ring extents
   constant P_W     : natural := Q_W + O_W;         -- T products
-  constant DRAIN   : natural := 5;                 -- px_last -> S_P1 (the last count is in the RAM)
-  constant DVT_W  : natural := BIN_W + Q_W + 3;   -- divider tag [last | qz | T | Q | u]
-  constant MTT_W  : natural := BIN_W + Q_W + O_W + 1;  -- T product tag [last | O | Q | u]
+  constant DRAIN   : natural := 6;                 -- px_last -> S_P1 (the last count is in the RAM)
+  constant DVT_W  : natural := 3;                 -- divider tag [last | qz | T]
+  constant QD_W   : natural := clog2(QN_W + 2);   -- Q delay memory address (holds > divider latency)
+  constant MTT_W  : natural := Q_W + O_W + 1;    -- T product tag [last | O | Q]
   constant MVT_W  : natural := BIN_W + 2;         -- v Q product tag [last | T | u]
   -- ms_mult_r4 latency for an A_W-bit digit operand: 1 + max(1, ceil(log2(ceil(A_W / 2))))
   function mult_lat(a_w : natural) return natural is
@@ -148,10 +149,13 @@ architecture rtl of ms_bg_model is
   signal clr_addr       : unsigned(BIN_W - 1 downto 0) := (others => '0');
   signal drain_cnt      : natural range 0 to DRAIN := 0;
 
-  -- pixel stages A (|dx|, |dy|) and B (flags)
+  -- pixel stages A (|dx|, |dy|), B (XR, rectangles), C (b_*: box / ring flags)
   signal a_v            : std_logic := '0';
   signal a_bin          : unsigned(BIN_W - 1 downto 0) := (others => '0');
   signal a_adx, a_ady   : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal xb_v, xb_in, xb_ring : std_logic := '0';
+  signal xb_xr, xb_adx  : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal xb_bin         : unsigned(BIN_W - 1 downto 0) := (others => '0');
   signal b_acc, b_box   : std_logic := '0';
   signal b_bin          : unsigned(BIN_W - 1 downto 0) := (others => '0');
   signal nq_r           : unsigned(Q_W - 1 downto 0) := (others => '0');
@@ -191,7 +195,6 @@ architecture rtl of ms_bg_model is
   signal mt_in_v        : std_logic;
   signal mt_tag_in      : std_logic_vector(MTT_W - 1 downto 0);
   signal t_v, t_t, t_last : std_logic := '0';
-  signal t_u            : unsigned(BIN_W - 1 downto 0) := (others => '0');
   signal t_q            : unsigned(Q_W - 1 downto 0) := (others => '0');
   signal t_o            : unsigned(O_W - 1 downto 0) := (others => '0');
   signal dv_in_v, dv_out_v : std_logic;
@@ -199,6 +202,10 @@ architecture rtl of ms_bg_model is
   signal dv_d           : unsigned(DD_W - 1 downto 0);
   signal dv_tag_in, dv_tag : std_logic_vector(DVT_W - 1 downto 0);
   signal dv_q           : unsigned(QN_W - 1 downto 0);
+  signal dv_cnt         : unsigned(BIN_W - 1 downto 0) := (others => '0');  -- results out of the divider
+  signal qd_wp, qd_rp   : unsigned(QD_W - 1 downto 0) := (others => '0');   -- Q delay memory pointers
+  type qd_ram_t is array (0 to 2 ** QD_W - 1) of std_logic_vector(Q_W - 1 downto 0);
+  signal qd_ram         : qd_ram_t;                  -- Q beside the divider (pass 2), LUT RAM
   signal mv_in_v, mv_v  : std_logic;
   signal mv_a           : unsigned(V_W - 1 downto 0);
   signal mv_b           : std_logic_vector(Q_W - 1 downto 0);
@@ -334,7 +341,6 @@ begin
   ---------------------------------------------------------------------------- pixel flags
   p_pix : process (clk)
     variable dx, dy : signed(COORD_W downto 0);
-    variable xr     : unsigned(HALF_W - 1 downto 0);
     variable in_ex, in_ey, box, ring : boolean;
   begin
     if rising_edge(clk) then
@@ -352,30 +358,37 @@ begin
       a_ady <= resize(unsigned(dy), COORD_W);
       a_bin <= px_bin;
       a_v   <= px_valid and to_sl(state = S_COUNT);
-      -- stage B: box (ellipse) and ring flags
-      xr    := xr_ram(to_integer(a_ady(HALF_W - 1 downto 0)));
+      -- stage B: XR[|dy|] registered (LUT RAM read), the rectangle tests
       in_ex := a_adx <= resize(ex_r, COORD_W);
       in_ey := a_ady <= resize(ey_r, COORD_W);
-      box   := in_ey and a_adx <= resize(xr, COORD_W);
       ring  := resize(a_adx, G_W) <= rx and resize(a_ady, G_W) <= ry and not (in_ex and in_ey);
-      b_acc <= a_v and to_sl(box or ring);
+      xb_xr   <= xr_ram(to_integer(a_ady(HALF_W - 1 downto 0)));
+      xb_adx  <= a_adx(HALF_W - 1 downto 0);
+      xb_in   <= to_sl(in_ex and in_ey);
+      xb_ring <= to_sl(ring);
+      xb_v    <= a_v;
+      xb_bin  <= a_bin;
+      -- stage C: box = inside the rectangle and |dx| <= XR[|dy|] (XR <= ex < 2**HALF_W, so the
+      -- low HALF_W bits of |dx| suffice once |dx| <= ex)
+      box   := xb_in = '1' and xb_adx <= xb_xr;
+      b_acc <= xb_v and to_sl(box or xb_ring = '1');
       b_box <= to_sl(box);
-      b_bin <= a_bin;
+      b_bin <= xb_bin;
+      -- totals from the registered flags
       if state = S_SETUP then
         nq_r <= (others => '0');
         no_r <= (others => '0');
-      end if;
-      if a_v = '1' and box then
+      elsif b_acc = '1' and b_box = '1' then
         nq_r <= nq_r + 1;
         -- the widths are the caller's (Q_W, O_W): the totals must not wrap
         assert nq_r /= 2 ** Q_W - 1 report "ms_bg_model: sum Q overflows Q_W" severity error;
-      end if;
-      if a_v = '1' and ring then
+      elsif b_acc = '1' then
         no_r <= no_r + 1;
         assert no_r /= 2 ** O_W - 1 report "ms_bg_model: sum O overflows O_W" severity error;
       end if;
       if rst = '1' then
         a_v   <= '0';
+        xb_v  <= '0';
         b_acc <= '0';
       end if;
     end if;
@@ -515,7 +528,7 @@ begin
 
   -- pass 2 stage 1: T products Q no and nq O
   mt_in_v   <= r2_v when state = S_P2 else '0';
-  mt_tag_in <= r2_last & std_logic_vector(w_o) & std_logic_vector(w_q) & std_logic_vector(r2_u);
+  mt_tag_in <= r2_last & std_logic_vector(w_o) & std_logic_vector(w_q);
   u_mt1 : entity work.ms_mult_r4
     generic map (A_W => Q_W, B_W => O_W, B_SIGNED => false, P_W => P_W, TAG_W => MTT_W)
     port map (clk => clk, rst => rst, in_valid => mt_in_v, in_a => w_q, in_b => std_logic_vector(no_r),
@@ -530,11 +543,10 @@ begin
     variable q : unsigned(Q_W - 1 downto 0);
   begin
     if rising_edge(clk) then
-      q := unsigned(m1_tag(BIN_W + Q_W - 1 downto BIN_W));
+      q := unsigned(m1_tag(Q_W - 1 downto 0));
       t_v    <= m1_v;
-      t_u    <= unsigned(m1_tag(BIN_W - 1 downto 0));
       t_q    <= q;
-      t_o    <= unsigned(m1_tag(BIN_W + Q_W + O_W - 1 downto BIN_W + Q_W));
+      t_o    <= unsigned(m1_tag(Q_W + O_W - 1 downto Q_W));
       t_last <= m1_tag(MTT_W - 1);
       if no_r = 0 then
         t_t <= to_sl(q /= 0);
@@ -552,9 +564,32 @@ begin
   dv_n      <= shift_left(resize(omin, DN_W), BG_FRAC) when state = S_P2
                else shift_left(resize(unsigned(rd_word(QV_W - 1 downto 0)), DN_W), QN_FRAC);
   dv_d      <= resize(t_o, DD_W) when state = S_P2 else resize(tot, DD_W);
-  dv_tag_in <= (t_last & '0' & t_t & std_logic_vector(t_q) & std_logic_vector(t_u)) when state = S_P2
-               else (r2_last & to_sl(unsigned(rd_word(QV_W - 1 downto 0)) = 0) & rd_word(CW - 1)
-                     & std_logic_vector(to_unsigned(0, Q_W)) & std_logic_vector(r2_u));
+  dv_tag_in <= (t_last & '0' & t_t) when state = S_P2
+               else (r2_last & to_sl(unsigned(rd_word(QV_W - 1 downto 0)) = 0) & rd_word(CW - 1));
+
+  -- results leave the divider in bin order: counters give their bin; in pass 2 Q waits beside
+  -- the divider in a small delay memory (written at the divider input, read at its output)
+  p_dcnt : process (clk)
+  begin
+    if rising_edge(clk) then
+      if state = S_P1 or pass_end = '1' then
+        qd_wp  <= (others => '0');
+        qd_rp  <= (others => '0');
+        dv_cnt <= (others => '0');
+      else
+        if dv_in_v = '1' then
+          qd_wp <= qd_wp + 1;
+        end if;
+        if dv_out_v = '1' then
+          qd_rp  <= qd_rp + 1;
+          dv_cnt <= dv_cnt + 1;
+        end if;
+      end if;
+      if state = S_P2 and t_v = '1' then
+        qd_ram(to_integer(qd_wp)) <= std_logic_vector(t_q);
+      end if;
+    end if;
+  end process;
   u_div : entity work.ms_divider
     generic map (N_W => DN_W, D_W => DD_W, Q_W => QN_W, TAG_W => DVT_W)
     port map (clk => clk, rst => rst, in_valid => dv_in_v, in_n => dv_n, in_d => dv_d,
@@ -563,8 +598,8 @@ begin
   -- pass 2 stage 3: v = min(q, 2**8), qv = v Q
   mv_in_v   <= dv_out_v when state = S_P2 else '0';
   mv_a      <= to_unsigned(2 ** BG_FRAC, V_W) when dv_q >= 2 ** BG_FRAC else resize(dv_q, V_W);
-  mv_b      <= dv_tag(BIN_W + Q_W - 1 downto BIN_W);
-  mv_tag_in <= dv_tag(DVT_W - 1) & dv_tag(BIN_W + Q_W) & dv_tag(BIN_W - 1 downto 0);
+  mv_b      <= qd_ram(to_integer(qd_rp));
+  mv_tag_in <= dv_tag(2) & dv_tag(0) & std_logic_vector(dv_cnt);
   u_mv : entity work.ms_mult_r4
     generic map (A_W => V_W, B_W => Q_W, B_SIGNED => false, P_W => QV_W, TAG_W => MVT_W)
     port map (clk => clk, rst => rst, in_valid => mv_in_v, in_a => mv_a, in_b => mv_b,
@@ -611,9 +646,9 @@ begin
       m_we <= '0';
       if state = S_P3 and dv_out_v = '1' then
         m_we <= '1';
-        m_wa <= unsigned(dv_tag(BIN_W - 1 downto 0));
-        m_wd(MW - 1) <= dv_tag(BIN_W + Q_W);
-        if dv_tag(BIN_W + Q_W + 1) = '1' then            -- qv = 0: Qn = 0 (also when tot = 0)
+        m_wa <= dv_cnt;
+        m_wd(MW - 1) <= dv_tag(0);
+        if dv_tag(1) = '1' then            -- qv = 0: Qn = 0 (also when tot = 0)
           m_wd(QN_W - 1 downto 0) <= (others => '0');
         else
           m_wd(QN_W - 1 downto 0) <= std_logic_vector(dv_q);

@@ -8,8 +8,9 @@ o* and tot = sum Q v, exactly.  Synthetic cases: random images (all bins), no ri
 (ring16 = 0; box = whole image), box touching each frame edge, a one-bin ring, v = 0 bins and
 tot = 0, even sizes, the largest box; real cases: the init frame of real sequences with the
 geometry of FixedTrackerV2.init (checked against the tracker's own model).  Full speed and with
-random input gaps; the clocks from the last pixel to `done` must equal LAT_DONE of the header
-(3 N_BINS + 60 at the default widths), models follow each other without reset (pass 3 clears the counts).
+random input gaps, with a `start` pulse while busy (ignored); an init frame abandoned half way
+by a reset, then a model from scratch.  The clocks from the last pixel to `done` must equal LAT_DONE of the header
+(3 N_BINS + 61 at the default widths), models follow each other without reset (pass 3 clears the counts).
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_bg_model.py``.
 """
@@ -42,10 +43,10 @@ def mult_lat(a_w: int) -> int:
 
 
 def lat_done(g: dict) -> int:
-    """px_last -> done of rtl/ms_bg_model.vhd (header: LAT_DONE; 3 N_BINS + 60 at the defaults):
-    drain 5, pass 1 N + 3, pass 2 N + 2 + M(Q_W) + 1 + 18 + M(9) + 1, pass 3 N + 2 + 18 + 2."""
+    """px_last -> done of rtl/ms_bg_model.vhd (header: LAT_DONE; 3 N_BINS + 61 at the defaults):
+    drain 6, pass 1 N + 3, pass 2 N + 2 + M(Q_W) + 1 + 18 + M(9) + 1, pass 3 N + 2 + 18 + 2."""
     n = 1 << int(g["BIN_W"])
-    return 5 + (n + 3) + (n + 2 + mult_lat(int(g["Q_W"])) + 1 + 18 + mult_lat(9) + 1) + (n + 2 + 18 + 2)
+    return 6 + (n + 3) + (n + 2 + mult_lat(int(g["Q_W"])) + 1 + 18 + mult_lat(9) + 1) + (n + 2 + 18 + 2)
 
 
 def _counts(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: int, n_bins: int):
@@ -159,6 +160,8 @@ class BgTB:
                 d.px_bin.value = rng.randrange(self.n_bins)
             else:
                 y, x = pix[i]
+                d.start.value = int(i == last // 2)         # ignored while busy
+                d.cx.value = rng.randrange(1 << int(g["COORD_W"])) if i == last // 2 else cx
                 d.px_valid.value = 1
                 d.px_bin.value = int(bins[y, x])
                 d.px_x.value = x
@@ -167,6 +170,8 @@ class BgTB:
                 i += 1
             await RisingEdge(d.clk)
         t_last = self.cyc
+        d.start.value = 0
+        d.cx.value = cx
         d.px_valid.value = 0
         d.px_last.value = 0
         while True:
@@ -257,6 +262,41 @@ async def bg_model_synthetic(dut, gap):
                      order=c["order"], name=c["name"])
 
 
+@cocotb.test()
+async def bg_model_abandoned(dut):
+    """An init frame abandoned half way (reset, as after a stream error): the reset clears the
+    counts, the next model is exact."""
+    tb = BgTB(dut)
+    await tb.reset()
+    rng = random.Random(1300)
+    c = synthetic_cases(tb.g, rng)[1]
+    d = tb.dut
+    await tb.wait_idle()
+    for k in ("cx", "cy", "wb", "hb", "ring16"):
+        getattr(d, k).value = c[k]
+    d.start.value = 1
+    await RisingEdge(d.clk)
+    d.start.value = 0
+    while True:
+        await RisingEdge(d.clk)
+        await ReadOnly()
+        if int(d.counting.value):
+            break
+    await Timer(1, "ns")
+    h, w = c["bins"].shape
+    for i in range(h * w // 2):                       # half the frame, then reset
+        d.px_valid.value = 1
+        d.px_bin.value = int(c["bins"][i // w, i % w])
+        d.px_x.value = i % w
+        d.px_y.value = i // w
+        await RisingEdge(d.clk)
+    d.px_valid.value = 0
+    d.rst.value = 1
+    await RisingEdge(d.clk)
+    d.rst.value = 0
+    await tb.run(c["bins"], c["cx"], c["cy"], c["wb"], c["hb"], c["ring16"], 0.0, rng, name="after reset")
+
+
 def real_cases(g: dict) -> list[dict]:
     """The init frame of real sequences, with FixedTrackerV2.init's geometry (decimation D,
     box diameters, centre clamped into the decimated interior)."""
@@ -329,7 +369,8 @@ PARAMS = [
 @pytest.mark.ghdl
 @pytest.mark.parametrize("generics", PARAMS)
 def test_ms_bg_model_ghdl(generics, hdl_waves):
-    hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves, test_filter="bg_model_synthetic")
+    hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves,
+                 test_filter="bg_model_synthetic|bg_model_abandoned")
 
 
 @pytest.mark.ghdl
@@ -345,4 +386,5 @@ def test_ms_bg_model_real_ghdl(generics, hdl_waves):
 @pytest.mark.verilator
 def test_ms_bg_model_verilator(hdl_waves):
     """The synthesised netlist (GHDL -> Verilog -> Verilator) on the synthetic cases."""
-    hdl.run_verilator(TOP, MODULE, DEFAULTS, hdl.rtl_sources(TOP), waves=hdl_waves, test_filter="bg_model_synthetic")
+    hdl.run_verilator(TOP, MODULE, DEFAULTS, hdl.rtl_sources(TOP), waves=hdl_waves,
+                      test_filter="bg_model_synthetic|bg_model_abandoned")

@@ -17,22 +17,27 @@
 --   pass 3: Qn[u] = floor(qv[u] 2**16 / tot) (0 when qv[u] = 0); {T, Qn} written into the
 --           model RAM; the count word cleared (ready for the next init).
 -- One pipelined ms_divider (17 quotient bits) serves passes 2 and 3 (o* 2**8 / O < 2**9 never
--- saturates it); the products Q no, nq O, v Q are ms_mult_r4 LUT multipliers (no MULT18X18D).
+-- saturates it); its results come out in bin order, so a counter gives their bin and Q waits
+-- beside it in a 32-word LUT RAM (not in its tag).  The products Q no, nq O, v Q are ms_mult_r4
+-- LUT multipliers (no MULT18X18D).
 --
 -- Pixel input: any order (each pixel carries its coordinates), at most one per clock, gaps
 -- allowed; px_last marks the frame's last pixel.  The caller streams every pixel of the image
 -- the model sees (the decimated frame frame[::D, ::D], coordinates in decimated px) exactly once.
--- Counting: two stages compute the box / ring flags (|dx|, |dy| registered, then the XR look-up
--- and compares), then a read-modify-write of the count RAM word {T | Q | O} at the pixel's bin
--- with the forwarding of ms_histogram (any sequence of bins, runs of one bin included, counts
--- exactly).
+-- Counting: stage A registers |dx|, |dy|; stage B the XR look-up (registered) and the rectangle
+-- tests; stage C the box / ring flags; then a read-modify-write of the count RAM word
+-- {T | Q | O} at the pixel's bin with the forwarding of ms_histogram (any sequence of bins, runs
+-- of one bin included, counts exactly).
 --
 -- Memories: count RAM N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32), model
--- RAM N_BINS x 18 {T | Qn} (1 DP16KD), XR table 2**HALF_W x HALF_W (LUT RAM).
+-- RAM N_BINS x 18 {T | Qn} (1 DP16KD), XR table 2**HALF_W x HALF_W and the Q delay memory
+-- (LUT RAM).
+-- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
+-- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz.
 --
 -- Latency (tb/test_ms_bg_model.py measures both):
 --   start -> counting : the kernel-table set-up of (wb, hb) (flat ms_kernel_tables: at most
---                       215 clocks at HALF_W = 6) + 2 clocks; pixels before `counting` are
+--                       215 clocks at HALF_W = 6) + 2 clocks, exactly; pixels before `counting` are
 --                       ignored (the top starts the block when the init box is taken, between
 --                       frames, so this costs nothing on the stream).
 --   px_last -> done   : LAT_DONE = 3 N_BINS + 61 clocks at the default widths: drain 6, pass 1

@@ -90,6 +90,16 @@ def expected(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: int, 
     return {"Qn": Qn, "T": T, "nq": int(Q.sum()), "no": no, "omin": omin, "tot": tot}
 
 
+def setup_latency(wb: int, hb: int, half_w: int) -> int:
+    """start -> counting: the flat ms_kernel_tables latency of (wb, hb) (its header: n + S + 2 + X,
+    n = max(ex, ey), S = 3 (HALF_W + 1) + 3, X = 2 ex - XR[n]) + 2 (start taken, done seen)."""
+    ker = ms_kernel(wb, hb, "flat", 8)
+    n = max(ker.ex, ker.ey)
+    row = ker.inside[ker.ey + n] if n <= ker.ey else np.zeros(1, bool)
+    xr_n = int(np.nonzero(row)[0].max()) - ker.ex if row.any() else 0
+    return n + 3 * (half_w + 1) + 3 + 2 + (2 * ker.ex - xr_n) + 2
+
+
 class BgTB:
     def __init__(self, dut):
         self.dut = dut
@@ -145,6 +155,8 @@ class BgTB:
                 break
             assert self.cyc - t_start < 400, "set-up does not finish"
         setup = self.cyc - t_start
+        assert setup == setup_latency(wb, hb, int(g["HALF_W"])), \
+            f"{name}: start -> counting {setup} clocks, documented {setup_latency(wb, hb, int(g['HALF_W']))}"
         await Timer(1, "ns")
         h, w = bins.shape
         ys, xs = np.mgrid[0:h, 0:w]

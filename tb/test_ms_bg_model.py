@@ -258,7 +258,7 @@ def synthetic_cases(g: dict, rng: random.Random) -> list[dict]:
     case("v_zero", img, 24, 24, 15, 15, 16)
     # even sizes, largest box, large ring
     case("even", rand_img(h, w), 20, 16, 10, 8, 12)
-    big = min(wmax, 63)
+    big = wmax                                         # 127 x 127 at HALF_W = 6
     case("largest", rand_img(big + 6, big + 10), (big + 10) // 2, (big + 6) // 2, big, big, rmax)
     return out
 

@@ -421,7 +421,7 @@ def loss_flag(rho_s: float, con_s: float, rho0: float, share: float, p: TrackerP
     (share = 0), or the window matches the model worse than at init *and* its target colours do
     not stand out from the ring around the box, both smoothed (:func:`loss_filter` of rho and of
     contrast = share - ring_share): rho_s < loss_rho rho0 and con_s < loss_contrast."""
-    return share == 0 or (rho_s < p.loss_rho * rho0 and con_s < p.loss_contrast)
+    return share == 0 or rho_s == 0 or (rho_s < p.loss_rho * rho0 and con_s < p.loss_contrast)
 
 
 def report_status(searching: bool, flagged: bool, was_flagged_lost: bool) -> Status:

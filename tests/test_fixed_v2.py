@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from mstrack import Tracker
-from mstrack.fixed.blocks import ms_kernel
+from mstrack.fixed.blocks import ms_colour_bin, ms_kernel
 from mstrack.fixed.blocks_v2 import (ONE, ms_bg_model, ms_box_size, ms_confidence, ms_decimation, ms_loss_filter,
                                      ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share,
                                      ms_spread,
@@ -193,13 +193,27 @@ def test_loss_filter_against_exact_definition():
                 assert min(s_, x) <= got <= max(s_, x)
 
 
+def test_degenerate_init_model_reports_lost_not_ok():
+    """Every box colour > 256x as frequent in the ring as the rarest ring colour: every v_u = 0,
+    sum(Q v) = 0, Qn = 0 (as rtl/ms_bg_model.vhd); the model matches nothing, so the tracker
+    must not report ok (rho_s = 0 raises the loss flag)."""
+    f = np.zeros((120, 160, 3), np.uint8)
+    f[42, 62] = 255
+    m = ms_bg_model(ms_colour_bin(f, 3), 77, 57, 15, 15, 10, 512)
+    assert m.Qn.sum() == 0 and m.Q.sum() > 0
+    trk = Tracker(model="fixed", preset="v2")
+    trk.init(f, (70, 50, 15, 15))
+    r = trk.update(f)
+    assert not r.ok and r.confidence == 0.0
+
+
 def test_loss_flag_against_exact_definition():
-    """flag = share = 0 or (rho_s / rho0 < loss_rho / 2**16 and con_s < loss_contrast), as exact
+    """flag = share = 0 or rho_s = 0 or (rho_s / rho0 < loss_rho / 2**16 and con_s < loss_contrast), as exact
     rationals; large random over the full ranges plus every threshold edge."""
     rng = np.random.default_rng(12)
     cases = []
     for _ in range(50000):
-        cases.append((int(rng.integers(0, ONE + 1)), int(rng.integers(0, ONE + 1)), int(rng.integers(-ONE, ONE + 1)),
+        cases.append((int(rng.integers(0, 3) > 0) * int(rng.integers(0, ONE + 1)), int(rng.integers(0, ONE + 1)), int(rng.integers(-ONE, ONE + 1)),
                       int(rng.integers(0, 3)) * int(rng.integers(0, ONE + 1)),  # share: 0 one time in three
                       int(rng.integers(0, 2 * ONE + 1)), int(rng.integers(-ONE, ONE + 1))))
     lr, lc = round(V2.loss_rho * ONE), round(V2.loss_contrast * ONE)
@@ -209,7 +223,7 @@ def test_loss_flag_against_exact_definition():
                 for share in (0, 1, ONE):
                     cases.append((rho, rho0, c, share, lr, lc))
     for rho_s, rho0, con_s, share, loss_rho, loss_contrast in cases:
-        want = share == 0 or ((Fraction(rho_s) < Fraction(loss_rho, ONE) * rho0) and (con_s < loss_contrast))
+        want = share == 0 or rho_s == 0 or ((Fraction(rho_s) < Fraction(loss_rho, ONE) * rho0) and (con_s < loss_contrast))
         assert ms_loss_flag(rho_s, rho0, con_s, share, loss_rho, loss_contrast) == want, \
             (rho_s, rho0, con_s, share, loss_rho, loss_contrast)
 

@@ -99,6 +99,9 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     v_u = min(floor(o* 2**8 / O_u), 2**8) (2**8 where O_u = 0);
     Qn_u = floor(Q_u v_u 2**16 / sum(Q v));  T_u = 1 where Q_u sum(O) > O_u sum(Q)
     (q_u > o_u, exact); without any ring pixel: v = 1 and T_u = (Q_u > 0).
+    When sum(Q v) = 0 (every colour of the box more than 256x as frequent in the ring as the
+    rarest ring colour, so every v_u = 0), Qn = 0: the model matches nothing and the first
+    frame reports the target lost (rtl/ms_bg_model.vhd does the same).
     """
     height, width = bins.shape
     ker = ms_kernel(wb, hb, "flat", 8)
@@ -126,7 +129,8 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     tot = int(qv.sum())
     Qn = np.zeros(n_bins, np.int64)
     nz = qv > 0
-    Qn[nz] = ms_divider(qv[nz] << QN_BITS, tot, QN_BITS + 1)
+    if tot > 0:  # tot = 0: every box colour has v = 0 (> 256x more frequent in the ring): Qn = 0
+        Qn[nz] = ms_divider(qv[nz] << QN_BITS, tot, QN_BITS + 1)
     return ModelV2(Qn=Qn, T=T, Q=Q, O=O)
 
 
@@ -194,16 +198,17 @@ def ms_loss_filter(s: int, x: int, k: int) -> int:
 
 
 def ms_loss_flag(rho_s: int, rho0: int, con_s: int, share: int, loss_rho: int, loss_contrast: int) -> bool:
-    """The loss flag: share = 0  or  (rho_s 2**16 < loss_rho rho0  and  con_s < loss_contrast).
+    """The loss flag: share = 0  or  rho_s = 0  or  (rho_s 2**16 < loss_rho rho0  and  con_s < loss_contrast).
 
     rho_s (smoothed rho) and rho0 (rho at init): unsigned Q1.16 in 0 .. 2**16;
     con_s (smoothed share - ring_share): signed Q1.16 in -2**16 .. 2**16;
     loss_rho (unsigned Q1.16, 0 .. 2**17) and loss_contrast (signed Q1.16,
     -2**16 .. 2**16) are the rounded parameters.  Exact comparisons: an 18 x 17 bit
     product (< 2**34) against rho_s 2**16 (< 2**33), an 18-bit signed compare, and a
-    zero test of this frame's share (Q1.16; 0 = no target-coloured pixel in the box).
+    zero test of this frame's share (Q1.16; 0 = no target-coloured pixel in the box) and of rho_s
+    (0 = the model matches nothing, e.g. a degenerate init model with Qn = 0, where rho0 = 0 too).
     """
-    return share == 0 or (rho_s << 16 < loss_rho * rho0 and con_s < loss_contrast)
+    return share == 0 or rho_s == 0 or (rho_s << 16 < loss_rho * rho0 and con_s < loss_contrast)
 
 
 def ms_spread(st: TargetStats) -> int:

@@ -386,3 +386,16 @@ def test_ms_decimate_real_640(gap, hdl_waves):
            else {"seq": _seq("Deer"), "d": [8], "max_window": 63})
     job = {"seed": 41, "gap": gap, "expect_d": src["d"], "sources": [src]}
     _run(f"real640_{'gap' if gap else 'full'}", g, job, hdl_waves)
+
+
+@pytest.mark.verilator
+def test_ms_decimate_verilator(hdl_waves):
+    """The GHDL -> Verilog netlist of the capture path (shift muxes, latch) under Verilator:
+    the synthetic cases, LANES 2, with input gaps."""
+    g = dec_generics(2, FixedParams(**SMALL_FP), 128)
+    job = {"seed": 27, "gap": 0.3, "fp": SMALL_FP, "abandon": True, "expect_d": list(DEC_VALUES),
+           "sources": [{"w": 45, "h": 37, "d": [1, 2, 4], "max_window": 7},
+                       {"w": 83, "h": 70, "d": [8, 16], "max_window": 7},
+                       {"scene": 5, "w": 96, "h": 80, "d": list(DEC_VALUES), "max_window": 7}]}
+    hdl.run_verilator(TOP, MODULE, g, hdl.rtl_sources(TOP, extra=[WRAPPER]), waves=hdl_waves,
+                      build_name="ms_decimate_verilator", extra_env={"MSTRACK_JOB": json.dumps(job)})

@@ -16,7 +16,9 @@
 -- only: the edge RAM is unused there).
 -- D = 1 (dec_log2 = 0) passes every pixel unchanged, 1 clock later.
 -- Latency: 1 clock (pixels and events).  Throughput: 1 pixel per clock, no handshake.
--- Cost: 2 COORD_W-bit (LOG2_D_MAX + 1):1 shift muxes, the low-bit test, 2 COORD_W + bins + 5 FF.
+-- Cost: two COORD_W-bit barrel shifters (x, y), the low-bit test, 2 COORD_W + bins + 8 FF
+-- (docs/blocks/ms_decimate.md: 80 LUT4, 47 FF for the v2 defaults).
+-- dec_log2 above LOG2_D_MAX gives D = 1.
 -- Python model: frame[::D, ::D] (mstrack.fixed.tracker_v2.FixedTrackerV2._bins / _capture).
 -- Reset: synchronous, active high; valid and event flags, dec_log2 latch back to D = 1.
 library ieee;
@@ -69,14 +71,8 @@ begin
   begin
     if rising_edge(clk) then
       on_grid := (resize(ip_x, LW) and mask) = 0 and (resize(ip_y, LW) and mask) = 0;
-      xs := ip_x;
-      ys := ip_y;
-      for i in 1 to LOG2_D_MAX loop
-        if k = i then
-          xs := shift_right(ip_x, i);
-          ys := shift_right(ip_y, i);
-        end if;
-      end loop;
+      xs := shift_right(ip_x, to_integer(k));  -- k <= LOG2_D_MAX (latched below)
+      ys := shift_right(ip_y, to_integer(k));
       dp_valid <= '1' when ip_valid = '1' and on_grid else '0';
       dp_x     <= xs;
       dp_y     <= ys;

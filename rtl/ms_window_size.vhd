@@ -8,13 +8,14 @@
 -- limit is the caller's: min(MAX_WINDOW, decimated frame size - 2) for the window,
 -- decimated frame size - 2 for the init box (tracker_v2: _geometry, init).
 -- Pipeline: 1 p = (16 + PAD16) s8 as a sum of shifted copies of s8, one per set bit of the
--- constant (no multiplier block); 2 t = p >> (sh - 1) (a mux over log2 D), n0 = (t + 1) >> 1;
+-- constant (no multiplier block); 2 t = p >> (sh - 1) (a 3-level barrel shifter over log2 D),
+-- n0 = (t + 1) >> 1;
 -- 3 clamp to [3, limit].
 -- Latency: 3 clocks from in_valid to out_valid.  Throughput: 1 per clock.
 -- Handshake: valid only (no back-pressure); used once or twice per frame.
 -- Cost: popcount(16 + PAD16) - 1 adders of S8_W + 7 bits (1 for the default PAD16 = 4, 0 for
--- PAD16 = 0), a (LOG2_D_MAX + 1):1 mux, one incrementer, two compares of N0_W bits; about
--- 2 S8_W + 2 N_W FF.
+-- PAD16 = 0), a barrel shifter, one incrementer, two compares of N0_W bits; about
+-- 2 S8_W + 2 N_W FF (docs/blocks/ms_window_size.md: 54 LUT4, 55 FF, 36 CCU2C for the defaults).
 -- Reset: synchronous, active high; valid flags only.
 library ieee;
 use ieee.std_logic_1164.all;
@@ -24,15 +25,14 @@ entity ms_window_size is
   generic (
     S8_W       : natural range 9 to 30 := 20;  -- width of s8 (Q(COORD_W).8: COORD_W + 8)
     PAD16      : natural range 0 to 64 := 4;   -- window padding in 1/16 (0: ms_box_size)
-    N_W        : natural range 2 to 16 := 7;   -- width of limit and n (7: MAX_WINDOW 127)
-    LOG2_D_MAX : natural range 0 to 7 := 4     -- largest log2 D (4: D = 16, lost at D = 8)
+    N_W        : natural range 2 to 16 := 7    -- width of limit and n (7: MAX_WINDOW 127)
   );
   port (
     clk       : in  std_logic;                          -- clock
     rst       : in  std_logic;                          -- synchronous reset (valid flags only)
     in_valid  : in  std_logic;                          -- inputs valid
     s8        : in  unsigned(S8_W - 1 downto 0);        -- target size along this axis, Q.8 px
-    log2_d    : in  unsigned(2 downto 0);               -- log2 D, 0 .. LOG2_D_MAX
+    log2_d    : in  unsigned(2 downto 0);               -- log2 D, 0 .. 7 (v2: 0 .. 4, D = 16 while lost)
     limit     : in  unsigned(N_W - 1 downto 0);         -- largest n (values below 3 give 3)
     out_valid : out std_logic;                          -- n valid (in_valid delayed 3 clocks)
     n         : out unsigned(N_W - 1 downto 0)          -- diameter in decimated px, 3 .. max(3, limit)
@@ -75,8 +75,6 @@ architecture rtl of ms_window_size is
   signal n0         : unsigned(N0_W - 1 downto 0);
   signal n_r        : unsigned(N_W - 1 downto 0);
 begin
-  assert LOG2_D_MAX <= 7 report "ms_window_size: LOG2_D_MAX > 7" severity failure;
-
   p_size : process (clk)
     variable t : unsigned(N0_W downto 0);
   begin
@@ -87,12 +85,7 @@ begin
       lim1 <= limit;
       v1   <= in_valid;
       -- stage 2: t = p >> (11 + log2 D), n0 = (t + 1) >> 1 (round half up)
-      t := (others => '0');
-      for k in 0 to LOG2_D_MAX loop
-        if k1 = k then
-          t := resize(shift_right(p1, SH0 + k), N0_W + 1);
-        end if;
-      end loop;
+      t := resize(shift_right(p1, SH0 + to_integer(k1)), N0_W + 1);
       t    := t + 1;
       n0   <= t(N0_W downto 1);
       lim2 <= lim1;

@@ -29,7 +29,7 @@ from test_ms_window_size import LATENCY, size_vectors, start, stream
 @cocotb.parametrize(gap=[0.0, 0.3])
 async def box_size(dut, gap):
     g = dut_generics()
-    kmax = int(g["LOG2_D_MAX"])
+    kmax = 7                                   # the whole log2_d port
     await start(dut)
     vecs = size_vectors(g, 0, kmax, seed=9 + int(gap * 10), exhaustive=bool(g.get("EXHAUSTIVE_TB", 0)))
     n = await stream(dut, vecs, ("n",), LATENCY,
@@ -44,14 +44,14 @@ MODULE = "test_ms_box_size"
 
 
 def v2_generics(fp: FixedParams | None = None) -> dict[str, int]:
-    """ms_box_size generics of the v2 core: s8 in Q(COORD_W).8, limit = decimated frame - 2, D <= 8."""
+    """ms_box_size generics of the v2 core: s8 in Q(COORD_W).8, limit = decimated frame - 2."""
     fp = fp or FixedParams()
-    return {"S8_W": fp.coord_bits + 8, "N_W": fp.coord_bits, "LOG2_D_MAX": 3}
+    return {"S8_W": fp.coord_bits + 8, "N_W": fp.coord_bits}
 
 
 PARAMS = [
     pytest.param(v2_generics(), id="v2_default"),
-    pytest.param({"S8_W": 12, "N_W": 6, "LOG2_D_MAX": 4, "EXHAUSTIVE_TB": 1}, id="small_exhaustive"),
+    pytest.param({"S8_W": 12, "N_W": 6, "EXHAUSTIVE_TB": 1}, id="small_exhaustive"),
 ]
 
 

@@ -128,7 +128,7 @@ def size_vectors(g: dict, pad16: int, kmax: int, seed: int, exhaustive: bool) ->
 @cocotb.parametrize(gap=[0.0, 0.3])
 async def window_size(dut, gap):
     g = dut_generics()
-    pad16, kmax = int(g["PAD16"]), int(g["LOG2_D_MAX"])
+    pad16, kmax = int(g["PAD16"]), 7           # the whole log2_d port
     await start(dut)
     vecs = size_vectors(g, pad16, kmax, seed=5 + int(gap * 10), exhaustive=bool(g.get("EXHAUSTIVE_TB", 0)))
     n = await stream(dut, vecs, ("n",), LATENCY,
@@ -152,18 +152,18 @@ MODULE = "test_ms_window_size"
 
 
 def v2_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None) -> dict[str, int]:
-    """ms_window_size generics of the v2 core: s8 in Q(COORD_W).8, n up to max_window, D up to 16."""
+    """ms_window_size generics of the v2 core: s8 in Q(COORD_W).8, n up to max_window."""
     tp = tp or TrackerParams(preset="v2")
     fp = fp or FixedParams()
     return {"S8_W": fp.coord_bits + 8, "PAD16": sixteenths(tp.pad, "pad"),
-            "N_W": tp.max_window.bit_length(), "LOG2_D_MAX": 4}
+            "N_W": tp.max_window.bit_length()}
 
 
 PARAMS = [
     pytest.param(v2_generics(), id="v2_default"),
     pytest.param({**v2_generics(), "PAD16": 0}, id="pad0"),
     pytest.param({**v2_generics(TrackerParams(preset="v2", pad=0.4375, max_window=1023))}, id="pad7_w1023"),
-    pytest.param({"S8_W": 12, "PAD16": 4, "N_W": 5, "LOG2_D_MAX": 4, "EXHAUSTIVE_TB": 1}, id="small_exhaustive"),
+    pytest.param({"S8_W": 12, "PAD16": 4, "N_W": 5, "EXHAUSTIVE_TB": 1}, id="small_exhaustive"),
 ]
 
 

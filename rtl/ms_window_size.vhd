@@ -13,7 +13,7 @@
 -- 3 clamp to [3, limit].
 -- Latency: 3 clocks from in_valid to out_valid.  Throughput: 1 per clock.
 -- Handshake: valid only (no back-pressure); used once or twice per frame.
--- Cost: popcount(16 + PAD16) - 1 adders of S8_W + 7 bits (1 for the default PAD16 = 4, 0 for
+-- Cost: popcount(16 + PAD16) - 1 adders of S8_W + bits(16 + PAD16) bits (1 for the default PAD16 = 4, 0 for
 -- PAD16 = 0), a barrel shifter, one incrementer, two compares of N0_W bits; about
 -- 2 S8_W + 2 N_W FF (docs/blocks/ms_window_size.md: 54 LUT4, 55 FF, 36 CCU2C for the defaults).
 -- Reset: synchronous, active high; valid flags only.

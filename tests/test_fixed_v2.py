@@ -401,3 +401,17 @@ def test_v2_worst_frames_fit_1080p60_blanking_with_lanes_4():
     from mstrack.synth import v2_cycle_budget
     rows = v2_cycle_budget(4)
     assert len(rows) == 3 and all(r["clocks"] <= 99000 for r in rows), rows
+
+
+def test_init_model_box_is_limited_to_max_window():
+    """A target above ~812 px (D capped at 8) is learned on at most MAX_WINDOW decimated px, the
+    size rtl/ms_bg_model.vhd and the kernel tables hold (the box size clamp of ms_box_size)."""
+    rng = np.random.default_rng(4)
+    f = rng.integers(0, 120, (1080, 1920, 3)).astype(np.uint8)
+    f[20:1060, 20:1900] = (40, 200, 60)
+    trk = Tracker(model="fixed", preset="v2")
+    trk.init(f, (20, 20, 1880, 1040))
+    m = trk._impl.model
+    assert m.Q.sum() <= 127 * 127 and m.Q.sum() > 0.7 * 127 * 127
+    r = trk.update(f)
+    assert r.extra["decimation"] == 8

@@ -124,8 +124,8 @@ class FixedTrackerV2:
         hd_, wd_ = bins.shape
         sh = d.bit_length() - 1
         cd = (ms_round_centre(self.c8[0] >> sh, cf), ms_round_centre(self.c8[1] >> sh, cf))
-        wb = ms_box_size(self.w8, d, wd_ - 2)
-        hb = ms_box_size(self.h8, d, hd_ - 2)
+        wb = ms_box_size(self.w8, d, min(p.max_window, wd_ - 2))
+        hb = ms_box_size(self.h8, d, min(p.max_window, hd_ - 2))
         # keep the box inside the decimated interior
         cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))

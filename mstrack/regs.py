@@ -13,6 +13,7 @@ Outputs (relative to the repository root): :data:`OUTPUTS`.
 from __future__ import annotations
 
 import filecmp
+from dataclasses import dataclass
 import subprocess
 import sys
 import tempfile
@@ -102,6 +103,66 @@ def generate(root: Path = REPO, rdl_root: Path = REPO) -> list[Path]:
         if p.name != "ms_tracker_result.h":
             _mark(p)
     (root / "sw" / "ms_tracker_result.h").write_text(result_header_text())
+    return out
+
+
+@dataclass(frozen=True)
+class Field:
+    """One field of a register: bits ``lsb .. lsb + width - 1``; ``sw`` is 'r', 'w' or 'rw'."""
+
+    name: str
+    lsb: int
+    width: int
+    sw: str
+    reset: int | None
+
+
+@dataclass(frozen=True)
+class Register:
+    """One 32-bit register of the map: byte offset and fields by name."""
+
+    name: str
+    offset: int
+    fields: dict[str, Field]
+
+    @property
+    def readable(self) -> bool:
+        return any("r" in f.sw for f in self.fields.values())
+
+    @property
+    def writable(self) -> bool:
+        return any("w" in f.sw for f in self.fields.values())
+
+    def decode(self, value: int) -> dict[str, int]:
+        """Field values of a 32-bit register value."""
+        return {n: (value >> f.lsb) & ((1 << f.width) - 1) for n, f in self.fields.items()}
+
+    def encode(self, **values: int) -> int:
+        """32-bit value with the named fields set (others 0); a value that does not fit raises."""
+        word = 0
+        for n, v in values.items():
+            f = self.fields[n]
+            if not 0 <= v < 1 << f.width:
+                raise ValueError(f"{self.name}.{n} = {v} does not fit {f.width} bits")
+            word |= v << f.lsb
+        return word
+
+
+def register_map(rdl: Path | None = None) -> dict[str, Register]:
+    """The register map, read from the SystemRDL description with systemrdl-compiler."""
+    from systemrdl import RDLCompiler
+    from systemrdl.rdltypes import AccessType
+
+    rc = RDLCompiler()
+    rc.compile_file(str(rdl or REPO / RDL))
+    top = rc.elaborate().top
+    acc = {AccessType.r: "r", AccessType.w: "w", AccessType.rw: "rw", AccessType.na: ""}
+    out: dict[str, Register] = {}
+    for reg in top.registers():
+        fields = {f.inst_name: Field(f.inst_name, f.lsb, f.width, acc.get(f.get_property("sw"), "rw"),
+                                     f.get_property("reset"))
+                  for f in reg.fields()}
+        out[reg.inst_name] = Register(reg.inst_name, reg.absolute_address, fields)
     return out
 
 

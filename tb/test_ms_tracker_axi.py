@@ -361,12 +361,13 @@ async def run_axi(dut):
 SMALL = {"fp": {"max_half": 15, "margin": 8}}
 
 
-def _run(job: dict, build_name: str) -> None:
-    from mstrack.hdl import run_ghdl
+def _run(job: dict, build_name: str, verilator: bool = False) -> None:
+    from mstrack.hdl import run_ghdl, run_verilator
     g = config_of(job).generics()
     g["RESULT_STREAM"] = bool(job["result_stream"])
-    run_ghdl("ms_tracker_axi", "test_ms_tracker_axi", generics=g, build_name=build_name,
-             extra_env={"MSTRACK_JOB": json.dumps(job)})
+    runner = run_verilator if verilator else run_ghdl
+    runner("ms_tracker_axi", "test_ms_tracker_axi", generics=g, build_name=build_name,
+           extra_env={"MSTRACK_JOB": json.dumps(job)})
 
 
 @pytest.mark.parametrize("variant", ["stream", "throttled", "no_stream"])
@@ -375,6 +376,13 @@ def test_axi_synthetic(variant):
     job = {**SMALL, "scene": "pattern", "result_stream": variant != "no_stream",
            "throttle": variant == "throttled", "reject_at": 4, "seed": 2}
     _run(job, f"ms_tracker_axi_{variant}")
+
+
+@pytest.mark.verilator
+def test_axi_verilator():
+    """The GHDL-synthesised netlist (generated register block included) under Verilator, throttled."""
+    job = {**SMALL, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 3}
+    _run(job, "ms_tracker_axi_verilator", verilator=True)
 
 
 def test_axi_real():

@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: setup demo test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
+.PHONY: regs setup demo test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
 
 setup:
 	bash tools/setup.sh
@@ -56,6 +56,12 @@ lock:
 	{ sed -n '1,2p' requirements.lock; $(LATEST_VENV)/bin/python -m pip freeze --exclude-editable \
 	  | grep -v '^#'; echo "setuptools==$$($(LATEST_VENV)/bin/python -m pip index versions setuptools 2>/dev/null \
 	  | sed -n 's/^setuptools (\(.*\))/\1/p')"; } > requirements.lock.new && mv requirements.lock.new requirements.lock
+
+# Register interface: regenerate everything made from regs/ms_tracker_regs.rdl (PeakRDL: the VHDL
+# register block, the C header, docs/registers.md) and sw/ms_tracker_result.h (result word layout);
+# tests/test_regs.py fails when a checked-in file differs from a fresh generation.
+regs: setup
+	$(PY) -m mstrack.regs
 
 eval: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval $(ARGS)

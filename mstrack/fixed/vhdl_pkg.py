@@ -151,7 +151,16 @@ FRAME_COUNT_W = 16
 
 
 def result_layout(g: dict[str, int] | None = None) -> list[tuple[str, int, int]]:
-    """Fields of the result word, LSB first: (name, offset, width).  ms_tracker packs the same order."""
+    """Fields of result word v1, LSB first: ``[(name, offset, width), ...]``.
+
+    ms_tracker packs the same order (rtl/ms_tracker.vhd); the widths follow the generics ``g``
+    (default: :func:`core_generics` of the default parameters).  Fields: ``cx, cy`` target centre,
+    unsigned Q(COORD_W).CF px; ``rho_c, rho_e`` Bhattacharyya coefficients Q.RHO_OUT_FRAC;
+    ``alpha_c`` colour weight Q.AF; ``iter_c, iter_e`` iterations; ``stop_c, stop_e`` stop codes
+    (0 shift, 1 rho, 2 max_iter, 3 lost); ``flags`` (bits :data:`RESULT_FLAGS`); ``err_code``
+    (stream error, rtl/ms_stream_pkg.vhd); ``box_w, box_h`` box size (px); ``frame_count``
+    (frames since reset, mod 2**16).  The word is :func:`result_width` bits wide.
+    """
     g = g or core_generics()
     win_w = g["WIN_W"]
     fields_ = [("cx", g["CENTRE_ABS_W"]), ("cy", g["CENTRE_ABS_W"]), ("rho_c", g["RHO_OUT_W"]),
@@ -172,8 +181,34 @@ def result_width(g: dict[str, int] | None = None) -> int:
     return -(-(off + w) // 8) * 8
 
 
+def pack_result(fields: dict[str, int], g: dict[str, int] | None = None) -> int:
+    """Pack the fields of :func:`result_layout` (missing ones are 0) into one result word v1.
+
+    Raises ValueError for an unknown field or a value that is negative or does not fit its width.
+    """
+    word = 0
+    layout = result_layout(g)
+    extra = set(fields) - {name for name, _, _ in layout}
+    if extra:
+        raise ValueError(f"unknown result field(s): {sorted(extra)}")
+    for name, off, w in layout:
+        v = int(fields.get(name, 0))
+        if v < 0 or v >= 1 << w:
+            raise ValueError(f"result field {name} = {v} does not fit in {w} bits")
+        word |= v << off
+    return word
+
+
 def unpack_result(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
-    """Split a result word into its fields; flags are also given one key each (flag_<name>)."""
+    """Split a result word v1 into its fields (:func:`result_layout`), as non-negative ints.
+
+    Flags are also given one key each (``flag_<name>``, 0 or 1, names :data:`RESULT_FLAGS`).
+    ``g``: the generics of the core that produced the word (default: the default core).
+    The C driver's ``mstrack_decode_word`` (sw/mstrack_drv.c) decodes the same way (tested).
+
+    >>> unpack_result(pack_result({"cx": 5, "flags": 4}))["flag_lost"]
+    1
+    """
     out = {name: (word >> off) & ((1 << w) - 1) for name, off, w in result_layout(g)}
     for i, f in enumerate(RESULT_FLAGS):
         out[f"flag_{f}"] = (out["flags"] >> i) & 1

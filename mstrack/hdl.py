@@ -386,7 +386,8 @@ def run_ghdl_plain(
 ) -> str:
     """Analyse *sources*, elaborate and run *toplevel* with GHDL, no cocotb (a VHDL testbench).
 
-    String generics are passed as ``-gNAME=VALUE`` too.  The simulation runs in *run_dir*
+    String generics are passed as ``-gNAME=VALUE`` too, at run time, so the analysis and
+    elaboration are redone only when a source changes (hash in the build dir).  The simulation runs in *run_dir*
     (default: the build dir ``build/sim/<build_name>``), so relative file names in generics
     are resolved there.  elab_only=True stops after elaboration (``--no-run``: the generic
     assertions are checked).  Returns the run's output; raises :class:`HdlError` with its tail
@@ -400,9 +401,15 @@ def run_ghdl_plain(
     work.mkdir(exist_ok=True)
     env = {"GHDL_BACKEND": ghdl_backend()}
     flags = [*GHDL_STD_FLAGS, f"--workdir={work}"]
-    _run(["ghdl", "-a", *flags, *map(str, sources)], build_dir / "analyse.log", build_dir, "ghdl -a", env=env)
     exe = build_dir / toplevel
-    _run(["ghdl", "-e", *flags, "-o", str(exe), toplevel], build_dir / "elab.log", build_dir, "ghdl -e", env=env)
+    stamp = build_dir / "sources.hash"
+    digest = _hash_inputs(toplevel, None, [Path(s) for s in sources], extra=env["GHDL_BACKEND"])
+    if not (stamp.is_file() and stamp.read_text() == digest and (exe.is_file() or env["GHDL_BACKEND"] == "mcode")):
+        # generics are given at run time: one analysis + elaboration serves every generic set
+        _run(["ghdl", "-a", *flags, *map(str, sources)], build_dir / "analyse.log", build_dir, "ghdl -a", env=env)
+        out = [] if env["GHDL_BACKEND"] == "mcode" else ["-o", str(exe)]
+        _run(["ghdl", "-e", *flags, *out, toplevel], build_dir / "elab.log", build_dir, "ghdl -e", env=env)
+        stamp.write_text(digest)
     if exe.is_file():   # llvm / gcc back ends: an executable
         cmd = [str(exe)]
     else:               # mcode: elaborated and run in one step

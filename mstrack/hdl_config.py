@@ -183,7 +183,7 @@ def render(cfg: CoreConfiguration, fmt: str = "package", name: str = "ms_tracker
         raise ConfigError(f"format {fmt!r} unknown (one of {', '.join(FORMATS)})")
     if not re.fullmatch(r"[A-Za-z]\w*", name):
         raise ConfigError(f"package name {name!r} is not a VHDL identifier")
-    width = max(len(k) for k in g) + 2
+    width = max(len(k) for k in g) + 3      # "C_" + the longest name + one blank
     out = _header(cfg, command, "--")
     out += ["--", "-- Use: compile this file before the core's instance, then", "--   use work." + name + ".all;",
             "--   u_tracker : entity work.ms_tracker"]

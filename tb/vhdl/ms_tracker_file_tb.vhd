@@ -179,7 +179,7 @@ begin
     variable st    : file_open_status;
     variable l, w  : line;
     variable ln    : natural := 0;
-    variable fw, fh, n_w, n_h : integer := 0;
+    variable fw, fh : integer := 0;
     variable bx, by, bw, bh : integer;
     variable pix   : std_logic_vector(23 downto 0);
     variable ok    : boolean;

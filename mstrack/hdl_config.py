@@ -115,7 +115,7 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         raise ConfigError(f"max frame width {c.max_frame_width} px: frames are at least 3 px wide")
     if c.max_frame_width > coord_max:
         need = c.max_frame_width.bit_length()
-        hint = f"; use coord bits {need}" if need <= 14 else "; COORD_W is at most 14 (16383 px)"
+        hint = f"; use --coord-bits {need}" if need <= 14 else "; COORD_W is at most 14 (16383 px)"
         raise ConfigError(f"max frame width {c.max_frame_width} px does not fit COORD_W = {c.coord_bits} bits "
                           f"(at most {coord_max} px){hint}")
     if c.max_target < 3:

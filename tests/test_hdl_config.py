@@ -49,7 +49,7 @@ def test_choices_map_to_model_parameters(choices, tp, fp, lanes):
     (dict(max_target=600), "largest target 600 px > 511 px, the largest window the kernel tables hold"),
     (dict(max_target=2), "at least 3x3"),
     (dict(max_frame_width=5000), "max frame width 5000 px does not fit COORD_W = 12 bits (at most 4095 px); "
-                                 "use coord bits 13"),
+                                 "use --coord-bits 13"),
     (dict(max_frame_width=4096), "does not fit COORD_W = 12 bits"),
     (dict(max_frame_width=2), "at least 3 px wide"),
     (dict(coord_bits=15), "COORD_W 15 out of 8..14"),

@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: regs setup demo test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
+.PHONY: regs setup demo test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -80,3 +80,8 @@ clean:
 # Quick: make synth ARGS="--config default --seeds 1"
 synth: setup
 	$(VENV)/bin/mstrack synth --write $(ARGS)
+
+# generated packaging files: rtl/files.txt, mstrack.core, tb/vhdl/data/ (docs/packaging.md);
+# tests/test_packaging.py fails when they are stale
+hdl-files: setup
+	$(VENV)/bin/mstrack hdl files

@@ -451,12 +451,17 @@ def decide_status(conf: float, was_lost: bool, p: TrackerParams) -> Status:
 
 
 def rescale(size: tuple[float, float], size0: tuple[float, float], spread: float, spread_ref: float,
-            shape: tuple[int, int], p: TrackerParams) -> tuple[float, float]:
+            shape: tuple[int, int], p: TrackerParams, est_rho: float | None = None) -> tuple[float, float]:
     """One frame's size update: est = sqrt(spread / spread_ref) clamped to 1 +- step;
-    s = clamp(1 + gain (est - 1) - reg (w / w0 - 1), 1 +- step); size s, in [3, frame]."""
+    s = clamp(1 + gain (est - 1) - reg (w / w0 - 1), 1 +- step); size s, in [3, frame].
+    ``est_rho`` (the scale test, off by default): est <- mix est_rho + (1 - mix) est."""
     w, h = size
     est = math.sqrt(spread / spread_ref)
     est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
+    if est_rho is not None and p.scale_test_gate:
+        est = est if (est - 1.0) * (est_rho - 1.0) > 0 else 1.0
+    elif est_rho is not None:
+        est = p.scale_test_mix * est_rho + (1.0 - p.scale_test_mix) * est
     s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / size0[0] - 1.0)
     s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
     return (min(max(w * s, 3.0), float(shape[1])), min(max(h * s, 3.0), float(shape[0])))
@@ -546,6 +551,24 @@ class FloatTrackerV2:
     def _confidence(self, ps: PassV2) -> float:
         return confidence(ps, self._rho_ref, self._share_ref)
 
+    def _pass(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> PassV2:
+        p = self.params
+        inner2 = 1.0 / (1.0 + p.pad) ** 2
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            return window_pass_numba(bins, p.colour_bits, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+        return window_pass(bins, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+
+    def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
+        """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
+        the largest (two more passes at the final centre)."""
+        d = self.params.scale_test
+        best, rho = 1.0, self._pass(bins, c, hx, hy).rho
+        for s in (1.0 - d, 1.0 + d):
+            r = self._pass(bins, c, s * hx, s * hy).rho
+            if r > rho:
+                best, rho = s, r
+        return best
+
     # ------------------------------------------------------------------ API
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
         frame = check_frame(frame)
@@ -573,6 +596,7 @@ class FloatTrackerV2:
         self._rho_s, self._con_s = ps.rho, ps.share - ps.ring_share  # its filters start at init
         self._lost = False
         self._reported_lost = False
+        self._vel = (0.0, 0.0)  # last centre step (frame px), for motion_gain
         return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
                            message="init box clipped to the frame" if clipped else "",
@@ -599,6 +623,9 @@ class FloatTrackerV2:
         else:
             bins = self._lazy_bins(frame, d, w, h)
         start = (self._centre[0] / d, self._centre[1] / d)
+        if p.motion_gain > 0 and not self._lost:  # constant-velocity start (off by default)
+            start = ((self._centre[0] + p.motion_gain * self._vel[0]) / d,
+                     (self._centre[1] + p.motion_gain * self._vel[1]) / d)
         # lost: every start point (this one included) runs search_iter iterations
         c, ps, it = self._track(bins, start, hx, hy, p.search_iter if self._lost else p.max_iter)
         conf = self._confidence(ps)
@@ -619,14 +646,17 @@ class FloatTrackerV2:
         self._lost = state == Status.LOST
         # a loss stays reported (uncertain frames keep it) until a frame is ok again
         self._reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self._reported_lost)
+        old = self._centre
         self._centre = (c[0] * d, c[1] * d)  # searching: the search's best candidate
+        self._vel = (self._centre[0] - old[0], self._centre[1] - old[1]) if state == Status.OK else (0.0, 0.0)
         if state == Status.OK:
             a = p.ref_rate
             self._rho_ref += a * (ps.rho - self._rho_ref)
             self._share_ref += a * (ps.share - self._share_ref)
         # scale: every frame (a lost or uncertain target changes size too), from the spread
         if p.scale_gain > 0 and ps.nt > 0:
-            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p)
+            est_rho = self._scale_test(bins, c, hx, hy) if p.scale_test > 0 else None
+            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho)
         box = box_from_centre_index(*self._centre, *self._size)
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=it, iter_e=0, status=status, confidence=conf,

@@ -102,6 +102,19 @@ class TrackerParams:
         sizes in x and y (8 points).
     search_iter : int
         Mean-shift iterations from each start point of the wide search.
+    motion_gain : float
+        Constant-velocity start (experimental, off by default: 0): the mean
+        shift starts at the last centre + motion_gain x the last centre step
+        (the step is set to 0 unless the frame's search state is ok)
+        (docs/results_v2_mean.md).
+    scale_test, scale_test_mix : float
+        Scale test by rho (experimental, off by default: 0): two more passes
+        at the final centre with the window scaled by 1 -+ scale_test; the
+        scale of the largest rho (1, 1 - scale_test or 1 + scale_test) is the
+        rho estimate, and the size step uses scale_test_mix x it + (1 -
+        scale_test_mix) x the spread estimate; scale_test_gate: instead, the
+        spread estimate is kept only where the rho test moves the same way
+        (else no step) (docs/results_v2_mean.md).
     """
 
     features: Features = None  # type: ignore[assignment]  # resolved per preset
@@ -127,6 +140,10 @@ class TrackerParams:
     ref_rate: float = 0.015625
     search_step: float = 1.0
     search_iter: int = 5
+    motion_gain: float = 0.0
+    scale_test: float = 0.0
+    scale_test_mix: float = 1.0
+    scale_test_gate: bool = False
 
     def __post_init__(self) -> None:
         if self.preset not in ("paper", "v2"):
@@ -155,7 +172,8 @@ class TrackerParams:
                                  ("scale_step", 0.0, 0.5), ("scale_reg", 0.0, 1.0), ("conf_lost", 0.0, 1.0),
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
                                  ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
-                                 ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0)):
+                                 ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
+                                 ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:

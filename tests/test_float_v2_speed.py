@@ -155,6 +155,17 @@ def test_scale_change(kernel):
 
 
 @needs_numba
+@pytest.mark.parametrize("extra", [{"scale_test": 0.05, "scale_test_gate": True},
+                                   {"scale_test": 0.1, "scale_test_mix": 0.5}, {"motion_gain": 0.5}])
+def test_experimental_options(extra):
+    """The experimental options (off by default; docs/results_v2_mean.md) are bit-identical too."""
+    sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]
+    boxes = [(60 + 2 * i - s // 2, 90 - s // 2, s, s) for i, s in enumerate(sizes)]
+    res = _assert_identical(_render(200, 280, boxes, seed=1), boxes[0], **extra)
+    assert sum(r.ok for r in res) > 40
+
+
+@needs_numba
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_large_target_decimated(kernel):
     """Targets of 300 and 430 px: decimation 4 and 8 (the kernel reads every D-th pixel)."""

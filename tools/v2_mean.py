@@ -1,0 +1,166 @@
+"""Issue 10, last accuracy target: mean AUC over the dev sequences of tracker v2 variants.
+
+Every variant runs on every sequence with the same parameters (no per-sequence choice), one
+pass (OPE), scored as ``mstrack eval`` (mstrack.evaluate.run_sequence + aggregate).  Prints the
+overall (frame-weighted) AUC, the mean of the per-sequence AUCs, the per-sequence AUCs and the
+wins / losses against the default v2 on the sequences (docs/results_v2_mean.md).
+
+    PYTHONPATH=. python tools/v2_mean.py [--data DIR] [--jobs 2] [--only LABEL ...] [--md OUT.md]
+    PYTHONPATH=. python tools/v2_mean.py --robust LABEL ...
+
+``--robust``: the given variants and the baseline under the 8 perturbed starts of
+tools/v2_features.py (TRE at n//3 and 2n//3, SRE shifts +-10 % and scales 0.9 / 1.1): overall
+AUC and mean over sequences per start, over all 9 starts, and wins on the 8 perturbed starts.
+"""
+from __future__ import annotations
+
+import argparse
+import multiprocessing as mp
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from mstrack import Tracker  # noqa: E402
+from mstrack.data import load_dataset  # noqa: E402
+from mstrack.evaluate import aggregate, run_sequence  # noqa: E402
+from mstrack.features_v2 import Feature, MultiFeatureV2  # noqa: E402
+from mstrack.params import TrackerParams  # noqa: E402
+
+BASELINE = "v2 default (float)"
+
+
+def variants() -> dict[str, tuple]:
+    """label -> (kind, kwargs): kind "v2" = Tracker(model, preset="v2", **kwargs); "multi" =
+    MultiFeatureV2(colour + orient(T=32), disc_frame) with TrackerParams(preset="v2", **kwargs)."""
+    v: dict[str, tuple] = {BASELINE: ("v2", {})}
+    for g in (0.5, 1.0):
+        v[f"motion_gain {g}"] = ("v2", {"motion_gain": g})
+    v["orient(T=32) disc_frame"] = ("multi", {})
+    v["orient(T=32) disc_frame + scale_test 0.05 gate"] = ("multi", {"scale_test": 0.05, "scale_test_gate": True})
+    v["orient(T=32) disc_frame + scale_test 0.02 mix 0.5"] = ("multi", {"scale_test": 0.02, "scale_test_mix": 0.5})
+    for d in (0.03, 0.1):
+        v[f"orient(T=32) disc_frame + scale_test {d} gate"] = ("multi", {"scale_test": d, "scale_test_gate": True})
+    v["kernel epanechnikov"] = ("v2", {"kernel": "epanechnikov"})
+    v["eps2 0.25"] = ("v2", {"eps2": 0.25})
+    v["colour_bits 4"] = ("v2", {"colour_bits": 4})
+    v["search_step 0.5"] = ("v2", {"search_step": 0.5})
+    v["conf_lost 0.45"] = ("v2", {"conf_lost": 0.45})
+    for d in (0.05, 0.1):
+        v[f"scale_test {d} gate"] = ("v2", {"scale_test": d, "scale_test_gate": True})
+    for d in (0.02, 0.05, 0.1):
+        for m in (1.0, 0.5):
+            v[f"scale_test {d} mix {m}"] = ("v2", {"scale_test": d, "scale_test_mix": m})
+    return v
+
+
+def make(kind: str, kw: dict):
+    if kind == "v2":
+        return Tracker(model="float", preset="v2", **kw)
+    if kind == "v2fixed":
+        return Tracker(model="fixed", preset="v2", **kw)
+    return MultiFeatureV2([Feature("colour", bits=3), Feature("orient", T=32)], fusion="disc_frame",
+                          params=TrackerParams(preset="v2", **kw))
+
+
+_SEQS = None
+
+
+def _run(job):
+    label, kind, kw, data = job
+    global _SEQS
+    if _SEQS is None:
+        _SEQS = load_dataset(data)
+    t0 = time.perf_counter()
+    runs = {s.name: run_sequence(make(kind, kw), s, label=label) for s in _SEQS}
+    return label, runs, time.perf_counter() - t0
+
+
+def _run_robust(job):
+    label, kind, kw, pert, data = job
+    global _SEQS
+    if _SEQS is None:
+        _SEQS = load_dataset(data)
+    from v2_features import perturbed
+    runs = []
+    for s in _SEQS:
+        s2, trk = perturbed(s, pert, make(kind, kw))
+        runs.append((s2, run_sequence(trk, s2, label=label)))
+    return label, pert, runs
+
+
+def robust(a, labels: list[str]) -> str:
+    from v2_features import PERTURB
+    from mstrack.metrics import concat_scores, score
+    vs = variants()
+    labels = [BASELINE] + [x for x in labels if x != BASELINE]
+    jobs = [(lb, *vs[lb], k, a.data) for lb in labels for k in PERTURB]
+    res: dict = {}
+    with mp.get_context("fork").Pool(a.jobs) as pool:
+        for lb, k, runs in pool.imap_unordered(_run_robust, jobs):
+            res[(lb, k)] = [score(r.boxes, s2.gt[:r.n_frames]) for s2, r in runs]
+            print(f"  {lb} / {k}", file=sys.stderr, flush=True)
+    auc = {key: concat_scores(v).auc for key, v in res.items()}
+    mean = {key: float(np.mean([x.auc for x in v])) for key, v in res.items()}
+    head = ["variant", "all 9 AUC", "all 9 mean", "wins /8 (AUC, mean)"] + [f"{k} AUC / mean" for k in PERTURB]
+    lines = ["| " + " | ".join(head) + " |", "|---|" + "|".join(["---:"] * (len(head) - 1)) + "|"]
+    for lb in labels:
+        all_auc = concat_scores([x for k in PERTURB for x in res[(lb, k)]]).auc
+        all_mean = float(np.mean([mean[(lb, k)] for k in PERTURB]))
+        wa = sum(auc[(lb, k)] > auc[(BASELINE, k)] for k in PERTURB[1:])
+        wm = sum(mean[(lb, k)] > mean[(BASELINE, k)] for k in PERTURB[1:])
+        lines.append(f"| {lb} | {all_auc:.3f} | {all_mean:.3f} | {'-' if lb == BASELINE else f'{wa}, {wm}'} | "
+                     + " | ".join(f"{auc[(lb, k)]:.3f} / {mean[(lb, k)]:.3f}" for k in PERTURB) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--data", default=str(Path(__file__).resolve().parents[2] / "shared/data/sequences"))
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--only", nargs="*", help="labels to run (the baseline always runs)")
+    ap.add_argument("--md", help="also write the table (markdown) to this file")
+    ap.add_argument("--robust", nargs="+", metavar="LABEL", help="these variants under perturbed starts")
+    a = ap.parse_args(argv)
+    if a.robust:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        out = robust(a, a.robust)
+        print(out)
+        if a.md:
+            Path(a.md).write_text(out)
+        return 0
+    seqs = load_dataset(a.data)
+    names = [s.name for s in seqs]
+    vs = variants()
+    if a.only:
+        vs = {k: v for k, v in vs.items() if k == BASELINE or k in a.only}
+    jobs = [(label, kind, kw, a.data) for label, (kind, kw) in vs.items()]
+    runs = {}
+    with mp.get_context("fork").Pool(a.jobs) as pool:
+        for label, r, t in pool.imap_unordered(_run, jobs):
+            runs[label] = r
+            print(f"  {label}: {t:.0f} s", file=sys.stderr, flush=True)
+    runs = {label: runs[label] for label in vs}
+    ev = aggregate(runs, seqs)
+    base = [ev.per_sequence[BASELINE][n].auc for n in names]
+    short = {"MotorRolling": "MotorR", "Football1": "Footb1", "ball1_vot": "ball1", "bag_vot": "bag"}
+    head = ["variant", "AUC", "mean", "wins/losses"] + [short.get(n, n) for n in names]
+    lines = ["| " + " | ".join(head) + " |", "|---|" + "|".join(["---:"] * (len(head) - 1)) + "|"]
+    for label in vs:
+        per = [ev.per_sequence[label][n].auc for n in names]
+        w = sum(x > b + 1e-9 for x, b in zip(per, base))
+        lo = sum(x < b - 1e-9 for x, b in zip(per, base))
+        lines.append(f"| {label} | {ev.overall[label].auc:.3f} | {np.mean(per):.3f} | "
+                     f"{'-' if label == BASELINE else f'{w}/{lo}'} | " + " | ".join(f"{x:.3f}" for x in per) + " |")
+    out = "\n".join(lines) + "\n"
+    print(out)
+    if a.md:
+        Path(a.md).write_text(out)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -508,7 +508,14 @@ class FloatTrackerV2:
         return decimation(w, h, self.params)
 
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
-        return colour_bins(frame[::d, ::d], self.params.colour_bits)
+        p = self.params
+        c = colour_bins(frame[::d, ::d], p.colour_bits)
+        if p.orient_T <= 0:
+            return c
+        # joint colour x orientation (off by default): Sobel on the full-resolution grey frame
+        from .features_v2 import orientation_bins, sobel
+        gx, gy = sobel(frame)
+        return c * 9 + orientation_bins(gx[::d, ::d], gy[::d, ::d], p.orient_T)
 
     def _lazy_bins(self, frame: np.ndarray, d: int, w: float, h: float) -> LazyBins:
         """Bins computed around the windows the frame's mean shift visits (same values)."""
@@ -524,7 +531,7 @@ class FloatTrackerV2:
         p = self.params
         if isinstance(bins, np.ndarray) and bins.ndim == 3:
             return self._track_numba(bins, start, hx, hy, max_iter)
-        return meanshift_v2(bins, p.n_colour_bins, self._qb, self._t, start, hx, hy, p, max_iter)
+        return meanshift_v2(bins, p.n_bins_v2, self._qb, self._t, start, hx, hy, p, max_iter)
 
     def _track_numba(self, frame: np.ndarray, start: tuple[float, float], hx: float, hy: float,
                      max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
@@ -544,8 +551,7 @@ class FloatTrackerV2:
             # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
             if (c1x - c0x) ** 2 + (c1y - c0y) ** 2 < p.eps2:
                 c = (c1x, c1y)
-                return c, window_pass_numba(frame, p.colour_bits, self._qb, self._t, c, hx, hy, inner2,
-                                            p.kernel, self._bufs), it
+                return c, self._pass(frame, c, hx, hy), it  # (on the frame's bins cache)
             sx, sy, it0 = c1x, c1y, it  # go on from c1 (its pass is recomputed: the same numbers)
 
     def _confidence(self, ps: PassV2) -> float:
@@ -554,9 +560,14 @@ class FloatTrackerV2:
     def _pass(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> PassV2:
         p = self.params
         inner2 = 1.0 / (1.0 + p.pad) ** 2
-        if isinstance(bins, np.ndarray) and bins.ndim == 3:
-            return window_pass_numba(bins, p.colour_bits, self._qb, self._t, c, hx, hy, inner2, p.kernel)
-        return window_pass(bins, p.n_colour_bins, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache (joint bins too)
+            if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
+            height, width = bins.shape[:2]
+            return PassV2(*_nb_window_pass(bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy),
+                                           width, height, float(inner2), p.kernel == "flat", self._qb, self._t,
+                                           *self._bufs, *self._cache))
+        return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)
 
     def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
@@ -583,10 +594,10 @@ class FloatTrackerV2:
         self._centre = (cx, cy)
         d = self.decimation(box.w, box.h)
         bins = self._bins(frame, d)
-        self._q, self._qb, self._t = background_model(bins, p.n_colour_bins, cx / d, cy / d, box.w / d,
+        self._q, self._qb, self._t = background_model(bins, p.n_bins_v2, cx / d, cy / d, box.w / d,
                                                       box.h / d, p.bg_ring, p.kernel)
         pad = 1.0 + p.pad
-        ps = window_pass(bins, p.n_colour_bins, self._qb, self._t, (cx / d, cy / d), pad * box.w / 2 / d,
+        ps = window_pass(bins, p.n_bins_v2, self._qb, self._t, (cx / d, cy / d), pad * box.w / 2 / d,
                          pad * box.h / 2 / d, 1.0 / pad ** 2, p.kernel)
         # references: rho and share are learnt from the first tracked frames (start at the init values)
         self._rho_ref = ps.rho
@@ -614,12 +625,19 @@ class FloatTrackerV2:
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
         if self.active_path() == "numba":
             bins: np.ndarray | LazyBins = frame[::d, ::d]  # the kernel bins the pixels it visits
-            if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_colour_bins):
-                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_colour_bins)  # room to grow
+            if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)  # room to grow
             if self._cache is None:
                 self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
             else:
                 self._cache[1][:] = 0  # a new frame: no bins yet
+            if p.orient_T > 0:  # joint bins: the whole decimated image, marked as computed in the cache
+                jb = self._bins(frame, d)
+                self._cache[0][:jb.shape[0], :jb.shape[1]] = jb
+                self._cache[1][0, :jb.shape[0]] = 0
+                self._cache[1][1, :jb.shape[0]] = jb.shape[1]
+        elif p.orient_T > 0:
+            bins = self._bins(frame, d)
         else:
             bins = self._lazy_bins(frame, d, w, h)
         start = (self._centre[0] / d, self._centre[1] / d)

@@ -115,6 +115,11 @@ class TrackerParams:
         scale_test_mix) x the spread estimate; scale_test_gate: instead, the
         spread estimate is kept only where the rho test moves the same way
         (else no step) (docs/results_v2_mean.md).
+    orient_T : int
+        Joint colour x gradient-orientation bins (experimental, off by default:
+        0): bin = colour bin x 9 + octant of the 3x3 Sobel gradient of the grey
+        frame where |Gx| + |Gy| >= orient_T, 8 for flatter pixels (9 x 512
+        bins) (docs/results_v2_mean.md).
     """
 
     features: Features = None  # type: ignore[assignment]  # resolved per preset
@@ -144,6 +149,7 @@ class TrackerParams:
     scale_test: float = 0.0
     scale_test_mix: float = 1.0
     scale_test_gate: bool = False
+    orient_T: int = 0
 
     def __post_init__(self) -> None:
         if self.preset not in ("paper", "v2"):
@@ -182,10 +188,17 @@ class TrackerParams:
                 raise ValueError("max_window must be in 7..1023")
             if self.search_iter < 1:
                 raise ValueError("search_iter must be >= 1")
+            if not 0 <= self.orient_T <= 2040:
+                raise ValueError("orient_T must be in 0..2040")
 
     @property
     def n_colour_bins(self) -> int:
         return 1 << (3 * self.colour_bits)
+
+    @property
+    def n_bins_v2(self) -> int:
+        """Bins of tracker v2's feature: the colour bins, x 9 with orient_T > 0."""
+        return self.n_colour_bins * (9 if self.orient_T > 0 else 1)
 
     @property
     def n_edge_bins(self) -> int:

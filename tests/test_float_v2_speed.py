@@ -156,7 +156,8 @@ def test_scale_change(kernel):
 
 @needs_numba
 @pytest.mark.parametrize("extra", [{"scale_test": 0.05, "scale_test_gate": True},
-                                   {"scale_test": 0.1, "scale_test_mix": 0.5}, {"motion_gain": 0.5}])
+                                   {"scale_test": 0.1, "scale_test_mix": 0.5}, {"motion_gain": 0.5},
+                                   {"orient_T": 64}, {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True}])
 def test_experimental_options(extra):
     """The experimental options (off by default; docs/results_v2_mean.md) are bit-identical too."""
     sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]
@@ -249,6 +250,13 @@ def real_sequences():
 def test_real_sequences_identical(real_sequences):
     for name, (frames, box) in real_sequences.items():
         _assert_identical(frames, box)
+
+
+@needs_numba
+def test_real_sequences_identical_joint_gate(real_sequences):
+    """The joint colour x orientation bins with the gated scale test (off by default), both paths."""
+    for name, (frames, box) in real_sequences.items():
+        _assert_identical(frames, box, orient_T=64, scale_test=0.05, scale_test_gate=True)
 
 
 # ----------------------------------------------------------------------------- path selection

@@ -44,6 +44,17 @@ def variants() -> dict[str, tuple]:
     v["orient(T=32) disc_frame + scale_test 0.02 mix 0.5"] = ("multi", {"scale_test": 0.02, "scale_test_mix": 0.5})
     for d in (0.03, 0.1):
         v[f"orient(T=32) disc_frame + scale_test {d} gate"] = ("multi", {"scale_test": d, "scale_test_gate": True})
+    g = {"scale_test": 0.05, "scale_test_gate": True}
+    for T in (16, 64):
+        v[f"orient(T={T}) disc_frame + scale_test 0.05 gate"] = (f"multi:{T}", g)
+    for T in (32, 64):
+        v[f"joint colour 3b x orient(T={T}) + scale_test 0.05 gate"] = (f"joint:{T}:3", g)
+    v["joint colour 3b x orient(T=64)"] = ("joint:64:3", {})
+    for k, x in (("scale_reg", 0.05), ("scale_reg", 0.2), ("scale_gain", 0.5), ("scale_gain", 0.2)):
+        v[f"orient(T=32) disc_frame + scale_test 0.05 gate, {k} {x}"] = ("multi", {**g, k: x})
+    for T in (32, 64):
+        v[f"v2 orient_T {T} + scale_test 0.05 gate (FloatTrackerV2)"] = ("v2", {**g, "orient_T": T})
+    v["v2 orient_T 64 (FloatTrackerV2)"] = ("v2", {"orient_T": 64})
     v["kernel epanechnikov"] = ("v2", {"kernel": "epanechnikov"})
     v["eps2 0.25"] = ("v2", {"eps2": 0.25})
     v["colour_bits 4"] = ("v2", {"colour_bits": 4})
@@ -62,8 +73,14 @@ def make(kind: str, kw: dict):
         return Tracker(model="float", preset="v2", **kw)
     if kind == "v2fixed":
         return Tracker(model="fixed", preset="v2", **kw)
-    return MultiFeatureV2([Feature("colour", bits=3), Feature("orient", T=32)], fusion="disc_frame",
-                          params=TrackerParams(preset="v2", **kw))
+    # "multi" = colour + orient(T=32), disc_frame; "multi:T" = another threshold; "joint:T:b" = the
+    # joint colour b bits x orient(T) histogram as the only feature
+    parts = kind.split(":")
+    params = TrackerParams(preset="v2", **kw)
+    if parts[0] == "joint":
+        return MultiFeatureV2([Feature("joint", T=int(parts[1]), bits=int(parts[2]))], fusion="rho", params=params)
+    T = int(parts[1]) if len(parts) > 1 else 32
+    return MultiFeatureV2([Feature("colour", bits=3), Feature("orient", T=T)], fusion="disc_frame", params=params)
 
 
 _SEQS = None

@@ -55,6 +55,13 @@ def variants() -> dict[str, tuple]:
     for T in (32, 64):
         v[f"v2 orient_T {T} + scale_test 0.05 gate (FloatTrackerV2)"] = ("v2", {**g, "orient_T": T})
     v["v2 orient_T 64 (FloatTrackerV2)"] = ("v2", {"orient_T": 64})
+    for d in (0.03, 0.1):
+        v[f"v2 orient_T 64 + scale_test {d} gate"] = ("v2", {"scale_test": d, "scale_test_gate": True, "orient_T": 64})
+    for T in (48, 96, 128):
+        v[f"v2 orient_T {T} + scale_test 0.05 gate"] = ("v2", {**g, "orient_T": T})
+    for k, x in (("max_iter", 10), ("max_iter", 15), ("search_iter", 3)):
+        v[f"v2 orient_T 64 + scale_test 0.05 gate, {k} {x}"] = ("v2", {**g, "orient_T": 64, k: x})
+    v["v2 orient_T 64 + scale_test 0.05 gate, colour_bits 2"] = ("v2", {**g, "orient_T": 64, "colour_bits": 2})
     v["kernel epanechnikov"] = ("v2", {"kernel": "epanechnikov"})
     v["eps2 0.25"] = ("v2", {"eps2": 0.25})
     v["colour_bits 4"] = ("v2", {"colour_bits": 4})
@@ -134,6 +141,25 @@ def robust(a, labels: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def loss_figures(runs: dict, seqs) -> tuple[float, float]:
+    """The loss flag on the frames after init (as tools/loss_study.py scores it, with the default
+    thresholds; MultiFeatureV2 reports the search state instead): recall = share of off-target
+    frames (IoU = 0) not ok, false alarms = share of on-target frames (IoU >= 0.5) not ok."""
+    from mstrack.metrics import iou, valid_gt
+    off = on = off_f = on_f = 0
+    for s in seqs:
+        r = runs[s.name]
+        gt = s.gt[:r.n_frames]
+        v = valid_gt(gt)
+        v[0] = False
+        io = np.full(len(gt), np.nan)
+        io[v] = iou(r.boxes[v], gt[v])
+        flag = np.array([st in ("uncertain", "lost") for st in r.status])
+        off += int(np.sum(io == 0)); off_f += int(np.sum((io == 0) & flag))
+        on += int(np.sum(io >= 0.5)); on_f += int(np.sum((io >= 0.5) & flag))
+    return off_f / max(off, 1), on_f / max(on, 1)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", default=str(Path(__file__).resolve().parents[2] / "shared/data/sequences"))
@@ -164,14 +190,16 @@ def main(argv: list[str] | None = None) -> int:
     ev = aggregate(runs, seqs)
     base = [ev.per_sequence[BASELINE][n].auc for n in names]
     short = {"MotorRolling": "MotorR", "Football1": "Footb1", "ball1_vot": "ball1", "bag_vot": "bag"}
-    head = ["variant", "AUC", "mean", "wins/losses"] + [short.get(n, n) for n in names]
+    head = ["variant", "AUC", "mean", "wins/losses", "loss flag recall / FA"] + [short.get(n, n) for n in names]
     lines = ["| " + " | ".join(head) + " |", "|---|" + "|".join(["---:"] * (len(head) - 1)) + "|"]
     for label in vs:
         per = [ev.per_sequence[label][n].auc for n in names]
         w = sum(x > b + 1e-9 for x, b in zip(per, base))
         lo = sum(x < b - 1e-9 for x, b in zip(per, base))
+        rec, fa = loss_figures(runs[label], seqs)
         lines.append(f"| {label} | {ev.overall[label].auc:.3f} | {np.mean(per):.3f} | "
-                     f"{'-' if label == BASELINE else f'{w}/{lo}'} | " + " | ".join(f"{x:.3f}" for x in per) + " |")
+                     f"{'-' if label == BASELINE else f'{w}/{lo}'} | {rec:.2f} / {fa:.3f} | "
+                     + " | ".join(f"{x:.3f}" for x in per) + " |")
     out = "\n".join(lines) + "\n"
     print(out)
     if a.md:

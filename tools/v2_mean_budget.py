@@ -6,6 +6,9 @@ The joint histogram has 512 x 9 = 4608 bins: every bin pass (one per mean-shift 
 4608 bins instead of 512.  The gated scale test adds, on the final centre, two pixel passes
 (windows x0.95 and x1.05, the larger one limited to the window memory) and two bin passes.
 
+A bin pass with B banks (the histogram and model RAMs split by orientation bin, B datapaths
+walking the addresses in parallel, partial sums added) walks 4608 / B addresses: rows "4608 / B".
+
 Usage: PYTHONPATH=. python tools/v2_mean_budget.py
 """
 from __future__ import annotations
@@ -49,14 +52,18 @@ def budget(lanes: int, n_bins: int, max_iter: int, scale_test: bool) -> list[tup
 
 
 def main() -> None:
-    print("| LANES | bins | max_iter | scale test | frame | worst clocks | vs 99,000 |")
+    print("| LANES | bins (/ banks) | max_iter | scale test | frame | worst clocks | vs 99,000 |")
     print("|---:|---:|---:|---|---|---:|---|")
     for lanes in (4, 8):
-        for nb, it, st in ((512, 20, False), (512, 20, True), (4608, 20, False), (4608, 20, True),
-                           (4608, 15, True), (4608, 10, True)):
-            for case, clk in budget(lanes, nb, it, st):
+        for nb, banks, it, st in ((512, 1, 20, False), (512, 1, 20, True), (4608, 1, 20, False),
+                                  (4608, 1, 20, True), (4608, 1, 15, True), (4608, 1, 10, True),
+                                  (4608, 3, 20, True), (4608, 9, 20, True)):
+            if lanes == 8 and banks > 1:
+                continue
+            for case, clk in budget(lanes, nb // banks, it, st):
                 fit = "fits" if clk <= 99000 else "**does not fit**"
-                print(f"| {lanes} | {nb} | {it} | {'gated' if st else '-'} | {case} | {clk:,} | {fit} |")
+                label = f"{nb}" + (f" / {banks}" if banks > 1 else "")
+                print(f"| {lanes} | {label} | {it} | {'gated' if st else '-'} | {case} | {clk:,} | {fit} |")
 
 
 if __name__ == "__main__":

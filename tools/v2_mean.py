@@ -7,6 +7,11 @@ wins / losses against the default v2 on the sequences (docs/results_v2_mean.md).
 
     PYTHONPATH=. python tools/v2_mean.py [--data DIR] [--jobs 2] [--only LABEL ...] [--md OUT.md]
     PYTHONPATH=. python tools/v2_mean.py --robust LABEL ...
+    PYTHONPATH=. python tools/v2_mean.py --loss-grid LABEL ...
+
+``--loss-grid``: for FloatTrackerV2 variants, the loss flag's thresholds (loss_rho, loss_contrast)
+chosen again on a 0.01 grid as docs/algorithm.md v2.7a does (the highest recall with false alarms
+<= 0.05, in sample; the boxes do not depend on the flag, so this re-scores one run exactly).
 
 ``--robust``: the given variants and the baseline under the 8 perturbed starts of
 tools/v2_features.py (TRE at n//3 and 2n//3, SRE shifts +-10 % and scales 0.9 / 1.1): overall
@@ -160,6 +165,45 @@ def loss_figures(runs: dict, seqs) -> tuple[float, float]:
     return off_f / max(off, 1), on_f / max(on, 1)
 
 
+def loss_grid(a, labels: list[str]) -> str:
+    from mstrack.metrics import iou, valid_gt
+    seqs = load_dataset(a.data)
+    vs = variants()
+    lines = ["| variant | loss_rho | loss_contrast | recall | false alarms |", "|---|---:|---:|---:|---:|"]
+    for lb in [BASELINE] + [x for x in labels if x != BASELINE]:
+        kind, kw = vs[lb]
+        R, C, S, IO = [], [], [], []
+        for s in seqs:
+            t = make(kind, kw)
+            r0 = t.init(s.frame(0), s.init_box())
+            rho0 = r0.rho_c
+            boxes = []
+            for i in range(1, len(s)):
+                r = t.update(s.frame(i))
+                boxes.append(r.box.as_tuple())
+                R.append(r.extra["rho_s"] / rho0 if rho0 > 0 else 0.0)
+                C.append(r.extra["contrast_s"])
+                S.append(r.extra["share"])
+            gt = s.gt[1:len(s)]
+            io = np.full(len(gt), np.nan)
+            v = valid_gt(gt)
+            io[v] = iou(np.array(boxes)[v], gt[v])
+            IO.append(io)
+        R, C, S, io = np.array(R), np.array(C), np.array(S), np.concatenate(IO)
+        off, on = io == 0, io >= 0.5
+        best = (-1.0, 0.0, 0.0, 0.0)
+        for lr in np.arange(0.50, 1.201, 0.01):
+            for lc in np.arange(-0.20, 0.601, 0.01):
+                f = (S == 0) | ((R < lr) & (C < lc))
+                fa = f[on].mean()
+                rec = f[off].mean()
+                if fa <= 0.05 and rec > best[0]:
+                    best = (rec, fa, lr, lc)
+        lines.append(f"| {lb} | {best[2]:.2f} | {best[3]:.2f} | {best[0]:.3f} | {best[1]:.3f} |")
+        print(lines[-1], file=sys.stderr, flush=True)
+    return "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", default=str(Path(__file__).resolve().parents[2] / "shared/data/sequences"))
@@ -167,7 +211,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", nargs="*", help="labels to run (the baseline always runs)")
     ap.add_argument("--md", help="also write the table (markdown) to this file")
     ap.add_argument("--robust", nargs="+", metavar="LABEL", help="these variants under perturbed starts")
+    ap.add_argument("--loss-grid", nargs="+", metavar="LABEL", help="loss thresholds chosen again")
     a = ap.parse_args(argv)
+    if a.loss_grid:
+        out = loss_grid(a, a.loss_grid)
+        print(out)
+        return 0
     if a.robust:
         sys.path.insert(0, str(Path(__file__).resolve().parent))
         out = robust(a, a.robust)

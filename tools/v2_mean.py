@@ -66,6 +66,8 @@ def variants() -> dict[str, tuple]:
         v[f"v2 orient_T {T} + scale_test 0.05 gate"] = ("v2", {**g, "orient_T": T})
     for k, x in (("max_iter", 10), ("max_iter", 15), ("search_iter", 3)):
         v[f"v2 orient_T 64 + scale_test 0.05 gate, {k} {x}"] = ("v2", {**g, "orient_T": 64, k: x})
+    v["fixed v2 default"] = ("v2fixed", {})
+    v["fixed v2 orient_T 64 + scale_test 0.05 gate"] = ("v2fixed", {**g, "orient_T": 64})
     v["v2 orient_T 64 + scale_test 0.05 gate, colour_bits 2"] = ("v2", {**g, "orient_T": 64, "colour_bits": 2})
     v["kernel epanechnikov"] = ("v2", {"kernel": "epanechnikov"})
     v["eps2 0.25"] = ("v2", {"eps2": 0.25})

@@ -172,8 +172,11 @@ def loss_grid(a, labels: list[str]) -> str:
     seqs = load_dataset(a.data)
     vs = variants()
     lines = ["| variant | loss_rho | loss_contrast | recall | false alarms |", "|---|---:|---:|---:|---:|"]
+    data: dict = {}
     for lb in [BASELINE] + [x for x in labels if x != BASELINE]:
         kind, kw = vs[lb]
+        if kind not in ("v2", "v2fixed"):
+            raise SystemExit(f"--loss-grid needs a Tracker variant, not {lb!r}")
         R, C, S, IO = [], [], [], []
         for s in seqs:
             t = make(kind, kw)
@@ -183,8 +186,9 @@ def loss_grid(a, labels: list[str]) -> str:
             for i in range(1, len(s)):
                 r = t.update(s.frame(i))
                 boxes.append(r.box.as_tuple())
-                R.append(r.extra["rho_s"] / rho0 if rho0 > 0 else 0.0)
-                C.append(r.extra["contrast_s"])
+                u = 65536.0 if kind == "v2fixed" else 1.0  # the fixed model's extras are Q.16
+                R.append(r.extra["rho_s"] / u / rho0 if rho0 > 0 else 0.0)
+                C.append(r.extra["contrast_s"] / u)
                 S.append(r.extra["share"])
             gt = s.gt[1:len(s)]
             io = np.full(len(gt), np.nan)
@@ -192,18 +196,36 @@ def loss_grid(a, labels: list[str]) -> str:
             io[v] = iou(np.array(boxes)[v], gt[v])
             IO.append(io)
         R, C, S, io = np.array(R), np.array(C), np.array(S), np.concatenate(IO)
-        off, on = io == 0, io >= 0.5
+        data[lb] = (R, C, S, io == 0, io >= 0.5)
         best = (-1.0, 0.0, 0.0, 0.0)
-        for lr in np.arange(0.50, 1.201, 0.01):
-            for lc in np.arange(-0.20, 0.601, 0.01):
-                f = (S == 0) | ((R < lr) & (C < lc))
-                fa = f[on].mean()
-                rec = f[off].mean()
-                if fa <= 0.05 and rec > best[0]:
-                    best = (rec, fa, lr, lc)
+        for lr, lc, (rec, fa) in grid(data[lb]):
+            if fa <= 0.05 and rec > best[0]:
+                best = (rec, fa, lr, lc)
         lines.append(f"| {lb} | {best[2]:.2f} | {best[3]:.2f} | {best[0]:.3f} | {best[1]:.3f} |")
         print(lines[-1], file=sys.stderr, flush=True)
+    others = [lb for lb in data if lb != BASELINE]
+    if len(others) > 1:  # one pair for all of them: the highest lowest recall, every FA <= 0.05
+        best = None
+        per = [list(grid(data[lb])) for lb in others]
+        for k in range(len(per[0])):
+            lr, lc = per[0][k][:2]
+            rf = [per[i][k][2] for i in range(len(others))]
+            if all(fa <= 0.05 for _, fa in rf) and (best is None or min(r for r, _ in rf) > best[0]):
+                best = (min(r for r, _ in rf), lr, lc, rf)
+        if best:
+            lines.append(f"| one pair for: {' / '.join(others)} | {best[1]:.2f} | {best[2]:.2f} | "
+                         + " / ".join(f"{r:.3f}" for r, _ in best[3]) + " | "
+                         + " / ".join(f"{fa:.3f}" for _, fa in best[3]) + " |")
     return "\n".join(lines) + "\n"
+
+
+def grid(d):
+    """(loss_rho, loss_contrast, (recall, false alarms)) on the 0.01 grid."""
+    R, C, S, off, on = d
+    for lr in np.round(np.arange(0.50, 1.201, 0.01), 2):
+        for lc in np.round(np.arange(-0.20, 0.601, 0.01), 2):
+            f = (S == 0) | ((R < lr) & (C < lc))
+            yield lr, lc, (float(f[off].mean()), float(f[on].mean()))
 
 
 def main(argv: list[str] | None = None) -> int:

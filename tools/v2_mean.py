@@ -67,6 +67,7 @@ def variants() -> dict[str, tuple]:
     for k, x in (("max_iter", 10), ("max_iter", 15), ("search_iter", 3)):
         v[f"v2 orient_T 64 + scale_test 0.05 gate, {k} {x}"] = ("v2", {**g, "orient_T": 64, k: x})
     v["fixed v2 default"] = ("v2fixed", {})
+    v["float v2 default (for --loss-grid)"] = ("v2", {})
     v["fixed v2 orient_T 64 + scale_test 0.05 gate"] = ("v2fixed", {**g, "orient_T": 64})
     v["v2 orient_T 64 + scale_test 0.05 gate, colour_bits 2"] = ("v2", {**g, "orient_T": 64, "colour_bits": 2})
     v["kernel epanechnikov"] = ("v2", {"kernel": "epanechnikov"})
@@ -173,12 +174,13 @@ def loss_grid(a, labels: list[str]) -> str:
     vs = variants()
     lines = ["| variant | loss_rho | loss_contrast | recall | false alarms |", "|---|---:|---:|---:|---:|"]
     data: dict = {}
+    sid: dict = {}
     for lb in [BASELINE] + [x for x in labels if x != BASELINE]:
         kind, kw = vs[lb]
         if kind not in ("v2", "v2fixed"):
             raise SystemExit(f"--loss-grid needs a Tracker variant, not {lb!r}")
-        R, C, S, IO = [], [], [], []
-        for s in seqs:
+        R, C, S, IO, SID = [], [], [], [], []
+        for k_s, s in enumerate(seqs):
             t = make(kind, kw)
             r0 = t.init(s.frame(0), s.init_box())
             rho0 = r0.rho_c
@@ -195,8 +197,10 @@ def loss_grid(a, labels: list[str]) -> str:
             v = valid_gt(gt)
             io[v] = iou(np.array(boxes)[v], gt[v])
             IO.append(io)
+            SID.append(np.full(len(gt), k_s))
         R, C, S, io = np.array(R), np.array(C), np.array(S), np.concatenate(IO)
         data[lb] = (R, C, S, io == 0, io >= 0.5)
+        sid[lb] = np.concatenate(SID)
         best = (-1.0, 0.0, 0.0, 0.0)
         for lr, lc, (rec, fa) in grid(data[lb]):
             if fa <= 0.05 and rec > best[0]:
@@ -216,6 +220,24 @@ def loss_grid(a, labels: list[str]) -> str:
             lines.append(f"| one pair for: {' / '.join(others)} | {best[1]:.2f} | {best[2]:.2f} | "
                          + " / ".join(f"{r:.3f}" for r, _ in best[3]) + " | "
                          + " / ".join(f"{fa:.3f}" for _, fa in best[3]) + " |")
+        # leave one sequence out: the pair chosen on 9 sequences, its flags on the 10th
+        flags = {lb: np.zeros(len(data[lb][0]), bool) for lb in others}
+        for k_s in range(len(seqs)):
+            tr = {lb: tuple(a[sid[lb] != k_s] for a in data[lb]) for lb in others}
+            per = [list(grid(tr[lb])) for lb in others]
+            best = None
+            for k in range(len(per[0])):
+                rf = [per[i][k][2] for i in range(len(others))]
+                if all(fa <= 0.05 for _, fa in rf) and (best is None or min(r for r, _ in rf) > best[0]):
+                    best = (min(r for r, _ in rf), per[0][k][0], per[0][k][1])
+            for lb in others:
+                R, C, S, _, _ = data[lb]
+                m = sid[lb] == k_s
+                flags[lb][m] = (S[m] == 0) | ((R[m] < best[1]) & (C[m] < best[2]))
+        rec = [flags[lb][data[lb][3]].mean() for lb in others]
+        fa = [flags[lb][data[lb][4]].mean() for lb in others]
+        lines.append("| the same, leave one sequence out | - | - | " + " / ".join(f"{r:.3f}" for r in rec) + " | "
+                     + " / ".join(f"{f:.3f}" for f in fa) + " |")
     return "\n".join(lines) + "\n"
 
 

@@ -31,6 +31,7 @@ import math
 import warnings
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from . import float_model as _fm
@@ -335,6 +336,40 @@ def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray
                                    float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width)))
 
 
+def joint_bins_area(frame: np.ndarray, d: int, bits: int, T: int, x0: int, x1: int, y0: int,
+                    y1: int) -> np.ndarray:
+    """Joint colour x orientation bins (``FloatTrackerV2._bins`` with orient_T = T) of the
+    decimated image's [y0, y1) x [x0, x1), from the frame's pixels around them only.
+
+    The Sobel runs on the grey of a strip of frame rows and SOBEL_ALIGN-aligned columns, as
+    :func:`~mstrack.float_model.edge_bins_area` does, so Gx, Gy equal the whole frame's bit for
+    bit; the frame's 1-px border is flat (bin 8), as :func:`~mstrack.features_v2.sobel` makes it.
+    """
+    from .features_v2 import orientation_bins
+    height, width = frame.shape[:2]
+    fx0, fx1, fy0, fy1 = d * x0, d * (x1 - 1) + 1, d * y0, d * (y1 - 1) + 1  # frame px of the area
+    gx0, gx1 = max(fx0 - 1, 0), min(fx1 + 1, width)
+    gy0, gy1 = max(fy0 - 1, 0), min(fy1 + 1, height)
+    sx0 = gx0 - gx0 % _fm.SOBEL_ALIGN
+    sx1 = -(-gx1 // _fm.SOBEL_ALIGN) * _fm.SOBEL_ALIGN
+    if sx1 > width - _fm.SOBEL_ALIGN:
+        sx1 = width
+    if (sx0, sx1) == (gx0, gx1):
+        strip = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
+    else:
+        strip = np.zeros((gy1 - gy0, sx1 - sx0), np.float32)
+        strip[:, gx0 - sx0: gx1 - sx0] = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
+    r0, c0 = fy0 - gy0, fx0 - sx0
+    gx = cv2.Sobel(strip, cv2.CV_32F, 1, 0, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
+    gy = cv2.Sobel(strip, cv2.CV_32F, 0, 1, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
+    o = orientation_bins(gx, gy, T)
+    ys = np.arange(y0, y1) * d
+    xs = np.arange(x0, x1) * d
+    o[(ys == 0) | (ys == height - 1), :] = 8
+    o[:, (xs == 0) | (xs == width - 1)] = 8
+    return colour_bins(frame[fy0:fy1:d, fx0:fx1:d], bits) * 9 + o
+
+
 class LazyBins:
     """Colour bins of an image, computed on the first request for a rectangle and kept.
 
@@ -543,9 +578,9 @@ class FloatTrackerV2:
         eps2 = float(p.eps2)
         sx, sy, it0 = float(start[0]), float(start[1]), 0
         while True:
-            code, it, c0x, c0y, c1x, c1y, r = _nb_track(frame, p.colour_bits, sx, sy, it0, hx, hy, width, height,
-                                                        inner2, flat, self._qb, self._t, int(max_iter), eps2,
-                                                        *self._bufs, *self._cache)
+            code, it, c0x, c0y, c1x, c1y, r = self._joint_checked(lambda: _nb_track(
+                frame, p.colour_bits, sx, sy, it0, hx, hy, width, height, inner2, flat, self._qb, self._t,
+                int(max_iter), eps2, *self._bufs, *self._cache))
             if code == 0:
                 return (c0x, c0y), PassV2(*r), it
             # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
@@ -557,6 +592,36 @@ class FloatTrackerV2:
     def _confidence(self, ps: PassV2) -> float:
         return confidence(ps, self._rho_ref, self._share_ref)
 
+    def _fill_joint(self, frame: np.ndarray, d: int, cx: float, cy: float, m: float) -> None:
+        """Joint bins of the decimated image within m px of (cx, cy) (all of it if m is None) into the
+        numba kernel's bins cache, those rows marked computed; the kernel must not compute any
+        other (it would compute colour bins): :meth:`_joint_checked` verifies it.  m = inf: all."""
+        p = self.params
+        hd, wd = (frame.shape[0] + d - 1) // d, (frame.shape[1] + d - 1) // d
+        if math.isinf(m):
+            x0, x1, y0, y1 = 0, wd, 0, hd
+        else:
+            x0, x1 = max(0, math.floor(cx - m)), min(wd, math.ceil(cx + m) + 1)
+            y0, y1 = max(0, math.floor(cy - m)), min(hd, math.ceil(cy + m) + 1)
+            if x1 <= x0 or y1 <= y0:
+                x0, x1, y0, y1 = 0, wd, 0, hd
+        cache, rows = self._cache
+        cache[y0:y1, x0:x1] = joint_bins_area(frame, d, p.colour_bits, p.orient_T, x0, x1, y0, y1)
+        rows[:] = 0
+        rows[0, y0:y1], rows[1, y0:y1] = x0, x1
+        self._joint_rows = rows.copy()
+        self._joint_d = d
+
+    def _joint_checked(self, run):
+        """``run()`` (a numba kernel call on the bins cache) when every pixel it read had joint bins;
+        else the whole decimated image's joint bins and ``run()`` again (same results as if they
+        had been there from the start: the bins do not depend on what was computed before)."""
+        out = run()
+        if self.params.orient_T <= 0 or not (self._cache[1] != self._joint_rows).any():
+            return out
+        self._fill_joint(self._joint_frame, self._joint_d, 0.0, 0.0, float("inf"))
+        return run()
+
     def _pass(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> PassV2:
         p = self.params
         inner2 = 1.0 / (1.0 + p.pad) ** 2
@@ -564,9 +629,9 @@ class FloatTrackerV2:
             if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
                 self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
             height, width = bins.shape[:2]
-            return PassV2(*_nb_window_pass(bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy),
-                                           width, height, float(inner2), p.kernel == "flat", self._qb, self._t,
-                                           *self._bufs, *self._cache))
+            return PassV2(*self._joint_checked(lambda: _nb_window_pass(
+                bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
+                p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache)))
         return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)
 
     def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
@@ -631,11 +696,11 @@ class FloatTrackerV2:
                 self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
             else:
                 self._cache[1][:] = 0  # a new frame: no bins yet
-            if p.orient_T > 0:  # joint bins: the whole decimated image, marked as computed in the cache
-                jb = self._bins(frame, d)
-                self._cache[0][:jb.shape[0], :jb.shape[1]] = jb
-                self._cache[1][0, :jb.shape[0]] = 0
-                self._cache[1][1, :jb.shape[0]] = jb.shape[1]
+            if p.orient_T > 0:  # joint bins: a region around the start, marked as computed in the cache
+                self._joint_frame = frame
+                # the window + slack (lost: +-2 windows); anything beyond: _joint_checked
+                m = (3.5 if self._lost else 1.5) * max(hx, hy) + 8
+                self._fill_joint(frame, d, self._centre[0] / d, self._centre[1] / d, m)
         elif p.orient_T > 0:
             bins = self._bins(frame, d)
         else:

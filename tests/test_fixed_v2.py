@@ -398,8 +398,10 @@ def _orient_exact(grey: np.ndarray, T: int) -> np.ndarray:
     g = [[int(v) for v in row] for row in grey]
     for y in range(1, h - 1):
         for x in range(1, w - 1):
-            gx = (g[y - 1][x + 1] + 2 * g[y][x + 1] + g[y + 1][x + 1]) - (g[y - 1][x - 1] + 2 * g[y][x - 1] + g[y + 1][x - 1])
-            gy = (g[y + 1][x - 1] + 2 * g[y + 1][x] + g[y + 1][x + 1]) - (g[y - 1][x - 1] + 2 * g[y - 1][x] + g[y - 1][x + 1])
+            gx = ((g[y - 1][x + 1] + 2 * g[y][x + 1] + g[y + 1][x + 1])
+                  - (g[y - 1][x - 1] + 2 * g[y][x - 1] + g[y + 1][x - 1]))
+            gy = ((g[y + 1][x - 1] + 2 * g[y + 1][x] + g[y + 1][x + 1])
+                  - (g[y - 1][x - 1] + 2 * g[y - 1][x] + g[y - 1][x + 1]))
             if abs(gx) + abs(gy) >= T:
                 out[y, x] = (4 if gx < 0 else 0) + (2 if gy < 0 else 0) + (1 if abs(gy) > abs(gx) else 0)
     return out

@@ -279,3 +279,18 @@ def test_numba_switched_off_falls_back_to_numpy(monkeypatch):
     assert v2.FloatTrackerV2().active_path() == "numpy"
     with pytest.raises(RuntimeError):
         v2.FloatTrackerV2(path="numba").active_path()
+
+
+def test_joint_bins_area_equals_whole_frame():
+    """The joint bins of an area (numba path's region) equal the whole decimated image's."""
+    rng = np.random.default_rng(5)
+    frame = np.ascontiguousarray(rng.integers(0, 256, (97, 203, 3), dtype=np.uint8))
+    frame[20:60, 30:150] = cv2.GaussianBlur(frame[20:60, 30:150], (0, 0), 3)
+    for d in (1, 2, 4):
+        trk = v2.FloatTrackerV2(TrackerParams(preset="v2", orient_T=32), path="numpy")
+        whole = trk._bins(frame, d)
+        h, w = whole.shape
+        for x0, x1, y0, y1 in ((0, w, 0, h), (0, 5, 0, 7), (w - 9, w, h - 4, h), (3, 40, 2, 11),
+                               (w // 3, w // 2, h // 4, h - 1), (60 // d, 130 // d + 1, 1, h)):
+            got = v2.joint_bins_area(frame, d, 3, 32, x0, x1, y0, y1)
+            assert np.array_equal(got, whole[y0:y1, x0:x1]), (d, x0, x1, y0, y1)

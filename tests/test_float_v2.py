@@ -612,3 +612,21 @@ def test_real_sequences_auc_floor_and_beats_paper():
     # every v2 status is one of the documented ones
     assert {s for r in runs["mstrack-v2"].values() for s in r.status} <= {s.value for s in Status}
     assert elapsed < 120, f"took {elapsed:.0f} s (budget ~60 s)"
+
+
+def test_rescale_scale_test_options():
+    """rescale with a rho-test estimate (experimental, docs/results_v2_mean.md): mix blends it with
+    the spread estimate; the gate keeps the spread estimate only where both move the same way."""
+    from mstrack.float_v2 import rescale
+    shape, size0 = (480, 640), (40.0, 20.0)
+    spread_up = 1.21  # sqrt -> est 1.1 (the bound)
+    base = TrackerParams(preset="v2")
+    grow = rescale(size0, size0, spread_up, 1.0, shape, base)
+    assert grow[0] > 40.0
+    gate = TrackerParams(preset="v2", scale_test=0.05, scale_test_gate=True)
+    assert rescale(size0, size0, spread_up, 1.0, shape, gate, 1.05) == grow
+    assert rescale(size0, size0, spread_up, 1.0, shape, gate, 1.0) == size0
+    assert rescale(size0, size0, spread_up, 1.0, shape, gate, 0.95) == size0
+    mix = TrackerParams(preset="v2", scale_test=0.05, scale_test_mix=0.5)
+    w, _ = rescale(size0, size0, spread_up, 1.0, shape, mix, 0.95)
+    assert w == pytest.approx(40.0 * (1.0 + 0.3 * (0.5 * 0.95 + 0.5 * 1.1 - 1.0)))

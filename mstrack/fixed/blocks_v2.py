@@ -247,3 +247,58 @@ def ms_scale(spread: int, spread_ref: int, w8: int, w0_8: int, tp: TrackerParams
 def ms_resize(s8: int, s: int, frame_size: int) -> int:
     """New size (Q.8): (s8 s) >> 16, clamped to [3, frame_size] px."""
     return min(max((s8 * s) >> 16, 3 << SIZE_FRAC), frame_size << SIZE_FRAC)
+
+
+# ----------------------------------------------------------------------------- experimental (off by default)
+# docs/results_v2_mean.md: joint colour x orientation bins and the gated scale test
+# (TrackerParams.orient_T, scale_test, scale_test_gate; docs/fixed_point.md "Experimental").
+ORIENT_FLAT = 8  # the orientation bin of pixels with |Gx| + |Gy| < T (and of the frame's 1-px border)
+
+
+def ms_orient_bin(grey: np.ndarray, T: int) -> np.ndarray:
+    """Orientation bin of every pixel of ``grey`` (H, W) from the 3x3 Sobel (ms_sobel's Gx, Gy):
+    4 [Gx < 0] + 2 [Gy < 0] + [|Gy| > |Gx|] where |Gx| + |Gy| >= T, else 8; 8 on the 1-px frame
+    border (no Sobel there).  Gx, Gy 11-bit signed, |Gx| + |Gy| 11 bits (0..2040); T 11 bits.
+    Two sign bits, one 10-bit compare, one 11-bit compare.  (H, W) int64 in 0..8."""
+    g = grey.astype(np.int64)
+    out = np.full(g.shape, ORIENT_FLAT, np.int64)
+    if g.shape[0] < 3 or g.shape[1] < 3:
+        return out
+    gx = (g[:-2, 2:] + 2 * g[1:-1, 2:] + g[2:, 2:]) - (g[:-2, :-2] + 2 * g[1:-1, :-2] + g[2:, :-2])
+    gy = (g[2:, :-2] + 2 * g[2:, 1:-1] + g[2:, 2:]) - (g[:-2, :-2] + 2 * g[:-2, 1:-1] + g[:-2, 2:])
+    ax, ay = np.abs(gx), np.abs(gy)
+    octant = 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax)
+    out[1:-1, 1:-1] = np.where(ax + ay >= T, octant, ORIENT_FLAT)
+    return out
+
+
+def ms_joint_bin(colour: np.ndarray, orient: np.ndarray) -> np.ndarray:
+    """Joint bin = 9 colour + orient ((colour << 3) + colour + orient: one adder), < 9 2**(3b)."""
+    return (colour << 3) + colour + orient
+
+
+def ms_scale_test_size(s8: int, d256: int, up: bool) -> int:
+    """Size (Q.8) of a scale-test window: (s8 (256 +- d256) + 128) >> 8 (round half up)."""
+    return (s8 * (256 + d256 if up else 256 - d256) + 128) >> 8
+
+
+def ms_scale_test(rho: int, rho_lo: int | None, rho_hi: int | None) -> int:
+    """The scale test's verdict from rho at the window x1, x(1 - d), x(1 + d) (Q.16; None: that
+    window did not fit the captured region, it never wins): -1 / 0 / +1, the largest rho, ties to
+    the earlier of (1, 1 - d, 1 + d).  Two 17-bit compares."""
+    best, v = rho, 0
+    if rho_lo is not None and rho_lo > best:
+        best, v = rho_lo, -1
+    if rho_hi is not None and rho_hi > best:
+        v = 1
+    return v
+
+
+def ms_scale_gate(spread: int, spread_ref: int, verdict: int) -> int:
+    """The spread that ms_scale gets: ``spread`` when the rho test moves the same way
+    (spread > spread_ref and verdict +1, or spread < spread_ref and verdict -1), else spread_ref
+    (est = 1 exactly in ms_scale: floor(r 2**16 / r) = 2**16, isqrt(2**32) = 2**16).  One
+    40-bit compare."""
+    if (spread > spread_ref and verdict > 0) or (spread < spread_ref and verdict < 0):
+        return spread
+    return spread_ref

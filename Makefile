@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: setup demo typecheck test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth
+.PHONY: regs setup demo typecheck test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -61,6 +61,12 @@ lock:
 	  | grep -v '^#'; echo "setuptools==$$($(LATEST_VENV)/bin/python -m pip index versions setuptools 2>/dev/null \
 	  | sed -n 's/^setuptools (\(.*\))/\1/p')"; } > requirements.lock.new && mv requirements.lock.new requirements.lock
 
+# Register interface: regenerate everything made from regs/ms_tracker_regs.rdl (PeakRDL: the VHDL
+# register block, the C header, docs/registers.md) and sw/ms_tracker_result.h (result word layout);
+# tests/test_regs.py fails when a checked-in file differs from a fresh generation.
+regs: setup
+	$(PY) -m mstrack.regs
+
 eval: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval $(ARGS)
 
@@ -78,3 +84,8 @@ clean:
 # Quick: make synth ARGS="--config default --seeds 1"
 synth: setup
 	$(VENV)/bin/mstrack synth --write $(ARGS)
+
+# generated packaging files: rtl/files.txt, mstrack.core, tb/vhdl/data/ (docs/packaging.md);
+# tests/test_packaging.py fails when they are stale
+hdl-files: setup
+	$(VENV)/bin/mstrack hdl files

@@ -14,6 +14,9 @@ Public API::
 
     tracker = mstrack.TrackerMeanShift.create()   # OpenCV's tracker API (cv2.TrackerCSRT drop-in)
     tracker.init(frame, rect); ok, rect = tracker.update(frame)
+
+The core's result word (v1 and v2): ``mstrack.unpack_result(word)``, ``result_layout()``, ...
+(re-exported from :mod:`mstrack.fixed`; docs/integration.md, "Result word").
 """
 from typing import TYPE_CHECKING
 
@@ -22,8 +25,10 @@ from .types import Box, FeatureResult, Status, TrackResult
 if TYPE_CHECKING:  # for type checkers; at run time they are imported lazily by __getattr__
     from .tracker import FrameError, Tracker, TrackerMeanShift, TrackerParams
 
+_RESULT_API = ("RESULT_FLAGS", "result_layout", "result_width", "pack_result", "unpack_result",
+               "STATUS_V2", "result_layout_v2", "result_width_v2", "pack_result_v2", "unpack_result_v2")
 __all__ = ["Box", "FeatureResult", "Status", "TrackResult", "Tracker", "TrackerMeanShift", "TrackerParams",
-           "FrameError"]
+           "FrameError", *_RESULT_API]
 
 _LAZY = ("Tracker", "TrackerMeanShift", "TrackerParams", "FrameError")
 
@@ -32,6 +37,9 @@ def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
     if name in _LAZY:
         from . import tracker
         return getattr(tracker, name)
+    if name in _RESULT_API:
+        from .fixed import vhdl_pkg
+        return getattr(vhdl_pkg, name)
     raise AttributeError(name)
 
 

@@ -748,6 +748,7 @@ EXTENSIONS: list[str] = [
     "mstrack.vectors:register_cli",     # vectors: test vectors for the VHDL core
     "mstrack.agreement:register_cli",   # agree: float vs fixed-point agreement
     "mstrack.synth:register_cli",       # synth: open synthesis, Fmax, cycle figures (performance.md)
+    "mstrack.hdl_config:register_cli",  # hdl config / hdl files: core configuration, file lists (packaging.md)
     # "mstrack.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
 ]
 

@@ -41,8 +41,9 @@ mean shift from the same start and the two centres are fused by a rule
 * ``tie``: main feature unless its confidence is below ``conf_uncertain``,
   then ``disc``.
 
-With a single feature ``colour`` the class reproduces FloatTrackerV2
-(checked by the tool before it reports).
+With a single feature ``colour`` the class reproduces FloatTrackerV2's boxes
+(checked by the tool before it reports); its status is v2's search state
+(``decide_status``), without v2's loss flag.
 """
 from __future__ import annotations
 
@@ -274,7 +275,16 @@ class MultiFeatureV2:
             self._rho_ref += a * (ps.rho - self._rho_ref)
             self._share_ref += a * (ps.share - self._share_ref)
         if p.scale_gain > 0 and ps.nt > 0:
-            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p)
+            est_rho = None
+            if p.scale_test > 0:  # FloatTrackerV2._scale_test on the main feature at the final centre
+                k0 = self.features[0].n_bins
+                best, rho = 1.0, window_pass(bins[0], k0, self._qb[0], self._t[0], c, hx, hy, inner2, p.kernel).rho
+                for sc in (1.0 - p.scale_test, 1.0 + p.scale_test):
+                    r = window_pass(bins[0], k0, self._qb[0], self._t[0], c, sc * hx, sc * hy, inner2, p.kernel).rho
+                    if r > rho:
+                        best, rho = sc, r
+                est_rho = best
+            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho)
         if self.fusion == "disc_frame" and len(self.features) == 2 and status == Status.OK:
             # background rho re-measured on the ring around the box just found (for the next frame)
             for k in range(2):

@@ -10,8 +10,11 @@ in a window padded around the target, with
 * a confidence = min(1, rho / rho_ref) * min(1, share / share_ref) from the
   Bhattacharyya coefficient and the share of target-coloured pixels in the
   box, against their running references,
-* loss (confidence below a threshold: the box is kept, nothing is learnt)
-  and re-acquisition by a wider search from several start points.
+* a search state from the confidence (below a threshold: nothing is
+  learnt, and a wider search from several start points runs next frame),
+* a loss flag, the reported status (``TrackResult.ok`` False): rho below
+  loss_rho x rho at init and the target colours' share in the box less
+  their share in the window's ring below loss_contrast.
 
 Every step is a pass over the window's pixels or over the bins, so the
 fixed-point model and the RTL can do the same in integers.
@@ -28,6 +31,7 @@ import math
 import warnings
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from . import float_model as _fm
@@ -45,7 +49,8 @@ class PassV2:
     sw, swx, swy: sums of the mean-shift weights sqrt(q_u / p_u), and of the
     weights times x, y; nt, st2: count and sum of d2 of the target-coloured
     pixels (t_u = 1) in the window; n_in, nt_in: pixels, and target-coloured
-    pixels, in the inner window d2 < 1 / (1 + pad)^2 (the box itself).
+    pixels, in the inner window d2 < 1 / (1 + pad)^2 (the box itself); n: pixels
+    in the window.
     """
 
     rho: float
@@ -56,11 +61,17 @@ class PassV2:
     st2: float
     n_in: int
     nt_in: int
+    n: int
 
     @property
     def share(self) -> float:
         """Share of target-coloured pixels in the box (inner window)."""
         return self.nt_in / self.n_in if self.n_in else 0.0
+
+    @property
+    def ring_share(self) -> float:
+        """Share of target-coloured pixels in the window's ring around the box (0 if none)."""
+        return (self.nt - self.nt_in) / (self.n - self.n_in) if self.n > self.n_in else 0.0
 
     @property
     def spread(self) -> float:
@@ -133,7 +144,7 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
     inner = d2 < inner2
     return PassV2(rho=rho, sw=float(w.sum()), swx=float((w * xs).sum()), swy=float((w * ys).sum()),
                   nt=float(tp.sum()), st2=float((tp * d2).sum()), n_in=int(inner.sum()),
-                  nt_in=int(tp[inner].sum()))
+                  nt_in=int(tp[inner].sum()), n=len(b))
 
 
 # ----------------------------------------------------------------------------- numba kernels
@@ -242,11 +253,11 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
 def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
                     ibuf, fbuf, ax, cnt, td, cache, rows):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
-    the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in).  Buffers: :func:`_nb_buffers_v2`."""
+    the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in, n).  Buffers: :func:`_nb_buffers_v2`."""
     n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
                                     ibuf[2], fbuf, ax[0], cnt, cache, rows)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
-    return rho, sw, swx, swy, nt, st2, n_in, nt_in
+    return rho, sw, swx, swy, nt, st2, n_in, nt_in, n
 
 
 @_jit
@@ -278,13 +289,13 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
         if abs(s2 - eps2) <= _SHIFT2_BAND * eps2:
-            return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0)
+            return 1, it, c0x, c0y, c1x, c1y, (rho0, rho1, 0.0, 0.0, 0.0, 0.0, 0, 0, 0)
         c0x, c0y, n0, rho0, sw0, swx0, swy0 = c1x, c1y, n1, rho1, sw1, swx1, swy1
         B0, X0, Y0, ax0, B1, X1, Y1, ax1 = B1, X1, Y1, ax1, B0, X0, Y0, ax0
         if s2 < eps2:
             break
     nt, st2, n_in, nt_in = _nb_stats(n0, B0, X0, Y0, ax0, c0x, c0y, hx, hy, t, inner2, td)
-    return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in)
+    return 0, it, c0x, c0y, c0x, c0y, (rho0, sw0, swx0, swy0, nt, st2, n_in, nt_in, n0)
 
 
 def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
@@ -323,6 +334,40 @@ def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray
         bufs = _nb_buffers_v2(hx, hy, q.shape[0])
     return PassV2(*_nb_window_pass(frame, bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height,
                                    float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width)))
+
+
+def joint_bins_area(frame: np.ndarray, d: int, bits: int, T: int, x0: int, x1: int, y0: int,
+                    y1: int) -> np.ndarray:
+    """Joint colour x orientation bins (``FloatTrackerV2._bins`` with orient_T = T) of the
+    decimated image's [y0, y1) x [x0, x1), from the frame's pixels around them only.
+
+    The Sobel runs on the grey of a strip of frame rows and SOBEL_ALIGN-aligned columns, as
+    :func:`~mstrack.float_model.edge_bins_area` does, so Gx, Gy equal the whole frame's bit for
+    bit; the frame's 1-px border is flat (bin 8), as :func:`~mstrack.features_v2.sobel` makes it.
+    """
+    from .features_v2 import orientation_bins
+    height, width = frame.shape[:2]
+    fx0, fx1, fy0, fy1 = d * x0, d * (x1 - 1) + 1, d * y0, d * (y1 - 1) + 1  # frame px of the area
+    gx0, gx1 = max(fx0 - 1, 0), min(fx1 + 1, width)
+    gy0, gy1 = max(fy0 - 1, 0), min(fy1 + 1, height)
+    sx0 = gx0 - gx0 % _fm.SOBEL_ALIGN
+    sx1 = -(-gx1 // _fm.SOBEL_ALIGN) * _fm.SOBEL_ALIGN
+    if sx1 > width - _fm.SOBEL_ALIGN:
+        sx1 = width
+    if (sx0, sx1) == (gx0, gx1):
+        strip = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
+    else:
+        strip = np.zeros((gy1 - gy0, sx1 - sx0), np.float32)
+        strip[:, gx0 - sx0: gx1 - sx0] = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
+    r0, c0 = fy0 - gy0, fx0 - sx0
+    gx = cv2.Sobel(strip, cv2.CV_32F, 1, 0, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
+    gy = cv2.Sobel(strip, cv2.CV_32F, 0, 1, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
+    o = orientation_bins(gx, gy, T)
+    ys = np.arange(y0, y1) * d
+    xs = np.arange(x0, x1) * d
+    o[(ys == 0) | (ys == height - 1), :] = 8
+    o[:, (xs == 0) | (xs == width - 1)] = 8
+    return colour_bins(frame[fy0:fy1:d, fx0:fx1:d], bits) * 9 + o
 
 
 class LazyBins:
@@ -401,6 +446,27 @@ def confidence(ps: PassV2, rho_ref: float, share_ref: float) -> float:
     return cr * cs
 
 
+def loss_filter(s: float, x: float, p: TrackerParams) -> float:
+    """One step of the loss flag's smoothing: s + loss_smooth (x - s)."""
+    return s + p.loss_smooth * (x - s)
+
+
+def loss_flag(rho_s: float, con_s: float, rho0: float, share: float, p: TrackerParams) -> bool:
+    """The loss flag (docs/algorithm.md, "v2.7a Loss flag"): no target-coloured pixel in the box
+    (share = 0), or the window matches the model worse than at init *and* its target colours do
+    not stand out from the ring around the box, both smoothed (:func:`loss_filter` of rho and of
+    contrast = share - ring_share): rho_s < loss_rho rho0 and con_s < loss_contrast."""
+    return share == 0 or rho_s == 0 or (rho_s < p.loss_rho * rho0 and con_s < p.loss_contrast)
+
+
+def report_status(searching: bool, flagged: bool, was_flagged_lost: bool) -> Status:
+    """The reported status: flagged -> lost (while the wide search runs) or uncertain; not
+    flagged -> reacquired on the first unflagged frame after a reported loss, else ok."""
+    if flagged:
+        return Status.LOST if searching else Status.UNCERTAIN
+    return Status.REACQUIRED if was_flagged_lost else Status.OK
+
+
 def search_starts(start: tuple[float, float], hx: float, hy: float,
                   p: TrackerParams) -> list[tuple[float, float]]:
     """The 8 wide-search start points: start +- search_step window diameters in x and y."""
@@ -409,7 +475,9 @@ def search_starts(start: tuple[float, float], hx: float, hy: float,
 
 
 def decide_status(conf: float, was_lost: bool, p: TrackerParams) -> Status:
-    """lost / reacquired / uncertain / ok from the confidence and whether the target was lost."""
+    """The search state from the confidence and whether the tracker was searching: lost (search
+    from the next frame on) / reacquired / uncertain / ok (only ok frames teach the references).
+    FloatTrackerV2 reports :func:`report_status` (the loss flag), not this."""
     if conf < (p.conf_reacquire if was_lost else p.conf_lost):
         return Status.LOST
     if was_lost:
@@ -418,12 +486,17 @@ def decide_status(conf: float, was_lost: bool, p: TrackerParams) -> Status:
 
 
 def rescale(size: tuple[float, float], size0: tuple[float, float], spread: float, spread_ref: float,
-            shape: tuple[int, int], p: TrackerParams) -> tuple[float, float]:
+            shape: tuple[int, int], p: TrackerParams, est_rho: float | None = None) -> tuple[float, float]:
     """One frame's size update: est = sqrt(spread / spread_ref) clamped to 1 +- step;
-    s = clamp(1 + gain (est - 1) - reg (w / w0 - 1), 1 +- step); size s, in [3, frame]."""
+    s = clamp(1 + gain (est - 1) - reg (w / w0 - 1), 1 +- step); size s, in [3, frame].
+    ``est_rho`` (the scale test, off by default): est <- mix est_rho + (1 - mix) est."""
     w, h = size
     est = math.sqrt(spread / spread_ref)
     est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
+    if est_rho is not None and p.scale_test_gate:
+        est = est if (est - 1.0) * (est_rho - 1.0) > 0 else 1.0
+    elif est_rho is not None:
+        est = p.scale_test_mix * est_rho + (1.0 - p.scale_test_mix) * est
     s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / size0[0] - 1.0)
     s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
     return (min(max(w * s, 3.0), float(shape[1])), min(max(h * s, 3.0), float(shape[0])))
@@ -470,7 +543,14 @@ class FloatTrackerV2:
         return decimation(w, h, self.params)
 
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
-        return colour_bins(frame[::d, ::d], self.params.colour_bits)
+        p = self.params
+        c = colour_bins(frame[::d, ::d], p.colour_bits)
+        if p.orient_T <= 0:
+            return c
+        # joint colour x orientation (off by default): Sobel on the full-resolution grey frame
+        from .features_v2 import orientation_bins, sobel
+        gx, gy = sobel(frame)
+        return c * 9 + orientation_bins(gx[::d, ::d], gy[::d, ::d], p.orient_T)
 
     def _lazy_bins(self, frame: np.ndarray, d: int, w: float, h: float) -> LazyBins:
         """Bins computed around the windows the frame's mean shift visits (same values)."""
@@ -486,7 +566,7 @@ class FloatTrackerV2:
         p = self.params
         if isinstance(bins, np.ndarray) and bins.ndim == 3:
             return self._track_numba(bins, start, hx, hy, max_iter)
-        return meanshift_v2(bins, p.n_colour_bins, self._qb, self._t, start, hx, hy, p, max_iter)
+        return meanshift_v2(bins, p.n_bins_v2, self._qb, self._t, start, hx, hy, p, max_iter)
 
     def _track_numba(self, frame: np.ndarray, start: tuple[float, float], hx: float, hy: float,
                      max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
@@ -498,20 +578,72 @@ class FloatTrackerV2:
         eps2 = float(p.eps2)
         sx, sy, it0 = float(start[0]), float(start[1]), 0
         while True:
-            code, it, c0x, c0y, c1x, c1y, r = _nb_track(frame, p.colour_bits, sx, sy, it0, hx, hy, width, height,
-                                                        inner2, flat, self._qb, self._t, int(max_iter), eps2,
-                                                        *self._bufs, *self._cache)
+            code, it, c0x, c0y, c1x, c1y, r = self._joint_checked(lambda: _nb_track(
+                frame, p.colour_bits, sx, sy, it0, hx, hy, width, height, inner2, flat, self._qb, self._t,
+                int(max_iter), eps2, *self._bufs, *self._cache))
             if code == 0:
                 return (c0x, c0y), PassV2(*r), it
             # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
             if (c1x - c0x) ** 2 + (c1y - c0y) ** 2 < p.eps2:
                 c = (c1x, c1y)
-                return c, window_pass_numba(frame, p.colour_bits, self._qb, self._t, c, hx, hy, inner2,
-                                            p.kernel, self._bufs), it
+                return c, self._pass(frame, c, hx, hy), it  # (on the frame's bins cache)
             sx, sy, it0 = c1x, c1y, it  # go on from c1 (its pass is recomputed: the same numbers)
 
     def _confidence(self, ps: PassV2) -> float:
         return confidence(ps, self._rho_ref, self._share_ref)
+
+    def _fill_joint(self, frame: np.ndarray, d: int, cx: float, cy: float, m: float) -> None:
+        """Joint bins of the decimated image within m px of (cx, cy) (all of it if m is None) into the
+        numba kernel's bins cache, those rows marked computed; the kernel must not compute any
+        other (it would compute colour bins): :meth:`_joint_checked` verifies it.  m = inf: all."""
+        p = self.params
+        hd, wd = (frame.shape[0] + d - 1) // d, (frame.shape[1] + d - 1) // d
+        if math.isinf(m):
+            x0, x1, y0, y1 = 0, wd, 0, hd
+        else:
+            x0, x1 = max(0, math.floor(cx - m)), min(wd, math.ceil(cx + m) + 1)
+            y0, y1 = max(0, math.floor(cy - m)), min(hd, math.ceil(cy + m) + 1)
+            if x1 <= x0 or y1 <= y0:
+                x0, x1, y0, y1 = 0, wd, 0, hd
+        cache, rows = self._cache
+        cache[y0:y1, x0:x1] = joint_bins_area(frame, d, p.colour_bits, p.orient_T, x0, x1, y0, y1)
+        rows[:] = 0
+        rows[0, y0:y1], rows[1, y0:y1] = x0, x1
+        self._joint_rows = rows.copy()
+        self._joint_d = d
+
+    def _joint_checked(self, run):
+        """``run()`` (a numba kernel call on the bins cache) when every pixel it read had joint bins;
+        else the whole decimated image's joint bins and ``run()`` again (same results as if they
+        had been there from the start: the bins do not depend on what was computed before)."""
+        out = run()
+        if self.params.orient_T <= 0 or not (self._cache[1] != self._joint_rows).any():
+            return out
+        self._fill_joint(self._joint_frame, self._joint_d, 0.0, 0.0, float("inf"))
+        return run()
+
+    def _pass(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> PassV2:
+        p = self.params
+        inner2 = 1.0 / (1.0 + p.pad) ** 2
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache (joint bins too)
+            if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
+            height, width = bins.shape[:2]
+            return PassV2(*self._joint_checked(lambda: _nb_window_pass(
+                bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
+                p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache)))
+        return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+
+    def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
+        """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
+        the largest (two more passes at the final centre)."""
+        d = self.params.scale_test
+        best, rho = 1.0, self._pass(bins, c, hx, hy).rho
+        for s in (1.0 - d, 1.0 + d):
+            r = self._pass(bins, c, s * hx, s * hy).rho
+            if r > rho:
+                best, rho = s, r
+        return best
 
     # ------------------------------------------------------------------ API
     def init(self, frame: np.ndarray, box: Box | tuple[float, float, float, float]) -> TrackResult:
@@ -527,20 +659,24 @@ class FloatTrackerV2:
         self._centre = (cx, cy)
         d = self.decimation(box.w, box.h)
         bins = self._bins(frame, d)
-        self._q, self._qb, self._t = background_model(bins, p.n_colour_bins, cx / d, cy / d, box.w / d,
+        self._q, self._qb, self._t = background_model(bins, p.n_bins_v2, cx / d, cy / d, box.w / d,
                                                       box.h / d, p.bg_ring, p.kernel)
         pad = 1.0 + p.pad
-        ps = window_pass(bins, p.n_colour_bins, self._qb, self._t, (cx / d, cy / d), pad * box.w / 2 / d,
+        ps = window_pass(bins, p.n_bins_v2, self._qb, self._t, (cx / d, cy / d), pad * box.w / 2 / d,
                          pad * box.h / 2 / d, 1.0 / pad ** 2, p.kernel)
         # references: rho and share are learnt from the first tracked frames (start at the init values)
         self._rho_ref = ps.rho
         self._share_ref = ps.share
         self._spread_ref = ps.spread if ps.spread > 0 else 0.5 / pad ** 2
+        self._rho0 = ps.rho  # the loss flag's reference: rho at init
+        self._rho_s, self._con_s = ps.rho, ps.share - ps.ring_share  # its filters start at init
         self._lost = False
+        self._reported_lost = False
+        self._vel = (0.0, 0.0)  # last centre step (frame px), for motion_gain
         return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
                            message="init box clipped to the frame" if clipped else "",
-                           confidence=1.0, extra={"decimation": d, "share": ps.share})
+                           confidence=1.0, extra={"decimation": d, "share": ps.share, "ring_share": ps.ring_share})
 
     def update(self, frame: np.ndarray) -> TrackResult:
         if self._shape is None:
@@ -554,15 +690,25 @@ class FloatTrackerV2:
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
         if self.active_path() == "numba":
             bins: np.ndarray | LazyBins = frame[::d, ::d]  # the kernel bins the pixels it visits
-            if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_colour_bins):
-                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_colour_bins)  # room to grow
+            if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)  # room to grow
             if self._cache is None:
                 self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
             else:
                 self._cache[1][:] = 0  # a new frame: no bins yet
+            if p.orient_T > 0:  # joint bins: a region around the start, marked as computed in the cache
+                self._joint_frame = frame
+                # the window + slack (lost: +-2 windows); anything beyond: _joint_checked
+                m = (3.5 if self._lost else 1.5) * max(hx, hy) + 8
+                self._fill_joint(frame, d, self._centre[0] / d, self._centre[1] / d, m)
+        elif p.orient_T > 0:
+            bins = self._bins(frame, d)
         else:
             bins = self._lazy_bins(frame, d, w, h)
         start = (self._centre[0] / d, self._centre[1] / d)
+        if p.motion_gain > 0 and not self._lost:  # constant-velocity start (off by default)
+            start = ((self._centre[0] + p.motion_gain * self._vel[0]) / d,
+                     (self._centre[1] + p.motion_gain * self._vel[1]) / d)
         # lost: every start point (this one included) runs search_iter iterations
         c, ps, it = self._track(bins, start, hx, hy, p.search_iter if self._lost else p.max_iter)
         conf = self._confidence(ps)
@@ -575,21 +721,32 @@ class FloatTrackerV2:
                 conf2 = self._confidence(ps2)
                 if conf2 > conf:
                     c, ps, conf = c2, ps2, conf2
-        status = decide_status(conf, self._lost, p)
-        self._lost = status == Status.LOST
-        self._centre = (c[0] * d, c[1] * d)  # lost: the search's best candidate (not trusted: ok False)
-        if status == Status.OK:
+        state = decide_status(conf, self._lost, p)  # the search state (what the tracker does next)
+        self._rho_s = loss_filter(self._rho_s, ps.rho, p)
+        self._con_s = loss_filter(self._con_s, ps.share - ps.ring_share, p)
+        flagged = loss_flag(self._rho_s, self._con_s, self._rho0, ps.share, p)  # what it reports (ok False when flagged)
+        status = report_status(state == Status.LOST, flagged, self._reported_lost)
+        self._lost = state == Status.LOST
+        # a loss stays reported (uncertain frames keep it) until a frame is ok again
+        self._reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self._reported_lost)
+        old = self._centre
+        self._centre = (c[0] * d, c[1] * d)  # searching: the search's best candidate
+        self._vel = (self._centre[0] - old[0], self._centre[1] - old[1]) if state == Status.OK else (0.0, 0.0)
+        if state == Status.OK:
             a = p.ref_rate
             self._rho_ref += a * (ps.rho - self._rho_ref)
             self._share_ref += a * (ps.share - self._share_ref)
         # scale: every frame (a lost or uncertain target changes size too), from the spread
         if p.scale_gain > 0 and ps.nt > 0:
-            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p)
+            est_rho = self._scale_test(bins, c, hx, hy) if p.scale_test > 0 else None
+            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho)
         box = box_from_centre_index(*self._centre, *self._size)
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=it, iter_e=0, status=status, confidence=conf,
                            extra={"decimation": d, "share": ps.share, "spread": ps.spread,
-                                  "searched": searched})
+                                  "searched": searched, "nt": ps.nt, "n_in": ps.n_in, "nt_in": ps.nt_in,
+                                  "n": ps.n, "ring_share": ps.ring_share, "state": state.value,
+                                  "rho_s": self._rho_s, "contrast_s": self._con_s})
 
 
 _NUMBA_OK: bool | None = None

@@ -375,6 +375,55 @@ def run_ghdl(
                            test_filter=test_filter)
 
 
+def run_ghdl_plain(
+    toplevel: str,
+    sources: Sequence[Path | str],
+    generics: Mapping[str, object] | None = None,
+    build_name: str | None = None,
+    run_dir: Path | str | None = None,
+    stop_time: str | None = None,
+    elab_only: bool = False,
+) -> str:
+    """Analyse *sources*, elaborate and run *toplevel* with GHDL, no cocotb (a VHDL testbench).
+
+    String generics are passed as ``-gNAME=VALUE`` too, at run time, so the analysis and
+    elaboration are redone only when a source changes (hash in the build dir).  The simulation runs in *run_dir*
+    (default: the build dir ``build/sim/<build_name>``), so relative file names in generics
+    are resolved there.  elab_only=True stops after elaboration (``--no-run``: the generic
+    assertions are checked).  Returns the run's output; raises :class:`HdlError` with its tail
+    when analysis, elaboration or the run fails (e.g. a ``severity failure`` assertion).
+    """
+    if not have_ghdl():
+        raise HdlError("ghdl not found (apt-get install ghdl ghdl-llvm)")
+    build_dir = BUILD_DIR / "sim" / (build_name or f"ghdl_plain_{toplevel}_{_generics_tag(generics)}")
+    build_dir.mkdir(parents=True, exist_ok=True)
+    work = build_dir / "work"
+    work.mkdir(exist_ok=True)
+    env = {"GHDL_BACKEND": ghdl_backend()}
+    flags = [*GHDL_STD_FLAGS, f"--workdir={work}"]
+    exe = build_dir / toplevel
+    stamp = build_dir / "sources.hash"
+    digest = _hash_inputs(toplevel, None, [Path(s) for s in sources], extra=env["GHDL_BACKEND"])
+    if not (stamp.is_file() and stamp.read_text() == digest and (exe.is_file() or env["GHDL_BACKEND"] == "mcode")):
+        # generics are given at run time: one analysis + elaboration serves every generic set
+        _run(["ghdl", "-a", *flags, *map(str, sources)], build_dir / "analyse.log", build_dir, "ghdl -a", env=env)
+        out = [] if env["GHDL_BACKEND"] == "mcode" else ["-o", str(exe)]
+        _run(["ghdl", "-e", *flags, *out, toplevel], build_dir / "elab.log", build_dir, "ghdl -e", env=env)
+        stamp.write_text(digest)
+    if exe.is_file():   # llvm / gcc back ends: an executable
+        cmd = [str(exe)]
+    else:               # mcode: elaborated and run in one step
+        cmd = ["ghdl", "-r", *flags, toplevel]
+    cmd += [*[f"-g{k}={_vhdl_generic(v)}" for k, v in (generics or {}).items()], "--ieee-asserts=disable-at-0"]
+    if elab_only:
+        cmd.append("--no-run")
+    if stop_time:
+        cmd.append(f"--stop-time={stop_time}")
+    log = build_dir / "run.log"
+    _run(cmd, log, Path(run_dir) if run_dir else build_dir, f"ghdl -r {toplevel}", env=env)
+    return log.read_text(errors="replace")
+
+
 # --------------------------------------------------------------------------
 # GHDL -> Verilog
 # --------------------------------------------------------------------------
@@ -832,6 +881,6 @@ def synth_xilinx(
 
 __all__ = [
     "REPO_ROOT", "RTL_DIR", "TB_DIR", "BUILD_DIR", "TOOLS_HDL_DIR", "HdlError", "HdlTestFailure",
-    "rtl_sources", "run_ghdl", "run_verilator", "run_verilator_axis", "verilog_ports", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "synth_ecp5", "synth_xilinx",
+    "rtl_sources", "run_ghdl", "run_ghdl_plain", "run_verilator", "run_verilator_axis", "verilog_ports", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "synth_ecp5", "synth_xilinx",
     "ghdl_backend", "have_ghdl", "dut_generics", "GENERICS_ENV", "have_verilator", "verilator_root",
 ]

@@ -113,10 +113,15 @@ class TrackerParams:
         1 + step) - 1) - reg (w / w0 - 1), 1 - step, 1 + step), est =
         sqrt(spread / spread at init).  scale_gain = 0 keeps the init size.
     conf_lost, conf_uncertain, conf_reacquire : float
-        Confidence thresholds: below conf_lost the target is lost (ok False,
-        nothing learnt, wide search from the next frame on); below
-        conf_uncertain the result is uncertain (ok False, nothing learnt); a
-        wide search re-acquires the target at conf_reacquire or above.
+        Search state from the confidence: below conf_lost the tracker searches
+        (wide search from the next frame on, nothing learnt); below
+        conf_uncertain nothing is learnt; a wide search ends at conf_reacquire
+        or above.
+    loss_rho, loss_contrast, loss_smooth : float
+        Loss flag (``TrackResult.ok`` False): rho < loss_rho x rho at init and
+        contrast = share in the box - share in the window's ring < loss_contrast,
+        both smoothed by s <- s + loss_smooth (x - s) (1: no smoothing; a power
+        of two for the fixed model) (docs/algorithm.md, "v2.7a Loss flag").
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -124,6 +129,24 @@ class TrackerParams:
         sizes in x and y (8 points).
     search_iter : int
         Mean-shift iterations from each start point of the wide search.
+    motion_gain : float
+        Constant-velocity start (experimental, off by default: 0): the mean
+        shift starts at the last centre + motion_gain x the last centre step
+        (the step is set to 0 unless the frame's search state is ok)
+        (docs/results_v2_mean.md).
+    scale_test, scale_test_mix : float
+        Scale test by rho (experimental, off by default: 0): two more passes
+        at the final centre with the window scaled by 1 -+ scale_test; the
+        scale of the largest rho (1, 1 - scale_test or 1 + scale_test) is the
+        rho estimate, and the size step uses scale_test_mix x it + (1 -
+        scale_test_mix) x the spread estimate; scale_test_gate: instead, the
+        spread estimate is kept only where the rho test moves the same way
+        (else no step) (docs/results_v2_mean.md).
+    orient_T : int
+        Joint colour x gradient-orientation bins (experimental, off by default:
+        0): bin = colour bin x 9 + octant of the 3x3 Sobel gradient of the grey
+        frame where |Gx| + |Gy| >= orient_T, 8 for flatter pixels (9 x 512
+        bins) (docs/results_v2_mean.md).
     """
 
     features: Features = None  # type: ignore[assignment]  # resolved per preset
@@ -143,9 +166,17 @@ class TrackerParams:
     conf_lost: float = 0.4
     conf_uncertain: float = 0.5
     conf_reacquire: float = 0.5
+    loss_rho: float = 0.88
+    loss_contrast: float = 0.19
+    loss_smooth: float = 0.5
     ref_rate: float = 0.015625
     search_step: float = 1.0
     search_iter: int = 5
+    motion_gain: float = 0.0
+    scale_test: float = 0.0
+    scale_test_mix: float = 1.0
+    scale_test_gate: bool = False
+    orient_T: int = 0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -176,7 +207,9 @@ class TrackerParams:
             for name, lo, hi in (("pad", 0.0, 2.0), ("bg_ring", 0.05, 4.0), ("scale_gain", 0.0, 1.0),
                                  ("scale_step", 0.0, 0.5), ("scale_reg", 0.0, 1.0), ("conf_lost", 0.0, 1.0),
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
-                                 ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0)):
+                                 ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
+                                 ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
+                                 ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:
@@ -185,10 +218,17 @@ class TrackerParams:
                 raise ValueError("max_window must be in 7..1023")
             if self.search_iter < 1:
                 raise ValueError("search_iter must be >= 1")
+            if not 0 <= self.orient_T <= 2040:
+                raise ValueError("orient_T must be in 0..2040")
 
     @property
     def n_colour_bins(self) -> int:
         return 1 << (3 * self.colour_bits)
+
+    @property
+    def n_bins_v2(self) -> int:
+        """Bins of tracker v2's feature: the colour bins, x 9 with orient_T > 0."""
+        return self.n_colour_bins * (9 if self.orient_T > 0 else 1)
 
     @property
     def n_edge_bins(self) -> int:

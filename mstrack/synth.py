@@ -365,6 +365,27 @@ def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
         "ms_centre": pick("SW_W", "SWX_W", "SHIFT_Q_W", "CF", "REGION_W", "CENTRE_W"),
         "ms_fusion": pick("FEATURES", "RHO_SUM_W", "HIST_W", "CENTRE_ABS_W", "AF", "ALPHA_W", "RF",
                           "RHO_OUT_FRAC", "RHO_OUT_W"),
+        **v2_scale_block_generics(cfg),
+    }
+
+
+def v2_scale_block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
+    """Generics of the v2 statistics / scale blocks (mstrack.fixed.vhdl_pkg.v2_scale_generics) for the
+    configuration's sizes, with the v2 parameters (preset "v2")."""
+    from .fixed.vhdl_pkg import v2_scale_generics
+
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    tp_kw = {k: v for k, v in cfg.tp.items() if k not in ("features", "kernel")}
+    g = v2_scale_generics(TrackerParams(preset="v2", **tp_kw), FixedParams(**cfg.fp), cfg.lanes)
+    pick = lambda *ks: {k: g[k] for k in ks}  # noqa: E731
+    return {
+        "ms_target_stats": pick("LANES", "BIN_W", "HALF_W", "REGION_W", "KERNEL_BITS", "KT_W", "PAD16", "COUNT_W",
+                                "ST2_W"),
+        "ms_share": pick("COUNT_W", "SHARE_W"),
+        "ms_spread": pick("COUNT_W", "ST2_W", "SPREAD_W"),
+        "ms_scale": pick("SPREAD_W", "SIZE_W", "SCALE_W", "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "RATIO_Q_W",
+                         "WR_Q_W"),
+        "ms_resize": pick("SIZE_W", "SCALE_W", "COORD_W"),
     }
 
 
@@ -881,16 +902,26 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
 # ----------------------------------------------------------------------------- tracker v2 budget
 #: per-frame v2 arithmetic after the mean shift, issued one after the other into one iterative
 #: divider (Q bits + 2 clocks each): share (17), spread (40), rho / rho_ref (34), share /
-#: share_ref (34), spread ratio (40), w / w0 (40); one isqrt of 56 bits (28 clocks); the model
+#: share_ref (34), spread ratio (40), w / w0 (40), ring share (17, the loss flag's
+#: ms_ring_share; its ms_loss_flag is one multiplier and two compares); one isqrt of 56 bits (28 clocks); the model
 #: scaling Qw = Qn K >> 16 rides in the bin pass (one multiplier, no clock); kernel tables for a
-#: new window size: 3 (HALF_W + 1) + 3 clocks (ms_kernel_tables set-up).
-V2_DIVISIONS_Q = (17, 40, 34, 34, 40, 40)
+#: new window size: the worst start -> done of ms_kernel_tables with KA/KB (:func:`kernel_tables_clocks`;
+#: they can also be built while the next frame streams in, so this is conservative).
+V2_DIVISIONS_Q = (17, 40, 34, 34, 40, 40, 17)
 V2_ISQRT = 28
 
 
-def v2_frame_overhead(half_w: int = 63) -> int:
+def kernel_tables_clocks(max_half: int = 63, half_w: int = 6, kval_w: int = 9) -> int:
+    """Worst start -> done clocks of rtl/ms_kernel_tables.vhd with the KA/KB divider (KERNEL_EPAN = 1,
+    as v2 needs): 2 (n + 1) + KVAL_W + S + 2 + X, S = 3 (HALF_W + 1) + 3, reached with
+    ex = n = MAX_HALF > ey (X = 2 ex - XR[n] = 2 MAX_HALF): 289 for the defaults
+    (tb/test_ms_kernel_tables.py measures every v2 window size)."""
+    return 2 * (max_half + 1) + kval_w + 3 * (half_w + 1) + 3 + 2 + 2 * max_half
+
+
+def v2_frame_overhead(max_half: int = 63, half_w: int = 6, kval_w: int = 9) -> int:
     """Clocks per frame that v2 adds to the paper's engine (estimate for core v2, issue 11)."""
-    return sum(q + 2 for q in V2_DIVISIONS_Q) + V2_ISQRT + 3 * (half_w + 1) + 3
+    return sum(q + 2 for q in V2_DIVISIONS_Q) + V2_ISQRT + kernel_tables_clocks(max_half, half_w, kval_w)
 
 
 def v2_cycle_budget(lanes: int | None = None) -> list[dict[str, Any]]:
@@ -918,7 +949,7 @@ def v2_cycle_budget(lanes: int | None = None) -> list[dict[str, Any]]:
         pp = pixel_pass_cycles(ex, ex, g["LANES"], None, xr)
         return pp, engine_cycles(g, [pp] * (iters + 1), nc, iters)
 
-    ov = v2_frame_overhead(g["MAX_HALF"])
+    ov = v2_frame_overhead(g["MAX_HALF"], g["HALF_W"], g["KERNEL_BITS"] + 1)
     w = tp.max_window
     pp, e = run(w, tp.max_iter)
     out.append({"case": f"tracking, {w}x{w} window, {tp.max_iter} iterations", "pixel_pass": pp,
@@ -940,7 +971,7 @@ def v2_budget_table(lanes: int | None = None) -> str:
     L = lanes or g["LANES"]
     lines = [f"LANES = {L}, colour only (512 bins), default generics; 1080p60 vertical blanking = 99,000 "
              f"clocks at 148.5 MHz.  Per-frame v2 overhead (divisions, isqrt, kernel tables): "
-             f"{v2_frame_overhead(g['MAX_HALF'])} clocks.", "",
+             f"{v2_frame_overhead(g['MAX_HALF'], g['HALF_W'], g['KERNEL_BITS'] + 1)} clocks.", "",
              "| frame | pixel pass | worst clocks | vs 99,000 |", "|---|---:|---:|---|"]
     for r in v2_cycle_budget(L):
         ok = "fits" if r["clocks"] <= 99000 else "**does not fit**"

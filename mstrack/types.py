@@ -103,10 +103,10 @@ class Status(str, Enum):
 
     OK = "ok"                  # tracked normally
     INIT = "init"              # the frame the target was initialised on
-    LOST = "lost"              # the target is not where the tracker looks (v2: confidence below
-                               # the loss threshold; paper preset: all weights 0); box kept
-    UNCERTAIN = "uncertain"    # v2: confidence low, position reported but not trusted
-    REACQUIRED = "reacquired"  # v2: the wide search found the target again after a loss
+    LOST = "lost"              # the target is not where the tracker looks (v2: loss flag set while
+                               # the wide search runs; paper preset: all weights 0); box kept
+    UNCERTAIN = "uncertain"    # v2: loss flag set, position reported but not trusted
+    REACQUIRED = "reacquired"  # v2: the loss flag clears after a reported loss
     CLIPPED = "clipped"        # init box clipped to the frame / to the maximum window
     ERROR = "error"            # frame rejected (bad frame); position kept from the previous frame
 

@@ -144,11 +144,21 @@ def _parse_frames(s: str) -> list[int]:
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     """Arguments of ``python -m mstrack.vectors`` and ``mstrack vectors``."""
-    ap.add_argument("seq_dir")
-    ap.add_argument("--frames", type=_parse_frames, default=[0, 1], help="comma separated, e.g. 0,1,5")
-    ap.add_argument("--out", required=True, metavar="FILE.jsonl.gz",
-                    help="output file: gzip-compressed JSON lines (another extension is refused)")
+    ap.add_argument("seq_dir", help="sequence folder (or, with --format vhdl-files and --box, any video "
+                                    "or image folder)")
+    ap.add_argument("--frames", type=_parse_frames, default=[0, 1], help="comma separated, e.g. 0,1,5 "
+                    "(vhdl-files: frames 0 .. the largest one are streamed)")
+    ap.add_argument("--out", required=True, metavar="FILE.jsonl.gz|DIR",
+                    help="output file, gzip-compressed JSON lines (jsonl: another extension is refused), "
+                         "or folder (vhdl-files)")
     ap.add_argument("--lanes", type=int, default=DEFAULT_LANES)
+    ap.add_argument("--format", choices=("jsonl", "vhdl-files"), default="jsonl",
+                    help="jsonl: every fixed-point intermediate (default); vhdl-files: frames.txt, "
+                         "expected.txt, generics.json for tb/vhdl/ms_tracker_file_tb.vhd (mstrack.tb_files)")
+    ap.add_argument("--box", help="vhdl-files: init box x,y,w,h (integers; default: the ground truth of frame 0)")
+    ap.add_argument("--max-frame-width", type=int, default=2048, help="vhdl-files: MAX_FRAME_W (default 2048)")
+    ap.add_argument("--rgb-packing", choices=("mstrack", "ug934"), default="mstrack",
+                    help="vhdl-files: layout of the pixel words (the testbench's RGB_PACKING)")
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                     help="TrackerParams or FixedParams field (repeatable)")
 
@@ -167,8 +177,46 @@ def run(args: argparse.Namespace) -> int:
                 params[k] = float(v)
             except ValueError:
                 params[k] = v
+    if getattr(args, "format", "jsonl") == "vhdl-files":
+        print(dump_vhdl_files(args.seq_dir, max(args.frames) + 1, args.out, args.lanes, box=args.box,
+                              max_frame_w=args.max_frame_width, packing=args.rgb_packing, **params))
+        return 0
     print(dump_vectors(args.seq_dir, args.frames, args.out, args.lanes, **params))
     return 0
+
+
+def dump_vhdl_files(source: str | Path, n_frames: int, out: str | Path, lanes: int = DEFAULT_LANES,
+                    box: str | None = None, max_frame_w: int = 2048, packing: str = "mstrack",
+                    **params: Any) -> Path:
+    """Files of the standalone VHDL testbench (:func:`mstrack.tb_files.write_tb_files`) for the
+    first ``n_frames`` frames of ``source`` (sequence folder, video or image folder); init box
+    ``box`` ("x,y,w,h") or the sequence's ground truth on frame 0.  Returns the folder."""
+    from .cosim import CoreConfig
+    from .data import VideoSource
+    from .tb_files import write_tb_files
+
+    src = VideoSource(source)
+    if box:
+        try:
+            ib = tuple(int(v) for v in box.split(","))
+        except ValueError:
+            raise ValueError(f"--box wants integers x,y,w,h, got {box!r}") from None
+        if len(ib) != 4:
+            raise ValueError(f"--box wants x,y,w,h, got {box!r}")
+    elif src.sequence is not None:
+        ib = round_box(*Box.of(src.sequence.gt[0]).as_tuple())
+    else:
+        raise ValueError("--box x,y,w,h is required unless the source is a sequence folder with ground truth")
+    frames: list[np.ndarray] = []
+    for f in src.frames():  # on_bad="raise": never None
+        assert f is not None
+        frames.append(f)
+        if len(frames) == n_frames:
+            break
+    tp, fp = split_params(params)
+    cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
+    write_tb_files(out, frames, ib, cfg, packing={"mstrack": 0, "ug934": 1}[packing], source=str(source))
+    return Path(out)
 
 
 def register_cli(sub: argparse._SubParsersAction) -> None:

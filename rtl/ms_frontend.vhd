@@ -15,6 +15,8 @@
 -- (check 1, grey 2, sobel 5 after the grey; ms_sobel reads its line buffer
 -- with the position, which it gets one clock before the grey).  Throughput: 1 pixel/clock; never stalls (no
 -- ready): the top must back-pressure upstream itself if it needs to.
+-- Pixel layout (RGB_PACKING): 0 = R 23:16, G 15:8, B 7:0 (default); 1 = AMD UG934's RGB
+-- order (video format code 2: R 23:16, B 15:8, G 7:0), so that AMD video IP connects directly.
 -- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height; ms_stream_check drops a
 -- frame out of that range (frame_error, ERR_SIZE).
 -- Python model: mstrack.fixed.blocks ms_colour_bin and
@@ -30,7 +32,9 @@ entity ms_frontend is
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
     COLOUR_BITS    : natural range 1 to 8 := 3;  -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural range 1 to 8 := 4;  -- edge bin width
-    EDGE_SHIFT     : natural range 0 to 11 := 5  -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
+    EDGE_SHIFT     : natural range 0 to 11 := 5; -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
+    RGB_PACKING    : natural range 0 to 1 := 0   -- in_data layout: 0 R 23:16 G 15:8 B 7:0 (mstrack);
+                                                 -- 1 R 23:16 B 15:8 G 7:0 (AMD UG934, RGB video); wiring only
   );
   port (
     clk          : in  std_logic;                                       -- clock
@@ -38,7 +42,7 @@ entity ms_frontend is
     frame_width  : in  unsigned(COORD_W - 1 downto 0);                  -- W, sampled on sof
     frame_height : in  unsigned(COORD_W - 1 downto 0);                  -- H, sampled on sof
     in_valid     : in  std_logic;                                       -- beat present (AXI tvalid; tready = 1)
-    in_data      : in  std_logic_vector(23 downto 0);                   -- RGB: R 23:16, G 15:8, B 7:0
+    in_data      : in  std_logic_vector(23 downto 0);                   -- RGB pixel, layout set by RGB_PACKING
     in_sof       : in  std_logic;                                       -- start of frame (AXI tuser)
     in_eol       : in  std_logic;                                       -- end of line (AXI tlast)
     ip_valid     : out std_logic;                                       -- interior pixel out
@@ -58,6 +62,7 @@ architecture rtl of ms_frontend is
   constant EVT_DELAY : natural := 8;  -- = pixel path after ms_stream_check (grey 2 + sobel 5) + 1
   constant CB_W : natural := 3 * COLOUR_BITS;
 
+  signal rgb      : std_logic_vector(23 downto 0);  -- in_data as R 23:16, G 15:8, B 7:0
   signal px_valid : std_logic;
   signal px_data  : std_logic_vector(23 downto 0);
   signal px_x, px_y : unsigned(COORD_W - 1 downto 0);
@@ -75,11 +80,14 @@ architecture rtl of ms_frontend is
   type ev_pipe_t is array (1 to EVT_DELAY) of std_logic_vector(EV_W - 1 downto 0);
   signal ev : ev_pipe_t := (others => (others => '0'));
 begin
+  -- pixel layout of the input (no logic: a permutation of wires)
+  rgb <= in_data when RGB_PACKING = 0 else in_data(23 downto 16) & in_data(7 downto 0) & in_data(15 downto 8);
+
   u_check : entity work.ms_stream_check
     generic map (COORD_W => COORD_W, DATA_W => 24, MIN_SIZE => 3, MAX_W => MAX_FRAME_W)
     port map (
       clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
-      in_valid => in_valid, in_data => in_data, in_sof => in_sof, in_eol => in_eol,
+      in_valid => in_valid, in_data => rgb, in_sof => in_sof, in_eol => in_eol,
       px_valid => px_valid, px_data => px_data, px_x => px_x, px_y => px_y,
       frame_start => c_start, frame_end => c_end, frame_error => c_err, err_code => c_code);
 

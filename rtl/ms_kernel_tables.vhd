@@ -1,4 +1,7 @@
--- ms_kernel_tables: kernel tables of a w x h target (run once per target, at init).
+-- ms_kernel_tables: kernel tables of a w x h target (paper core: once per target, at init;
+-- tracker v2: once per frame, for that frame's window wd x hd from ms_window_size, any size
+-- 3 .. 2 MAX_HALF + 1, with KERNEL_EPAN = 1 since v2's target statistics need KA/KB with the flat
+-- kernel; tb/test_ms_kernel_tables.py checks every such size, docs/blocks/ms_kernel_tables.md).
 --
 -- On `start` with the integer target size (w, h), 3 <= w, h <= 2 MAX_HALF + 1:
 --   ex = (w - 1) / 2, ey = (h - 1) / 2, kd_d = D = w^2 h^2        (held until the next start)

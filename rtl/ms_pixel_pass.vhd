@@ -25,6 +25,9 @@
 -- the bin read port is used only between passes (from the cycle of `done` on), a
 -- bin at most once in 3 clocks (ms_histogram).  ex, ey and the kernel tables must
 -- be stable during a pass.
+-- Scan tap (px_*): the scan's beat (valid, lane mask, lane-0 dx, dy, last) in the cycle its
+-- ram_addr is out, for ms_target_stats (v2), which reads the same beat's bins from ram_data one
+-- clock later; wires from the scan's registers, the pass itself is unchanged.
 -- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -69,6 +72,12 @@ entity ms_pixel_pass is
     -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
     ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
     ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, 1 clock after ram_addr
+    -- scan tap (ms_target_stats sits beside the pass on it; the bins of a beat are ram_data one clock later)
+    px_valid     : out std_logic;                                    -- beat valid (the beat whose ram_addr is out now)
+    px_mask      : out std_logic_vector(LANES - 1 downto 0);          -- lane l inside the kernel ellipse
+    px_dx        : out signed(REGION_W downto 0);                    -- dx of lane 0 (lane l: px_dx + l)
+    px_dy        : out signed(REGION_W downto 0);                    -- dy of the beat's row
+    px_last      : out std_logic;                                    -- final beat of the pass
     -- bin read-and-clear port
     bin_rd_en    : in  std_logic;                                    -- read and clear bin bin_rd_addr
     bin_rd_addr  : in  unsigned(BIN_W - 1 downto 0);                 -- bin
@@ -111,6 +120,13 @@ begin
       start => start, win_x => win_x, win_y => win_y, ex => ex, ey => ey,
       busy => open, out_valid => sc_valid, out_addr => sc_addr, out_dx => sc_dx, out_dy => sc_dy,
       out_mask => sc_mask, out_last => sc_last);
+
+  -- scan tap: the scan's registered outputs, unchanged (no logic added to the pass)
+  px_valid <= sc_valid;
+  px_mask  <= sc_mask;
+  px_dx    <= sc_dx;
+  px_dy    <= sc_dy;
+  px_last  <= sc_last;
 
   g_addr : for l in 0 to LANES - 1 generate
     ram_addr((l + 1) * ADDR_W - 1 downto l * ADDR_W) <= std_logic_vector(sc_addr);

@@ -2,7 +2,8 @@
 --
 -- Computes, per video frame, the tracking result of mstrack.fixed.FixedTracker bit for bit
 -- (docs/architecture.md, docs/fixed_point.md).  Video in as AXI4-Stream, 1 pixel per clock:
--- s_axis_tdata = R(23:16) G(15:8) B(7:0), tuser = start of frame (first pixel),
+-- s_axis_tdata = R(23:16) G(15:8) B(7:0) (RGB_PACKING = 0) or AMD UG934's R(23:16) B(15:8) G(7:0)
+-- (RGB_PACKING = 1), tuser = start of frame (first pixel),
 -- tlast = last pixel of each line.  One result word per frame out on m_axis_result
 -- (fields: mstrack.fixed.vhdl_pkg.result_layout, LSB first: cx, cy, rho_c, rho_e, alpha_c,
 -- iter_c, iter_e, stop_c, stop_e, flags, err_code, box_w, box_h, frame_count).
@@ -38,7 +39,8 @@ use work.ms_stream_pkg.all;
 
 entity ms_tracker is
   generic (
-    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth); 3 .. 2**COORD_W - 1
+    RGB_PACKING    : natural := 0;               -- s_axis_tdata layout: 0 R 23:16 G 15:8 B 7:0; 1 AMD UG934 (R B G)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
@@ -95,7 +97,7 @@ entity ms_tracker is
     s_init_w             : in  unsigned(COORD_W downto 0);               -- box width
     s_init_h             : in  unsigned(COORD_W downto 0);               -- box height
     -- video in
-    s_axis_tdata         : in  std_logic_vector(23 downto 0);            -- R 23:16, G 15:8, B 7:0
+    s_axis_tdata         : in  std_logic_vector(23 downto 0);            -- pixel: R 23:16, G 15:8, B 7:0 (RGB_PACKING 1: R, B, G)
     s_axis_tvalid        : in  std_logic;                                -- pixel valid
     s_axis_tready        : out std_logic;                                -- pixel accepted
     s_axis_tlast         : in  std_logic;                                -- last pixel of a line
@@ -241,11 +243,105 @@ architecture rtl of ms_tracker is
   begin
     return '0' & ovf & notgt & rej & err & lost & clipped & init;
   end function;
+
+  ------------------------------------------------------------------------------ generic checks
+  -- The derived widths are generics (computed by mstrack.fixed.vhdl_pkg.core_generics; `mstrack hdl
+  -- config` writes them all).  The relations below are the ones the RTL is built on; each is
+  -- checked at elaboration (severity failure), with the formula of mstrack.fixed.formats.widths.
+  -- Products are formed on 128-bit unsigned values, so no integer overflows for any MAX_HALF.
+  subtype big_t is unsigned(127 downto 0);
+  function big(n : natural) return big_t is
+  begin
+    return to_unsigned(n, 128);
+  end function;
+  function mul(a, b : big_t) return big_t is
+  begin
+    return resize(a * b, 128);
+  end function;
+  function bits_of(v : big_t) return natural is     -- bits to hold 0 .. v (at least 1)
+  begin
+    for i in 127 downto 1 loop
+      if v(i) = '1' then
+        return i + 1;
+      end if;
+    end loop;
+    return 1;
+  end function;
+  function img(n : natural) return string is
+  begin
+    return integer'image(n);
+  end function;
+  procedure check(name : string; got, want : natural; formula : string) is
+  begin
+    assert got = want
+      report "ms_tracker: " & name & " = " & img(got) & ", expected " & formula & " = " & img(want)
+             & " (derive every width with mstrack hdl config)"
+      severity failure;
+  end procedure;
+
+  constant X_WIN     : natural := 2 * MAX_HALF + 1;
+  constant X_PIX     : big_t := mul(big(X_WIN), big(X_WIN));
+  function kmax return big_t is                     -- largest kernel value: 1 flat, 2**KERNEL_BITS Epanechnikov
+  begin
+    if KERNEL_EPAN = 0 then
+      return big(1);
+    end if;
+    return shift_left(big(1), KERNEL_BITS);
+  end function;
+  constant X_KMAX    : big_t := kmax;
+  constant X_HISTMAX : big_t := mul(X_PIX, X_KMAX);
+  constant X_WMAX    : big_t := shift_left(big(1), WI + WF) - 1;
+  constant X_REGION  : natural := X_WIN + 2 * MARGIN;
+  constant X_STRIDE  : natural := (X_REGION + LANES - 1) / max(LANES, 1);
+  constant X_SQRT_IN : natural := bits_of(shift_left(mul(X_HISTMAX, X_HISTMAX), 2 * RF));
+  constant X_RESULT  : natural := 2 * CENTRE_ABS_W + 2 * RHO_OUT_W + ALPHA_W + 2 * ITER_W + 4 + FLAGS_W
+                                  + ERR_W + 2 * WIN_W + FCOUNT_W;
+
+  -- evaluated once at elaboration; returns true so that it can initialise a constant
+  function checks return boolean is
+  begin
+    assert LANES = 1 or (LANES >= 1 and 2 ** clog2(LANES) = LANES)
+      report "ms_tracker: LANES = " & img(LANES) & " is not a power of two" severity failure;
+    assert FEATURES <= 2 report "ms_tracker: FEATURES = " & img(FEATURES) & " (0 fused, 1 colour, 2 edge)"
+      severity failure;
+    assert KERNEL_EPAN <= 1 report "ms_tracker: KERNEL_EPAN = " & img(KERNEL_EPAN) & " (0 flat, 1 Epanechnikov)"
+      severity failure;
+    assert RGB_PACKING <= 1 report "ms_tracker: RGB_PACKING = " & img(RGB_PACKING) & " (0 mstrack, 1 UG934)"
+      severity failure;
+    assert MAX_HALF >= 1 report "ms_tracker: MAX_HALF must be >= 1" severity failure;
+    assert MAX_FRAME_W >= 3 and MAX_FRAME_W <= 2 ** COORD_W - 1
+      report "ms_tracker: MAX_FRAME_W = " & img(MAX_FRAME_W) & " out of 3 .. 2**COORD_W - 1 = "
+             & img(2 ** COORD_W - 1) severity failure;
+    check("HALF_W", HALF_W, bits_of(big(MAX_HALF)), "bits_for(MAX_HALF)");
+    check("WIN_W", WIN_W, bits_of(big(X_WIN)), "bits_for(2 MAX_HALF + 1)");
+    check("REGION_MAX", REGION_MAX, X_REGION, "2 MAX_HALF + 1 + 2 MARGIN");
+    check("REGION_W", REGION_W, bits_of(big(REGION_MAX)), "bits_for(REGION_MAX)");
+    check("STRIDE", STRIDE, X_STRIDE, "ceil(REGION_MAX / LANES)");
+    check("ADDR_W", ADDR_W, bits_of(big(REGION_MAX * STRIDE - 1)), "bits_for(REGION_MAX STRIDE - 1)");
+    check("KVAL_W", KVAL_W, bits_of(X_KMAX), "bits_for(kernel maximum)");
+    check("HIST_W", HIST_W, bits_of(X_HISTMAX), "bits_for(window pixels x kernel maximum)");
+    check("COUNT_W", COUNT_W, bits_of(X_PIX), "bits_for((2 MAX_HALF + 1)**2)");
+    check("POSSUM_W", POSSUM_W, bits_of(mul(X_PIX, big(MAX_HALF))) + 1, "bits_for(pixels MAX_HALF) + 1");
+    check("KD_W", KD_W, bits_of(mul(big(4), mul(mul(big(MAX_HALF), big(MAX_HALF)), X_PIX)) + mul(X_PIX, X_PIX)),
+          "bits_for(4 MAX_HALF**2 win**2 + win**4)");
+    check("SQRT_IN_W", SQRT_IN_W, X_SQRT_IN + X_SQRT_IN mod 2, "even(bits_for(HIST_MAX**2 2**(2 RF)))");
+    check("RHO_SUM_W", RHO_SUM_W, bits_of(shift_left(X_HISTMAX, RF)) + 1, "bits_for(HIST_MAX 2**RF) + 1");
+    check("WEIGHT_W", WEIGHT_W, WI + WF, "WI + WF");
+    check("RATIO_Q_W", RATIO_Q_W, 2 * (WI + WF), "2 (WI + WF)");
+    check("SW_W", SW_W, bits_of(mul(X_WMAX, X_PIX)), "bits_for((2**WEIGHT_W - 1) pixels)");
+    check("SWX_W", SWX_W, bits_of(mul(X_WMAX, mul(X_PIX, big(MAX_HALF)))) + 1,
+          "bits_for((2**WEIGHT_W - 1) pixels MAX_HALF) + 1");
+    check("SHIFT_Q_W", SHIFT_Q_W, bits_of(shift_left(big(MAX_HALF), CF)), "bits_for(MAX_HALF 2**CF)");
+    check("CENTRE_W", CENTRE_W, REGION_W + CF, "REGION_W + CF");
+    check("CENTRE_ABS_W", CENTRE_ABS_W, COORD_W + CF, "COORD_W + CF");
+    check("ITER_W", ITER_W, bits_of(big(MAX_ITER)), "bits_for(MAX_ITER)");
+    check("RHO_OUT_W", RHO_OUT_W, RHO_OUT_FRAC + 1, "RHO_OUT_FRAC + 1");
+    check("ALPHA_W", ALPHA_W, AF + 1, "AF + 1");
+    check("RESULT_W", RESULT_W, 8 * ((X_RESULT + 7) / 8), "the result fields rounded up to 8 bits");
+    return true;
+  end function;
+  constant GENERICS_OK : boolean := checks;
 begin
-  assert WIN_W = HALF_W + 1 report "ms_tracker: WIN_W must be HALF_W + 1" severity failure;
-  assert RESULT_W >= 2 * CENTRE_ABS_W + 2 * RHO_OUT_W + ALPHA_W + 2 * ITER_W + 4 + FLAGS_W + ERR_W
-                     + 2 * WIN_W + FCOUNT_W
-    report "ms_tracker: RESULT_W too small" severity failure;
 
   ---------------------------------------------------------------------------- video input gate
   -- closed: outside T_IDLE, after a frame's last beat until its result, while an error result is
@@ -301,7 +397,7 @@ begin
   ---------------------------------------------------------------------------- front end, capture, RAMs
   u_fe : entity work.ms_frontend
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
-                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT)
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, RGB_PACKING => RGB_PACKING)
     port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
               in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
               ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,

@@ -9,6 +9,15 @@ XR[i] (row extent of the ellipse, for ms_window_scan) is checked against
 :func:`model_xr`, computed from the model's TA, TB, D (and its ``inside`` mask),
 and the start -> done latency against the documented formula.
 
+Tracker v2 (``v2_windows``, through tb/ms_kernel_tables_tb_top.vhd, which keeps a copy of
+every table write): the window size changes every frame, so the tables are recomputed per
+frame for any (wd, hd) = ms_window_size output, 3 .. max_window each, odd and even.  Every one
+of these sizes (the full grid, in a random order, each start right after the previous done) is
+compared with ``ms_kernel(wd, hd, "flat", KERNEL_BITS)``: ex, ey, D, TA, TB, XR and KA, KB,
+which v2 needs with the flat kernel (d2q = KA[|dx|] + KB[|dy|] of ms_target_stats), so the
+tables run with KERNEL_EPAN = 1 (divider in) while the pixel pass stays flat.  The start ->
+done latency is asserted against the documented formula for every size.
+
 Run: ``.venv/bin/python -m pytest tb/test_ms_kernel_tables.py``.
 """
 
@@ -16,10 +25,13 @@ from __future__ import annotations
 
 import random
 
+import numpy as np
+
 import cocotb
 from cocotb.clock import Clock
 from cocotb.handle import Immediate
-from cocotb.triggers import ClockCycles, RisingEdge
+from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
+from cocotb.utils import get_sim_time
 
 from mstrack.fixed.blocks import ms_kernel
 from mstrack.fixed.primitives import ms_divider
@@ -139,6 +151,75 @@ async def tables(dut):
     dut._log.info("%d sizes OK, worst latency %d clocks (bound %d)", len(sizes), worst, bound)
 
 
+def documented_latency(ker: ms_kernel, xr: list[int], half_w: int, kval_w: int, epan: bool) -> int:
+    """start -> done clocks of the rtl/ms_kernel_tables.vhd header."""
+    n_last = max(ker.ex, ker.ey)
+    walk = 2 * ker.ex - xr[n_last]
+    setup = 3 * (half_w + 1) + 3
+    return (2 * (n_last + 1) + kval_w + setup + 2 if epan else n_last + setup + 2) + walk
+
+
+def unpack(v: int, width: int, n: int) -> list[int]:
+    m = (1 << width) - 1
+    return [(v >> (i * width)) & m for i in range(n)]
+
+
+@cocotb.test()
+async def v2_windows(dut):
+    """Every v2 window size (wd, hd) in 3 .. MAX_WINDOW_TB, against ms_kernel(wd, hd, "flat", KB)."""
+    g = dut_generics()
+    mw, kb, kval_w = int(g["MAX_WINDOW_TB"]), int(g["KERNEL_BITS"]), int(g["KVAL_W"])
+    half_w, kd_w, epan = int(g["HALF_W"]), int(g["KD_W"]), int(g["KERNEL_EPAN"]) == 1
+    assert epan, "v2 needs KA/KB: run the tables with KERNEL_EPAN = 1"
+    dut.rst.value = Immediate(1)
+    dut.start.value = Immediate(0)
+    cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
+    await ClockCycles(dut.clk, 3)
+    dut.rst.value = 0
+    await RisingEdge(dut.clk)
+    sizes = [(w, h) for w in range(3, mw + 1) for h in range(3, mw + 1)]
+    random.Random(11).shuffle(sizes)
+    worst = 0
+    for w, h in sizes:
+        dut.w.value = w
+        dut.h.value = h
+        dut.start.value = 1
+        await RisingEdge(dut.clk)
+        t0 = int(get_sim_time("ns")) // 10
+        dut.start.value = 0
+        await RisingEdge(dut.done)
+        # counted as ``tables`` does: up to the clock edge at which a consumer samples done = 1
+        lat = int(get_sim_time("ns")) // 10 - t0 + 1
+        await RisingEdge(dut.clk)            # the copy has the write that came with done
+        await ReadOnly()
+        ker = ms_kernel(w, h, "flat", kb)
+        n = max(ker.ex, ker.ey) + 1
+        ctx = f"{w}x{h}"
+        assert (int(dut.ex.value), int(dut.ey.value), int(dut.kd_d.value)) == (ker.ex, ker.ey, ker.D), ctx
+        assert int(dut.n_writes.value) == n and int(dut.order_err.value) == 0, f"{ctx}: writes not 0..{n - 1}"
+        i = np.arange(n, dtype=np.int64)
+        ta, tb = unpack(int(dut.tab_ta.value), kd_w, n), unpack(int(dut.tab_tb.value), kd_w, n)
+        ka, kbt = unpack(int(dut.tab_ka.value), kval_w, n), unpack(int(dut.tab_kb.value), kval_w, n)
+        xr = unpack(int(dut.tab_xr.value), half_w, n)
+        # the model's tables (entries <= ex / ey); beyond them the exact TA/TB and saturating KA/KB
+        exp_ta, exp_tb = (4 * i * i * h * h).tolist(), (4 * i * i * w * w).tolist()
+        exp_ka = ms_divider((4 * i * i) << kb, w * w, kval_w).tolist()
+        exp_kb = ms_divider((4 * i * i) << kb, h * h, kval_w).tolist()
+        assert exp_ta[:ker.ex + 1] == ker.TA.tolist() and exp_ka[:ker.ex + 1] == ker.KA.tolist(), ctx
+        assert exp_tb[:ker.ey + 1] == ker.TB.tolist() and exp_kb[:ker.ey + 1] == ker.KB.tolist(), ctx
+        rows = ker.inside[ker.ey:].sum(axis=1)          # row |dy| = i holds |dx| <= XR[i]
+        exp_xr = [(int(r) - 1) // 2 for r in rows] + [0] * (n - len(rows))
+        assert ta == exp_ta and tb == exp_tb, f"{ctx}: TA/TB"
+        assert ka == exp_ka and kbt == exp_kb, f"{ctx}: KA {ka} / {exp_ka}, KB {kbt} / {exp_kb}"
+        assert xr == exp_xr, f"{ctx}: XR {xr} != {exp_xr}"
+        exp_lat = documented_latency(ker, exp_xr, half_w, kval_w, epan)
+        assert lat == exp_lat, f"{ctx}: done after {lat} clocks, documented {exp_lat}"
+        worst = max(worst, lat)
+        await RisingEdge(dut.clk)
+    dut._log.info("%d window sizes (3..%d)^2 match ms_kernel(wd, hd, 'flat', %d); worst latency %d clocks",
+                  len(sizes), mw, kb, worst)
+
+
 # ---------------------------------------------------------------- pytest entry points
 
 import pytest  # noqa: E402
@@ -171,7 +252,7 @@ def test_ms_kernel_tables(kernel, fp, hdl_waves):
     gen = tables_generics(kernel, fp)
     # MAX_HALF is not a generic of the entity: pass it to the test through the generics env only
     import json
-    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase="tables",
                  extra_env={hdl.GENERICS_ENV: json.dumps({**gen, "MAX_HALF_TB": fp.max_half})})
 
 
@@ -181,3 +262,33 @@ def test_ms_kernel_tables_synth(kernel, tmp_path):
     """ghdl --synth (to Verilog, as the Verilator/yosys flow does) succeeds."""
     gen = tables_generics(kernel, FixedParams())
     hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")
+
+
+V2_TOP = "ms_kernel_tables_tb_top"
+V2_WRAPPER = hdl.TB_DIR / "ms_kernel_tables_tb_top.vhd"
+
+
+def v2_tables_generics(tp: TrackerParams, fp: FixedParams) -> dict:
+    """ms_kernel_tables as core v2 instantiates it: KA/KB computed (KERNEL_EPAN = 1, KVAL_W =
+    KERNEL_BITS + 1) for the flat-kernel tracker's d2q; HALF_W, KD_W for windows up to max_window."""
+    g = core_generics(tp.with_(kernel="epanechnikov", preset="paper", features="fused"), fp)
+    return {k: g[k] for k in ("HALF_W", "KERNEL_EPAN", "KERNEL_BITS", "KVAL_W", "KD_W")}
+
+
+V2_CASES = [
+    pytest.param(TrackerParams(preset="v2"), FixedParams(), id="v2_default"),
+    pytest.param(TrackerParams(preset="v2", max_window=31), FixedParams(max_half=15, margin=8, kernel_bits=6),
+                 id="v2_w31_kb6"),
+]
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("tp,fp", V2_CASES)
+def test_ms_kernel_tables_v2(tp, fp, hdl_waves, request):
+    """Every (wd, hd) window size tracker v2 can produce (3 .. max_window each)."""
+    import json
+    gen = v2_tables_generics(tp, fp)
+    assert gen["KERNEL_EPAN"] == 1 and gen["KVAL_W"] == fp.kernel_bits + 1, gen
+    hdl.run_ghdl(V2_TOP, MODULE, gen, hdl.rtl_sources(V2_TOP, extra=[V2_WRAPPER]), waves=hdl_waves,
+                 testcase="v2_windows", build_name=f"ms_kernel_tables_{request.node.callspec.id}",
+                 extra_env={hdl.GENERICS_ENV: json.dumps({**gen, "MAX_WINDOW_TB": tp.max_window})})

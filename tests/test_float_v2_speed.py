@@ -155,6 +155,18 @@ def test_scale_change(kernel):
 
 
 @needs_numba
+@pytest.mark.parametrize("extra", [{"scale_test": 0.05, "scale_test_gate": True},
+                                   {"scale_test": 0.1, "scale_test_mix": 0.5}, {"motion_gain": 0.5},
+                                   {"orient_T": 64}, {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True}])
+def test_experimental_options(extra):
+    """The experimental options (off by default; docs/results_v2_mean.md) are bit-identical too."""
+    sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]
+    boxes = [(60 + 2 * i - s // 2, 90 - s // 2, s, s) for i, s in enumerate(sizes)]
+    res = _assert_identical(_render(200, 280, boxes, seed=1), boxes[0], **extra)
+    assert sum(r.ok for r in res) > 40
+
+
+@needs_numba
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_large_target_decimated(kernel):
     """Targets of 300 and 430 px: decimation 4 and 8 (the kernel reads every D-th pixel)."""
@@ -240,6 +252,13 @@ def test_real_sequences_identical(real_sequences):
         _assert_identical(frames, box)
 
 
+@needs_numba
+def test_real_sequences_identical_joint_gate(real_sequences):
+    """The joint colour x orientation bins with the gated scale test (off by default), both paths."""
+    for name, (frames, box) in real_sequences.items():
+        _assert_identical(frames, box, orient_T=64, scale_test=0.05, scale_test_gate=True)
+
+
 # ----------------------------------------------------------------------------- path selection
 def test_unknown_path_rejected():
     with pytest.raises(ValueError):
@@ -260,3 +279,18 @@ def test_numba_switched_off_falls_back_to_numpy(monkeypatch):
     assert v2.FloatTrackerV2().active_path() == "numpy"
     with pytest.raises(RuntimeError):
         v2.FloatTrackerV2(path="numba").active_path()
+
+
+def test_joint_bins_area_equals_whole_frame():
+    """The joint bins of an area (numba path's region) equal the whole decimated image's."""
+    rng = np.random.default_rng(5)
+    frame = np.ascontiguousarray(rng.integers(0, 256, (97, 203, 3), dtype=np.uint8))
+    frame[20:60, 30:150] = cv2.GaussianBlur(frame[20:60, 30:150], (0, 0), 3)
+    for d in (1, 2, 4):
+        trk = v2.FloatTrackerV2(TrackerParams(preset="v2", orient_T=32), path="numpy")
+        whole = trk._bins(frame, d)
+        h, w = whole.shape
+        for x0, x1, y0, y1 in ((0, w, 0, h), (0, 5, 0, 7), (w - 9, w, h - 4, h), (3, 40, 2, 11),
+                               (w // 3, w // 2, h // 4, h - 1), (60 // d, 130 // d + 1, 1, h)):
+            got = v2.joint_bins_area(frame, d, 3, 32, x0, x1, y0, y1)
+            assert np.array_equal(got, whole[y0:y1, x0:x1]), (d, x0, x1, y0, y1)

@@ -77,7 +77,9 @@ def loss_section(seq_root: Path) -> list[str]:
            "off-target frames (IoU = 0) whose result is not `ok`; *false alarms* = share of on-target "
            "frames (IoU >= 0.5) whose result is not `ok` (`TrackResult.ok`: status ok, init, clipped or "
            "reacquired).  Target: recall >= 0.6 at false alarms <= 0.05.  From the cached runs of the "
-           "two commands above.", "",
+           "two commands above.  v2's `ok` is its loss flag (docs/algorithm.md, \"v2.7a Loss flag\"); "
+           "the signals, the choice of the rule and its leave-one-sequence-out scores: "
+           "[results_loss.md](results_loss.md).", "",
            "| tracker | off-target frames | recall | on-target frames | false alarms |", "|---|---:|---:|---:|---:|"]
     out += rows
     labels = [n if m == "float" else f"{n}@fixed" for n, m in LOSS_TRACKERS[:2]]

@@ -99,6 +99,9 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     v_u = min(floor(o* 2**8 / O_u), 2**8) (2**8 where O_u = 0);
     Qn_u = floor(Q_u v_u 2**16 / sum(Q v));  T_u = 1 where Q_u sum(O) > O_u sum(Q)
     (q_u > o_u, exact); without any ring pixel: v = 1 and T_u = (Q_u > 0).
+    When sum(Q v) = 0 (every colour of the box more than 256x as frequent in the ring as the
+    rarest ring colour, so every v_u = 0), Qn = 0: the model matches nothing and the first
+    frame reports the target lost (rtl/ms_bg_model.vhd does the same).
     """
     height, width = bins.shape
     ker = ms_kernel(wb, hb, "flat", 8)
@@ -126,7 +129,8 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     tot = int(qv.sum())
     Qn = np.zeros(n_bins, np.int64)
     nz = qv > 0
-    Qn[nz] = ms_divider(qv[nz] << QN_BITS, tot, QN_BITS + 1)
+    if tot > 0:  # tot = 0: every box colour has v = 0 (> 256x more frequent in the ring): Qn = 0
+        Qn[nz] = ms_divider(qv[nz] << QN_BITS, tot, QN_BITS + 1)
     return ModelV2(Qn=Qn, T=T, Q=Q, O=O)
 
 
@@ -171,6 +175,42 @@ def ms_share(st: TargetStats) -> int:
     return int(ms_divider(st.nt_in << 16, st.n_in, 17)) if st.n_in else 0
 
 
+def ms_ring_share(st: TargetStats, K: int) -> int:
+    """ring_share = floor((nt - nt_in) 2**16 / (K - n_in)) (Q.16; 0 when K <= n_in).
+
+    The share of target-coloured pixels in the window's ring around the box
+    (the K - n_in window pixels outside the inner window; flat kernel: K is the
+    window's pixel count).  nt - nt_in <= K - n_in, so the result is in
+    0 .. 2**16 (17 bits); dividend < 2**(16 + 14) for K < 2**14.
+    """
+    den = K - st.n_in
+    return int(ms_divider((st.nt - st.nt_in) << 16, den, 17)) if den > 0 else 0
+
+
+def ms_loss_filter(s: int, x: int, k: int) -> int:
+    """One step of the loss flag's smoothing: s + ((x - s) >> k) (arithmetic shift = floor).
+
+    Used for rho (unsigned Q1.16, 0 .. 2**16) and for contrast = share - ring_share
+    (signed Q1.16, -2**16 .. 2**16); k = log2(1 / loss_smooth) (default 1).  The
+    result lies between s and x, so it keeps the range of its inputs (18 bits signed).
+    """
+    return s + ((x - s) >> k)
+
+
+def ms_loss_flag(rho_s: int, rho0: int, con_s: int, share: int, loss_rho: int, loss_contrast: int) -> bool:
+    """The loss flag: share = 0  or  rho_s = 0  or  (rho_s 2**16 < loss_rho rho0  and  con_s < loss_contrast).
+
+    rho_s (smoothed rho) and rho0 (rho at init): unsigned Q1.16 in 0 .. 2**16;
+    con_s (smoothed share - ring_share): signed Q1.16 in -2**16 .. 2**16;
+    loss_rho (unsigned Q1.16, 0 .. 2**17) and loss_contrast (signed Q1.16,
+    -2**16 .. 2**16) are the rounded parameters.  Exact comparisons: an 18 x 17 bit
+    product (< 2**34) against rho_s 2**16 (< 2**33), an 18-bit signed compare, and a
+    zero test of this frame's share (Q1.16; 0 = no target-coloured pixel in the box) and of rho_s
+    (0 = the model matches nothing, e.g. a degenerate init model with Qn = 0, where rho0 = 0 too).
+    """
+    return share == 0 or rho_s == 0 or (rho_s << 16 < loss_rho * rho0 and con_s < loss_contrast)
+
+
 def ms_spread(st: TargetStats) -> int:
     """spread = floor(st2 2**16 / nt): mean d2q of the target-coloured pixels, Q.(KB + 16); 0 if nt = 0."""
     return int(ms_divider(st.st2 << 16, st.nt, 40)) if st.nt else 0
@@ -207,3 +247,58 @@ def ms_scale(spread: int, spread_ref: int, w8: int, w0_8: int, tp: TrackerParams
 def ms_resize(s8: int, s: int, frame_size: int) -> int:
     """New size (Q.8): (s8 s) >> 16, clamped to [3, frame_size] px."""
     return min(max((s8 * s) >> 16, 3 << SIZE_FRAC), frame_size << SIZE_FRAC)
+
+
+# ----------------------------------------------------------------------------- experimental (off by default)
+# docs/results_v2_mean.md: joint colour x orientation bins and the gated scale test
+# (TrackerParams.orient_T, scale_test, scale_test_gate; docs/fixed_point.md "Experimental").
+ORIENT_FLAT = 8  # the orientation bin of pixels with |Gx| + |Gy| < T (and of the frame's 1-px border)
+
+
+def ms_orient_bin(grey: np.ndarray, T: int) -> np.ndarray:
+    """Orientation bin of every pixel of ``grey`` (H, W) from the 3x3 Sobel (ms_sobel's Gx, Gy):
+    4 [Gx < 0] + 2 [Gy < 0] + [|Gy| > |Gx|] where |Gx| + |Gy| >= T, else 8; 8 on the 1-px frame
+    border (no Sobel there).  Gx, Gy 11-bit signed, |Gx| + |Gy| 11 bits (0..2040); T 11 bits.
+    Two sign bits, one 10-bit compare, one 11-bit compare.  (H, W) int64 in 0..8."""
+    g = grey.astype(np.int64)
+    out = np.full(g.shape, ORIENT_FLAT, np.int64)
+    if g.shape[0] < 3 or g.shape[1] < 3:
+        return out
+    gx = (g[:-2, 2:] + 2 * g[1:-1, 2:] + g[2:, 2:]) - (g[:-2, :-2] + 2 * g[1:-1, :-2] + g[2:, :-2])
+    gy = (g[2:, :-2] + 2 * g[2:, 1:-1] + g[2:, 2:]) - (g[:-2, :-2] + 2 * g[:-2, 1:-1] + g[:-2, 2:])
+    ax, ay = np.abs(gx), np.abs(gy)
+    octant = 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax)
+    out[1:-1, 1:-1] = np.where(ax + ay >= T, octant, ORIENT_FLAT)
+    return out
+
+
+def ms_joint_bin(colour: np.ndarray, orient: np.ndarray) -> np.ndarray:
+    """Joint bin = 9 colour + orient ((colour << 3) + colour + orient: one adder), < 9 2**(3b)."""
+    return (colour << 3) + colour + orient
+
+
+def ms_scale_test_size(s8: int, d256: int, up: bool) -> int:
+    """Size (Q.8) of a scale-test window: (s8 (256 +- d256) + 128) >> 8 (round half up)."""
+    return (s8 * (256 + d256 if up else 256 - d256) + 128) >> 8
+
+
+def ms_scale_test(rho: int, rho_lo: int | None, rho_hi: int | None) -> int:
+    """The scale test's verdict from rho at the window x1, x(1 - d), x(1 + d) (Q.16; None: that
+    window did not fit the captured region, it never wins): -1 / 0 / +1, the largest rho, ties to
+    the earlier of (1, 1 - d, 1 + d).  Two 17-bit compares."""
+    best, v = rho, 0
+    if rho_lo is not None and rho_lo > best:
+        best, v = rho_lo, -1
+    if rho_hi is not None and rho_hi > best:
+        v = 1
+    return v
+
+
+def ms_scale_gate(spread: int, spread_ref: int, verdict: int) -> int:
+    """The spread that ms_scale gets: ``spread`` when the rho test moves the same way
+    (spread > spread_ref and verdict +1, or spread < spread_ref and verdict -1), else spread_ref
+    (est = 1 exactly in ms_scale: floor(r 2**16 / r) = 2**16, isqrt(2**32) = 2**16).  One
+    40-bit compare."""
+    if (spread > spread_ref and verdict > 0) or (spread < spread_ref and verdict < 0):
+        return spread
+    return spread_ref

@@ -11,7 +11,9 @@ Per frame (all integer; blocks in :mod:`mstrack.fixed.blocks_v2` and :mod:`mstra
    loop) from the last centre; while lost also from 8 start points at
    +-search_step window diameters (search_iter iterations each).
 4. rho = ms_rho_out(S, K); share and spread from :func:`ms_target_stats` at
-   the final centre; confidence; status; the best start point wins while lost.
+   the final centre; confidence; the best start point wins while lost; the
+   search state from the confidence; the reported status from the loss flag
+   (ms_ring_share, ms_loss_flag against rho0 = rho at init).
 5. References (rho_ref, share_ref) follow confident frames by a shift;
    the size changes by ms_scale every frame.
 
@@ -24,11 +26,13 @@ import numpy as np
 from ..frames import check_frame
 from ..params import TrackerParams
 from ..types import Box, Status, TrackResult
-from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_histogram,
+from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_grey, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
-from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_model_scale,
-                        ms_ref_update, ms_resize, ms_scale, ms_share, ms_spread, ms_target_stats,
-                        ms_window_size, ms_box_size, q16, rate_shift, sixteenths)
+from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,
+                        ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+                        ms_target_stats,
+                        ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
+                        ms_scale_gate, ms_scale_test, ms_scale_test_size)
 from .formats import FixedParams, widths
 
 # Integer fields of one v2 result (what result word v2 will carry).
@@ -50,8 +54,13 @@ class FixedTrackerV2:
         self.ring16 = sixteenths(p.bg_ring, "bg_ring")
         self.step16 = sixteenths(p.search_step, "search_step")
         self.ref_k = rate_shift(p.ref_rate)
+        self.loss_rho16, self.loss_contrast16 = q16(p.loss_rho), q16(p.loss_contrast)
+        self.loss_k = rate_shift(p.loss_smooth)
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
+        if p.motion_gain > 0 or (p.scale_test > 0 and not p.scale_test_gate):
+            raise ValueError("the fixed-point v2 model has, of the experimental options, orient_T and the "
+                             "gated scale test only (motion_gain 0, scale_test_gate with scale_test)")
         if p.max_window > 2 * self.fixed.max_half + 1:
             raise ValueError(f"max_window {p.max_window} > 2 max_half + 1 = {2 * self.fixed.max_half + 1}")
         self.widths = widths(p, self.fixed)
@@ -59,7 +68,11 @@ class FixedTrackerV2:
 
     # ------------------------------------------------------------------ helpers
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
-        return ms_colour_bin(frame[::d, ::d], self.params.colour_bits)
+        c = ms_colour_bin(frame[::d, ::d], self.params.colour_bits)
+        if self.params.orient_T <= 0:
+            return c
+        # joint bins (experimental, off by default): Sobel on the full-resolution grey frame
+        return ms_joint_bin(c, ms_orient_bin(ms_grey(frame), self.params.orient_T)[::d, ::d])
 
     def _geometry(self, d: int, dims: tuple[int, int]) -> tuple[int, int]:
         """Window diameters (decimated px), limited to the decimated frame's interior."""
@@ -78,14 +91,42 @@ class FixedTrackerV2:
         if sub is None:
             sub = self._capture(img, reg)
         tp = p.with_(max_iter=max_iter)
-        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_colour_bins, self.widths.shift_q)
+        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_bins_v2, self.widths.shift_q)
         win = (ms_round_centre(r.c8[0], cf) - reg.x, ms_round_centre(r.c8[1], cf) - reg.y)
         st = ms_target_stats(sub, self.model.T, win, ker, fx.kernel_bits, self.pad16)
         return r.c8, r.S, r.iterations, r.stop, st
 
     def _capture(self, img: np.ndarray, reg: Region) -> np.ndarray:
-        """ms_region_capture for v2: the colour bins of the region's pixels of the decimated image."""
+        """ms_region_capture for v2: the colour bins of the region's pixels of the decimated image
+        (joint bins: the region of the frame's joint bin image, ``self._joint``)."""
+        if self.params.orient_T > 0:
+            return self._joint[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
         return ms_colour_bin(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], self.params.colour_bits)
+
+    def _scale_verdict(self, sub: np.ndarray, reg: Region, c8d: tuple[int, int], d: int,
+                       rho: int, dims: tuple[int, int]) -> int:
+        """The scale test (experimental): rho of the windows of sizes x(1 -+ scale_test) at the
+        final centre (ms_scale_test_size, ms_window_size, kernel tables, model at that window, one
+        pixel pass and one bin pass each); a window outside the captured region does not count."""
+        p, fx = self.params, self.fixed
+        cf = fx.centre_frac
+        d256 = round(p.scale_test * 256)
+        win = (ms_round_centre(c8d[0], cf), ms_round_centre(c8d[1], cf))
+        rhos = []
+        for up in (False, True):
+            w8 = ms_scale_test_size(self.w8, d256, up)
+            h8 = ms_scale_test_size(self.h8, d256, up)
+            wd = ms_window_size(w8, self.pad16, d, min(p.max_window, dims[1] - 2))
+            hd = ms_window_size(h8, self.pad16, d, min(p.max_window, dims[0] - 2))
+            ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+            if (win[0] - ker.ex < reg.x or win[1] - ker.ey < reg.y or win[0] + ker.ex >= reg.x + reg.w
+                    or win[1] + ker.ey >= reg.y + reg.h):
+                rhos.append(None)
+                continue
+            hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
+            S = ms_bin_pass(ms_model_scale(self.model.Qn, ker.K), hist, fx).S
+            rhos.append(ms_rho_out(S, ker.K, fx))
+        return ms_scale_test(rho, rhos[0], rhos[1])
 
     def _box(self) -> Box:
         s = float(1 << self.fixed.centre_frac)
@@ -119,26 +160,33 @@ class FixedTrackerV2:
         hd_, wd_ = bins.shape
         sh = d.bit_length() - 1
         cd = (ms_round_centre(self.c8[0] >> sh, cf), ms_round_centre(self.c8[1] >> sh, cf))
-        wb = ms_box_size(self.w8, d, wd_ - 2)
-        hb = ms_box_size(self.h8, d, hd_ - 2)
+        wb = ms_box_size(self.w8, d, min(p.max_window, wd_ - 2))
+        hb = ms_box_size(self.h8, d, min(p.max_window, hd_ - 2))
         # keep the box inside the decimated interior
         cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
-        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_colour_bins)
+        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2)
         wd, hd = self._geometry(d, bins.shape)
         ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one pass at the init centre (no iteration) gives the references
+        if p.orient_T > 0:
+            self._joint = bins
         _, S, _, _, st = self._ref_pass(frame[::d, ::d], Qw, ker, start8)
         self.rho_ref = ms_rho_out(S, ker.K, fx)
         self.share_ref = ms_share(st)
+        self.rho0 = self.rho_ref  # the loss flag's reference: rho at init
+        self.rho_s = self.rho0    # the loss flag's filters start at the init values
+        self.con_s = self.share_ref - ms_ring_share(st, ker.K)
         sp = ms_spread(st)
         self.spread_ref = sp if sp > 0 else ((128 << (fx.kernel_bits + 16)) // (16 + self.pad16) ** 2)
         self.lost = False
+        self.reported_lost = False
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
                "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
-               "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref}
+               "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref,
+               "rho_s": self.rho_s, "contrast_s": self.con_s}
         return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
                            rho_c=self.rho_ref / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=0,
                            iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
@@ -152,7 +200,7 @@ class FixedTrackerV2:
         c8 = clamp_centre(start8, reg, cf)
         win = (ms_round_centre(c8[0], cf), ms_round_centre(c8[1], cf))
         sub = self._capture(img, reg)
-        hist = ms_histogram(sub, reg, win, ker, p.n_colour_bins)
+        hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
         S = ms_bin_pass(Qw, hist, fx).S
         st = ms_target_stats(sub, self.model.T, (win[0] - reg.x, win[1] - reg.y), ker, fx.kernel_bits, self.pad16)
         return c8, S, 0, "shift", st
@@ -167,6 +215,8 @@ class FixedTrackerV2:
         d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
         sh = d.bit_length() - 1
         img = frame[::d, ::d]
+        if p.orient_T > 0:
+            self._joint = self._bins(frame, d)
         wd, hd = self._geometry(d, img.shape[:2])
         ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
         Qw = ms_model_scale(self.model.Qn, ker.K)
@@ -193,28 +243,45 @@ class FixedTrackerV2:
                     conf2 = ms_confidence(rho2, share2, self.rho_ref, self.share_ref)
                     if conf2 > conf:
                         c8d, S, st, rho, share, conf = c2, S2, st2, rho2, share2, conf2
+        # search state (what the tracker does next) from the confidence
         if conf < q16(p.conf_reacquire if self.lost else p.conf_lost):
-            status = Status.LOST
+            state = Status.LOST
         elif self.lost:
-            status = Status.REACQUIRED
+            state = Status.REACQUIRED
         elif conf < q16(p.conf_uncertain):
-            status = Status.UNCERTAIN
+            state = Status.UNCERTAIN
         else:
-            status = Status.OK
-        self.lost = status == Status.LOST
+            state = Status.OK
+        # reported status from the loss flag (float: report_status)
+        ring = ms_ring_share(st, ker.K)
+        self.rho_s = ms_loss_filter(self.rho_s, rho, self.loss_k)
+        self.con_s = ms_loss_filter(self.con_s, share - ring, self.loss_k)
+        if ms_loss_flag(self.rho_s, self.rho0, self.con_s, share, self.loss_rho16, self.loss_contrast16):
+            status = Status.LOST if state == Status.LOST else Status.UNCERTAIN
+        else:
+            status = Status.REACQUIRED if self.reported_lost else Status.OK
+        self.lost = state == Status.LOST
+        self.reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self.reported_lost)
         self.c8 = (c8d[0] << sh, c8d[1] << sh)
-        if status == Status.OK:
+        if state == Status.OK:
             self.rho_ref = ms_ref_update(self.rho_ref, rho, self.ref_k)
             self.share_ref = ms_ref_update(self.share_ref, share, self.ref_k)
         spread = ms_spread(st)
         if p.scale_gain > 0 and st.nt > 0:
-            s = ms_scale(spread, self.spread_ref, self.w8, self.w0_8, p)
+            sp = spread
+            if p.scale_test > 0 and p.scale_test_gate:  # experimental (off by default)
+                sp = ms_scale_gate(spread, self.spread_ref,
+                                   self._scale_verdict(sub, reg, c8d, d, rho, img.shape[:2]))
+            s = ms_scale(sp, self.spread_ref, self.w8, self.w0_8, p)
             fh, fw = self._shape
             self.w8 = ms_resize(self.w8, s, fw)
             self.h8 = ms_resize(self.h8, s, fh)
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": rho,
                "confidence": conf, "status": STATUS_CODES_V2[status], "iter": it, "decimation": d,
-               "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched}
+               "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched,
+               "nt": st.nt, "n_in": st.n_in, "nt_in": st.nt_in, "K": ker.K,
+               "ring_share": ring, "state": STATUS_CODES_V2[state], "rho_s": self.rho_s,
+               "contrast_s": self.con_s}
         return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
                            rho_c=rho / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=it, iter_e=0,
                            status=status, confidence=conf / 65536.0, extra=raw)

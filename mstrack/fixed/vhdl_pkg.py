@@ -76,6 +76,56 @@ def core_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None
     return g
 
 
+def v2_scale_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None,
+                      lanes: int = DEFAULT_LANES) -> dict[str, int]:
+    """Generics of the v2 statistics and scale blocks (ms_target_stats, ms_share, ms_spread,
+    ms_scale, ms_resize), derived from the model (docs/fixed_point.md, "Tracker v2").
+
+    Worst case over all windows: the counts hold the largest window's pixels; st2 the largest window
+    times the largest d2q (2**(KB + 1) - 1, the bound docs/fixed_point.md states; inside the ellipse
+    d2q < 2**KB in fact); spread = floor(st2 2**16 / nt) <= that d2q in Q.16.  ms_scale's ratio
+    division needs only RATIO_Q_W quotient bits: every ratio r >= 2**RATIO_Q_W - 1 gives
+    isqrt(r 2**16) >= 1 + step, clamped to the same value, so saturating there is exact.  The size
+    ratio w8 2**16 / w0_8 (w0_8 >= 3 px, w8 < 2**SIZE_W) never saturates with WR_Q_W bits.
+    """
+    from .blocks_v2 import ONE, SIZE_FRAC, q16, sixteenths
+    from .primitives import ms_isqrt
+
+    tp = tp or TrackerParams(preset="v2")
+    fp = fp or FixedParams()
+    g = core_generics(tp, fp, lanes)
+    w = widths(tp, fp)
+    kb = fp.kernel_bits
+    d2q_max = (1 << (kb + 1)) - 1
+    step = q16(tp.scale_step)
+    hi = ONE + step
+    ratio_q = 1
+    while int(ms_isqrt(((1 << ratio_q) - 1) << 16)) < hi:
+        ratio_q += 1
+    size_w = fp.coord_bits + SIZE_FRAC
+    return {
+        "LANES": lanes,
+        "BIN_W": 3 * tp.colour_bits,
+        "HALF_W": g["HALF_W"],
+        "REGION_W": g["REGION_W"],
+        "KERNEL_BITS": kb,
+        "KT_W": kb + 1,
+        "PAD16": sixteenths(tp.pad, "pad"),
+        "COUNT_W": w.count,
+        "ST2_W": bits_for(w.pix_max * d2q_max),
+        "SHARE_W": bits_for(ONE),
+        "SPREAD_W": bits_for(d2q_max << 16),
+        "SIZE_W": size_w,
+        "COORD_W": fp.coord_bits,
+        "SCALE_W": bits_for(hi),
+        "SCALE_GAIN": q16(tp.scale_gain),
+        "SCALE_REG": q16(tp.scale_reg),
+        "SCALE_STEP": step,
+        "RATIO_Q_W": ratio_q,
+        "WR_Q_W": bits_for((((1 << size_w) - 1) << 16) // (3 << SIZE_FRAC)),
+    }
+
+
 def formats_pkg_text(lanes: int = DEFAULT_LANES) -> str:
     g = core_generics(lanes=lanes)
     lines = [
@@ -101,7 +151,16 @@ FRAME_COUNT_W = 16
 
 
 def result_layout(g: dict[str, int] | None = None) -> list[tuple[str, int, int]]:
-    """Fields of the result word, LSB first: (name, offset, width).  ms_tracker packs the same order."""
+    """Fields of result word v1, LSB first: ``[(name, offset, width), ...]``.
+
+    ms_tracker packs the same order (rtl/ms_tracker.vhd); the widths follow the generics ``g``
+    (default: :func:`core_generics` of the default parameters).  Fields: ``cx, cy`` target centre,
+    unsigned Q(COORD_W).CF px; ``rho_c, rho_e`` Bhattacharyya coefficients Q.RHO_OUT_FRAC;
+    ``alpha_c`` colour weight Q.AF; ``iter_c, iter_e`` iterations; ``stop_c, stop_e`` stop codes
+    (0 shift, 1 rho, 2 max_iter, 3 lost); ``flags`` (bits :data:`RESULT_FLAGS`); ``err_code``
+    (stream error, rtl/ms_stream_pkg.vhd); ``box_w, box_h`` box size (px); ``frame_count``
+    (frames since reset, mod 2**16).  The word is :func:`result_width` bits wide.
+    """
     g = g or core_generics()
     win_w = g["WIN_W"]
     fields_ = [("cx", g["CENTRE_ABS_W"]), ("cy", g["CENTRE_ABS_W"]), ("rho_c", g["RHO_OUT_W"]),
@@ -122,12 +181,127 @@ def result_width(g: dict[str, int] | None = None) -> int:
     return -(-(off + w) // 8) * 8
 
 
+def pack_result(fields: dict[str, int], g: dict[str, int] | None = None) -> int:
+    """Pack the fields of :func:`result_layout` (missing ones are 0) into one result word v1.
+
+    Raises ValueError for an unknown field or a value that is negative or does not fit its width.
+    """
+    word = 0
+    layout = result_layout(g)
+    extra = set(fields) - {name for name, _, _ in layout}
+    if extra:
+        raise ValueError(f"unknown result field(s): {sorted(extra)}")
+    for name, off, w in layout:
+        v = int(fields.get(name, 0))
+        if v < 0 or v >= 1 << w:
+            raise ValueError(f"result field {name} = {v} does not fit in {w} bits")
+        word |= v << off
+    return word
+
+
 def unpack_result(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
-    """Split a result word into its fields; flags are also given one key each (flag_<name>)."""
+    """Split a result word v1 into its fields (:func:`result_layout`), as non-negative ints.
+
+    Flags are also given one key each (``flag_<name>``, 0 or 1, names :data:`RESULT_FLAGS`).
+    ``g``: the generics of the core that produced the word (default: the default core).
+    The C driver's ``mstrack_decode_word`` (sw/mstrack_drv.c) decodes the same way (tested).
+
+    >>> unpack_result(pack_result({"cx": 5, "flags": 4}))["flag_lost"]
+    1
+    """
     out = {name: (word >> off) & ((1 << w) - 1) for name, off, w in result_layout(g)}
     for i, f in enumerate(RESULT_FLAGS):
         out[f"flag_{f}"] = (out["flags"] >> i) & 1
     return out
+
+
+# ----------------------------------------------------------------------------- result word v2
+# Core v2 (issue 11) carries tracker v2's result: the box size follows the target, the status is
+# one of STATUS_V2 and the confidence is a Q1.16 number.  The model side (this layout, packing
+# FixedTrackerV2's raw integers, decoding) exists before the RTL so that core v2 is built against
+# it; docs/architecture.md ("Result word v2") lists it.
+STATUS_V2 = ("ok", "uncertain", "lost", "reacquired", "init", "clipped", "error")
+STATUS_W = 3
+CONF_W = 17                 # Q1.16, 0 .. 2**16
+DECIM_LOG2_W = 3            # log2 D: 0 .. 4 (D = 16 while lost at D = 8)
+SEARCHED_W = 4              # start points searched besides the centre while lost: 0 .. 8
+STOP_CODES_V2 = ("shift", "rho", "max_iter", "lost")
+
+
+def result_layout_v2(g: dict[str, int] | None = None) -> list[tuple[str, int, int]]:
+    """Fields of result word v2, LSB first: (name, offset, width).
+
+    ``cx, cy``: centre Q(COORD_W).CF in full-resolution pixel-index coordinates;
+    ``w8, h8``: box size Q(COORD_W).8 px; ``rho``, ``confidence``: Q1.16;
+    ``status``: index into :data:`STATUS_V2`; ``iter``, ``stop``: the winning mean shift;
+    ``decim_log2``: log2 of the decimation used in the frame; ``searched``: extra start points;
+    ``flags`` and ``err_code`` as in result word v1 (stream errors); ``frame_count``.
+    """
+    if g is None:
+        from ..params import TrackerParams
+        g = core_generics(TrackerParams(preset="v2"))
+    size_w = g["COORD_W"] + 8
+    fields_ = [("cx", g["CENTRE_ABS_W"]), ("cy", g["CENTRE_ABS_W"]), ("w8", size_w), ("h8", size_w),
+               ("rho", g["RHO_OUT_W"]), ("confidence", CONF_W), ("status", STATUS_W),
+               ("iter", g["ITER_W"]), ("stop", 2), ("decim_log2", DECIM_LOG2_W), ("searched", SEARCHED_W),
+               ("flags", len(RESULT_FLAGS)), ("err_code", ERR_CODE_W), ("frame_count", FRAME_COUNT_W)]
+    out, off = [], 0
+    for name, w in fields_:
+        out.append((name, off, w))
+        off += w
+    return out
+
+
+def result_width_v2(g: dict[str, int] | None = None) -> int:
+    """Result word v2 width: the fields rounded up to a multiple of 8 bits."""
+    name, off, w = result_layout_v2(g)[-1]
+    return -(-(off + w) // 8) * 8
+
+
+def pack_result_v2(fields: dict[str, int], g: dict[str, int] | None = None) -> int:
+    """Pack the fields of :func:`result_layout_v2` (missing ones are 0) into one word.
+
+    Raises ValueError when a value is negative or does not fit its field (the widths are the
+    specification: a value that does not fit is a model or width bug, never truncated silently).
+    """
+    word = 0
+    layout = result_layout_v2(g)
+    known = {name for name, _, _ in layout}
+    extra = set(fields) - known
+    if extra:
+        raise ValueError(f"unknown result v2 field(s): {sorted(extra)}")
+    for name, off, w in layout:
+        v = int(fields.get(name, 0))
+        if v < 0 or v >= 1 << w:
+            raise ValueError(f"result v2 field {name} = {v} does not fit in {w} bits")
+        word |= v << off
+    return word
+
+
+def unpack_result_v2(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
+    """Split a result word v2 into its fields; flags also one key each (flag_<name>)."""
+    out = {name: (word >> off) & ((1 << w) - 1) for name, off, w in result_layout_v2(g)}
+    for i, f in enumerate(RESULT_FLAGS):
+        out[f"flag_{f}"] = (out["flags"] >> i) & 1
+    return out
+
+
+def result_fields_v2(extra: dict[str, int], frame_count: int = 0) -> dict[str, int]:
+    """The result word v2 fields of one frame of FixedTrackerV2 (``TrackResult.extra``).
+
+    Flags follow the status (init, clipped, lost); a model frame has no stream error.
+    """
+    status = STATUS_V2[int(extra["status"])]
+    d = int(extra["decimation"])
+    flags = 0
+    for name in ("init", "clipped", "lost"):
+        if status == name:
+            flags |= 1 << RESULT_FLAGS.index(name)
+    return {"cx": int(extra["cx"]), "cy": int(extra["cy"]), "w8": int(extra["w8"]), "h8": int(extra["h8"]),
+            "rho": int(extra["rho"]), "confidence": int(extra["confidence"]), "status": int(extra["status"]),
+            "iter": int(extra["iter"]), "stop": int(extra.get("stop", 0)), "decim_log2": d.bit_length() - 1,
+            "searched": int(extra.get("searched", 0)), "flags": flags, "err_code": 0,
+            "frame_count": frame_count & ((1 << FRAME_COUNT_W) - 1)}
 
 
 if __name__ == "__main__":

@@ -22,6 +22,7 @@ use work.ms_formats_pkg.all;
 entity ms_tracker_pins is
   generic (
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    RGB_PACKING    : natural := 0;               -- s_axis_tdata layout (ms_tracker)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
@@ -109,6 +110,7 @@ begin
   u_core : entity work.ms_tracker
     generic map (
       MAX_FRAME_W  => MAX_FRAME_W,
+      RGB_PACKING  => RGB_PACKING,
       LANES        => LANES,
       COLOUR_BITS  => COLOUR_BITS,
       EDGE_BINS_LOG2=> EDGE_BINS_LOG2,

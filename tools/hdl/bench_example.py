@@ -1,4 +1,4 @@
-"""Measure simulator speed (cycles/s) on the toy rtl/ms_example.vhd.
+"""Measure simulator speed (cycles/s) on the toy tb/flow_example.vhd.
 
     .venv/bin/python tools/hdl/bench_example.py [LINES]
 
@@ -21,7 +21,7 @@ from mstrack import hdl  # noqa: E402
 
 def main() -> None:
     lines = sys.argv[1] if len(sys.argv) > 1 else "400"
-    env = {"MS_EXAMPLE_LINES": lines, "MS_EXAMPLE_RAW_CYCLES": str(int(lines) * 2560)}
+    env = {"FLOW_EXAMPLE_LINES": lines, "FLOW_EXAMPLE_RAW_CYCLES": str(int(lines) * 2560)}
     g = {"WIDTH": 8}
     runs = [("ghdl-mcode", "mcode"), ("ghdl-llvm", "llvm")]
     for name, backend in runs:
@@ -29,11 +29,11 @@ def main() -> None:
             continue
         with hdl._environ(MSTRACK_GHDL_BACKEND=backend):
             t0 = time.monotonic()
-            hdl.run_ghdl("ms_example", "test_ms_example", g, build_name=f"bench_{name}",
+            hdl.run_ghdl("flow_example", "test_flow_example", g, [hdl.TB_DIR / "flow_example.vhd"], build_name=f"bench_{name}",
                          testcase=["throughput", "raw_speed"], extra_env=env)
             print(f"{name:12s} wall {time.monotonic() - t0:6.1f} s  (see SPEED line above)", flush=True)
     t0 = time.monotonic()
-    hdl.run_verilator("ms_example", "test_ms_example", g, build_name="bench_verilator",
+    hdl.run_verilator("flow_example", "test_flow_example", g, [hdl.TB_DIR / "flow_example.vhd"], build_name="bench_verilator",
                       testcase=["throughput", "raw_speed"], extra_env=env)
     print(f"{'verilator':12s} wall {time.monotonic() - t0:6.1f} s  (see SPEED line above)", flush=True)
 

@@ -1,4 +1,4 @@
-"""cocotb test bench + pytest entry points for rtl/ms_example.vhd (flow smoke test).
+"""cocotb test bench + pytest entry points for tb/flow_example.vhd (flow smoke test).
 
 One file holds both:
   * the cocotb tests (run inside the simulator: ``@cocotb.test`` functions), and
@@ -13,7 +13,7 @@ Video framing with cocotbext-axi (one pixel per beat):
     width (the default splits tdata into 8-bit lanes and rejects widths that
     are not a multiple of 8).
 
-Run: ``.venv/bin/python -m pytest tb/test_ms_example.py`` (``--waves`` for waves).
+Run: ``.venv/bin/python -m pytest tb/test_flow_example.py`` (``--waves`` for waves).
 """
 
 from __future__ import annotations
@@ -142,7 +142,7 @@ async def throughput(dut):
     """One pixel per clock with no pauses; reports simulated cycles per wall second."""
     tb = TB(dut)
     await tb.reset()
-    lines, cols = int(os.environ.get("MS_EXAMPLE_LINES", "40")), min(tb.cols, 256)
+    lines, cols = int(os.environ.get("FLOW_EXAMPLE_LINES", "40")), min(tb.cols, 256)
     frame = tb.random_frame(random.Random(5), lines, cols)
     t0, c0 = time.perf_counter(), get_sim_time("ns")
     await tb.check_frames([frame])
@@ -156,7 +156,7 @@ async def throughput(dut):
 async def raw_speed(dut):
     """Simulator speed without per-cycle Python: inputs held constant (valid pixels,
     tlast every 2**COLS_LOG2 by the column counter wrapping), only the clock runs."""
-    cycles = int(os.environ.get("MS_EXAMPLE_RAW_CYCLES", "20000"))
+    cycles = int(os.environ.get("FLOW_EXAMPLE_RAW_CYCLES", "20000"))
     cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start(start_high=False))
     dut.rst.value = 1
     dut.s_axis_tvalid.value = 1
@@ -173,7 +173,7 @@ async def raw_speed(dut):
     dut._log.info("SPEED raw %d cycles in %.2f s = %.0f cycles/s", cycles, wall, cycles / wall)
 
 
-@cocotb.test(skip=os.environ.get("MS_EXAMPLE_DELIBERATE_FAIL") != "1")
+@cocotb.test(skip=os.environ.get("FLOW_EXAMPLE_DELIBERATE_FAIL") != "1")
 async def deliberate_failure(dut):
     """Only run by test_failure_is_reported: proves that a failing cocotb test fails pytest."""
     tb = TB(dut)
@@ -189,8 +189,10 @@ import pytest  # noqa: E402  (only needed on the pytest side)
 
 from mstrack import hdl  # noqa: E402
 
-TOP = "ms_example"
-MODULE = "test_ms_example"
+TOP = "flow_example"
+MODULE = "test_flow_example"
+#: the toy lives in tb/ (not in rtl/: it is no part of the core and not in the ms_ namespace)
+SOURCES = [hdl.TB_DIR / "flow_example.vhd"]
 
 PARAMS = [
     pytest.param({"WIDTH": 8}, id="w8"),
@@ -200,36 +202,36 @@ PARAMS = [
 
 @pytest.mark.ghdl
 @pytest.mark.parametrize("generics", PARAMS)
-def test_ms_example_ghdl(generics, hdl_waves):
-    hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves)
+def test_flow_example_ghdl(generics, hdl_waves):
+    hdl.run_ghdl(TOP, MODULE, generics, SOURCES, waves=hdl_waves)
 
 
 @pytest.mark.verilator
 @pytest.mark.parametrize("generics", PARAMS)
-def test_ms_example_verilator(generics, hdl_waves):
-    hdl.run_verilator(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves)
+def test_flow_example_verilator(generics, hdl_waves):
+    hdl.run_verilator(TOP, MODULE, generics, SOURCES, waves=hdl_waves)
 
 
 @pytest.mark.ghdl
 def test_failure_is_reported():
     with pytest.raises(hdl.HdlTestFailure, match="deliberate failure"):
-        hdl.run_ghdl(TOP, MODULE, {"WIDTH": 8}, hdl.rtl_sources(TOP), build_name="ghdl_ms_example_fail",
-                     testcase="deliberate_failure", extra_env={"MS_EXAMPLE_DELIBERATE_FAIL": "1"})
+        hdl.run_ghdl(TOP, MODULE, {"WIDTH": 8}, SOURCES, build_name="ghdl_flow_example_fail",
+                     testcase="deliberate_failure", extra_env={"FLOW_EXAMPLE_DELIBERATE_FAIL": "1"})
 
 
 @pytest.mark.synth
-def test_ms_example_synth():
+def test_flow_example_synth():
     """Flow smoke test: GHDL -> Yosys (ECP5 + Xilinx) -> nextpnr; RAM and multiplier inferred."""
-    r = hdl.synth_ecp5(TOP, {"WIDTH": 8}, hdl.rtl_sources(TOP), seed=1, freq_mhz=150)
+    r = hdl.synth_ecp5(TOP, {"WIDTH": 8}, SOURCES, seed=1, freq_mhz=150)
     assert (r["DP16KD"], r["MULT18X18D"]) == (1, 1), r["cells"]
     assert r["fmax_min_mhz"] and r["fmax_min_mhz"] > 60, r["fmax_mhz"]
-    x = hdl.synth_xilinx(TOP, {"WIDTH": 8}, hdl.rtl_sources(TOP))
+    x = hdl.synth_xilinx(TOP, {"WIDTH": 8}, SOURCES)
     assert (x["BRAM36"], x["DSP48E1"]) == (0.5, 1), x["cells"]
 
 
 @pytest.mark.verilator
 @pytest.mark.parametrize("pause", [0, 30])
-def test_ms_example_verilator_axis(pause):
+def test_flow_example_verilator_axis(pause):
     """Long-run path: generated Verilator C++ harness, whole frames, numpy model."""
     import numpy as np
 
@@ -241,7 +243,7 @@ def test_ms_example_verilator_axis(pause):
     tlast = np.zeros_like(pix)
     tlast[:, :, -1] = 1                     # end of each line
     beats = np.stack([pix.reshape(-1), tuser.reshape(-1), tlast.reshape(-1)], axis=1)
-    r = hdl.run_verilator_axis(TOP, {"WIDTH": 8}, beats, in_pause_pct=pause, out_pause_pct=pause)
+    r = hdl.run_verilator_axis(TOP, {"WIDTH": 8}, beats, sources=SOURCES, in_pause_pct=pause, out_pause_pct=pause)
     p = pix.astype(np.int64)
     above = np.concatenate([np.zeros((frames, 1, cols), np.int64), p[:, :-1, :]], axis=1)
     expected = (p * above).sum(axis=2).reshape(-1)

@@ -1,5 +1,5 @@
--- ms_example: toy design used to prove the HDL simulation / synthesis flow
--- (mstrack/hdl.py, tb/test_ms_example.py, docs/hdl_flow.md). Not part of the
+-- flow_example: toy design used to prove the HDL simulation / synthesis flow
+-- (mstrack/hdl.py, tb/test_flow_example.py, docs/hdl_flow.md). Not part of the
 -- tracker core.
 --
 -- Video in on an AXI4-Stream-style port, one pixel per beat:
@@ -22,7 +22,7 @@ library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
 
-entity ms_example is
+entity flow_example is
   generic (
     WIDTH     : natural := 8;     -- pixel width
     COLS_LOG2 : natural := 10;    -- line buffer depth = 2**COLS_LOG2 pixels
@@ -47,7 +47,7 @@ entity ms_example is
   );
 end entity;
 
-architecture rtl of ms_example is
+architecture rtl of flow_example is
   constant SUM_W : natural := 2 * WIDTH + COLS_LOG2;
 
   type ram_t is array (0 to 2 ** COLS_LOG2 - 1) of std_logic_vector(WIDTH - 1 downto 0);

@@ -1,0 +1,262 @@
+"""Configuration of the core from user-level choices: ``mstrack hdl config``.
+
+An integrator chooses what the system needs (widest frame, largest target, pixels per clock,
+features, kernel, preset, pixel packing); :func:`derive` turns the choices into every generic of
+``ms_tracker`` (the derived widths come from :func:`mstrack.fixed.vhdl_pkg.core_generics`, the
+single source of truth) and refuses impossible combinations with a one-line reason
+(:class:`ConfigError`).  The RTL checks the same relations at elaboration (``ms_tracker``,
+"generic checks"), so a hand-edited generic map is refused too.
+
+Outputs (:func:`render`): a VHDL package of constants (``C_<GENERIC>``, plus the generic map
+that uses them, as a comment to paste), a plain generic map, or JSON::
+
+    mstrack hdl config --max-frame-width 1920 --max-target 127 --lanes 4 --out ms_tracker_config_pkg.vhd
+    mstrack hdl config --kernel epanechnikov --format generic-map
+
+docs/packaging.md, "Configuration", lists the choices and the refusals.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from .fixed.formats import FixedParams
+from .fixed.vhdl_pkg import DEFAULT_LANES, core_generics
+from .params import TrackerParams
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+TRACKER_VHD = REPO_ROOT / "rtl" / "ms_tracker.vhd"
+
+#: s_axis_tdata layouts (generic RGB_PACKING): name -> (value, description)
+RGB_PACKINGS = {
+    "mstrack": (0, "R 23:16, G 15:8, B 7:0"),
+    "ug934": (1, "R 23:16, B 15:8, G 7:0 (AMD UG934, video format code 2: RGB)"),
+}
+#: largest window half-extent the kernel tables and the fixed-point formats are built for
+#: (FixedParams.max_half), i.e. targets up to 2 * 255 + 1 = 511 px
+MAX_HALF_LIMIT = 255
+FEATURES = ("fused", "colour", "edge")
+KERNELS = ("flat", "epanechnikov")
+PRESETS = ("paper", "v2")
+FORMATS = ("package", "generic-map", "json")
+
+
+class ConfigError(ValueError):
+    """An impossible combination of choices; the message is one line saying why."""
+
+
+@dataclass(frozen=True)
+class CoreChoices:
+    """What an integrator chooses (everything else is derived).
+
+    Attributes
+    ----------
+    max_frame_width : int
+        Widest frame in px (MAX_FRAME_W: depth of the Sobel line buffer); 3 .. 2**coord_bits - 1.
+    max_target : int
+        Largest target (window) in px, width and height; larger init boxes are shrunk about their
+        centre.  MAX_HALF = max_target // 2, so the largest window is 2 MAX_HALF + 1 px (odd).
+    lanes : int
+        LANES: region pixels per clock in a pixel pass (power of two).
+    features : {"fused", "colour", "edge"}
+    kernel : {"flat", "epanechnikov"}
+    preset : {"paper", "v2"}
+        Only "paper" has a core; "v2" is refused until core v2 is built (issue 11).
+    margin : int
+        MARGIN: search margin in px around the window (largest motion per frame followed).
+    coord_bits : int
+        COORD_W: frame coordinate bits; frames up to 2**coord_bits - 1 px wide and high.
+    rgb_packing : {"mstrack", "ug934"}
+        Layout of s_axis_tdata (:data:`RGB_PACKINGS`).
+    """
+
+    max_frame_width: int = 2048
+    max_target: int = 2 * FixedParams.max_half + 1
+    lanes: int = DEFAULT_LANES
+    features: str = "fused"
+    kernel: str = "flat"
+    preset: str = "paper"
+    margin: int = FixedParams.margin
+    coord_bits: int = FixedParams.coord_bits
+    rgb_packing: str = "mstrack"
+
+
+@dataclass(frozen=True)
+class CoreConfiguration:
+    """The result of :func:`derive`: model parameters and every generic of ms_tracker."""
+
+    choices: CoreChoices
+    tp: TrackerParams
+    fp: FixedParams
+    generics: dict[str, int]
+
+
+def derive(c: CoreChoices) -> CoreConfiguration:
+    """Every generic of ms_tracker for the choices ``c``; :class:`ConfigError` with the reason if impossible."""
+    if c.preset not in PRESETS:
+        raise ConfigError(f"preset {c.preset!r} unknown (one of {', '.join(PRESETS)})")
+    if c.preset == "v2":
+        raise ConfigError("preset v2 has no core yet (core v2, issue 11, is not built): use preset paper")
+    if c.features not in FEATURES:
+        raise ConfigError(f"features {c.features!r} unknown (one of {', '.join(FEATURES)})")
+    if c.kernel not in KERNELS:
+        raise ConfigError(f"kernel {c.kernel!r} unknown (one of {', '.join(KERNELS)})")
+    if c.rgb_packing not in RGB_PACKINGS:
+        raise ConfigError(f"rgb packing {c.rgb_packing!r} unknown (one of {', '.join(RGB_PACKINGS)})")
+    if not 8 <= c.coord_bits <= 14:
+        raise ConfigError(f"COORD_W {c.coord_bits} out of 8..14 (frames up to 255 .. 16383 px)")
+    coord_max = (1 << c.coord_bits) - 1
+    if c.max_frame_width < 3:
+        raise ConfigError(f"max frame width {c.max_frame_width} px: frames are at least 3 px wide")
+    if c.max_frame_width > coord_max:
+        need = c.max_frame_width.bit_length()
+        hint = f"; use --coord-bits {need}" if need <= 14 else "; COORD_W is at most 14 (16383 px)"
+        raise ConfigError(f"max frame width {c.max_frame_width} px does not fit COORD_W = {c.coord_bits} bits "
+                          f"(at most {coord_max} px){hint}")
+    if c.max_target < 3:
+        raise ConfigError(f"largest target {c.max_target} px: windows are at least 3x3 px")
+    max_half = c.max_target // 2
+    if max_half > MAX_HALF_LIMIT:
+        raise ConfigError(f"largest target {c.max_target} px > {2 * MAX_HALF_LIMIT + 1} px, the largest window "
+                          f"the kernel tables hold (MAX_HALF <= {MAX_HALF_LIMIT})")
+    if not 0 <= c.margin <= 255:
+        raise ConfigError(f"margin {c.margin} px out of 0..255")
+    if c.lanes < 1 or c.lanes & (c.lanes - 1):
+        raise ConfigError(f"LANES {c.lanes} is not a power of two (1, 2, 4, 8, ...)")
+    region_max = 2 * max_half + 1 + 2 * c.margin
+    if c.lanes > region_max:
+        raise ConfigError(f"LANES {c.lanes} > the region width {region_max} px (REGION_MAX): "
+                          f"more lanes than pixels in a region row")
+    try:
+        tp = TrackerParams(features=c.features, kernel=c.kernel, preset=c.preset)  # type: ignore[arg-type]
+        fp = FixedParams(max_half=max_half, margin=c.margin, coord_bits=c.coord_bits)
+    except ValueError as exc:  # the model's own checks (one line each)
+        raise ConfigError(str(exc)) from None
+    g = {"MAX_FRAME_W": c.max_frame_width, "RGB_PACKING": RGB_PACKINGS[c.rgb_packing][0],
+         **core_generics(tp, fp, c.lanes)}
+    return CoreConfiguration(c, tp, fp, g)
+
+
+def entity_generics(path: Path = TRACKER_VHD) -> list[str]:
+    """Names of the generics of ms_tracker, in declaration order (read from the VHDL)."""
+    text = re.sub(r"--[^\n]*", "", path.read_text())
+    m = re.search(r"entity\s+ms_tracker\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
+    if not m:
+        raise RuntimeError(f"no generic clause found in {path}")
+    return re.findall(r"(\w+)\s*:\s*natural", m.group(1), re.I)
+
+
+def generic_map(g: dict[str, int], prefix: str = "", indent: str = "    ") -> str:
+    """``generic map (...)`` text: NAME => value, or NAME => <prefix>NAME when ``prefix`` is given."""
+    width = max(len(k) for k in g)
+    items = [f"{indent}{k:<{width}} => {prefix + k if prefix else v}" for k, v in g.items()]
+    return "generic map (\n" + ",\n".join(items) + "\n)"
+
+
+def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
+    c = cfg.choices
+    g = cfg.generics
+    lines = [f"GENERATED by `{command}`; do not edit (regenerate instead).",
+             "mstrack configuration of ms_tracker (docs/packaging.md, \"Configuration\"):",
+             f"  frames up to {c.max_frame_width} px wide, {(1 << c.coord_bits) - 1} px high (COORD_W {c.coord_bits});",
+             f"  targets up to {2 * g['MAX_HALF'] + 1} px (MAX_HALF {g['MAX_HALF']}), search margin {c.margin} px;",
+             f"  LANES {c.lanes}, features {c.features}, kernel {c.kernel}, preset {c.preset};",
+             f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]};",
+             f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout)."]
+    return [f"{comment} {ln}".rstrip() for ln in lines]
+
+
+def render(cfg: CoreConfiguration, fmt: str = "package", name: str = "ms_tracker_config_pkg",
+           command: str = "mstrack hdl config") -> str:
+    """The configuration as a VHDL package (``package``), a ``generic-map`` or ``json``."""
+    g = cfg.generics
+    if fmt == "json":
+        return json.dumps({"command": command, "choices": asdict(cfg.choices), "generics": g}, indent=1) + "\n"
+    if fmt == "generic-map":
+        return "\n".join(_header(cfg, command, "--")) + "\n" + generic_map(g) + "\n"
+    if fmt != "package":
+        raise ConfigError(f"format {fmt!r} unknown (one of {', '.join(FORMATS)})")
+    if not re.fullmatch(r"[A-Za-z]\w*", name):
+        raise ConfigError(f"package name {name!r} is not a VHDL identifier")
+    width = max(len(k) for k in g) + 3      # "C_" + the longest name + one blank
+    out = _header(cfg, command, "--")
+    out += ["--", "-- Use: compile this file before the core's instance, then", "--   use work." + name + ".all;",
+            "--   u_tracker : entity work.ms_tracker"]
+    out += ["--   " + ln for ln in generic_map(g, prefix="C_", indent="  ").splitlines()]
+    out += [f"package {name} is"]
+    out += [f"  constant {'C_' + k:<{width}}: natural := {v};" for k, v in g.items()]
+    out += [f"end package {name};", ""]
+    return "\n".join(out)
+
+
+# ----------------------------------------------------------------------------- CLI
+def add_config_arguments(p: argparse.ArgumentParser) -> None:
+    d = CoreChoices()
+    p.add_argument("--max-frame-width", type=int, default=d.max_frame_width,
+                   help=f"widest frame in px (MAX_FRAME_W, default {d.max_frame_width})")
+    p.add_argument("--max-target", type=int, default=d.max_target,
+                   help=f"largest target (window) in px, width and height (default {d.max_target}); "
+                        f"at most {2 * MAX_HALF_LIMIT + 1}")
+    p.add_argument("--lanes", type=int, default=d.lanes, help=f"LANES, a power of two (default {d.lanes})")
+    p.add_argument("--features", choices=FEATURES, default=d.features)
+    p.add_argument("--kernel", choices=KERNELS, default=d.kernel)
+    p.add_argument("--preset", default=d.preset, help="paper (v2: no core yet, refused)")
+    p.add_argument("--margin", type=int, default=d.margin, help=f"search margin in px (default {d.margin})")
+    p.add_argument("--coord-bits", type=int, default=d.coord_bits,
+                   help=f"COORD_W: frames up to 2**N - 1 px (default {d.coord_bits})")
+    p.add_argument("--rgb-packing", choices=tuple(RGB_PACKINGS), default=d.rgb_packing,
+                   help="s_axis_tdata layout: mstrack (R, G, B from the MSB) or ug934 (R, B, G)")
+    p.add_argument("--format", choices=FORMATS, default="package", help="output (default: VHDL package)")
+    p.add_argument("--name", default="ms_tracker_config_pkg", help="package name (--format package)")
+    p.add_argument("--out", help="output file (default: standard output)")
+
+
+def run_config(args: argparse.Namespace) -> int:
+    choices = CoreChoices(max_frame_width=args.max_frame_width, max_target=args.max_target, lanes=args.lanes,
+                          features=args.features, kernel=args.kernel, preset=args.preset, margin=args.margin,
+                          coord_bits=args.coord_bits, rgb_packing=args.rgb_packing)
+    cfg = derive(choices)
+    command = getattr(args, "command_line", None) or "mstrack hdl config"
+    text = render(cfg, args.format, args.name, command)
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(text)
+        print(f"wrote {args.out}", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+def run_files(args: argparse.Namespace) -> int:
+    from . import packaging
+    stale = packaging.write_generated(check=args.check)
+    if args.check:
+        if stale:
+            print("stale (regenerate with `mstrack hdl files`): " + ", ".join(map(str, stale)))
+            return 1
+        print("up to date")
+        return 0
+    for p in stale:
+        print(f"wrote {p}")
+    return 0
+
+
+def register_cli(sub: argparse._SubParsersAction) -> None:
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.hdl_config:register_cli"``): ``mstrack hdl ...``."""
+    p = sub.add_parser("hdl", help="integration of the VHDL core: configuration, file lists",
+                       description="Integration helpers for the VHDL core (docs/packaging.md).")
+    hsub = p.add_subparsers(dest="hdl_command", metavar="HDL_COMMAND", required=True)
+    c = hsub.add_parser("config", help="generics of ms_tracker from user-level choices (VHDL package / generic map)",
+                        description=__doc__.split("\n\n")[1].replace("\n", " "))
+    add_config_arguments(c)
+    c.set_defaults(func=run_config)
+    f = hsub.add_parser("files", help="regenerate rtl/files.txt and mstrack.core from mstrack.hdl's source list",
+                        description="Write the ordered file list rtl/files.txt and the FuseSoC core file "
+                                    "mstrack.core (both generated from mstrack.hdl.rtl_sources).")
+    f.add_argument("--check", action="store_true", help="only check that they are up to date (exit 1 if not)")
+    f.set_defaults(func=run_files)

@@ -1,0 +1,678 @@
+-- ms_bg_model: background-weighted (CBWH) target model of tracker v2, learnt at init.
+--
+-- Computes mstrack.fixed.blocks_v2.ms_bg_model(bins, cx, cy, wb, hb, ring16, N_BINS) bit for bit,
+-- from the pixel stream of the (decimated) init frame:
+--   box  : pixels with |dx| <= ex, |dy| <= ey and |dx| <= XR[|dy|] (dx = x - cx, dy = y - cy,
+--          ex = (wb - 1) / 2, ey = (hb - 1) / 2, XR = the row extents of ms_kernel_tables: the
+--          exact flat-ellipse test TA[|dx|] + TB[|dy|] < D of ms_kernel)   -> Q[u] += 1
+--   ring : pixels with |dx| <= ex + gx, |dy| <= ey + gy, not (|dx| <= ex and |dy| <= ey),
+--          gx = (ring16 wb) >> 4, gy = (ring16 hb) >> 4                     -> O[u] += 1
+--          (the clipping of the ring to the image is implicit: only image pixels stream in);
+-- then, after the frame, three passes over the bins (one bin per clock each):
+--   pass 1: o* = the smallest non-zero O[u];
+--   pass 2: T[u] = (Q[u] no > O[u] nq) (nq = sum Q, no = sum O; without ring pixels, no = 0:
+--           T[u] = (Q[u] > 0)); v[u] = min(floor(o* 2**8 / O[u]), 2**8) (O[u] = 0: the
+--           divider's d = 0 saturates to all ones, min gives 2**8, as the model);
+--           qv[u] = Q[u] v[u], tot = sum qv; {T, qv} written back over {Q, O};
+--   pass 3: Qn[u] = floor(qv[u] 2**16 / tot) (0 when qv[u] = 0); {T, Qn} written into the
+--           model RAM; the count word cleared (ready for the next init).
+-- One pipelined ms_divider (17 quotient bits) serves passes 2 and 3 (o* 2**8 / O < 2**9 never
+-- saturates it); its results come out in bin order, so a counter gives their bin and Q waits
+-- beside it in a 32-word LUT RAM (not in its tag).  The products Q no, nq O, v Q are ms_mult_r4
+-- LUT multipliers (no MULT18X18D).
+--
+-- Pixel input: any order (each pixel carries its coordinates), at most one per clock, gaps
+-- allowed; px_last marks the frame's last pixel.  The caller streams every pixel of the image
+-- the model sees (the decimated frame frame[::D, ::D], coordinates in decimated px) exactly once.
+-- Counting: stage A registers |dx|, |dy|; stage B the XR look-up (registered) and the rectangle
+-- tests; stage C the box / ring flags; then a read-modify-write of the count RAM word
+-- {T | Q | O} at the pixel's bin with the forwarding of ms_histogram (any sequence of bins, runs
+-- of one bin included, counts exactly).
+--
+-- Memories: count RAM N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32), model
+-- RAM N_BINS x 18 {T | Qn} (1 DP16KD), XR table 2**HALF_W x HALF_W and the Q delay memory
+-- (LUT RAM).
+-- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
+-- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz.
+--
+-- Latency (tb/test_ms_bg_model.py measures both):
+--   start -> counting : the kernel-table set-up of (wb, hb) (flat ms_kernel_tables: at most
+--                       215 clocks at HALF_W = 6) + 2 clocks, exactly; pixels before `counting` are
+--                       ignored (the top starts the block when the init box is taken, between
+--                       frames, so this costs nothing on the stream).
+--   px_last -> done   : LAT_DONE = 3 N_BINS + 61 clocks at the default widths: drain 6, pass 1
+--                       N_BINS + 3, pass 2 N_BINS + 30 (read 2, T products M(Q_W) = 4, T 1,
+--                       divider 18, v Q M(9) = 4, end 1), pass 3 N_BINS + 22 (read 2, divider 18,
+--                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
+--                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N_BINS = 512
+--                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.synth
+--                       --v2-budget: init frame 5,800 clocks, so 5,846 with this block).
+-- Throughput: one pixel per clock while counting; one model per init.
+-- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high
+--             until `done` (one-clock pulse); n_box, n_ring, o_min, qv_sum are stable from done
+--             until the next start.  The model RAM read port (m_rd_addr -> m_qn, m_t one clock
+--             later) may be used at any time; during a model computation it shows a mix of the
+--             old and the new model.
+-- Reset     : synchronous, active high; control state; then N_BINS clocks clear the count RAM
+--             (busy = 1 meanwhile).  The model RAM keeps its contents.  To abandon an init frame
+--             (stream error), reset the block.
+-- Model     : mstrack.fixed.blocks_v2.ms_bg_model (ModelV2 Qn, T; sums of Q, O).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+
+entity ms_bg_model is
+  generic (
+    BIN_W   : natural := 9;   -- bin index bits, N_BINS = 2**BIN_W (RAM depth, clocks per pass)
+    HALF_W  : natural := 6;   -- ex, ey bits; wb, hb have HALF_W + 1 bits (3 .. 2**(HALF_W+1) - 1)
+    COORD_W : natural := 12;  -- pixel coordinate bits (decimated px)
+    RING_W  : natural := 5;   -- ring16 bits (bg_ring = ring16 / 16)
+    Q_W     : natural := 14;  -- Q[u] and sum Q bits: must hold (2 ex + 1)(2 ey + 1)
+    O_W     : natural := 17;  -- O[u] and sum O bits: must hold the ring area (>= 8)
+    KD_W    : natural := 29   -- kernel-table width (ms_kernel_tables: holds w^2 h^2)
+  );
+  port (
+    clk       : in  std_logic;                             -- clock
+    rst       : in  std_logic;                             -- synchronous reset, active high
+    -- control
+    start     : in  std_logic;                             -- pulse: learn a model (taken when busy = 0)
+    cx        : in  unsigned(COORD_W - 1 downto 0);        -- box centre column (decimated px)
+    cy        : in  unsigned(COORD_W - 1 downto 0);        -- box centre row
+    wb        : in  unsigned(HALF_W downto 0);             -- box diameter x (3 ..)
+    hb        : in  unsigned(HALF_W downto 0);             -- box diameter y (3 ..)
+    ring16    : in  unsigned(RING_W - 1 downto 0);         -- ring width per side, 1/16 of the box size
+    busy      : out std_logic;                             -- from start (or reset) until done
+    counting  : out std_logic;                             -- pixels are counted
+    done      : out std_logic;                             -- pulse: model written
+    -- pixels of the init frame
+    px_valid  : in  std_logic;                             -- a pixel (ignored unless counting)
+    px_bin    : in  unsigned(BIN_W - 1 downto 0);          -- its bin
+    px_x      : in  unsigned(COORD_W - 1 downto 0);        -- its column
+    px_y      : in  unsigned(COORD_W - 1 downto 0);        -- its row
+    px_last   : in  std_logic;                             -- with px_valid: the frame's last pixel
+    -- results (stable from done)
+    n_box     : out unsigned(Q_W - 1 downto 0);            -- nq = sum Q
+    n_ring    : out unsigned(O_W - 1 downto 0);            -- no = sum O
+    o_min     : out unsigned(O_W - 1 downto 0);            -- o* (all ones when no = 0)
+    qv_sum    : out unsigned(Q_W + 7 downto 0);            -- tot = sum Q v
+    -- model read port
+    m_rd_addr : in  unsigned(BIN_W - 1 downto 0);          -- bin
+    m_qn      : out unsigned(16 downto 0);                 -- Qn[bin] (Q0.16, <= 2**16), 1 clock later
+    m_t       : out std_logic                              -- T[bin], 1 clock later
+  );
+end entity;
+
+architecture rtl of ms_bg_model is
+  constant N_BINS  : natural := 2 ** BIN_W;
+  constant BG_FRAC : natural := 8;                 -- v in Q.8 (blocks_v2.BG_FRAC)
+  constant QN_FRAC : natural := 16;                -- Qn in Q.16 (blocks_v2.QN_BITS)
+  constant QN_W    : natural := QN_FRAC + 1;       -- Qn bits (<= 2**16)
+  constant V_W     : natural := BG_FRAC + 1;       -- v bits (<= 2**8)
+  constant QV_W    : natural := Q_W + BG_FRAC;     -- Q v (Q <= 2**Q_W - 1, v <= 2**8)
+  constant TOT_W   : natural := Q_W + BG_FRAC;     -- sum Q v <= nq 2**8
+  constant CW      : natural := 1 + Q_W + O_W;     -- count word [T | Q | O], later [T | qv]
+  constant MW      : natural := 1 + QN_W;          -- model word [T | Qn]
+  constant DN_W    : natural := max(QV_W + QN_FRAC, O_W + BG_FRAC);   -- divider dividend
+  constant DD_W    : natural := max(TOT_W, O_W);                      -- divider divisor
+  constant G_W     : natural := max(COORD_W, RING_W + HALF_W + 1) + 1; -- ring extents
+  constant P_W     : natural := Q_W + O_W;         -- T products
+  constant DRAIN   : natural := 6;                 -- px_last -> S_P1 (the last count is in the RAM)
+  constant DVT_W  : natural := 3;                 -- divider tag [last | qz | T]
+  constant QD_W   : natural := clog2(QN_W + 2);   -- Q delay memory address (holds > divider latency)
+  constant MTT_W  : natural := Q_W + O_W + 1;    -- T product tag [last | O | Q]
+  constant MVT_W  : natural := BIN_W + 2;         -- v Q product tag [last | T | u]
+  -- ms_mult_r4 latency for an A_W-bit digit operand: 1 + max(1, ceil(log2(ceil(A_W / 2))))
+  function mult_lat(a_w : natural) return natural is
+  begin
+    return 1 + max(1, clog2((a_w + 1) / 2));
+  end function;
+  -- px_last -> done (documentation; the test measures it): drain, pass 1, pass 2, pass 3
+  constant LAT_DONE : natural := DRAIN + (N_BINS + 3)
+                                 + (N_BINS + 2 + mult_lat(Q_W) + 1 + (QN_W + 1) + mult_lat(V_W) + 1)
+                                 + (N_BINS + 2 + (QN_W + 1) + 2);
+
+  type state_t is (S_CLEAR, S_IDLE, S_SETUP, S_COUNT, S_DRAIN, S_P1, S_P2, S_P3, S_DONE);
+  signal state : state_t := S_CLEAR;
+
+  -- parameters
+  signal cx_r, cy_r     : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal wb_r, hb_r     : unsigned(HALF_W downto 0) := (others => '0');
+  signal ring_r         : unsigned(RING_W - 1 downto 0) := (others => '0');
+  signal ex_r, ey_r     : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal gx, gy         : unsigned(G_W - 1 downto 0) := (others => '0');   -- (ring16 n) << 0, then >> 4
+  signal rx, ry         : unsigned(G_W - 1 downto 0) := (others => '0');   -- ex + gx, ey + gy
+  signal mul_cnt        : natural range 0 to RING_W := 0;
+  signal mul_done       : std_logic := '0';
+  signal kt_start, kt_done, kt_we : std_logic;
+  signal kt_ex, kt_ey, kt_addr, kt_xr : unsigned(HALF_W - 1 downto 0);
+  signal kt_seen        : std_logic := '0';
+  type xr_ram_t is array (0 to 2 ** HALF_W - 1) of unsigned(HALF_W - 1 downto 0);
+  signal xr_ram         : xr_ram_t := (others => (others => '0'));
+
+  -- reset clear
+  signal clr_addr       : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal drain_cnt      : natural range 0 to DRAIN := 0;
+
+  -- pixel stages A (|dx|, |dy|), B (XR, rectangles), C (b_*: box / ring flags)
+  signal a_v            : std_logic := '0';
+  signal a_bin          : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal a_adx, a_ady   : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal xb_v, xb_in, xb_ring : std_logic := '0';
+  signal xb_xr, xb_adx  : unsigned(HALF_W - 1 downto 0) := (others => '0');
+  signal xb_bin         : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal b_acc, b_box   : std_logic := '0';
+  signal b_bin          : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal nq_r           : unsigned(Q_W - 1 downto 0) := (others => '0');
+  signal no_r           : unsigned(O_W - 1 downto 0) := (others => '0');
+
+  -- count RAM and its read-modify-write pipeline (ms_histogram's scheme, one lane)
+  type cnt_ram_t is array (0 to N_BINS - 1) of std_logic_vector(CW - 1 downto 0);
+  signal cram           : cnt_ram_t := (others => (others => '0'));
+  signal rd_addr        : unsigned(BIN_W - 1 downto 0);
+  signal rd_raw, rd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
+  signal s1_acc, s1_box, s2_acc, s2_box : std_logic := '0';
+  signal s1_b, s2_b     : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal old_w, new_w   : std_logic_vector(CW - 1 downto 0);
+  signal wq_we, wq2_we  : std_logic := '0';
+  signal wq_b, wq2_b    : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal wq_word, wq2_word, fwd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
+  signal h1, h2, h3, fwd_hit : std_logic := '0';
+
+  -- passes: issue side and read stages
+  signal iss_en         : std_logic := '0';
+  signal iss_addr       : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal r1_v, r2_v, r1_last, r2_last : std_logic := '0';
+  signal r1_u, r2_u     : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal pass_we        : std_logic;                        -- count RAM write of a pass
+  signal pass_wa        : unsigned(BIN_W - 1 downto 0);
+  signal pass_wd        : std_logic_vector(CW - 1 downto 0);
+  signal omin           : unsigned(O_W - 1 downto 0) := (others => '1');
+  signal tot            : unsigned(TOT_W - 1 downto 0) := (others => '0');
+  signal pass_end       : std_logic := '0';                 -- the pass's last bin is finished
+
+  -- pass 2: T products, divider, v Q product
+  signal w_q            : unsigned(Q_W - 1 downto 0);
+  signal w_o            : unsigned(O_W - 1 downto 0);
+  signal m1_v, m2_v     : std_logic;
+  signal m1_p, m2_p     : std_logic_vector(P_W - 1 downto 0);
+  signal m1_tag, m2_tag : std_logic_vector(MTT_W - 1 downto 0);
+  signal mt_in_v        : std_logic;
+  signal mt_tag_in      : std_logic_vector(MTT_W - 1 downto 0);
+  signal t_v, t_t, t_last : std_logic := '0';
+  signal t_q            : unsigned(Q_W - 1 downto 0) := (others => '0');
+  signal t_o            : unsigned(O_W - 1 downto 0) := (others => '0');
+  signal dv_in_v, dv_out_v : std_logic;
+  signal dv_n           : unsigned(DN_W - 1 downto 0);
+  signal dv_d           : unsigned(DD_W - 1 downto 0);
+  signal dv_tag_in, dv_tag : std_logic_vector(DVT_W - 1 downto 0);
+  signal dv_q           : unsigned(QN_W - 1 downto 0);
+  signal dv_cnt         : unsigned(BIN_W - 1 downto 0) := (others => '0');  -- results out of the divider
+  signal qd_wp, qd_rp   : unsigned(QD_W - 1 downto 0) := (others => '0');   -- Q delay memory pointers
+  type qd_ram_t is array (0 to 2 ** QD_W - 1) of std_logic_vector(Q_W - 1 downto 0);
+  signal qd_ram         : qd_ram_t;                  -- Q beside the divider (pass 2), LUT RAM
+  signal mv_in_v, mv_v  : std_logic;
+  signal mv_a           : unsigned(V_W - 1 downto 0);
+  signal mv_b           : std_logic_vector(Q_W - 1 downto 0);
+  signal mv_tag_in, mv_tag : std_logic_vector(MVT_W - 1 downto 0);
+  signal mv_p           : std_logic_vector(QV_W - 1 downto 0);
+
+  -- model RAM
+  type m_ram_t is array (0 to N_BINS - 1) of std_logic_vector(MW - 1 downto 0);
+  signal mram           : m_ram_t := (others => (others => '0'));
+  signal m_we           : std_logic := '0';
+  signal m_wa           : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal m_wd           : std_logic_vector(MW - 1 downto 0) := (others => '0');
+  signal m_rd           : std_logic_vector(MW - 1 downto 0) := (others => '0');
+
+  signal done_r         : std_logic := '0';
+
+  function to_sl(b : boolean) return std_logic is
+  begin
+    if b then return '1'; end if;
+    return '0';
+  end function;
+begin
+  assert O_W >= BG_FRAC report "ms_bg_model: O_W must be >= 8 (count word holds [T | qv])" severity failure;
+  assert HALF_W >= 2 and BIN_W >= 1 report "ms_bg_model: HALF_W >= 2, BIN_W >= 1" severity failure;
+
+  busy     <= '0' when state = S_IDLE else '1';
+  counting <= '1' when state = S_COUNT else '0';
+  done     <= done_r;
+
+  ---------------------------------------------------------------------------- set-up
+  u_tables : entity work.ms_kernel_tables
+    generic map (HALF_W => HALF_W, KERNEL_EPAN => 0, KERNEL_BITS => 8, KVAL_W => 1, KD_W => KD_W)
+    port map (clk => clk, rst => rst, start => kt_start, w => wb_r, h => hb_r, busy => open,
+              done => kt_done, ex => kt_ex, ey => kt_ey, kd_d => open, kt_we => kt_we,
+              kt_addr => kt_addr, kt_ta => open, kt_tb => open, kt_ka => open, kt_kb => open,
+              kt_xr => kt_xr);
+
+  p_xr : process (clk)
+  begin
+    if rising_edge(clk) then
+      if kt_we = '1' then
+        xr_ram(to_integer(kt_addr)) <= kt_xr;
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- control
+  p_ctrl : process (clk)
+  begin
+    if rising_edge(clk) then
+      kt_start <= '0';
+      done_r   <= '0';
+      case state is
+        when S_CLEAR =>                                  -- reset clear of the count RAM
+          clr_addr <= clr_addr + 1;
+          if clr_addr = N_BINS - 1 then
+            state <= S_IDLE;
+          end if;
+        when S_IDLE =>
+          if start = '1' then
+            cx_r <= cx;
+            cy_r <= cy;
+            wb_r <= wb;
+            hb_r <= hb;
+            ring_r <= ring16;
+            gx <= (others => '0');
+            gy <= (others => '0');
+            mul_cnt <= 0;
+            mul_done <= '0';
+            kt_seen <= '0';
+            kt_start <= '1';
+            state <= S_SETUP;
+          end if;
+        when S_SETUP =>
+          -- gx, gy = ring16 wb, ring16 hb by shift-and-add (MSB first), then >> 4, ex + gx, ey + gy
+          if mul_cnt < RING_W then
+            gx <= shift_left(gx, 1);
+            gy <= shift_left(gy, 1);
+            if ring_r(RING_W - 1 - mul_cnt) = '1' then
+              gx <= shift_left(gx, 1) + resize(wb_r, G_W);
+              gy <= shift_left(gy, 1) + resize(hb_r, G_W);
+            end if;
+            mul_cnt <= mul_cnt + 1;
+          elsif mul_done = '0' then
+            gx <= shift_right(gx, 4);
+            gy <= shift_right(gy, 4);
+            mul_done <= '1';
+          end if;
+          if kt_done = '1' then
+            kt_seen <= '1';
+            ex_r <= kt_ex;
+            ey_r <= kt_ey;
+          end if;
+          if kt_seen = '1' and mul_done = '1' then
+            rx <= gx + resize(ex_r, G_W);
+            ry <= gy + resize(ey_r, G_W);
+            state <= S_COUNT;
+          end if;
+        when S_COUNT =>
+          if px_valid = '1' and px_last = '1' then
+            drain_cnt <= 0;
+            state <= S_DRAIN;
+          end if;
+        when S_DRAIN =>                                  -- the last pixel's count is written
+          if drain_cnt = DRAIN - 1 then
+            state <= S_P1;
+          else
+            drain_cnt <= drain_cnt + 1;
+          end if;
+        when S_P1 | S_P2 | S_P3 =>
+          if pass_end = '1' then
+            if state = S_P1 then
+              state <= S_P2;
+            elsif state = S_P2 then
+              state <= S_P3;
+            else
+              state <= S_DONE;
+            end if;
+          end if;
+        when S_DONE =>
+          done_r <= '1';
+          state <= S_IDLE;
+      end case;
+      if rst = '1' then
+        state <= S_CLEAR;
+        clr_addr <= (others => '0');
+        kt_start <= '0';
+        done_r <= '0';
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- pixel flags
+  p_pix : process (clk)
+    variable dx, dy : signed(COORD_W downto 0);
+    variable in_ex, in_ey, box, ring : boolean;
+  begin
+    if rising_edge(clk) then
+      -- stage A: |dx|, |dy|
+      dx := signed('0' & px_x) - signed('0' & cx_r);
+      dy := signed('0' & px_y) - signed('0' & cy_r);
+      -- |dx|, |dy| by negation, not `abs` (GHDL 2.0's Verilog writer prints `abs` as VHDL)
+      if dx < 0 then
+        dx := -dx;
+      end if;
+      if dy < 0 then
+        dy := -dy;
+      end if;
+      a_adx <= resize(unsigned(dx), COORD_W);
+      a_ady <= resize(unsigned(dy), COORD_W);
+      a_bin <= px_bin;
+      a_v   <= px_valid and to_sl(state = S_COUNT);
+      -- stage B: XR[|dy|] registered (LUT RAM read), the rectangle tests
+      in_ex := a_adx <= resize(ex_r, COORD_W);
+      in_ey := a_ady <= resize(ey_r, COORD_W);
+      ring  := resize(a_adx, G_W) <= rx and resize(a_ady, G_W) <= ry and not (in_ex and in_ey);
+      xb_xr   <= xr_ram(to_integer(a_ady(HALF_W - 1 downto 0)));
+      xb_adx  <= a_adx(HALF_W - 1 downto 0);
+      xb_in   <= to_sl(in_ex and in_ey);
+      xb_ring <= to_sl(ring);
+      xb_v    <= a_v;
+      xb_bin  <= a_bin;
+      -- stage C: box = inside the rectangle and |dx| <= XR[|dy|] (XR <= ex < 2**HALF_W, so the
+      -- low HALF_W bits of |dx| suffice once |dx| <= ex)
+      box   := xb_in = '1' and xb_adx <= xb_xr;
+      b_acc <= xb_v and to_sl(box or xb_ring = '1');
+      b_box <= to_sl(box);
+      b_bin <= xb_bin;
+      -- totals from the registered flags
+      if state = S_SETUP then
+        nq_r <= (others => '0');
+        no_r <= (others => '0');
+      elsif b_acc = '1' and b_box = '1' then
+        nq_r <= nq_r + 1;
+        -- the widths are the caller's (Q_W, O_W): the totals must not wrap
+        assert nq_r /= 2 ** Q_W - 1 report "ms_bg_model: sum Q overflows Q_W" severity error;
+      elsif b_acc = '1' then
+        no_r <= no_r + 1;
+        assert no_r /= 2 ** O_W - 1 report "ms_bg_model: sum O overflows O_W" severity error;
+      end if;
+      if rst = '1' then
+        a_v   <= '0';
+        xb_v  <= '0';
+        b_acc <= '0';
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- count RAM
+  rd_addr <= iss_addr when iss_en = '1' else b_bin;
+
+  old_w <= fwd_word when fwd_hit = '1' else rd_word;
+  p_add : process (all)
+    variable w : std_logic_vector(CW - 1 downto 0);
+  begin
+    w := old_w;
+    if s2_box = '1' then
+      w(O_W + Q_W - 1 downto O_W) := std_logic_vector(unsigned(old_w(O_W + Q_W - 1 downto O_W)) + 1);
+    else
+      w(O_W - 1 downto 0) := std_logic_vector(unsigned(old_w(O_W - 1 downto 0)) + 1);
+    end if;
+    new_w <= w;
+  end process;
+
+  p_ram : process (clk)
+  begin
+    if rising_edge(clk) then
+      if wq_we = '1' then
+        cram(to_integer(wq_b)) <= wq_word;
+      end if;
+      -- a read/write collision's data is never used (forwarded: h3)
+      if wq_we = '1' and wq_b = rd_addr then
+        rd_raw <= (others => 'X');
+      else
+        rd_raw <= cram(to_integer(rd_addr));
+      end if;
+      rd_word <= rd_raw;                                 -- the RAM's output register
+    end if;
+  end process;
+
+  p_fw : process (clk)
+  begin
+    if rising_edge(clk) then
+      s1_acc <= b_acc;
+      s1_box <= b_box;
+      s1_b   <= rd_addr;
+      s2_acc <= s1_acc;
+      s2_box <= s1_box;
+      s2_b   <= s1_b;
+      -- RAM write register: reset clear, else a pass write, else the count
+      if state = S_CLEAR then
+        wq_we   <= '1';
+        wq_b    <= clr_addr;
+        wq_word <= (others => '0');
+      elsif pass_we = '1' then
+        wq_we   <= '1';
+        wq_b    <= pass_wa;
+        wq_word <= pass_wd;
+      else
+        wq_we   <= s2_acc;
+        wq_b    <= s2_b;
+        wq_word <= new_w;
+      end if;
+      wq2_we   <= wq_we;
+      wq2_b    <= wq_b;
+      wq2_word <= wq_word;
+      -- the read at this edge misses the writes of this edge (wq), of the next (stage 2) and of
+      -- the one after (stage 1): the newest one to the same bin is forwarded into stage 2
+      h1 <= s1_acc and to_sl(s1_b = rd_addr);
+      h2 <= s2_acc and to_sl(s2_b = rd_addr);
+      h3 <= wq_we and to_sl(wq_b = rd_addr);
+      fwd_hit <= h1 or h2 or h3;
+      if h1 = '1' then
+        fwd_word <= new_w;
+      elsif h2 = '1' then
+        fwd_word <= wq_word;
+      else
+        fwd_word <= wq2_word;
+      end if;
+      if rst = '1' then
+        s1_acc <= '0';
+        s2_acc <= '0';
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- bin passes
+  -- issue: bins 0 .. N_BINS - 1, one per clock, at the start of each pass
+  p_issue : process (clk)
+    variable first : boolean;
+  begin
+    if rising_edge(clk) then
+      first := (state = S_DRAIN and drain_cnt = DRAIN - 1)
+               or ((state = S_P1 or state = S_P2) and pass_end = '1');
+      if first then
+        iss_en   <= '1';
+        iss_addr <= (others => '0');
+      elsif iss_en = '1' then
+        if iss_addr = N_BINS - 1 then
+          iss_en <= '0';
+        else
+          iss_addr <= iss_addr + 1;
+        end if;
+      end if;
+      -- read stages: r1 = RAM read register, r2 = rd_word
+      r1_v    <= iss_en;
+      r1_u    <= iss_addr;
+      r1_last <= iss_en and to_sl(iss_addr = N_BINS - 1);
+      r2_v    <= r1_v;
+      r2_u    <= r1_u;
+      r2_last <= r1_last;
+      if rst = '1' then
+        iss_en <= '0';
+        r1_v   <= '0';
+        r2_v   <= '0';
+      end if;
+    end if;
+  end process;
+
+  w_q <= unsigned(rd_word(O_W + Q_W - 1 downto O_W));
+  w_o <= unsigned(rd_word(O_W - 1 downto 0));
+
+  -- pass 1: o* (also restarts tot)
+  p_p1 : process (clk)
+  begin
+    if rising_edge(clk) then
+      if state = S_DRAIN then
+        omin <= (others => '1');
+        tot  <= (others => '0');
+      elsif state = S_P1 and r2_v = '1' then
+        if w_o /= 0 and w_o < omin then
+          omin <= w_o;
+        end if;
+      end if;
+      if state = S_P2 and mv_v = '1' then
+        tot <= tot + resize(unsigned(mv_p), TOT_W);
+      end if;
+    end if;
+  end process;
+
+  -- pass 2 stage 1: T products Q no and nq O
+  mt_in_v   <= r2_v when state = S_P2 else '0';
+  mt_tag_in <= r2_last & std_logic_vector(w_o) & std_logic_vector(w_q);
+  u_mt1 : entity work.ms_mult_r4
+    generic map (A_W => Q_W, B_W => O_W, B_SIGNED => false, P_W => P_W, TAG_W => MTT_W)
+    port map (clk => clk, rst => rst, in_valid => mt_in_v, in_a => w_q, in_b => std_logic_vector(no_r),
+              in_tag => mt_tag_in, out_valid => m1_v, out_p => m1_p, out_tag => m1_tag);
+  u_mt2 : entity work.ms_mult_r4
+    generic map (A_W => Q_W, B_W => O_W, B_SIGNED => false, P_W => P_W, TAG_W => 1)
+    port map (clk => clk, rst => rst, in_valid => mt_in_v, in_a => nq_r, in_b => std_logic_vector(w_o),
+              in_tag => "0", out_valid => m2_v, out_p => m2_p, out_tag => open);
+
+  -- pass 2 stage 2: T registered with its bin, Q, O
+  p_t : process (clk)
+    variable q : unsigned(Q_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      q := unsigned(m1_tag(Q_W - 1 downto 0));
+      t_v    <= m1_v;
+      t_q    <= q;
+      t_o    <= unsigned(m1_tag(Q_W + O_W - 1 downto Q_W));
+      t_last <= m1_tag(MTT_W - 1);
+      if no_r = 0 then
+        t_t <= to_sl(q /= 0);
+      else
+        t_t <= to_sl(unsigned(m1_p) > unsigned(m2_p));
+      end if;
+      if rst = '1' then
+        t_v <= '0';
+      end if;
+    end if;
+  end process;
+
+  -- the divider: pass 2 floor(o* 2**8 / O), pass 3 floor(qv 2**16 / tot)
+  dv_in_v   <= t_v when state = S_P2 else r2_v when state = S_P3 else '0';
+  dv_n      <= shift_left(resize(omin, DN_W), BG_FRAC) when state = S_P2
+               else shift_left(resize(unsigned(rd_word(QV_W - 1 downto 0)), DN_W), QN_FRAC);
+  dv_d      <= resize(t_o, DD_W) when state = S_P2 else resize(tot, DD_W);
+  dv_tag_in <= (t_last & '0' & t_t) when state = S_P2
+               else (r2_last & to_sl(unsigned(rd_word(QV_W - 1 downto 0)) = 0) & rd_word(CW - 1));
+
+  -- results leave the divider in bin order: counters give their bin; in pass 2 Q waits beside
+  -- the divider in a small delay memory (written at the divider input, read at its output)
+  p_dcnt : process (clk)
+  begin
+    if rising_edge(clk) then
+      if state = S_P1 or pass_end = '1' then
+        qd_wp  <= (others => '0');
+        qd_rp  <= (others => '0');
+        dv_cnt <= (others => '0');
+      else
+        if dv_in_v = '1' then
+          qd_wp <= qd_wp + 1;
+        end if;
+        if dv_out_v = '1' then
+          qd_rp  <= qd_rp + 1;
+          dv_cnt <= dv_cnt + 1;
+        end if;
+      end if;
+      if state = S_P2 and t_v = '1' then
+        qd_ram(to_integer(qd_wp)) <= std_logic_vector(t_q);
+      end if;
+    end if;
+  end process;
+  u_div : entity work.ms_divider
+    generic map (N_W => DN_W, D_W => DD_W, Q_W => QN_W, TAG_W => DVT_W)
+    port map (clk => clk, rst => rst, in_valid => dv_in_v, in_n => dv_n, in_d => dv_d,
+              in_tag => dv_tag_in, out_valid => dv_out_v, out_q => dv_q, out_tag => dv_tag);
+
+  -- pass 2 stage 3: v = min(q, 2**8), qv = v Q
+  mv_in_v   <= dv_out_v when state = S_P2 else '0';
+  mv_a      <= to_unsigned(2 ** BG_FRAC, V_W) when dv_q >= 2 ** BG_FRAC else resize(dv_q, V_W);
+  mv_b      <= qd_ram(to_integer(qd_rp));
+  mv_tag_in <= dv_tag(2) & dv_tag(0) & std_logic_vector(dv_cnt);
+  u_mv : entity work.ms_mult_r4
+    generic map (A_W => V_W, B_W => Q_W, B_SIGNED => false, P_W => QV_W, TAG_W => MVT_W)
+    port map (clk => clk, rst => rst, in_valid => mv_in_v, in_a => mv_a, in_b => mv_b,
+              in_tag => mv_tag_in, out_valid => mv_v, out_p => mv_p, out_tag => mv_tag);
+
+  -- count RAM writes of the passes: pass 2 {T, qv}; pass 3 clears the word it has read
+  p_pw : process (all)
+  begin
+    pass_we <= '0';
+    pass_wa <= r2_u;
+    pass_wd <= (others => '0');
+    if state = S_P2 and mv_v = '1' then
+      pass_we <= '1';
+      pass_wa <= unsigned(mv_tag(BIN_W - 1 downto 0));
+      pass_wd(CW - 1) <= mv_tag(BIN_W);
+      pass_wd(QV_W - 1 downto 0) <= mv_p;
+    elsif state = S_P3 and r2_v = '1' then
+      pass_we <= '1';
+    end if;
+  end process;
+
+  -- pass end: pass 1 at its last read, pass 2 at its last write, pass 3 at its last model write
+  p_end : process (clk)
+  begin
+    if rising_edge(clk) then
+      pass_end <= '0';
+      if state = S_P1 and r2_v = '1' and r2_last = '1' then
+        pass_end <= '1';
+      elsif state = S_P2 and mv_v = '1' and mv_tag(MVT_W - 1) = '1' then
+        pass_end <= '1';
+      elsif state = S_P3 and dv_out_v = '1' and dv_tag(DVT_W - 1) = '1' then
+        pass_end <= '1';
+      end if;
+      if pass_end = '1' then
+        pass_end <= '0';
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- model RAM
+  p_mw : process (clk)
+  begin
+    if rising_edge(clk) then
+      m_we <= '0';
+      if state = S_P3 and dv_out_v = '1' then
+        m_we <= '1';
+        m_wa <= dv_cnt;
+        m_wd(MW - 1) <= dv_tag(0);
+        if dv_tag(1) = '1' then            -- qv = 0: Qn = 0 (also when tot = 0)
+          m_wd(QN_W - 1 downto 0) <= (others => '0');
+        else
+          m_wd(QN_W - 1 downto 0) <= std_logic_vector(dv_q);
+        end if;
+      end if;
+      if m_we = '1' then
+        mram(to_integer(m_wa)) <= m_wd;
+      end if;
+      m_rd <= mram(to_integer(m_rd_addr));
+      if rst = '1' then
+        m_we <= '0';
+      end if;
+    end if;
+  end process;
+  m_qn <= unsigned(m_rd(QN_W - 1 downto 0));
+  m_t  <= m_rd(MW - 1);
+
+  n_box  <= nq_r;
+  n_ring <= no_r;
+  o_min  <= omin;
+  qv_sum <= tot;
+end architecture;

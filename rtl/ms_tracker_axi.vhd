@@ -1,0 +1,406 @@
+-- ms_tracker_axi: ms_tracker with an AXI4-Lite register interface and an interrupt (system top).
+--
+-- Wraps rtl/ms_tracker.vhd (unchanged) for a camera pipeline with a CPU beside it:
+--   * video AXI4-Stream in (s_axis_*: 24-bit RGB, tuser = start of frame, tlast = end of line),
+--     passed to the core frame by frame: CTRL.enable is looked at on each start-of-frame beat; a
+--     frame that starts while enable = 0 is consumed (tready = 1) and dropped whole (DROP_COUNT),
+--     so the core never sees a partial frame; beats before the first start of frame are dropped;
+--   * AXI4-Lite slave (s_axil_*, 32-bit data, 12-bit byte address = 4 KiB window): the register
+--     block rtl/ms_tracker_regs.vhd, GENERATED from regs/ms_tracker_regs.rdl (docs/registers.md);
+--     an unmapped address or a write to a read-only register answers SLVERR (bresp/rresp = "10"),
+--     and the write changes nothing;
+--   * frame size, init box (CMD.init: the box is copied at the write and offered on the core's
+--     init port until taken, STATUS.init_pending), enable, status, counters (results, lost, error,
+--     rejected, dropped frames; CMD.clear_counters), the last result and interrupts;
+--   * the last result: latched whole in one clock when the core produces it (L); reading RES_HEAD
+--     returns L's head and copies all of L into the snapshot S that RES_CX .. RES_RAW4 show, in the
+--     same clock, so one frame's fields are read one by one without tearing (docs/integration.md);
+--   * irq: high while an INT_STATUS bit (result / lost / error; W1C) is set and enabled;
+--   * m_axis_result_* (RESULT_STREAM = true): the core's result words as an AXI4-Stream (one beat
+--     per frame, tlast = 1); its back-pressure reaches the video input through the core's result
+--     FIFO.  RESULT_STREAM = false: tvalid = 0, tready ignored, results only through registers.
+-- Latency    : the core's (docs/performance.md) + 1 clock to L; a register read answers in 2 clocks
+--              after the address (PeakRDL regblock + AXI4-Lite adapter), 2 transactions in flight.
+-- Throughput : the core's: 1 pixel per clock while a frame streams in.
+-- Reset      : rst synchronous, active high (core and registers; every register to its reset value).
+-- Cost       : over the core, ECP5 (yosys synth_ecp5, default generics): +1,509 LUT4, +748 FF,
+--              +161 CCU2C; no RAM, no multiplier (docs/blocks/ms_tracker_axi.md, Resources).
+-- Generics: those of ms_tracker (passed through; the derived widths come from
+-- mstrack.fixed.vhdl_pkg.core_generics) and RESULT_STREAM.
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+use work.ms_formats_pkg.all;
+use work.ms_tracker_regs_pkg.all;
+
+entity ms_tracker_axi is
+  generic (
+    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
+    COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
+    EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
+    EDGE_SHIFT     : natural := D_EDGE_SHIFT;    -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
+    FEATURES       : natural := D_FEATURES;      -- 0 fused, 1 colour only, 2 edge only
+    KERNEL_EPAN    : natural := D_KERNEL_EPAN;   -- 0 flat, 1 Epanechnikov
+    KERNEL_BITS    : natural := D_KERNEL_BITS;   -- Epanechnikov kernel bits
+    MAX_HALF       : natural := D_MAX_HALF;      -- largest window half extent
+    MARGIN         : natural := D_MARGIN;        -- search margin (px)
+    COORD_W        : natural := D_COORD_W;       -- frame coordinate bits
+    CF             : natural := D_CF;            -- centre fraction bits
+    WI             : natural := D_WI;            -- weight integer bits
+    WF             : natural := D_WF;            -- weight fraction bits
+    RF             : natural := D_RF;            -- Bhattacharyya term fraction bits
+    AF             : natural := D_AF;            -- alpha fraction bits
+    RHO_OUT_FRAC   : natural := D_RHO_OUT_FRAC;  -- reported rho fraction bits
+    MAX_ITER       : natural := D_MAX_ITER;      -- iteration limit per feature
+    EPS2           : natural := D_EPS2;          -- shift stop threshold (Q.2CF px^2)
+    HALF_W         : natural := D_HALF_W;        -- derived widths: see mstrack.fixed.vhdl_pkg
+    REGION_MAX     : natural := D_REGION_MAX;
+    REGION_W       : natural := D_REGION_W;
+    STRIDE         : natural := D_STRIDE;
+    ADDR_W         : natural := D_ADDR_W;
+    KVAL_W         : natural := D_KVAL_W;
+    HIST_W         : natural := D_HIST_W;
+    COUNT_W        : natural := D_COUNT_W;
+    POSSUM_W       : natural := D_POSSUM_W;
+    KD_W           : natural := D_KD_W;
+    SQRT_IN_W      : natural := D_SQRT_IN_W;
+    RHO_SUM_W      : natural := D_RHO_SUM_W;
+    RATIO_Q_W      : natural := D_RATIO_Q_W;
+    WEIGHT_W       : natural := D_WEIGHT_W;
+    SW_W           : natural := D_SW_W;
+    SWX_W          : natural := D_SWX_W;
+    SHIFT_Q_W      : natural := D_SHIFT_Q_W;
+    CENTRE_W       : natural := D_CENTRE_W;
+    CENTRE_ABS_W   : natural := D_CENTRE_ABS_W;
+    ITER_W         : natural := D_ITER_W;
+    RHO_OUT_W      : natural := D_RHO_OUT_W;
+    ALPHA_W        : natural := D_ALPHA_W;
+    WIN_W          : natural := D_WIN_W;
+    RESULT_W       : natural := D_RESULT_W;
+    RESULT_STREAM  : boolean := true              -- true: m_axis_result_* carries each result word
+  );
+  port (
+    clk                  : in  std_logic;                                -- core, register and pixel clock
+    rst                  : in  std_logic;                                -- synchronous reset, active high
+    -- AXI4-Lite slave (registers: docs/registers.md)
+    s_axil_awvalid       : in  std_logic;                                -- write address valid
+    s_axil_awready       : out std_logic;                                -- write address ready
+    s_axil_awaddr        : in  std_logic_vector(11 downto 0);            -- write byte address
+    s_axil_awprot        : in  std_logic_vector(2 downto 0);             -- ignored
+    s_axil_wvalid        : in  std_logic;                                -- write data valid
+    s_axil_wready        : out std_logic;                                -- write data ready
+    s_axil_wdata         : in  std_logic_vector(31 downto 0);            -- write data
+    s_axil_wstrb         : in  std_logic_vector(3 downto 0);             -- byte enables
+    s_axil_bvalid        : out std_logic;                                -- write response valid
+    s_axil_bready        : in  std_logic;                                -- write response ready
+    s_axil_bresp         : out std_logic_vector(1 downto 0);             -- OKAY "00" / SLVERR "10"
+    s_axil_arvalid       : in  std_logic;                                -- read address valid
+    s_axil_arready       : out std_logic;                                -- read address ready
+    s_axil_araddr        : in  std_logic_vector(11 downto 0);            -- read byte address
+    s_axil_arprot        : in  std_logic_vector(2 downto 0);             -- ignored
+    s_axil_rvalid        : out std_logic;                                -- read data valid
+    s_axil_rready        : in  std_logic;                                -- read data ready
+    s_axil_rdata         : out std_logic_vector(31 downto 0);            -- read data
+    s_axil_rresp         : out std_logic_vector(1 downto 0);             -- OKAY "00" / SLVERR "10"
+    -- video in
+    s_axis_tdata         : in  std_logic_vector(23 downto 0);            -- R 23:16, G 15:8, B 7:0
+    s_axis_tvalid        : in  std_logic;                                -- pixel valid
+    s_axis_tready        : out std_logic;                                -- pixel accepted
+    s_axis_tlast         : in  std_logic;                                -- last pixel of a line
+    s_axis_tuser         : in  std_logic;                                -- first pixel of a frame
+    -- result stream (RESULT_STREAM = true)
+    m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);  -- result word (result_layout)
+    m_axis_result_tvalid : out std_logic;                                -- result valid
+    m_axis_result_tready : in  std_logic;                                -- result taken
+    m_axis_result_tlast  : out std_logic;                                -- always 1
+    -- interrupt
+    irq                  : out std_logic                                 -- level, active high
+  );
+end entity;
+
+architecture rtl of ms_tracker_axi is
+  constant RAW_W  : natural := 160;                    -- raw result window RES_RAW0..4
+  -- result word v1 fields (mstrack.fixed.vhdl_pkg.result_layout), LSB first
+  constant O_CX   : natural := 0;
+  constant O_CY   : natural := O_CX + CENTRE_ABS_W;
+  constant O_RC   : natural := O_CY + CENTRE_ABS_W;
+  constant O_RE   : natural := O_RC + RHO_OUT_W;
+  constant O_AL   : natural := O_RE + RHO_OUT_W;
+  constant O_IC   : natural := O_AL + ALPHA_W;
+  constant O_IE   : natural := O_IC + ITER_W;
+  constant O_SC   : natural := O_IE + ITER_W;
+  constant O_SE   : natural := O_SC + 2;
+  constant O_FL   : natural := O_SE + 2;
+  constant O_EC   : natural := O_FL + 8;
+  constant O_BW   : natural := O_EC + 3;
+  constant O_BH   : natural := O_BW + WIN_W;
+  constant O_FC   : natural := O_BH + WIN_W;
+  constant F_LOST : natural := 2;                      -- RESULT_FLAGS indices
+  constant F_ERR  : natural := 3;
+  constant F_REJ  : natural := 4;
+  constant F_NOT  : natural := 5;
+  constant W_MAX  : natural := 2 ** COORD_W - 1;
+
+  signal hw_in    : ms_tracker_regs_in_t;
+  signal hw_out   : ms_tracker_regs_out_t;
+  -- video gate
+  signal pass_r   : std_logic := '0';                  -- the frame in progress goes to the core
+  signal sof_held : std_logic := '0';                  -- a start-of-frame beat waits; its route is fixed
+  signal sof_rt   : std_logic := '0';
+  signal route    : std_logic;                         -- where the current beat goes (1: core)
+  signal c_tvalid, c_tready : std_logic;
+  signal drop_sof : std_logic;
+  -- init
+  signal init_v   : std_logic := '0';
+  signal init_rdy : std_logic;
+  signal ib_x, ib_y : signed(COORD_W + 1 downto 0) := (others => '0');
+  signal ib_w, ib_h : unsigned(COORD_W downto 0) := (others => '0');
+  -- results
+  signal r_data   : std_logic_vector(RESULT_W - 1 downto 0);
+  signal r_valid, r_ready, r_take : std_logic;
+  signal lat      : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- L
+  signal snap     : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- S
+  signal lat_ok   : std_logic := '0';
+  signal ev_res, ev_lost, ev_err, ev_rej : std_logic := '0';
+  signal busy     : std_logic;
+  signal fw, fh   : unsigned(COORD_W - 1 downto 0);
+
+  function sat_u(v : std_logic_vector; w : natural) return unsigned is
+  begin
+    if unsigned(v) > 2 ** w - 1 then
+      return to_unsigned(2 ** w - 1, w);
+    end if;
+    return resize(unsigned(v), w);
+  end function;
+
+  function sat_s(v : std_logic_vector; w : natural) return signed is
+    variable s : integer := to_integer(signed(v));
+  begin
+    if s > 2 ** (w - 1) - 1 then
+      return to_signed(2 ** (w - 1) - 1, w);
+    elsif s < -(2 ** (w - 1)) then
+      return to_signed(-(2 ** (w - 1)), w);
+    end if;
+    return to_signed(s, w);
+  end function;
+
+  function fld(v : std_logic_vector; off, w, n : natural) return std_logic_vector is
+  begin
+    return std_logic_vector(resize(unsigned(v(off + w - 1 downto off)), n));
+  end function;
+begin
+  assert RESULT_W <= RAW_W report "ms_tracker_axi: RESULT_W > 160 does not fit RES_RAW0..4" severity failure;
+  assert CENTRE_ABS_W <= 32 and RHO_OUT_W <= 32 and ALPHA_W <= 32 and ITER_W <= 8 and WIN_W <= 16
+    report "ms_tracker_axi: a result field is wider than its register field" severity failure;
+  assert O_FC + 16 <= RESULT_W report "ms_tracker_axi: result layout and RESULT_W disagree" severity failure;
+  assert COORD_W + 2 <= 16 report "ms_tracker_axi: init box registers are 16 bits" severity failure;
+
+  ---------------------------------------------------------------------------- registers
+  u_regs : entity work.ms_tracker_regs
+    port map (
+      clk => clk, rst => rst,
+      s_axil_awready => s_axil_awready, s_axil_awvalid => s_axil_awvalid, s_axil_awaddr => s_axil_awaddr,
+      s_axil_awprot => s_axil_awprot, s_axil_wready => s_axil_wready, s_axil_wvalid => s_axil_wvalid,
+      s_axil_wdata => s_axil_wdata, s_axil_wstrb => s_axil_wstrb, s_axil_bready => s_axil_bready,
+      s_axil_bvalid => s_axil_bvalid, s_axil_bresp => s_axil_bresp, s_axil_arready => s_axil_arready,
+      s_axil_arvalid => s_axil_arvalid, s_axil_araddr => s_axil_araddr, s_axil_arprot => s_axil_arprot,
+      s_axil_rready => s_axil_rready, s_axil_rvalid => s_axil_rvalid, s_axil_rdata => s_axil_rdata,
+      s_axil_rresp => s_axil_rresp, hwif_in => hw_in, hwif_out => hw_out);
+
+  -- identification and build-time configuration
+  hw_in.VERSION.result_version.next_q <= x"1";
+  hw_in.VERSION.result_width.next_q   <= std_logic_vector(to_unsigned(RESULT_W, 8));
+  hw_in.CONFIG.features.next_q        <= std_logic_vector(to_unsigned(FEATURES, 2));
+  hw_in.CONFIG.kernel_epan.next_q     <= '1' when KERNEL_EPAN /= 0 else '0';
+  hw_in.CONFIG.result_stream.next_q   <= '1' when RESULT_STREAM else '0';
+  hw_in.CONFIG.lanes.next_q           <= std_logic_vector(to_unsigned(LANES, 8));
+  hw_in.CONFIG.max_half.next_q        <= std_logic_vector(to_unsigned(MAX_HALF, 16));
+  hw_in.FORMAT.max_frame_w.next_q     <= std_logic_vector(to_unsigned(MAX_FRAME_W, 16));
+  hw_in.FORMAT.centre_frac.next_q     <= std_logic_vector(to_unsigned(CF, 4));
+  hw_in.FORMAT.rho_frac.next_q        <= std_logic_vector(to_unsigned(RHO_OUT_FRAC, 5));
+  hw_in.FORMAT.alpha_frac.next_q      <= std_logic_vector(to_unsigned(AF, 5));
+
+  -- status
+  hw_in.STATUS.init_pending.next_q <= init_v;
+  hw_in.STATUS.busy.next_q         <= busy;
+  hw_in.STATUS.gate_open.next_q    <= pass_r;
+  hw_in.STATUS.tracking.next_q     <= lat_ok and not (lat(O_FL + F_NOT) or lat(O_FL + F_LOST) or lat(O_FL + F_ERR));
+  hw_in.STATUS.result_valid.next_q <= lat_ok;
+
+  -- interrupts (level inputs of sticky intr fields: a one-clock pulse sets the bit) and counters
+  hw_in.INT_STATUS.result.next_q <= ev_res;
+  hw_in.INT_STATUS.lost.next_q   <= ev_lost;
+  hw_in.INT_STATUS.error.next_q  <= ev_err or ev_rej;
+  irq <= hw_out.INT_STATUS.intr;
+  hw_in.RESULT_COUNT.count.incr <= ev_res;
+  hw_in.LOST_COUNT.count.incr   <= ev_lost;
+  hw_in.ERROR_COUNT.count.incr  <= ev_err;
+  hw_in.REJECT_COUNT.count.incr <= ev_rej;
+  hw_in.DROP_COUNT.count.incr   <= drop_sof;
+
+  -- last result: head from L, the rest from the snapshot S
+  hw_in.RES_HEAD.frame_count.next_q <= fld(lat, O_FC, 16, 16);
+  hw_in.RES_HEAD.flags.next_q       <= fld(lat, O_FL, 8, 8);
+  hw_in.RES_HEAD.err_code.next_q    <= fld(lat, O_EC, 3, 3);
+  hw_in.RES_HEAD.valid.next_q       <= lat_ok;
+  hw_in.RES_CX.value.next_q         <= fld(snap, O_CX, CENTRE_ABS_W, 32);
+  hw_in.RES_CY.value.next_q         <= fld(snap, O_CY, CENTRE_ABS_W, 32);
+  hw_in.RES_RHO_C.value.next_q      <= fld(snap, O_RC, RHO_OUT_W, 32);
+  hw_in.RES_RHO_E.value.next_q      <= fld(snap, O_RE, RHO_OUT_W, 32);
+  hw_in.RES_ALPHA.value.next_q      <= fld(snap, O_AL, ALPHA_W, 32);
+  hw_in.RES_ITER.iter_c.next_q      <= fld(snap, O_IC, ITER_W, 8);
+  hw_in.RES_ITER.iter_e.next_q      <= fld(snap, O_IE, ITER_W, 8);
+  hw_in.RES_ITER.stop_c.next_q      <= fld(snap, O_SC, 2, 2);
+  hw_in.RES_ITER.stop_e.next_q      <= fld(snap, O_SE, 2, 2);
+  hw_in.RES_BOX.box_w.next_q        <= fld(snap, O_BW, WIN_W, 16);
+  hw_in.RES_BOX.box_h.next_q        <= fld(snap, O_BH, WIN_W, 16);
+  hw_in.RES_RAW0.value.next_q       <= snap(31 downto 0);
+  hw_in.RES_RAW1.value.next_q       <= snap(63 downto 32);
+  hw_in.RES_RAW2.value.next_q       <= snap(95 downto 64);
+  hw_in.RES_RAW3.value.next_q       <= snap(127 downto 96);
+  hw_in.RES_RAW4.value.next_q       <= snap(159 downto 128);
+
+  ---------------------------------------------------------------------------- video gate
+  -- route of the current beat: a start-of-frame beat takes CTRL.enable (fixed once it waits),
+  -- any other beat follows its frame
+  route <= pass_r when s_axis_tuser = '0' else
+           sof_rt when sof_held = '1' else
+           hw_out.CTRL.enable.value;
+  c_tvalid <= s_axis_tvalid and route;
+  s_axis_tready <= c_tready when route = '1' else '1';
+  drop_sof <= s_axis_tvalid and s_axis_tuser and not route;
+
+  p_gate : process(clk)
+  begin
+    if rising_edge(clk) then
+      if s_axis_tvalid = '1' and s_axis_tuser = '1' then
+        if route = '0' or c_tready = '1' then        -- the start-of-frame beat is taken
+          pass_r   <= route;
+          sof_held <= '0';
+        else
+          sof_held <= '1';
+          sof_rt   <= route;
+        end if;
+      end if;
+      if rst = '1' then
+        pass_r   <= '0';
+        sof_held <= '0';
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- frame size, init
+  fw <= sat_u(hw_out.FRAME_SIZE.width.value, COORD_W);
+  fh <= sat_u(hw_out.FRAME_SIZE.height.value, COORD_W);
+
+  p_init : process(clk)
+  begin
+    if rising_edge(clk) then
+      if init_v = '1' and init_rdy = '1' then
+        init_v <= '0';
+      end if;
+      if hw_out.CMD.init.value = '1' then            -- copy the box; the latest command wins
+        ib_x   <= sat_s(hw_out.INIT_POS.x.value, COORD_W + 2);
+        ib_y   <= sat_s(hw_out.INIT_POS.y.value, COORD_W + 2);
+        ib_w   <= sat_u(hw_out.INIT_SIZE.width.value, COORD_W + 1);
+        ib_h   <= sat_u(hw_out.INIT_SIZE.height.value, COORD_W + 1);
+        init_v <= '1';
+      end if;
+      if rst = '1' then
+        init_v <= '0';
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- core
+  u_core : entity work.ms_tracker
+    generic map (
+      MAX_FRAME_W    => MAX_FRAME_W,
+      LANES          => LANES,
+      COLOUR_BITS    => COLOUR_BITS,
+      EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
+      EDGE_SHIFT     => EDGE_SHIFT,
+      FEATURES       => FEATURES,
+      KERNEL_EPAN    => KERNEL_EPAN,
+      KERNEL_BITS    => KERNEL_BITS,
+      MAX_HALF       => MAX_HALF,
+      MARGIN         => MARGIN,
+      COORD_W        => COORD_W,
+      CF             => CF,
+      WI             => WI,
+      WF             => WF,
+      RF             => RF,
+      AF             => AF,
+      RHO_OUT_FRAC   => RHO_OUT_FRAC,
+      MAX_ITER       => MAX_ITER,
+      EPS2           => EPS2,
+      HALF_W         => HALF_W,
+      REGION_MAX     => REGION_MAX,
+      REGION_W       => REGION_W,
+      STRIDE         => STRIDE,
+      ADDR_W         => ADDR_W,
+      KVAL_W         => KVAL_W,
+      HIST_W         => HIST_W,
+      COUNT_W        => COUNT_W,
+      POSSUM_W       => POSSUM_W,
+      KD_W           => KD_W,
+      SQRT_IN_W      => SQRT_IN_W,
+      RHO_SUM_W      => RHO_SUM_W,
+      RATIO_Q_W      => RATIO_Q_W,
+      WEIGHT_W       => WEIGHT_W,
+      SW_W           => SW_W,
+      SWX_W          => SWX_W,
+      SHIFT_Q_W      => SHIFT_Q_W,
+      CENTRE_W       => CENTRE_W,
+      CENTRE_ABS_W   => CENTRE_ABS_W,
+      ITER_W         => ITER_W,
+      RHO_OUT_W      => RHO_OUT_W,
+      ALPHA_W        => ALPHA_W,
+      WIN_W          => WIN_W,
+      RESULT_W       => RESULT_W
+    )
+    port map (
+      clk => clk, rst => rst, frame_width => fw, frame_height => fh,
+      s_init_tvalid => init_v, s_init_tready => init_rdy,
+      s_init_x => ib_x, s_init_y => ib_y, s_init_w => ib_w, s_init_h => ib_h,
+      s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
+      s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+      m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+      m_axis_result_tready => r_ready, m_axis_result_tlast => open,
+      busy => busy);
+
+  ---------------------------------------------------------------------------- results
+  r_ready <= m_axis_result_tready when RESULT_STREAM else '1';
+  r_take  <= r_valid and r_ready;
+  m_axis_result_tdata  <= r_data;
+  m_axis_result_tvalid <= r_valid when RESULT_STREAM else '0';
+  m_axis_result_tlast  <= '1';
+
+  p_result : process(clk)
+  begin
+    if rising_edge(clk) then
+      ev_res  <= r_take;
+      ev_lost <= r_take and r_data(O_FL + F_LOST);
+      ev_err  <= r_take and r_data(O_FL + F_ERR);
+      ev_rej  <= r_take and r_data(O_FL + F_REJ);
+      if r_take = '1' then                           -- L: the whole word in one clock
+        lat    <= std_logic_vector(resize(unsigned(r_data), RAW_W));
+        lat_ok <= '1';
+      end if;
+      if hw_out.RES_HEAD.frame_count.swacc = '1' then  -- read of RES_HEAD: S <= L, same clock
+        snap <= lat;
+      end if;
+      if rst = '1' then
+        lat    <= (others => '0');
+        snap   <= (others => '0');
+        lat_ok <= '0';
+        ev_res <= '0';
+        ev_lost <= '0';
+        ev_err <= '0';
+        ev_rej <= '0';
+      end if;
+    end if;
+  end process;
+end architecture;

@@ -1,0 +1,167 @@
+/* mstrack_drv: bare-metal driver of the mstrack tracking core (see mstrack_drv.h). */
+#include "mstrack_drv.h"
+
+/* one aligned 32-bit access at the offset of a register of the generated map */
+#define REG(dev, NAME) (*(volatile uint32_t *)((dev)->base + offsetof(ms_tracker_regs_t, NAME)))
+/* field of a register value, with the generated mask / position */
+#define FIELD(v, REGNAME, FNAME) \
+    (((v) & MS_TRACKER_REGS__##REGNAME##__##FNAME##_bm) >> MS_TRACKER_REGS__##REGNAME##__##FNAME##_bp)
+#define PUT(REGNAME, FNAME, x) \
+    ((((uint32_t)(x)) << MS_TRACKER_REGS__##REGNAME##__##FNAME##_bp) & MS_TRACKER_REGS__##REGNAME##__##FNAME##_bm)
+
+/* bits off .. off + w - 1 (w <= 32) of a word held LSB first in 32-bit pieces */
+static uint32_t bits(const uint32_t *words, unsigned off, unsigned w)
+{
+    unsigned i = off / 32u, s = off % 32u;
+    uint64_t v = words[i] >> s;
+    if (s + w > 32u) {
+        v |= (uint64_t)words[i + 1u] << (32u - s);
+    }
+    return (uint32_t)(v & ((w >= 32u) ? 0xFFFFFFFFu : ((1u << w) - 1u)));
+}
+
+int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t height)
+{
+    uint32_t v;
+    dev->base = base;
+    dev->irq_mask = 0;
+    dev->irq_count = 0;
+    dev->last.valid = 0;
+    if (REG(dev, ID) != MSTRACK_MAGIC) {
+        return MSTRACK_ERR_ID;
+    }
+    v = REG(dev, VERSION);
+    if (FIELD(v, VERSION, MAP_MAJOR) != MSTRACK_MAP_MAJOR || FIELD(v, VERSION, RESULT_VERSION) != 1u) {
+        return MSTRACK_ERR_VERSION;
+    }
+    if (width < 3u || height < 3u || width > FIELD(REG(dev, FORMAT), FORMAT, MAX_FRAME_W) || height > 0xFFFFu) {
+        return MSTRACK_ERR_ARG;
+    }
+    REG(dev, CTRL) = 0;                                    /* frames dropped from the next start */
+    REG(dev, INT_ENABLE) = 0;
+    REG(dev, INT_STATUS) = MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR;  /* W1C */
+    REG(dev, CMD) = PUT(CMD, CLEAR_COUNTERS, 1u);
+    REG(dev, FRAME_SIZE) = PUT(FRAME_SIZE, WIDTH, width) | PUT(FRAME_SIZE, HEIGHT, height);
+    return MSTRACK_OK;
+}
+
+int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h, uint32_t irq_mask)
+{
+    if (x < -32768 || x > 32767 || y < -32768 || y > 32767 || w > 0xFFFFu || h > 0xFFFFu) {
+        return MSTRACK_ERR_ARG;
+    }
+    REG(dev, INIT_POS) = PUT(INIT_POS, X, (uint32_t)x & 0xFFFFu) | PUT(INIT_POS, Y, (uint32_t)y & 0xFFFFu);
+    REG(dev, INIT_SIZE) = PUT(INIT_SIZE, WIDTH, w) | PUT(INIT_SIZE, HEIGHT, h);
+    REG(dev, CMD) = PUT(CMD, INIT, 1u);                    /* box copied now, taken between frames */
+    dev->irq_mask = irq_mask & (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR);
+    REG(dev, INT_ENABLE) = dev->irq_mask;
+    REG(dev, CTRL) = PUT(CTRL, ENABLE, 1u);
+    return MSTRACK_OK;
+}
+
+void mstrack_stop(mstrack_dev_t *dev)
+{
+    REG(dev, CTRL) = 0;
+    REG(dev, INT_ENABLE) = 0;
+    dev->irq_mask = 0;
+}
+
+int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r)
+{
+    uint32_t v = REG(dev, RES_HEAD);                       /* first: snapshot of one whole result */
+    r->valid = FIELD(v, RES_HEAD, VALID);
+    r->frame_count = FIELD(v, RES_HEAD, FRAME_COUNT);
+    r->flags = FIELD(v, RES_HEAD, FLAGS);
+    r->err_code = FIELD(v, RES_HEAD, ERR_CODE);
+    r->cx = REG(dev, RES_CX);
+    r->cy = REG(dev, RES_CY);
+    r->rho_c = REG(dev, RES_RHO_C);
+    r->rho_e = REG(dev, RES_RHO_E);
+    r->alpha_c = REG(dev, RES_ALPHA);
+    v = REG(dev, RES_ITER);
+    r->iter_c = FIELD(v, RES_ITER, ITER_C);
+    r->iter_e = FIELD(v, RES_ITER, ITER_E);
+    r->stop_c = FIELD(v, RES_ITER, STOP_C);
+    r->stop_e = FIELD(v, RES_ITER, STOP_E);
+    v = REG(dev, RES_BOX);
+    r->box_w = FIELD(v, RES_BOX, BOX_W);
+    r->box_h = FIELD(v, RES_BOX, BOX_H);
+    return r->valid ? MSTRACK_OK : MSTRACK_NO_RESULT;
+}
+
+void mstrack_read_raw(const mstrack_dev_t *dev, uint32_t words[5])
+{
+    words[0] = REG(dev, RES_RAW0);
+    words[1] = REG(dev, RES_RAW1);
+    words[2] = REG(dev, RES_RAW2);
+    words[3] = REG(dev, RES_RAW3);
+    words[4] = REG(dev, RES_RAW4);
+}
+
+void mstrack_decode_word(const uint32_t *words, mstrack_result_t *r)
+{
+    r->valid = 1u;
+    r->cx = bits(words, MSTRACK_RES_CX_OFF, MSTRACK_RES_CX_W);
+    r->cy = bits(words, MSTRACK_RES_CY_OFF, MSTRACK_RES_CY_W);
+    r->rho_c = bits(words, MSTRACK_RES_RHO_C_OFF, MSTRACK_RES_RHO_C_W);
+    r->rho_e = bits(words, MSTRACK_RES_RHO_E_OFF, MSTRACK_RES_RHO_E_W);
+    r->alpha_c = bits(words, MSTRACK_RES_ALPHA_C_OFF, MSTRACK_RES_ALPHA_C_W);
+    r->iter_c = bits(words, MSTRACK_RES_ITER_C_OFF, MSTRACK_RES_ITER_C_W);
+    r->iter_e = bits(words, MSTRACK_RES_ITER_E_OFF, MSTRACK_RES_ITER_E_W);
+    r->stop_c = bits(words, MSTRACK_RES_STOP_C_OFF, MSTRACK_RES_STOP_C_W);
+    r->stop_e = bits(words, MSTRACK_RES_STOP_E_OFF, MSTRACK_RES_STOP_E_W);
+    r->flags = bits(words, MSTRACK_RES_FLAGS_OFF, MSTRACK_RES_FLAGS_W);
+    r->err_code = bits(words, MSTRACK_RES_ERR_CODE_OFF, MSTRACK_RES_ERR_CODE_W);
+    r->box_w = bits(words, MSTRACK_RES_BOX_W_OFF, MSTRACK_RES_BOX_W_W);
+    r->box_h = bits(words, MSTRACK_RES_BOX_H_OFF, MSTRACK_RES_BOX_H_W);
+    r->frame_count = bits(words, MSTRACK_RES_FRAME_COUNT_OFF, MSTRACK_RES_FRAME_COUNT_W);
+}
+
+void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r)
+{
+    r->cx = bits(words, MSTRACK_RES2_CX_OFF, MSTRACK_RES2_CX_W);
+    r->cy = bits(words, MSTRACK_RES2_CY_OFF, MSTRACK_RES2_CY_W);
+    r->w8 = bits(words, MSTRACK_RES2_W8_OFF, MSTRACK_RES2_W8_W);
+    r->h8 = bits(words, MSTRACK_RES2_H8_OFF, MSTRACK_RES2_H8_W);
+    r->rho = bits(words, MSTRACK_RES2_RHO_OFF, MSTRACK_RES2_RHO_W);
+    r->confidence = bits(words, MSTRACK_RES2_CONFIDENCE_OFF, MSTRACK_RES2_CONFIDENCE_W);
+    r->status = bits(words, MSTRACK_RES2_STATUS_OFF, MSTRACK_RES2_STATUS_W);
+    r->iter = bits(words, MSTRACK_RES2_ITER_OFF, MSTRACK_RES2_ITER_W);
+    r->stop = bits(words, MSTRACK_RES2_STOP_OFF, MSTRACK_RES2_STOP_W);
+    r->decim_log2 = bits(words, MSTRACK_RES2_DECIM_LOG2_OFF, MSTRACK_RES2_DECIM_LOG2_W);
+    r->searched = bits(words, MSTRACK_RES2_SEARCHED_OFF, MSTRACK_RES2_SEARCHED_W);
+    r->flags = bits(words, MSTRACK_RES2_FLAGS_OFF, MSTRACK_RES2_FLAGS_W);
+    r->err_code = bits(words, MSTRACK_RES2_ERR_CODE_OFF, MSTRACK_RES2_ERR_CODE_W);
+    r->frame_count = bits(words, MSTRACK_RES2_FRAME_COUNT_OFF, MSTRACK_RES2_FRAME_COUNT_W);
+}
+
+uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
+{
+    uint32_t st = REG(dev, INT_STATUS) & (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR);
+    if (st == 0u) {
+        return 0u;
+    }
+    dev->irq_count++;
+    if (st & MSTRACK_IRQ_RESULT) {
+        (void)mstrack_read_result(dev, &dev->last);
+        if (r != NULL) {
+            *r = dev->last;
+        }
+    }
+    REG(dev, INT_STATUS) = st;                             /* W1C: exactly the bits handled */
+    return st;
+}
+
+void mstrack_read_counters(const mstrack_dev_t *dev, mstrack_counters_t *c)
+{
+    c->results = REG(dev, RESULT_COUNT);
+    c->lost = REG(dev, LOST_COUNT);
+    c->errors = REG(dev, ERROR_COUNT);
+    c->rejected = REG(dev, REJECT_COUNT);
+    c->dropped = REG(dev, DROP_COUNT);
+}
+
+void mstrack_clear_counters(const mstrack_dev_t *dev)
+{
+    REG(dev, CMD) = PUT(CMD, CLEAR_COUNTERS, 1u);
+}

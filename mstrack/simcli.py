@@ -147,7 +147,7 @@ def report_line(rep: dict[str, Any]) -> str:
                 "equal the fixed-point model")
     m = rep["first_mismatch"]
     return (f"MISMATCH: {rep['mismatched_frames']} of {rep['frames']} frames differ from the fixed-point model "
-            f"({rep['mismatches']} fields); first: frame {m['frame']} (result {m['result']}), field {m['field']}: "
+            f"({rep['mismatches']} field{'s' if rep['mismatches'] != 1 else ''}); first: frame {m['frame']} (result {m['result']}), field {m['field']}: "
             f"core={m['core']} model={m['model']}")
 
 

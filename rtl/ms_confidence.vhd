@@ -80,61 +80,57 @@ begin
     if rising_edge(clk) then
       dv_valid <= '0';
       done_r   <= '0';
-      case state is
-        when S_IDLE =>
-          if start = '1' then                            -- division 1: rho 2**16 / rho_ref (0 / 1 if 0)
-            if rho_ref = 0 then
-              dv_n <= (others => '0');
-              dv_d <= to_unsigned(1, W);
-            else
-              dv_n <= shift_left(resize(rho, W + 16), 16);
-              dv_d <= rho_ref;
-            end if;
-            dv_valid <= '1';
-            sh_r     <= share;
-            shref_r  <= share_ref;
-            state    <= S_DIV1;
-          end if;
-
-        when S_DIV1 =>
-          if dv_ov = '1' then                            -- division 2: share 2**16 / share_ref
-            ra <= clamp_one(dv_q);
-            if shref_r = 0 then
-              dv_n <= (others => '0');
-              dv_d <= to_unsigned(1, W);
-            else
-              dv_n <= shift_left(resize(sh_r, W + 16), 16);
-              dv_d <= shref_r;
-            end if;
-            dv_valid <= '1';
-            state    <= S_DIV2;
-          end if;
-
-        when S_DIV2 =>
-          if dv_ov = '1' then
-            rb    <= clamp_one(dv_q);
-            p     <= (others => '0');
-            k     <= Q_W - 1;
-            state <= S_MUL;
-          end if;
-
-        when S_MUL =>                                    -- MSB first: p = 2 p + bit_k(rb) ra
-          if rb(k) = '1' then
-            p <= shift_left(p, 1) + resize(ra, P_W);
+      if state = S_IDLE then
+        if start = '1' then                            -- division 1: rho 2**16 / rho_ref (0 / 1 if 0)
+          if rho_ref = 0 then
+            dv_n <= (others => '0');
+            dv_d <= to_unsigned(1, W);
           else
-            p <= shift_left(p, 1);
+            dv_n <= shift_left(resize(rho, W + 16), 16);
+            dv_d <= rho_ref;
           end if;
-          if k = 0 then
-            state <= S_OUT;
+          dv_valid <= '1';
+          sh_r     <= share;
+          shref_r  <= share_ref;
+          state    <= S_DIV1;
+        end if;
+      elsif state = S_DIV1 then
+        if dv_ov = '1' then                            -- division 2: share 2**16 / share_ref
+          ra <= clamp_one(dv_q);
+          if shref_r = 0 then
+            dv_n <= (others => '0');
+            dv_d <= to_unsigned(1, W);
           else
-            k <= k - 1;
+            dv_n <= shift_left(resize(sh_r, W + 16), 16);
+            dv_d <= shref_r;
           end if;
-
-        when S_OUT =>                                    -- >> 16 (p <= 2**32: 17 bits)
-          conf_r <= p(32 downto 16);
-          done_r <= '1';
-          state  <= S_IDLE;
-      end case;
+          dv_valid <= '1';
+          state    <= S_DIV2;
+        end if;
+      elsif state = S_DIV2 then
+        if dv_ov = '1' then
+          rb    <= clamp_one(dv_q);
+          p     <= (others => '0');
+          k     <= Q_W - 1;
+          state <= S_MUL;
+        end if;
+      elsif state = S_MUL then  -- MSB first: p = 2 p + bit_k(rb) ra (rb shifts up)
+        if rb(Q_W - 1) = '1' then
+          p <= shift_left(p, 1) + resize(ra, P_W);
+        else
+          p <= shift_left(p, 1);
+        end if;
+        rb <= shift_left(rb, 1);
+        if k = 0 then
+          state <= S_OUT;
+        else
+          k <= k - 1;
+        end if;
+      elsif state = S_OUT then  -- >> 16 (p <= 2**32: 17 bits)
+        conf_r <= p(32 downto 16);
+        done_r <= '1';
+        state  <= S_IDLE;
+      end if;
       if rst = '1' then
         state    <= S_IDLE;
         dv_valid <= '0';

@@ -69,47 +69,44 @@ begin
   begin
     if rising_edge(clk) then
       done_r <= '0';
-      case state is
-        when S_IDLE =>
-          if start = '1' then
-            r0 <= rho0;
-            rs <= rho_s;
-            if share = 0 or rho_s = 0 then
-              zero <= '1';
-            else
-              zero <= '0';
-            end if;
-            if con_s < to_signed(LOSS_CONTRAST, CON_W) then
-              con_lt <= '1';
-            else
-              con_lt <= '0';
-            end if;
-            p     <= (others => '0');
-            k     <= LR_W - 1;
-            state <= S_MUL;
-          end if;
-
-        when S_MUL =>                                  -- MSB first: p = 2 p + bit_k rho0
-          if LR_V(k) = '1' then
-            p <= shift_left(p, 1) + resize(r0, P_W);
+      if state = S_IDLE then
+        if start = '1' then
+          r0 <= rho0;
+          rs <= rho_s;
+          if share = 0 or rho_s = 0 then
+            zero <= '1';
           else
-            p <= shift_left(p, 1);
+            zero <= '0';
           end if;
-          if k = 0 then
-            state <= S_OUT;
+          if con_s < to_signed(LOSS_CONTRAST, CON_W) then
+            con_lt <= '1';
           else
-            k <= k - 1;
+            con_lt <= '0';
           end if;
-
-        when S_OUT =>
-          if zero = '1' or (shift_left(resize(rs, P_W), 16) < p and con_lt = '1') then
-            lost_r <= '1';
-          else
-            lost_r <= '0';
-          end if;
-          done_r <= '1';
-          state  <= S_IDLE;
-      end case;
+          p     <= (others => '0');
+          k     <= LR_W - 1;
+          state <= S_MUL;
+        end if;
+      elsif state = S_MUL then  -- MSB first: p = 2 p + bit_k rho0
+        if LR_V(k) = '1' then
+          p <= shift_left(p, 1) + resize(r0, P_W);
+        else
+          p <= shift_left(p, 1);
+        end if;
+        if k = 0 then
+          state <= S_OUT;
+        else
+          k <= k - 1;
+        end if;
+      elsif state = S_OUT then
+        if zero = '1' or (shift_left(resize(rs, P_W), 16) < p and con_lt = '1') then
+          lost_r <= '1';
+        else
+          lost_r <= '0';
+        end if;
+        done_r <= '1';
+        state  <= S_IDLE;
+      end if;
       if rst = '1' then
         state  <= S_IDLE;
         done_r <= '0';

@@ -18,7 +18,7 @@
 -- Handshake  : start pulse, ignored while busy = 1; done is a one-clock pulse; lost is registered and
 --              held until the next done.
 -- Cost       : one RHO_W + 18 bit adder (the product), one RHO_W + 18 bit compare, a CON_W-bit compare
---              with a constant, two zero tests; ~2 RHO_W + 24 flip-flops.
+--              with a constant, two zero tests; 3 RHO_W + 29 flip-flops (80 at RHO_W = 17).
 -- Reset      : synchronous, active high: control state.
 library ieee;
 use ieee.std_logic_1164.all;

@@ -386,6 +386,12 @@ def v2_scale_block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
         "ms_scale": pick("SPREAD_W", "SIZE_W", "SCALE_W", "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "RATIO_Q_W",
                          "WR_Q_W"),
         "ms_resize": pick("SIZE_W", "SCALE_W", "COORD_W"),
+        "ms_ring_share": pick("COUNT_W", "SHARE_W"),
+        "ms_loss_filter": {"W": g["CON_W"], "K_SHIFT": g["LOSS_K"]},
+        "ms_loss_flag": {"RHO_W": g["SHARE_W"], "CON_W": g["CON_W"], "LOSS_RHO": g["LOSS_RHO"],
+                         "LOSS_CONTRAST": g["LOSS_CONTRAST"]},
+        "ms_confidence": {"W": g["SHARE_W"]},
+        "ms_ref_update": {"W": g["SHARE_W"], "K_SHIFT": g["REF_K"]},
     }
 
 

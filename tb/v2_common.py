@@ -1,6 +1,7 @@
-"""Shared by the benches of the v2 per-frame blocks (ms_share, ms_spread, ms_scale, ms_resize).
+"""Shared by the benches of the v2 per-frame blocks (ms_share, ms_spread, ms_scale, ms_resize,
+ms_ring_share, ms_loss_filter, ms_loss_flag, ms_confidence, ms_ref_update).
 
-* :func:`record_v2_calls`: the arguments of every ms_share / ms_spread / ms_scale / ms_resize call
+* :func:`record_v2_calls`: the arguments of every call of those blocks
   FixedTrackerV2 makes on the first frames of real sequences (the model's own inputs, replayed
   value by value through the RTL).
 * :func:`run_stream`: a start/busy/done driver: each item's inputs are held with start = 1 until the
@@ -26,33 +27,38 @@ REAL_SEQS = ("Couple", "MotorRolling", "Deer", "Football1", "Subway")
 
 
 def record_v2_calls(names: Sequence[str] = REAL_SEQS, frames: int = 40) -> dict[str, list[tuple]]:
-    """{"ms_share": [(nt_in, n_in)], "ms_spread": [(st2, nt)], "ms_scale": [(spread, spread_ref, w8, w0_8)],
-    "ms_resize": [(s8, s, frame_size)]} of FixedTrackerV2 (default v2 parameters) on the first
-    ``frames`` frames of each sequence."""
+    """The arguments of every call FixedTrackerV2 (default v2 parameters) makes on the first ``frames``
+    frames of each sequence (init included), per block:
+
+    ms_share (nt_in, n_in), ms_spread (st2, nt), ms_scale (spread, spread_ref, w8, w0_8),
+    ms_resize (s8, s, frame_size), ms_ring_share (nt, nt_in, n_in, K), ms_loss_filter (s, x, k),
+    ms_loss_flag (rho_s, rho0, con_s, share, loss_rho, loss_contrast),
+    ms_confidence (rho, share, rho_ref, share_ref), ms_ref_update (ref, x, k)."""
     import mstrack.fixed.tracker_v2 as tv2
     from mstrack.data import load_sequence
 
-    out: dict[str, list[tuple]] = {"ms_share": [], "ms_spread": [], "ms_scale": [], "ms_resize": []}
+    args_of: dict[str, Callable[..., tuple]] = {
+        "ms_share": lambda st: (st.nt_in, st.n_in),
+        "ms_spread": lambda st: (st.st2, st.nt),
+        "ms_scale": lambda sp, sp_ref, w8, w0_8, tp: (sp, sp_ref, w8, w0_8),
+        "ms_resize": lambda s8, s, fs: (s8, s, fs),
+        "ms_ring_share": lambda st, K: (st.nt, st.nt_in, st.n_in, K),
+        "ms_loss_filter": lambda s, x, k: (s, x, k),
+        "ms_loss_flag": lambda *a: tuple(a),
+        "ms_confidence": lambda *a: tuple(a),
+        "ms_ref_update": lambda r, x, k: (r, x, k),
+    }
+    out: dict[str, list[tuple]] = {k: [] for k in args_of}
     orig = {k: getattr(tv2, k) for k in out}
 
-    def share(st):
-        out["ms_share"].append((st.nt_in, st.n_in))
-        return orig["ms_share"](st)
+    def wrap(name: str) -> Callable:
+        def f(*a):
+            out[name].append(args_of[name](*a))
+            return orig[name](*a)
+        return f
 
-    def spread(st):
-        out["ms_spread"].append((st.st2, st.nt))
-        return orig["ms_spread"](st)
-
-    def scale(sp, sp_ref, w8, w0_8, tp):
-        out["ms_scale"].append((sp, sp_ref, w8, w0_8))
-        return orig["ms_scale"](sp, sp_ref, w8, w0_8, tp)
-
-    def resize(s8, s, fs):
-        out["ms_resize"].append((s8, s, fs))
-        return orig["ms_resize"](s8, s, fs)
-
-    for k, f in (("ms_share", share), ("ms_spread", spread), ("ms_scale", scale), ("ms_resize", resize)):
-        setattr(tv2, k, f)
+    for k in out:
+        setattr(tv2, k, wrap(k))
     try:
         for name in names:
             seq = load_sequence(SEQ_ROOT / name)

@@ -78,8 +78,9 @@ def core_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None
 
 def v2_scale_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None,
                       lanes: int = DEFAULT_LANES) -> dict[str, int]:
-    """Generics of the v2 statistics and scale blocks (ms_target_stats, ms_share, ms_spread,
-    ms_scale, ms_resize), derived from the model (docs/fixed_point.md, "Tracker v2").
+    """Generics of the v2 statistics, scale and loss blocks (ms_target_stats, ms_share, ms_spread,
+    ms_scale, ms_resize, ms_ring_share, ms_loss_filter, ms_loss_flag, ms_confidence, ms_ref_update),
+    derived from the model (docs/fixed_point.md, "Tracker v2").
 
     Worst case over all windows: the counts hold the largest window's pixels; st2 the largest window
     times the largest d2q (2**(KB + 1) - 1, the bound docs/fixed_point.md states; inside the ellipse
@@ -88,7 +89,7 @@ def v2_scale_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
     isqrt(r 2**16) >= 1 + step, clamped to the same value, so saturating there is exact.  The size
     ratio w8 2**16 / w0_8 (w0_8 >= 3 px, w8 < 2**SIZE_W) never saturates with WR_Q_W bits.
     """
-    from .blocks_v2 import ONE, SIZE_FRAC, q16, sixteenths
+    from .blocks_v2 import ONE, SIZE_FRAC, q16, rate_shift, sixteenths
     from .primitives import ms_isqrt
 
     tp = tp or TrackerParams(preset="v2")
@@ -123,6 +124,13 @@ def v2_scale_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "SCALE_STEP": step,
         "RATIO_Q_W": ratio_q,
         "WR_Q_W": bits_for((((1 << size_w) - 1) << 16) // (3 << SIZE_FRAC)),
+        # loss flag, confidence, references: rho, share and their references are Q1.16 (SHARE_W bits);
+        # the contrast share - ring_share and its smoothed value are signed Q1.16 (SHARE_W + 1 bits)
+        "CON_W": bits_for(ONE) + 1,
+        "LOSS_K": rate_shift(tp.loss_smooth),
+        "REF_K": rate_shift(tp.ref_rate),
+        "LOSS_RHO": q16(tp.loss_rho),
+        "LOSS_CONTRAST": q16(tp.loss_contrast),
     }
 
 

@@ -30,7 +30,7 @@ def record_v2_calls(names: Sequence[str] = REAL_SEQS, frames: int = 40) -> dict[
     "ms_resize": [(s8, s, frame_size)]} of FixedTrackerV2 (default v2 parameters) on the first
     ``frames`` frames of each sequence."""
     import mstrack.fixed.tracker_v2 as tv2
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
 
     out: dict[str, list[tuple]] = {"ms_share": [], "ms_spread": [], "ms_scale": [], "ms_resize": []}
     orig = {k: getattr(tv2, k) for k in out}

@@ -1,0 +1,413 @@
+"""``mstrack sim VIDEO --box x,y,w,h``: the RTL core co-simulated on your own video.
+
+The frames of VIDEO (a video file, an image folder or an OTB/VOT sequence folder, read by
+:class:`mstrack.io.data.VideoSource` as ``mstrack track`` reads them) are streamed through the
+verilated netlist of ``ms_tracker`` (:func:`mstrack.hw.fastsim.simulate`: GHDL ``--synth`` to
+Verilog, Verilator, the C++ harness tools/hdl/cosim_main.cpp; the build is cached in
+``build/fastsim/``), with the init box given before the first frame.  Every result word is
+decoded and compared, field by field, with what the fixed-point model says the core must output
+(:func:`mstrack.hw.cosim.expected_results`).  Written to ``--out``:
+
+* ``results.csv``: one row per frame, the decoded result word (:data:`SIM_CSV_FIELDS`);
+* ``overlay.mp4`` (``.avi`` when mp4 cannot be written): the core's box on the frames, drawn by
+  :func:`mstrack.cli.draw_overlay` (the ``mstrack track`` overlay: status colour, banner, legend);
+* ``bitexact.json``: the comparison (:func:`bitexact_report`), also printed as one line.
+
+Exit codes: 0 bit-exact; 1 a field of a frame differs from the model (the first one is named),
+or the simulation failed; 2 bad input (missing file, box outside the frame, frame too large for
+the core's generics, a preset the core does not implement), with a one-line error.
+
+Registered in :data:`mstrack.cli.EXTENSIONS` as ``"mstrack.simcli:register_cli"``;
+docs/integration.md, "Simulate your own video".
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import itertools
+import json
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterator, Sequence
+
+import numpy as np
+
+from .hw.cosim import COMPARED_FIELDS, ERR_NAMES, MIN_FRAME, CoreConfig
+from .io.data import DataError, VideoSource
+from .fixed import FixedParams
+from .fixed.blocks import STOP_CODES, ms_box_clip, round_box
+from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, pack_result
+from .track.params import TrackerParams
+from .track.types import Box, Status, box_from_centre_index
+
+#: Columns of results.csv.  ``frame``: index in VIDEO; x, y, w, h: the core's box (0-based
+#: pixels, x, y = centre - (size - 1) / 2, exact: multiples of 2**-CF); cx, cy: its centre in
+#: pixel-index coordinates (Q.CF, exact); rho_c, rho_e, alpha_c: Q.RHO_OUT_FRAC / Q.AF as
+#: decimals (:data:`RHO_DECIMALS`); iter_*, stop_* (names of the stop codes); status (from the
+#: flags, :func:`result_status`); flags (the flag names set, "|"-joined); err_code (stream error
+#: name, empty when none); frame_count (the core's counter); latency (clocks from the frame's last
+#: pixel to the result); word: the raw result word, hexadecimal (every field, exactly).
+SIM_CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_c", "iter_c", "iter_e",
+                  "stop_c", "stop_e", "status", "flags", "err_code", "frame_count", "latency", "word")
+#: Decimals of rho_c, rho_e, alpha_c in results.csv: 2**-16 = 1.5e-5 apart, so 6 decimals keep
+#: every value apart (the raw integers are in ``word``).
+RHO_DECIMALS = 6
+STOP_NAMES = {v: k for k, v in STOP_CODES.items()}
+#: Presets the RTL core implements (preset v2 has no core yet: issue 11).
+CORE_PRESETS = ("paper",)
+#: Mismatches listed in bitexact.json (the count is always complete).
+MAX_LISTED = 200
+EXIT_OK, EXIT_MISMATCH, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class SimInputError(ValueError):
+    """Bad input to ``mstrack sim`` (exit code 2)."""
+
+
+# ----------------------------------------------------------------------------- decoding
+def result_status(fields: dict[str, int]) -> str:
+    """Status of a result word from its flags: error, no_target, clipped / init (the init frame),
+    lost, else ok (:class:`mstrack.track.types.Status` values, plus ``no_target``)."""
+    f = fields["flags"]
+    on = lambda name: (f >> RESULT_FLAGS.index(name)) & 1  # noqa: E731
+    if on("error"):
+        return Status.ERROR.value
+    if on("no_target"):
+        return "no_target"
+    if on("init"):
+        return Status.CLIPPED.value if on("clipped") else Status.INIT.value
+    return Status.LOST.value if on("lost") else Status.OK.value
+
+
+def decode_row(fields: dict[str, int], g: dict[str, int], frame: int, latency: int | None = None
+               ) -> dict[str, Any]:
+    """One results.csv row (:data:`SIM_CSV_FIELDS`) from the fields of a result word.
+
+    ``g``: the generics of the core (CF, RHO_OUT_FRAC, AF scale the fixed-point fields);
+    ``frame``: the frame's index in the video.  The row also serves the overlay
+    (:func:`mstrack.cli.draw_overlay` reads frame, status, x, y, w, h, cx, cy, rho_c, rho_e, alpha_c).
+    """
+    cf = float(1 << g["CF"])
+    cx, cy = fields["cx"] / cf, fields["cy"] / cf
+    b = box_from_centre_index(cx, cy, fields["box_w"], fields["box_h"])
+    rho = lambda v: round(v / (1 << g["RHO_OUT_FRAC"]), RHO_DECIMALS)  # noqa: E731
+    flags = "|".join(n for i, n in enumerate(RESULT_FLAGS) if (fields["flags"] >> i) & 1)
+    err = fields["err_code"]
+    err_name = ERR_NAMES[err] if err < len(ERR_NAMES) else str(err)
+    return {"frame": frame, "x": b.x, "y": b.y, "w": b.w, "h": b.h, "cx": cx, "cy": cy,
+            "rho_c": rho(fields["rho_c"]), "rho_e": rho(fields["rho_e"]),
+            "alpha_c": round(fields["alpha_c"] / (1 << g["AF"]), RHO_DECIMALS),
+            "iter_c": fields["iter_c"], "iter_e": fields["iter_e"],
+            "stop_c": STOP_NAMES[fields["stop_c"]], "stop_e": STOP_NAMES[fields["stop_e"]],
+            "status": result_status(fields), "flags": flags,
+            "err_code": err_name if fields["flags"] >> RESULT_FLAGS.index("error") & 1 else "",
+            "frame_count": fields["frame_count"], "latency": "" if latency is None else latency,
+            "word": f"{pack_result({k: fields[k] for k in COMPARED_FIELDS}, g):0{g['RESULT_W'] // 4}x}"}
+
+
+# ----------------------------------------------------------------------------- comparison
+def field_mismatches(results: Sequence[dict], expected: Sequence[dict], frames: Sequence[int],
+                     fields: Sequence[str] = COMPARED_FIELDS) -> list[dict[str, Any]]:
+    """Every differing (frame, field) between the core's results and the model's, in frame order:
+    ``{"result": i, "frame": frames[i], "field": name, "core": .., "model": ..}``; a missing
+    result has field ``"(no result)"``, an extra one ``"(extra result)"``."""
+    out: list[dict[str, Any]] = []
+    for i in range(max(len(results), len(expected))):
+        fr = frames[i] if i < len(frames) else frames[-1] + i - len(frames) + 1
+        if i >= len(results):
+            out.append({"result": i, "frame": fr, "field": "(no result)", "core": None, "model": "a result"})
+        elif i >= len(expected):
+            out.append({"result": i, "frame": fr, "field": "(extra result)", "core": results[i].get("word"),
+                        "model": None})
+        else:
+            out += [{"result": i, "frame": fr, "field": k, "core": results[i].get(k), "model": expected[i].get(k)}
+                    for k in fields if results[i].get(k) != expected[i].get(k)]
+    return out
+
+
+def bitexact_report(results: Sequence[dict], expected: Sequence[dict], frames: Sequence[int],
+                    fields: Sequence[str] = COMPARED_FIELDS) -> dict[str, Any]:
+    """The bit-exactness report: ``bit_exact``, ``frames`` compared, ``fields``, ``mismatched_frames``,
+    ``mismatches`` (count), ``first_mismatch`` (or None) and the first :data:`MAX_LISTED` in
+    ``listed`` (:func:`field_mismatches`)."""
+    mm = field_mismatches(results, expected, frames, fields)
+    return {"bit_exact": not mm, "frames": len(expected), "results": len(results), "fields": list(fields),
+            "reference": "fixed-point model, mstrack.hw.cosim.expected_results",
+            "mismatched_frames": len({m["result"] for m in mm}), "mismatches": len(mm),
+            "first_mismatch": mm[0] if mm else None, "listed": mm[:MAX_LISTED]}
+
+
+def report_line(rep: dict[str, Any]) -> str:
+    """The one printed line of a :func:`bitexact_report`."""
+    if rep["bit_exact"]:
+        return (f"bit-exact: {rep['frames']} frames x {len(rep['fields'])} fields of the result word "
+                "equal the fixed-point model")
+    m = rep["first_mismatch"]
+    return (f"MISMATCH: {rep['mismatched_frames']} of {rep['frames']} frames differ from the fixed-point model "
+            f"({rep['mismatches']} field{'s' if rep['mismatches'] != 1 else ''}); first: frame {m['frame']} (result {m['result']}), field {m['field']}: "
+            f"core={m['core']} model={m['model']}")
+
+
+# ----------------------------------------------------------------------------- input
+def parse_frame_range(s: str) -> tuple[int, int]:
+    """``"FIRST,LAST"`` (0-based, inclusive) -> (first, last)."""
+    try:
+        a, b = (int(v) for v in s.replace(" ", "").split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--frames wants FIRST,LAST (0-based, inclusive), got {s!r}") from None
+    if a < 0 or b < a:
+        raise argparse.ArgumentTypeError(f"--frames wants 0 <= FIRST <= LAST, got {s!r}")
+    return a, b
+
+
+@dataclass
+class SimJob:
+    """What ``mstrack sim`` streams: frames ``first`` .. ``first + count - 1`` of ``source`` with
+    the integer init box ``box`` (given on the core's init port) before the first."""
+
+    source: VideoSource
+    first: int
+    count: int
+    box: tuple[int, int, int, int]
+    given: Box
+    cfg: CoreConfig
+    size: tuple[int, int]                     # (W, H)
+    gt: np.ndarray | None = None              # ground truth of the streamed frames (sequence folder)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def frame_indices(self) -> list[int]:
+        return list(range(self.first, self.first + self.count))
+
+    def frames(self) -> Iterator[np.ndarray]:
+        """The streamed frames, read again from the source on every call (nothing held in memory)."""
+        for f in itertools.islice(self.source.frames(on_bad="raise"), self.first, self.first + self.count):
+            assert f is not None
+            yield f
+
+
+def check_frame_size(w: int, h: int, g: dict[str, int]) -> None:
+    """Raise :class:`SimInputError` when a w x h frame is outside what the core's generics take."""
+    if w > g["MAX_FRAME_W"]:
+        raise SimInputError(f"frames are {w}x{h}: wider than the core's MAX_FRAME_W = {g['MAX_FRAME_W']} "
+                            "(--max-frame-width)")
+    lim = (1 << g["COORD_W"]) - 1
+    if w > lim or h > lim:
+        raise SimInputError(f"frames are {w}x{h}: larger than the core's coordinates allow "
+                            f"(COORD_W = {g['COORD_W']}: at most {lim} px per side)")
+    if w < MIN_FRAME or h < MIN_FRAME:
+        raise SimInputError(f"frames are {w}x{h}: smaller than the core's {MIN_FRAME}x{MIN_FRAME} minimum")
+
+
+def prepare(video: str | Path, box: Box | None, frame_range: tuple[int, int] | None, max_frames: int | None,
+            cfg: CoreConfig) -> SimJob:
+    """Open ``video``, pick the frames and the init box and check them against the core.
+
+    Raises :class:`SimInputError` / :class:`mstrack.io.data.DataError` (both exit 2)."""
+    from .cli import init_box_note
+
+    src = VideoSource(video)
+    first, last = frame_range if frame_range is not None else (0, None)
+    n_max = None if last is None else last - first + 1
+    if max_frames is not None:
+        n_max = max_frames if n_max is None else min(n_max, max_frames)
+    # one pass: count the frames, check that they are readable and of one size
+    size: tuple[int, int] | None = None
+    count = 0
+    for i, f in enumerate(itertools.islice(src.frames(on_bad="raise"), first, None if n_max is None else first + n_max)):
+        assert f is not None
+        hw = (f.shape[1], f.shape[0])
+        if size is None:
+            size = hw
+            check_frame_size(*size, cfg.generics())
+        elif hw != size:
+            raise SimInputError(f"frame {first + i} is {hw[0]}x{hw[1]}, frame {first} {size[0]}x{size[1]}: "
+                                "the core tracks one frame size")
+        count += 1
+    if size is None:
+        raise SimInputError(f"{video}: no frame {first} (the source has {src.decoded} frames)")
+    if last is not None and count < last - first + 1 and (max_frames is None or count < max_frames):
+        raise SimInputError(f"--frames {first},{last}: the source ends after frame {first + count - 1}")
+    gt = None
+    if src.sequence is not None:
+        gt = src.sequence.gt[first:first + count]
+        if box is None:
+            g0 = src.sequence.gt[first]
+            if not np.isfinite(g0).all() or g0[2] <= 0 or g0[3] <= 0:
+                raise SimInputError(f"no ground truth box for frame {first} of {video}: give --box x,y,w,h")
+            box = Box.of(g0)
+    if box is None:
+        raise SimInputError("--box x,y,w,h is required unless VIDEO is a sequence folder with ground truth")
+    if box.w <= 0 or box.h <= 0:
+        raise SimInputError(f"--box {box.as_tuple()}: width and height must be positive")
+    ib = round_box(*box.as_tuple())
+    g = cfg.generics()
+    cw = g["COORD_W"]
+    if not (-(1 << (cw + 1)) <= ib[0] < 1 << (cw + 1) and -(1 << (cw + 1)) <= ib[1] < 1 << (cw + 1)
+            and ib[2] < 1 << (cw + 1) and ib[3] < 1 << (cw + 1)):
+        raise SimInputError(f"--box {ib}: does not fit the core's init port (COORD_W = {cw})")
+    clipped, _ = ms_box_clip(*ib, size[0], size[1], cfg.fp.max_half)
+    if clipped is None:
+        raise SimInputError(f"--box {ib} leaves less than 3x3 px inside the {size[0]}x{size[1]} frame "
+                            "(the core rejects it; 1-px border excluded)")
+    job = SimJob(src, first, count, ib, box, cfg, size, gt)
+    note = init_box_note(box, Box(clipped.x, clipped.y, clipped.w, clipped.h), (size[1], size[0]))
+    if note:
+        job.notes.append(note.replace("tracking", "the core tracks"))
+    return job
+
+
+# ----------------------------------------------------------------------------- run
+#: The model side: (frames, box, tp, fp) -> expected result fields per frame.  A parameter of
+#: :func:`run_sim` so that tests can check that a wrong expectation is caught.
+ModelFn = Callable[[Iterator[np.ndarray], tuple[int, int, int, int], TrackerParams, FixedParams],
+                   list[dict[str, int]]]
+
+
+def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool = False,
+            command: str = "") -> dict[str, Any]:
+    """Simulate ``job`` and write results.csv, the overlay video and bitexact.json to ``out``.
+
+    Returns the report (bitexact.json's content)."""
+    from .hw import fastsim
+    from .cli import draw_overlay
+    from .hw.cosim import expected_results
+    from .io.data import open_video_writer
+
+    model = model or expected_results
+    g = job.cfg.generics()
+    say = (lambda m: print(f"mstrack sim: {m}", file=sys.stderr, flush=True)) if progress else (lambda m: None)
+    t0 = time.monotonic()
+    say(f"co-simulating {job.count} frames {job.size[0]}x{job.size[1]} (LANES {job.cfg.lanes}; the first "
+        "run of a generic set builds the Verilator model, 1-2 min)...")
+    run = fastsim.simulate(job.frames(), job.box, job.cfg.tp, job.cfg.fp, lanes=job.cfg.lanes,
+                           max_frame_w=job.cfg.max_frame_w, check=False)
+    t_sim = time.monotonic() - t0
+    say(f"simulated {run.cycles} clocks in {run.seconds:.1f} s ({run.status}); running the fixed-point model...")
+    t1 = time.monotonic()
+    expected = model(job.frames(), job.box, job.cfg.tp, job.cfg.fp)
+    t_model = time.monotonic() - t1
+    idx = job.frame_indices
+    rep = bitexact_report(run.results, expected, idx)
+    rows = [decode_row(r, g, idx[i] if i < len(idx) else idx[-1] + i - len(idx) + 1, r.get("latency"))
+            for i, r in enumerate(run.results)]
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "results.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=SIM_CSV_FIELDS)
+        w.writeheader()
+        w.writerows(rows)
+    video = None
+    if rows:
+        writer = None
+        try:
+            for i, frame in enumerate(job.frames()):
+                if i >= len(rows):
+                    break
+                gt = None if job.gt is None or i >= len(job.gt) else job.gt[i]
+                img = draw_overlay(frame, rows[i], gt)
+                if writer is None:
+                    writer, video = open_video_writer(out / "overlay.mp4", job.source.fps, (img.shape[1], img.shape[0]))
+                writer.write(img)
+        finally:
+            if writer is not None:
+                writer.release()
+    lat = [r["latency"] for r in run.results if "latency" in r]
+    listed = rep.pop("listed")
+    rep = {**rep, "command": command, "source": str(job.source.path), "kind": job.source.kind,
+           "first_frame": job.first, "frames_streamed": job.count, "frame_size": list(job.size),
+           "init_box_given": list(job.given.as_tuple()), "init_box": list(job.box),
+           "preset": job.cfg.tp.preset, "lanes": job.cfg.lanes, "generics": g,
+           "simulation": {"status": run.status, "detail": run.detail, "cycles": run.cycles,
+                          "seconds": round(run.seconds, 3), "cpu_seconds": round(run.cpu_seconds, 3),
+                          "build_seconds": round(run.build_seconds, 1), "wall_seconds": round(t_sim, 1),
+                          "latency_min": min(lat) if lat else None, "latency_max": max(lat) if lat else None},
+           "model_seconds": round(t_model, 1),
+           "files": {"csv": str(out / "results.csv"), "video": None if video is None else str(video),
+                     "report": str(out / "bitexact.json")},
+           "listed": listed}
+    (out / "bitexact.json").write_text(json.dumps(rep, indent=1) + "\n")
+    return rep
+
+
+# ----------------------------------------------------------------------------- CLI
+def _cmd_sim(args: argparse.Namespace) -> int:
+    from .cli import check_out_dir
+
+    def bad(msg: str) -> int:
+        if os.environ.get("MSTRACK_TRACEBACK"):
+            raise SimInputError(msg)
+        print(f"mstrack sim: error: {msg}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+    if args.preset not in CORE_PRESETS:
+        return bad(f"--preset {args.preset}: the RTL core implements the paper preset only "
+                   "(core v2, issue 11, is not built); use --preset paper")
+    if args.lanes & (args.lanes - 1):
+        return bad(f"--lanes {args.lanes}: LANES must be a power of two (1, 2, 4, 8, ...)")
+    try:
+        cfg = CoreConfig(TrackerParams(preset="paper"), FixedParams(), lanes=args.lanes,
+                         max_frame_w=args.max_frame_width)
+        cfg.generics()
+        out = Path(args.out) if args.out else Path("out/sim") / Path(args.video).resolve().name
+        job = prepare(args.video, args.box, args.frames, args.max_frames, cfg)
+        check_out_dir(out)
+    except (DataError, ValueError) as exc:
+        return bad(str(exc))
+    for n in job.notes:
+        print(f"mstrack: warning: {n}", file=sys.stderr)
+    if job.source.truncated:
+        print(f"mstrack: warning: {job.source.path}: {job.source.truncated}", file=sys.stderr)
+    rep = run_sim(job, out, progress=not args.quiet, command=getattr(args, "command_line", ""))
+    sim = rep["simulation"]
+    print(f"{rep['results']} results for {job.count} frames {job.size[0]}x{job.size[1]}, {sim['cycles']} clocks "
+          f"({sim['status']}), latency {sim['latency_min']}..{sim['latency_max']} clocks after the last pixel")
+    print(report_line(rep))
+    print(f"wrote {rep['files']['csv']}, {rep['files']['video']}, {rep['files']['report']}")
+    if sim["status"] != "done":
+        print(f"mstrack sim: error: the harness stopped early: {sim['status']} {sim['detail']}", file=sys.stderr)
+        return EXIT_MISMATCH
+    return EXIT_OK if rep["bit_exact"] else EXIT_MISMATCH
+
+
+def register_cli(sub: argparse._SubParsersAction) -> None:
+    """CLI extension (:data:`mstrack.cli.EXTENSIONS` entry ``"mstrack.simcli:register_cli"``): ``mstrack sim``."""
+    p = sub.add_parser("sim", help="co-simulate the RTL core on a video and check it bit by bit against the model",
+                       description="Stream VIDEO through the verilated RTL core (GHDL -> Verilog -> Verilator, "
+                                   "mstrack.hw.fastsim), write results.csv, an overlay video and bitexact.json "
+                                   "(every result field vs the fixed-point model). Exit 0 bit-exact, 1 mismatch "
+                                   "or simulation failure, 2 bad input.")
+    p.add_argument("video", metavar="VIDEO", help="video file, image folder or OTB/VOT sequence folder")
+    p.add_argument("--box", type=_box_arg, metavar="X,Y,W,H",
+                   help="init box on the first frame, 0-based pixels (rounded to integers as the init port "
+                        "takes them), e.g. --box=-5,10,20,20 (default for a sequence folder: its ground truth); "
+                        "a box partly outside the frame is clipped, one larger than the core's window shrunk, "
+                        "with a warning")
+    p.add_argument("--frames", type=parse_frame_range, metavar="FIRST,LAST",
+                   help="stream frames FIRST..LAST (0-based, inclusive; init on FIRST); default all")
+    p.add_argument("--max-frames", type=_positive, metavar="N", help="stream at most N frames")
+    p.add_argument("--lanes", type=_positive, default=DEFAULT_LANES,
+                   help=f"LANES generic, pixels per clock in the bin passes, a power of two (default {DEFAULT_LANES}; "
+                        "one Verilator build per value, cached)")
+    p.add_argument("--max-frame-width", type=_positive, default=2048, help="MAX_FRAME_W generic (default 2048)")
+    p.add_argument("--preset", default="paper",
+                   help="tracker preset of the core: paper (the only one the RTL core implements)")
+    p.add_argument("--out", help="output folder (default out/sim/<VIDEO name>)")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=_cmd_sim)
+
+
+def _box_arg(s: str) -> Box:
+    from .cli import _parse_box
+    return _parse_box(s)
+
+
+def _positive(s: str) -> int:
+    from .cli import _positive_int
+    return _positive_int(s)
+
+
+__all__ = ["SIM_CSV_FIELDS", "SimInputError", "SimJob", "bitexact_report", "decode_row", "field_mismatches",
+           "parse_frame_range", "prepare", "register_cli", "report_line", "result_status", "run_sim"]

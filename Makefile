@@ -65,7 +65,7 @@ lock:
 # register block, the C header, docs/registers.md) and sw/ms_tracker_result.h (result word layout);
 # tests/test_regs.py fails when a checked-in file differs from a fresh generation.
 regs: setup
-	$(PY) -m mstrack.regs
+	$(PY) -m mstrack.hw.regs
 
 eval: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval $(ARGS)

@@ -4,7 +4,7 @@ Public API::
 
     import mstrack
     trk = mstrack.Tracker()                       # tracker v2 (the best measured), float model
-    res = trk.init(frame_bgr, (x, y, w, h))       # 0-based pixels, see mstrack.types
+    res = trk.init(frame_bgr, (x, y, w, h))       # 0-based pixels, see mstrack.track.types
     res = trk.update(next_frame_bgr)              # -> mstrack.TrackResult
     x, y, w, h = res.box                          # floats; res.box.to_cv() for OpenCV
     res.ok, res.confidence, res.status
@@ -20,10 +20,10 @@ The core's result word (v1 and v2): ``mstrack.unpack_result(word)``, ``result_la
 """
 from typing import TYPE_CHECKING
 
-from .types import Box, FeatureResult, Status, TrackResult
+from .track.types import Box, FeatureResult, Status, TrackResult
 
 if TYPE_CHECKING:  # for type checkers; at run time they are imported lazily by __getattr__
-    from .tracker import FrameError, Tracker, TrackerMeanShift, TrackerParams
+    from .track.tracker import FrameError, Tracker, TrackerMeanShift, TrackerParams
 
 _RESULT_API = ("RESULT_FLAGS", "result_layout", "result_width", "pack_result", "unpack_result",
                "STATUS_V2", "result_layout_v2", "result_width_v2", "pack_result_v2", "unpack_result_v2")
@@ -35,7 +35,7 @@ _LAZY = ("Tracker", "TrackerMeanShift", "TrackerParams", "FrameError")
 
 def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
     if name in _LAZY:
-        from . import tracker
+        from .track import tracker
         return getattr(tracker, name)
     if name in _RESULT_API:
         from .fixed import vhdl_pkg

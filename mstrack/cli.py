@@ -16,7 +16,7 @@ Extension point
 Each command is one ``register(subparsers)`` function that adds its parser
 and sets ``func=handler`` (``handler(args) -> int`` exit code).  Built-in ones
 are listed in :data:`BUILTIN_COMMANDS`; other modules add theirs by appending
-``"module:function"`` to :data:`EXTENSIONS`, e.g. ``"mstrack.hdl:register_cli"``
+``"module:function"`` to :data:`EXTENSIONS`, e.g. ``"mstrack.hw.hdl:register_cli"``
 for ``vectors`` / ``synth`` / ``cosim``.  Extension modules are imported only
 when the CLI starts, so they may import heavy tools lazily.
 """
@@ -38,8 +38,8 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from .data import DataError, VideoSource, load_dataset, open_video_writer
-from .types import Box, Status, box_centre_index
+from .io.data import DataError, VideoSource, load_dataset, open_video_writer
+from .track.types import Box, Status, box_centre_index
 
 DEFAULT_DATASET = "../shared/data/sequences"
 #: Tracker of ``track``, ``demo`` and ``bench`` when none is given: tracker v2, the best measured
@@ -352,14 +352,14 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
     -----
     A ``FrameError`` from ``update`` (or an unreadable frame) is recorded as
     status "error" with the previous box, and tracking goes on.  ``status`` is
-    a :class:`~mstrack.types.Status` value (v2 adds "uncertain" and
+    a :class:`~mstrack.track.types.Status` value (v2 adds "uncertain" and
     "reacquired"); ``confidence`` (0..1, :data:`CONFIDENCE_DECIMALS` decimals)
     is filled for tracker v2 only (:func:`reports_confidence`).  The overlay
     video is upscaled for frames narrower than :data:`OVERLAY_MIN_WIDTH`.
     """
     from tqdm import tqdm
 
-    from .evaluate import frame_error_types, result_status, to_box
+    from .eval.evaluate import frame_error_types, result_status, to_box
 
     if max_frames is not None and max_frames < 1:
         raise ValueError(f"max_frames must be >= 1, got {max_frames}")
@@ -451,7 +451,7 @@ def resolve_tracker(tracker: str | None, preset: str | None) -> str:
     only, so it takes no other ``--tracker``); ``--preset paper`` runs ``--tracker`` or
     :data:`PAPER_TRACKER` (mstrack-fused-flat, the paper's algorithm: the RTL core's).  An unknown
     name is refused with the list of known ones."""
-    from .evaluate import tracker_names
+    from .eval.evaluate import tracker_names
 
     v2 = "mstrack-v2"
     if tracker is not None and tracker not in tracker_names():
@@ -468,7 +468,7 @@ def resolve_tracker(tracker: str | None, preset: str | None) -> str:
 
 
 def _tracker_help() -> str:
-    from .evaluate import tracker_names
+    from .eval.evaluate import tracker_names
 
     return (f"tracker name: {', '.join(tracker_names())} (default {DEFAULT_TRACKER}, the best measured, "
             "docs/results.md; with --preset paper: " + PAPER_TRACKER + ")")
@@ -489,8 +489,8 @@ def _add_preset_options(p: argparse.ArgumentParser) -> None:
 # --------------------------------------------------------------------------- eval
 
 def _cmd_eval(args: argparse.Namespace) -> int:
-    from .evaluate import evaluate, tracker_names
-    from .report import write_report
+    from .eval.evaluate import evaluate, tracker_names
+    from .eval.report import write_report
 
     names = _csv_list(args.trackers) or tracker_names()
     unknown = [n for n in names if n not in tracker_names()]
@@ -538,7 +538,7 @@ def register_eval(sub: argparse._SubParsersAction) -> None:
 # --------------------------------------------------------------------------- track
 
 def _cmd_track(args: argparse.Namespace) -> int:
-    from .evaluate import make_tracker
+    from .eval.evaluate import make_tracker
 
     src = VideoSource(args.source)
     box = args.box
@@ -596,7 +596,7 @@ def bench_fps(tracker: Any, frames: list[np.ndarray], box: Box) -> float:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from .evaluate import make_tracker, run_label
+    from .eval.evaluate import make_tracker, run_label
 
     models = ["float", "fixed"] if args.model == "both" else [args.model]
     runs = [(run_label(args.tracker, m), args.tracker, m) for m in models] + [("opencv-camshift", "opencv-camshift", "float")]
@@ -606,7 +606,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
             n = min(len(s), args.frames)
             cases.append((s.name, [s.frame(i) for i in range(n)], s.init_box()))
     else:
-        from .synthetic import make_scene
+        from .io.synthetic import make_scene
         scene, gt = make_scene(args.frames, 640, 360, seed=0)
         cases.append(("synthetic-640x360", list(scene), Box.of(gt[0])))
     header = ["sequence", "frames", "size", *[r[0] + " fps" for r in runs],
@@ -676,9 +676,9 @@ def find_vtest() -> Path | None:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from .evaluate import make_tracker, run_label
-    from .metrics import score
-    from .synthetic import make_scene
+    from .eval.evaluate import make_tracker, run_label
+    from .eval.metrics import score
+    from .io.synthetic import make_scene
 
     out = Path(args.out)
     name = resolve_tracker(args.tracker, args.preset)
@@ -745,12 +745,12 @@ BUILTIN_COMMANDS: dict[str, Callable[[argparse._SubParsersAction], None]] = {
 #: EXTENSION POINT: "module:function" entries, each function registering one or
 #: more subcommands exactly like the built-in ``register_*`` functions above.
 EXTENSIONS: list[str] = [
-    "mstrack.vectors:register_cli",     # vectors: test vectors for the VHDL core
-    "mstrack.agreement:register_cli",   # agree: float vs fixed-point agreement
-    "mstrack.synth:register_cli",       # synth: open synthesis, Fmax, cycle figures (performance.md)
-    "mstrack.hdl_config:register_cli",  # hdl config / hdl files: core configuration, file lists (packaging.md)
+    "mstrack.hw.vectors:register_cli",     # vectors: test vectors for the VHDL core
+    "mstrack.eval.agreement:register_cli",   # agree: float vs fixed-point agreement
+    "mstrack.hw.synth:register_cli",       # synth: open synthesis, Fmax, cycle figures (performance.md)
+    "mstrack.hw.hdl_config:register_cli",  # hdl config / hdl files: core configuration, file lists (packaging.md)
     "mstrack.simcli:register_cli",      # sim: the RTL core co-simulated on a video, bit-exact check (integration.md)
-    # "mstrack.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
+    # "mstrack.hw.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
 ]
 
 

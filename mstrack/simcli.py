@@ -1,12 +1,12 @@
 """``mstrack sim VIDEO --box x,y,w,h``: the RTL core co-simulated on your own video.
 
 The frames of VIDEO (a video file, an image folder or an OTB/VOT sequence folder, read by
-:class:`mstrack.data.VideoSource` as ``mstrack track`` reads them) are streamed through the
-verilated netlist of ``ms_tracker`` (:func:`mstrack.fastsim.simulate`: GHDL ``--synth`` to
+:class:`mstrack.io.data.VideoSource` as ``mstrack track`` reads them) are streamed through the
+verilated netlist of ``ms_tracker`` (:func:`mstrack.hw.fastsim.simulate`: GHDL ``--synth`` to
 Verilog, Verilator, the C++ harness tools/hdl/cosim_main.cpp; the build is cached in
 ``build/fastsim/``), with the init box given before the first frame.  Every result word is
 decoded and compared, field by field, with what the fixed-point model says the core must output
-(:func:`mstrack.cosim.expected_results`).  Written to ``--out``:
+(:func:`mstrack.hw.cosim.expected_results`).  Written to ``--out``:
 
 * ``results.csv``: one row per frame, the decoded result word (:data:`SIM_CSV_FIELDS`);
 * ``overlay.mp4`` (``.avi`` when mp4 cannot be written): the core's box on the frames, drawn by
@@ -35,13 +35,13 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
-from .cosim import COMPARED_FIELDS, ERR_NAMES, MIN_FRAME, CoreConfig
-from .data import DataError, VideoSource
+from .hw.cosim import COMPARED_FIELDS, ERR_NAMES, MIN_FRAME, CoreConfig
+from .io.data import DataError, VideoSource
 from .fixed import FixedParams
 from .fixed.blocks import STOP_CODES, ms_box_clip, round_box
 from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, pack_result
-from .params import TrackerParams
-from .types import Box, Status, box_from_centre_index
+from .track.params import TrackerParams
+from .track.types import Box, Status, box_from_centre_index
 
 #: Columns of results.csv.  ``frame``: index in VIDEO; x, y, w, h: the core's box (0-based
 #: pixels, x, y = centre - (size - 1) / 2, exact: multiples of 2**-CF); cx, cy: its centre in
@@ -70,7 +70,7 @@ class SimInputError(ValueError):
 # ----------------------------------------------------------------------------- decoding
 def result_status(fields: dict[str, int]) -> str:
     """Status of a result word from its flags: error, no_target, clipped / init (the init frame),
-    lost, else ok (:class:`mstrack.types.Status` values, plus ``no_target``)."""
+    lost, else ok (:class:`mstrack.track.types.Status` values, plus ``no_target``)."""
     f = fields["flags"]
     on = lambda name: (f >> RESULT_FLAGS.index(name)) & 1  # noqa: E731
     if on("error"):
@@ -135,7 +135,7 @@ def bitexact_report(results: Sequence[dict], expected: Sequence[dict], frames: S
     ``listed`` (:func:`field_mismatches`)."""
     mm = field_mismatches(results, expected, frames, fields)
     return {"bit_exact": not mm, "frames": len(expected), "results": len(results), "fields": list(fields),
-            "reference": "fixed-point model, mstrack.cosim.expected_results",
+            "reference": "fixed-point model, mstrack.hw.cosim.expected_results",
             "mismatched_frames": len({m["result"] for m in mm}), "mismatches": len(mm),
             "first_mismatch": mm[0] if mm else None, "listed": mm[:MAX_LISTED]}
 
@@ -206,7 +206,7 @@ def prepare(video: str | Path, box: Box | None, frame_range: tuple[int, int] | N
             cfg: CoreConfig) -> SimJob:
     """Open ``video``, pick the frames and the init box and check them against the core.
 
-    Raises :class:`SimInputError` / :class:`mstrack.data.DataError` (both exit 2)."""
+    Raises :class:`SimInputError` / :class:`mstrack.io.data.DataError` (both exit 2)."""
     from .cli import init_box_note
 
     src = VideoSource(video)
@@ -272,10 +272,10 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
     """Simulate ``job`` and write results.csv, the overlay video and bitexact.json to ``out``.
 
     Returns the report (bitexact.json's content)."""
-    from . import fastsim
+    from .hw import fastsim
     from .cli import draw_overlay
-    from .cosim import expected_results
-    from .data import open_video_writer
+    from .hw.cosim import expected_results
+    from .io.data import open_video_writer
 
     model = model or expected_results
     g = job.cfg.generics()
@@ -376,7 +376,7 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
     """CLI extension (:data:`mstrack.cli.EXTENSIONS` entry ``"mstrack.simcli:register_cli"``): ``mstrack sim``."""
     p = sub.add_parser("sim", help="co-simulate the RTL core on a video and check it bit by bit against the model",
                        description="Stream VIDEO through the verilated RTL core (GHDL -> Verilog -> Verilator, "
-                                   "mstrack.fastsim), write results.csv, an overlay video and bitexact.json "
+                                   "mstrack.hw.fastsim), write results.csv, an overlay video and bitexact.json "
                                    "(every result field vs the fixed-point model). Exit 0 bit-exact, 1 mismatch "
                                    "or simulation failure, 2 bad input.")
     p.add_argument("video", metavar="VIDEO", help="video file, image folder or OTB/VOT sequence folder")

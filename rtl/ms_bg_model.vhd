@@ -45,7 +45,7 @@
 --                       divider 18, v Q M(9) = 4, end 1), pass 3 N_BINS + 22 (read 2, divider 18,
 --                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
 --                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N_BINS = 512
---                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.synth
+--                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.hw.synth
 --                       --v2-budget: init frame 5,800 clocks, so 5,846 with this block).
 -- Throughput: one pixel per clock while counting; one model per init.
 -- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high

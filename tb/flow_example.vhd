@@ -1,5 +1,5 @@
 -- flow_example: toy design used to prove the HDL simulation / synthesis flow
--- (mstrack/hdl.py, tb/test_flow_example.py, docs/hdl_flow.md). Not part of the
+-- (mstrack/hw/hdl.py, tb/test_flow_example.py, docs/hdl_flow.md). Not part of the
 -- tracker core.
 --
 -- Video in on an AXI4-Stream-style port, one pixel per beat:
@@ -133,7 +133,7 @@ begin
         last2  <= last1r;
         first2 <= first1r;
         -- (a `case` with `others` on purpose: GHDL 2.0 drops the others branch
-        -- in its Verilog output, mstrack.hdl.fix_ghdl_pmux repairs it; the
+        -- in its Verilog output, mstrack.hw.hdl.fix_ghdl_pmux repairs it; the
         -- USE_ABOVE=false co-simulation checks that)
         sel_v := '0' & first1r;
         if USE_ABOVE then

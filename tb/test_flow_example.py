@@ -31,7 +31,7 @@ from cocotb.utils import get_sim_time
 from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStreamSource
 
 try:
-    from mstrack.hdl import dut_generics
+    from mstrack.hw.hdl import dut_generics
 except ImportError:  # pragma: no cover
     import json
 
@@ -187,7 +187,7 @@ async def deliberate_failure(dut):
 
 import pytest  # noqa: E402  (only needed on the pytest side)
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "flow_example"
 MODULE = "test_flow_example"

@@ -29,7 +29,7 @@ from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge, Timer
 
 from mstrack.fixed.blocks import ms_kernel
 from mstrack.fixed.blocks_v2 import BG_FRAC, ms_bg_model
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"BIN_W": 9, "HALF_W": 6, "COORD_W": 12, "RING_W": 5, "Q_W": 14, "O_W": 17, "KD_W": 29}
 CLK_NS = 10
@@ -312,11 +312,11 @@ async def bg_model_abandoned(dut):
 def real_cases(g: dict) -> list[dict]:
     """The init frame of real sequences, with FixedTrackerV2.init's geometry (decimation D,
     box diameters, centre clamped into the decimated interior)."""
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import ms_box_clip, ms_colour_bin, ms_round_centre, round_box
     from mstrack.fixed.blocks_v2 import SIZE_FRAC, ms_box_size, ms_decimation, sixteenths
     from mstrack.fixed.tracker_v2 import FixedTrackerV2
-    from mstrack.params import TrackerParams
+    from mstrack.track.params import TrackerParams
 
     colour_bits = int(g["BIN_W"]) // 3
     tp = TrackerParams(preset="v2", colour_bits=colour_bits)
@@ -365,7 +365,7 @@ async def bg_model_real(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "ms_bg_model"
 MODULE = "test_ms_bg_model"

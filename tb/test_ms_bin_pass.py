@@ -24,7 +24,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 
 from mstrack.fixed.blocks import Hist, ms_bin_pass
 from mstrack.fixed.formats import FixedParams
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"BIN_W": 9, "HIST_W": 14, "COUNT_W": 14, "POSSUM_W": 21, "SQRT_IN_W": 40, "RHO_SUM_W": 21,
             "RATIO_Q_W": 16, "WEIGHT_W": 8, "WF": 4, "RF": 6, "SW_W": 22, "SWX_W": 29, "BIN_RD_LAT": 2}
@@ -205,9 +205,9 @@ async def bin_pass_sequence(dut, jitter):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_bin_pass"
 MODULE = "test_ms_bin_pass"

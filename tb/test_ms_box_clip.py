@@ -15,7 +15,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import init_centre, ms_box_clip, ms_region
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 
 #: clocks from in_valid to out_valid (the headers of rtl/ms_box_clip.vhd and rtl/ms_region.vhd)
@@ -105,7 +105,7 @@ async def region_random(dut):
 
 @pytest.mark.parametrize("max_half,margin", [(63, 32), (15, 8)])
 def test_ms_box_clip(max_half, margin):
-    from mstrack.hdl import rtl_sources, run_ghdl
+    from mstrack.hw.hdl import rtl_sources, run_ghdl
     g = core_generics(TrackerParams(), FixedParams(max_half=max_half, margin=margin))
     gen = {k: g[k] for k in ("COORD_W", "HALF_W", "MAX_HALF", "CF")}
     run_ghdl("ms_box_clip", "test_ms_box_clip", generics=gen, sources=rtl_sources("ms_box_clip"),
@@ -115,7 +115,7 @@ def test_ms_box_clip(max_half, margin):
 
 @pytest.mark.parametrize("max_half,margin", [(63, 32), (15, 8)])
 def test_ms_region(max_half, margin):
-    from mstrack.hdl import rtl_sources, run_ghdl
+    from mstrack.hw.hdl import rtl_sources, run_ghdl
     g = core_generics(TrackerParams(), FixedParams(max_half=max_half, margin=margin))
     gen = {k: g[k] for k in ("COORD_W", "HALF_W", "REGION_W", "MARGIN", "CF")}
     run_ghdl("ms_region", "test_ms_box_clip", generics=gen, sources=rtl_sources("ms_region"),

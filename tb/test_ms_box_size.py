@@ -17,10 +17,10 @@ from typing import Callable
 import cocotb
 import pytest
 
-from mstrack import hdl
+from mstrack.hw import hdl
 from mstrack.fixed.blocks_v2 import ms_box_size
 from mstrack.fixed.formats import FixedParams
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 from test_ms_window_size import LATENCY, size_vectors, start, stream
 

@@ -20,7 +20,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 
 from mstrack.fixed.blocks import BinPass, Region, ms_centre
 from mstrack.fixed.formats import FixedParams
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"SW_W": 22, "SWX_W": 29, "SHIFT_Q_W": 14, "CF": 8, "REGION_W": 8, "CENTRE_W": 16}
 CLK_NS = 10
@@ -125,7 +125,7 @@ async def centre_stream(dut, gap_prob):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
 
 TOP = "ms_centre"

@@ -43,7 +43,7 @@ from mstrack.fixed.blocks import Region, ms_edge_bin, ms_grey, ms_sobel, round_b
 from mstrack.fixed.blocks_v2 import PAD_FRAC, SIZE_FRAC, sixteenths
 from mstrack.fixed.formats import FixedParams
 from mstrack.fixed.tracker_v2 import FixedTrackerV2
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 from test_ms_frontend import ERR_SHORT_LINE, TB, frame_beats, random_frame
 
@@ -133,13 +133,13 @@ def job_cases(job: dict, g: dict) -> list[Case]:
     for src in job["sources"]:
         tp = TrackerParams(preset="v2", colour_bits=int(g["COLOUR_BITS"]), max_window=src["max_window"])
         if "seq" in src:
-            from mstrack.data import load_sequence
+            from mstrack.io.data import load_sequence
             seq = load_sequence(src["seq"])
             frame = seq.frame(src.get("frame", 0))
             box = round_box(*[float(v) for v in seq.gt[src.get("frame", 0)]])
             name = seq.name
         elif "scene" in src:
-            from mstrack.synthetic import make_scene
+            from mstrack.io.synthetic import make_scene
             frames, boxes = make_scene(2, src["w"], src["h"], seed=src["scene"])
             frame = np.ascontiguousarray(frames[0])
             box = round_box(*[float(v) for v in boxes[0]])
@@ -321,7 +321,7 @@ async def decimated_capture(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
 
 TOP = "ms_decimate_tb_top"

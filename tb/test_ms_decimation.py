@@ -20,11 +20,11 @@ from typing import Callable
 import cocotb
 import pytest
 
-from mstrack import hdl
+from mstrack.hw import hdl
 from mstrack.fixed.blocks_v2 import ms_decimation, sixteenths
 from mstrack.fixed.formats import FixedParams
-from mstrack.hdl import dut_generics
-from mstrack.params import TrackerParams
+from mstrack.hw.hdl import dut_generics
+from mstrack.track.params import TrackerParams
 
 from test_ms_window_size import start, stream
 

@@ -17,7 +17,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge
 
 from mstrack.fixed.primitives import ms_divider_reference
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"N_W": 22, "D_W": 14, "Q_W": 16, "TAG_W": 8}
 CLK_NS = 10
@@ -135,7 +135,7 @@ async def divider_zero_divisor(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "ms_divider"
 MODULE = "test_ms_divider"

@@ -18,7 +18,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge, Timer
 
 from mstrack.fixed.primitives import ms_divider_reference
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 from test_ms_divider import divider_cases
 
 DEFAULTS = {"N_W": 22, "D_W": 14, "Q_W": 16}
@@ -82,7 +82,7 @@ async def divider_iter_stream(dut, gap_prob):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "ms_divider_iter"
 MODULE = "test_ms_divider_iter"

@@ -26,7 +26,7 @@ from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 from cocotb.utils import get_sim_time
 
 from mstrack.fixed.blocks import ms_colour_bin, ms_edge_bin, ms_grey, ms_sobel
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 CLK_NS = 10
 DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5}
@@ -273,10 +273,10 @@ async def latency(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_frontend"
 MODULE = "test_ms_frontend"

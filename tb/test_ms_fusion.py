@@ -14,7 +14,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import ms_fusion, ms_rho_out
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 MODES = {0: "fused", 1: "colour", 2: "edge"}
 
@@ -60,7 +60,7 @@ async def fusion_random(dut):
 
 @pytest.mark.parametrize("features", ["fused", "colour", "edge"])
 def test_ms_fusion(features):
-    from mstrack.hdl import rtl_sources, run_ghdl
+    from mstrack.hw.hdl import rtl_sources, run_ghdl
     g = core_generics(TrackerParams(features=features), FixedParams())
     names = ("FEATURES", "RHO_SUM_W", "HIST_W", "CENTRE_ABS_W", "AF", "ALPHA_W", "RF", "RHO_OUT_FRAC",
              "RHO_OUT_W")

@@ -23,7 +23,7 @@ from cocotb.clock import Clock
 from cocotb.handle import Immediate
 from cocotb.triggers import ClockCycles, RisingEdge
 
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 BIN_RD_LAT = 3
 HIST_ACC_LAT = 4   # rtl/ms_histogram.vhd header: last_done after in_last
@@ -184,7 +184,7 @@ async def throttled(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "ms_histogram"
 MODULE = "test_ms_histogram"

@@ -17,7 +17,7 @@ import cocotb
 from cocotb.clock import Clock
 
 from mstrack.fixed.primitives import ms_isqrt_reference
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 from test_ms_divider import check_stream, reset, stream
 
 DEFAULTS = {"IN_W": 40, "TAG_W": 8}
@@ -69,10 +69,10 @@ async def isqrt_stream(dut, gap_prob):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_isqrt"
 MODULE = "test_ms_isqrt"

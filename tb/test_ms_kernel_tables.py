@@ -35,7 +35,7 @@ from cocotb.utils import get_sim_time
 
 from mstrack.fixed.blocks import ms_kernel
 from mstrack.fixed.primitives import ms_divider
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 
 def model_xr(ker: ms_kernel, n: int) -> list[int]:
@@ -224,10 +224,10 @@ async def v2_windows(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_kernel_tables"
 MODULE = "test_ms_kernel_tables"

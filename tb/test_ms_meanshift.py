@@ -21,7 +21,7 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import STOP_CODES, Region, ms_histogram, ms_kernel, ms_meanshift
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 ENGINE_GENERICS = ("LANES", "HALF_W", "REGION_W", "REGION_MAX", "STRIDE", "ADDR_W", "COORD_W", "KERNEL_EPAN",
                    "KERNEL_BITS", "KVAL_W", "KD_W", "HIST_W", "COUNT_W", "POSSUM_W", "SQRT_IN_W", "RHO_SUM_W",
@@ -152,7 +152,7 @@ CONFIGS = {
 
 @pytest.mark.parametrize("name", list(CONFIGS))
 def test_ms_meanshift(name):
-    from mstrack.hdl import TB_DIR, rtl_sources, run_ghdl
+    from mstrack.hw.hdl import TB_DIR, rtl_sources, run_ghdl
     tp, fp, lanes, feature = CONFIGS[name]
     g = core_generics(tp, fp, lanes)
     g["BIN_W"] = 3 * tp.colour_bits if feature == "colour" else tp.edge_bins_log2

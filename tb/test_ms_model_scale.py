@@ -22,7 +22,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge, Timer
 
 from mstrack.fixed.blocks_v2 import ms_model_scale
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"HIST_W": 14, "QN_FRAC": 16, "TAG_W": 10}
 CLK_NS = 10
@@ -40,7 +40,7 @@ def real_models(n: int) -> list[tuple[np.ndarray, int]]:
     """(Qn, K) of FixedTrackerV2's init model on real sequences, K of the init window."""
     if not all((SEQ_ROOT / s).is_dir() for s in REAL_SEQS):
         return []
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import ms_kernel
     from mstrack.fixed.tracker_v2 import FixedTrackerV2
     out = []
@@ -110,7 +110,7 @@ async def model_scale_stream(dut, gap):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "ms_model_scale"
 MODULE = "test_ms_model_scale"

@@ -15,7 +15,7 @@ import random
 import cocotb
 from cocotb.clock import Clock
 
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 from test_ms_divider import check_stream, reset, stream
 
 DEFAULTS = {"A_W": 8, "B_W": 21, "B_SIGNED": True, "P_W": 29, "TAG_W": 4}
@@ -63,7 +63,7 @@ async def mult_stream(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 TOP = "ms_mult_r4"
 MODULE = "test_ms_mult_r4"

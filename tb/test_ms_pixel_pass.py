@@ -252,10 +252,10 @@ async def runs_of_equal_bins_throttled(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_pixel_pass"
 MODULE = "test_ms_pixel_pass"

@@ -22,7 +22,7 @@ import cocotb
 from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 
 from mstrack.fixed.blocks import Region, ms_region_capture
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 from test_ms_frontend import ERR_SHORT_LINE, TB, edge_frame, frame_beats, random_frame
 
@@ -158,7 +158,7 @@ async def run_test(dut, gap):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics  # noqa: E402
 

@@ -21,7 +21,7 @@ import cocotb
 from cocotb.clock import Clock
 
 from mstrack.fixed.blocks_v2 import ONE, ms_scale
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 from v2_common import record_v2_calls, reset, run_stream
 
 CFG_ENV = "MS_SCALE_CFG"
@@ -90,7 +90,7 @@ async def scale_stream(dut, gap_prob):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import v2_scale_generics  # noqa: E402
 
 TOP = "ms_scale"

@@ -208,8 +208,8 @@ def real_windows(segments=SEGMENTS, max_window: int = 127) -> list[dict]:
     ``segments`` (the tracker runs from frame 0; frame 0 is the init pass), with the model's result;
     bins cropped to the window box plus 2 px (the statistics see only the window)."""
     import mstrack.fixed.tracker_v2 as tv2
-    from mstrack.data import load_sequence
-    from mstrack.params import TrackerParams
+    from mstrack.io.data import load_sequence
+    from mstrack.track.params import TrackerParams
 
     out: list[dict] = []
     orig = tv2.ms_target_stats
@@ -326,10 +326,10 @@ async def attached_real_windows(dut):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.vhdl_pkg import core_generics, v2_scale_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_target_stats"
 MODULE = "test_ms_target_stats"

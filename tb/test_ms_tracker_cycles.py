@@ -9,10 +9,10 @@ earlier; both run in parallel and the frame waits for the later one).  The model
 the iteration counts before the simulation starts.
 
 Asserted: every result field bit-exact with the fixed model, and the cycles from the last
-pixel of each frame to its result equal :func:`mstrack.synth.frame_latency` computed from the
+pixel of each frame to its result equal :func:`mstrack.hw.synth.frame_latency` computed from the
 block latencies and the window positions of each pass (the model's trace,
-:func:`mstrack.synth.model_latencies`).  Two simulators: the Verilator C++ harness
-(:mod:`mstrack.fastsim`, seconds per run once built; LANES 2, 4, 8) and GHDL + cocotb on the
+:func:`mstrack.hw.synth.model_latencies`).  Two simulators: the Verilator C++ harness
+(:mod:`mstrack.hw.fastsim`, seconds per run once built; LANES 2, 4, 8) and GHDL + cocotb on the
 VHDL (default LANES; minutes).  Reports: build/synth/cycles_64x64_lanes<L>[_ghdl].json, quoted
 by docs/performance.md.
 """
@@ -28,9 +28,9 @@ import pytest
 import cocotb
 from cocotb.triggers import ClockCycles
 
-from mstrack.cosim import CoreConfig, diff_fields, expected_results
+from mstrack.hw.cosim import CoreConfig, diff_fields, expected_results
 from mstrack.fixed import FixedParams
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 W, H = 256, 192
 BOX = (W // 2 - 32, H // 2 - 32, 64, 64)
@@ -56,7 +56,7 @@ def frames() -> list[np.ndarray]:
 
 def expected_cycles(lanes: int) -> dict:
     """Model iterations and analytic latency per frame (window positions from the model's trace)."""
-    from mstrack import synth
+    from mstrack.hw import synth
     m = synth.model_latencies(frames(), BOX, "default", lanes=lanes)
     return {"latency": [f["latency"] for f in m], "iter_c": m[1]["iter_c"], "iter_e": m[1]["iter_e"],
             "engine_c": m[1]["engine_c"], "engine_e": m[1]["engine_e"]}
@@ -95,7 +95,7 @@ async def worst_case(dut):
 
 # ----------------------------------------------------------------------------- pytest side
 def _check(lanes: int, latency: list[int], mismatches: list[str]) -> dict:
-    from mstrack import synth
+    from mstrack.hw import synth
     want = expected_cycles(lanes)
     assert want["iter_c"] == 20, want                                   # the scene does its job
     assert not mismatches, "\n".join(mismatches)
@@ -107,16 +107,16 @@ def _check(lanes: int, latency: list[int], mismatches: list[str]) -> dict:
 @pytest.mark.verilator
 @pytest.mark.parametrize("lanes", [2, 4, 8])
 def test_worst_case_cycles(lanes):
-    """Verilator (GHDL netlist, C++ harness: mstrack.fastsim): results bit-exact, latency per
+    """Verilator (GHDL netlist, C++ harness: mstrack.hw.fastsim): results bit-exact, latency per
     frame = analytic model, for LANES 2, 4 (default) and 8."""
-    from mstrack import fastsim
+    from mstrack.hw import fastsim
     run = fastsim.simulate(frames(), BOX, TrackerParams(), FixedParams(), lanes=lanes, lead=1000)
     exp = expected_results(frames(), BOX, TrackerParams(), FixedParams())
     lat = [r["latency"] for r in run.results]
     want = _check(lanes, lat, fastsim.compare(run.results, exp))
     REPORT.parent.mkdir(parents=True, exist_ok=True)
     REPORT.with_name(f"cycles_64x64_lanes{lanes}.json").write_text(json.dumps(
-        {"simulator": "verilator (mstrack.fastsim)", "latency_cycles": lat, "model": want,
+        {"simulator": "verilator (mstrack.hw.fastsim)", "latency_cycles": lat, "model": want,
          "cycles": run.cycles, "cpu_seconds": run.cpu_seconds, "build_seconds": run.build_seconds}, indent=1))
 
 
@@ -124,7 +124,7 @@ def test_worst_case_cycles(lanes):
 def test_worst_case_cycles_ghdl():
     """GHDL + cocotb (cocotbext-axi source and sink), default generics: the same check on the
     VHDL itself rather than the GHDL-synthesised netlist (slower: minutes)."""
-    from mstrack.hdl import run_ghdl
+    from mstrack.hw.hdl import run_ghdl
     cfg = CoreConfig(TrackerParams(), FixedParams(), max_frame_w=2048)
     lanes = cfg.lanes
     rep = REPORT.with_name(f"cycles_64x64_lanes{lanes}_ghdl.json")

@@ -5,7 +5,7 @@ cocotb module and pytest entry points in one file.  The bench drives the core be
 per frame, init boxes at any time, resets at any time) and consumes the results with a
 ready pattern (always, never = sustained back-pressure, random).  Every accepted beat, every
 init box the core takes and every reset is fed, in stream order, to
-:class:`mstrack.cosim.CoreModel` (the fixed-point model plus the documented stream, init and
+:class:`mstrack.hw.cosim.CoreModel` (the fixed-point model plus the documented stream, init and
 error behaviour of docs/architecture.md, "Errors and recovery"), which predicts every result
 word; each is compared field by field.  Watchdogs: a beat stalled too long, an init box never
 taken, or a predicted result that does not come fails the test as a lock-up.
@@ -33,12 +33,12 @@ from cocotb.utils import get_sim_time
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, Event, First, RisingEdge, Timer
 
-from mstrack.cosim import (COMPARED_FIELDS, ERR_NAMES, CoreConfig, CoreModel, diff_fields,
+from mstrack.hw.cosim import (COMPARED_FIELDS, ERR_NAMES, CoreConfig, CoreModel, diff_fields,
                            frame_words)
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import round_box
 from mstrack.fixed.vhdl_pkg import unpack_result
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 CLK_NS = 10
 MAX_FRAME_W = 64
@@ -54,7 +54,7 @@ def core_config() -> CoreConfig:
 # ----------------------------------------------------------------------------- stimulus
 def scene(n: int, w: int, h: int, seed: int) -> tuple[list[np.ndarray], list[tuple[int, int, int, int]]]:
     """n synthetic frames w x h (cropped from a scene at least 32x32) and the target's boxes."""
-    from mstrack.synthetic import make_scene
+    from mstrack.io.synthetic import make_scene
     frames, gt = make_scene(n, max(w, 32), max(h, 32), seed=seed, target_size=(14, 12))
     return ([frame_words(np.ascontiguousarray(f[:h, :w])) for f in frames],
             [round_box(*map(float, g)) for g in gt])
@@ -784,7 +784,7 @@ DIRECTED = ["result_backpressure", "init_mid_frame", "reinit_while_tracking", "f
 def _run(testcase, env: dict[str, str], build_name: str = "ms_tracker_faults") -> None:
     """Verilator on the GHDL netlist when installed (about 50x faster here), else GHDL;
     MSTRACK_FAULTS_SIM=ghdl forces GHDL on the VHDL."""
-    from mstrack.hdl import have_verilator, run_ghdl, run_verilator
+    from mstrack.hw.hdl import have_verilator, run_ghdl, run_verilator
     verilator = os.environ.get("MSTRACK_FAULTS_SIM", "verilator") == "verilator" and have_verilator()
     runner = run_verilator if verilator else run_ghdl
     runner("ms_tracker", "test_ms_tracker_faults", generics=core_config().generics(),

@@ -1,7 +1,7 @@
 """The standalone VHDL testbench tb/vhdl/ms_tracker_file_tb.vhd (no cocotb, no Python while simulating),
 the RGB packings, the generic checks of ms_tracker and the FuseSoC targets.
 
-* every result word the testbench writes equals the fixed-point model's (mstrack.tb_files writes
+* every result word the testbench writes equals the fixed-point model's (mstrack.hw.tb_files writes
   the frames and the expected words; the testbench compares too and must say PASSED);
   a synthetic scene at full speed and throttled, both RGB packings (same frames, same words),
   a stretch of a real sequence with the default generics;
@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mstrack.cosim import CoreConfig
+from mstrack.hw.cosim import CoreConfig
 from mstrack.fixed import FixedParams
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 pytestmark = pytest.mark.ghdl
 
@@ -34,14 +34,14 @@ FILE_TB = REPO / "tb" / "vhdl" / "ms_tracker_file_tb.vhd"
 
 
 def _sources(extra=()):
-    from mstrack.hdl import rtl_sources
+    from mstrack.hw.hdl import rtl_sources
     return rtl_sources("ms_tracker") + [FILE_TB, *extra]
 
 
 def run_file_tb(tmp_path: Path, frames, box, cfg: CoreConfig, packing: int = 0, **tb_generics) -> str:
     """Write the files, run the testbench in tmp_path, check its verdict and every word."""
-    from mstrack.hdl import run_ghdl_plain
-    from mstrack.tb_files import read_words, write_tb_files
+    from mstrack.hw.hdl import run_ghdl_plain
+    from mstrack.hw.tb_files import read_words, write_tb_files
     paths = write_tb_files(tmp_path, frames, box, cfg, packing=packing)
     g = json.loads(paths["generics"].read_text())
     out = run_ghdl_plain("ms_tracker_file_tb", _sources(), {**g, **tb_generics}, build_name="ms_tracker_file_tb",
@@ -53,7 +53,7 @@ def run_file_tb(tmp_path: Path, frames, box, cfg: CoreConfig, packing: int = 0, 
 
 
 def _scene(n=4, w=64, h=48, seed=3):
-    from mstrack.synthetic import make_scene
+    from mstrack.io.synthetic import make_scene
     frames, _ = make_scene(n, w, h, seed=seed)
     return [np.ascontiguousarray(f) for f in frames]
 
@@ -79,7 +79,7 @@ def test_file_tb_real_sequence(tmp_path):
     seq = SEQ_ROOT / "Girl"
     if not seq.is_dir():
         pytest.skip(f"{seq} not found: the real-sequence run needs ../shared/data/sequences")
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import round_box
     s = load_sequence(seq)
     frames = [s.frame(i) for i in range(4)]
@@ -89,8 +89,8 @@ def test_file_tb_real_sequence(tmp_path):
 
 def test_file_tb_detects_a_wrong_word(tmp_path):
     """A changed expected word makes the testbench fail (it is self-checking)."""
-    from mstrack.hdl import HdlError, run_ghdl_plain
-    from mstrack.tb_files import write_tb_files
+    from mstrack.hw.hdl import HdlError, run_ghdl_plain
+    from mstrack.hw.tb_files import write_tb_files
     paths = write_tb_files(tmp_path, _scene(n=2), (22, 14, 14, 12), SMALL)
     lines = paths["expected"].read_text().splitlines()
     lines[-1] = ("f" if lines[-1][0] != "f" else "e") + lines[-1][1:]
@@ -142,16 +142,16 @@ end architecture;
 @pytest.mark.parametrize("name", list(CONFIG_CASES))
 def test_config_elaborates(name):
     """The generics `mstrack hdl config` derives pass every generic check of ms_tracker."""
-    from mstrack.hdl import rtl_sources, run_ghdl_plain
-    from mstrack.hdl_config import CoreChoices, derive
+    from mstrack.hw.hdl import rtl_sources, run_ghdl_plain
+    from mstrack.hw.hdl_config import CoreChoices, derive
     g = derive(CoreChoices(**CONFIG_CASES[name])).generics
     run_ghdl_plain("ms_tracker", rtl_sources("ms_tracker"), g, build_name="ms_tracker_elab", elab_only=True)
 
 
 def test_config_package_compiles(tmp_path):
     """The VHDL package of `mstrack hdl config` and the generic map in its header make a working instance."""
-    from mstrack.hdl import rtl_sources, run_ghdl_plain
-    from mstrack.hdl_config import CoreChoices, derive, render
+    from mstrack.hw.hdl import rtl_sources, run_ghdl_plain
+    from mstrack.hw.hdl_config import CoreChoices, derive, render
     text = render(derive(CoreChoices(**CONFIG_CASES["small_l2_epan"])), "package")
     extra = _config_top(tmp_path, text)
     run_ghdl_plain("cfg_top", rtl_sources("ms_tracker") + extra, build_name="cfg_top", elab_only=True)
@@ -167,8 +167,8 @@ def test_config_package_compiles(tmp_path):
 ])
 def test_wrong_generic_refused(generic, value, message):
     """Elaborating the core with one wrong generic fails with the relation it breaks."""
-    from mstrack.hdl import HdlError, rtl_sources, run_ghdl_plain
-    from mstrack.hdl_config import CoreChoices, derive
+    from mstrack.hw.hdl import HdlError, rtl_sources, run_ghdl_plain
+    from mstrack.hw.hdl_config import CoreChoices, derive
     g = {**derive(CoreChoices()).generics, generic: value}
     with pytest.raises(HdlError) as e:
         run_ghdl_plain("ms_tracker", rtl_sources("ms_tracker"), g, build_name="ms_tracker_elab", elab_only=True)
@@ -193,7 +193,7 @@ def _fusesoc() -> str:
 @pytest.mark.parametrize("target", ["sim", "lint"])
 def test_fusesoc_target(target, tmp_path):
     """`fusesoc run --target sim` (self-checking file testbench) and `--target lint` pass in a temp build dir."""
-    from mstrack.hdl import ghdl_backend
+    from mstrack.hw.hdl import ghdl_backend
     cmd = [_fusesoc(), "--cores-root", str(REPO), "run", "--build-root", str(tmp_path / "build"),
            "--target", target, "mstrack:mstrack:ms_tracker"]
     r = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True,

@@ -23,7 +23,7 @@ from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 from cocotb.utils import get_sim_time
 
 from mstrack.fixed.blocks_v2 import ms_window_size
-from mstrack.hdl import dut_generics
+from mstrack.hw.hdl import dut_generics
 
 CLK_NS = 10
 #: in_valid -> out_valid (rtl/ms_window_size.vhd header)
@@ -142,10 +142,10 @@ import json  # noqa: E402
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.formats import FixedParams  # noqa: E402
 from mstrack.fixed.blocks_v2 import sixteenths  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_window_size"
 MODULE = "test_ms_window_size"

@@ -1,8 +1,8 @@
 """1080p60 real-time check and long real-video co-simulations of ms_tracker (C++ Verilator harness).
 
-Pytest only (no cocotb): :mod:`mstrack.fastsim` runs the GHDL netlist of the core under
+Pytest only (no cocotb): :mod:`mstrack.hw.fastsim` runs the GHDL netlist of the core under
 Verilator with ``tools/hdl/cosim_main.cpp``; every result word is compared field by field
-with :func:`mstrack.cosim.expected_results` (the fixed-point model).
+with :func:`mstrack.hw.cosim.expected_results` (the fixed-point model).
 
 * ``test_realtime_1080p60``: real footage (MotorRolling frames 78-81, 640x360 upscaled x3 with
   cv2.resize to 1920x1080, GT box x3, which the core shrinks to its largest window, 127 px;
@@ -13,7 +13,7 @@ with :func:`mstrack.cosim.expected_results` (the fixed-point model).
   first frame.  Asserts bit-exactness, then real time: no input stall (tvalid = 1 and
   tready = 0) and every result before the next frame's first pixel (for the last frame:
   within the 99,280 blank clocks after its last pixel).  Without ../shared the generated
-  scene of :func:`mstrack.synthetic.make_scene` (640x360, upscaled) is used.
+  scene of :func:`mstrack.io.synthetic.make_scene` (640x360, upscaled) is used.
   Run for LANES = 2 (the default generics) and 8.  LANES = 2 misses 1080p60: a colour
   iteration with a 127 px window takes 8,702 clocks, so more than 10 iterations overrun the
   blanking (20 take 182,763 clocks); it is an expected failure (strict, and only for
@@ -39,11 +39,11 @@ import pytest
 
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES
 
-from mstrack import fastsim
-from mstrack.cosim import expected_results
+from mstrack.hw import fastsim
+from mstrack.hw.cosim import expected_results
 from mstrack.fixed import FixedParams
-from mstrack.hdl import BUILD_DIR
-from mstrack.params import TrackerParams
+from mstrack.hw.hdl import BUILD_DIR
+from mstrack.track.params import TrackerParams
 
 REPO = Path(__file__).resolve().parents[1]
 SEQ_ROOT = REPO.parent / "shared" / "data" / "sequences"
@@ -73,12 +73,12 @@ def _hd_clip(n: int) -> tuple[list[np.ndarray], tuple[int, int, int, int], str]:
     import cv2
     seq = SEQ_ROOT / "MotorRolling"
     if seq.is_dir():
-        from mstrack.data import load_sequence
+        from mstrack.io.data import load_sequence
         s = load_sequence(seq)
         small = [cv2.imread(str(f), cv2.IMREAD_COLOR) for f in s.img_files[HD_START:HD_START + n]]
         gt0, src = s.gt[HD_START], f"MotorRolling {HD_START}-{HD_START + n - 1} x3"
     else:
-        from mstrack.synthetic import make_scene
+        from mstrack.io.synthetic import make_scene
         frames, gt = make_scene(n, 640, 360, seed=7)
         small, gt0, src = list(frames), gt[0], "make_scene(640x360, seed 7) x3"
     scale = HD_W / small[0].shape[1]
@@ -141,7 +141,7 @@ LONG_RUNS = [
 def test_long_real_video(name, stream):
     """Every frame of a real sequence at its native size, bit-exact frame by frame."""
     import cv2
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import round_box
     seq = SEQ_ROOT / name
     if not seq.is_dir():

@@ -1,11 +1,11 @@
 """``mstrack sim`` (mstrack/simcli.py): the RTL core co-simulated on a user's video, end to end.
 
-The simulations use :mod:`mstrack.fastsim` (GHDL netlist + Verilator + C++ harness, marker
+The simulations use :mod:`mstrack.hw.fastsim` (GHDL netlist + Verilator + C++ harness, marker
 ``verilator``: skipped without the tools unless MSTRACK_REQUIRE_TOOLS=1).  One Verilator build
 (default generics, LANES 4, about 30-90 s the first time) is cached in build/fastsim/ and shared by
 every test here; then each simulation takes about a second.
 
-* ``test_sim_synthetic_video``: a generated scene (:func:`mstrack.synthetic.make_scene`, known
+* ``test_sim_synthetic_video``: a generated scene (:func:`mstrack.io.synthetic.make_scene`, known
   ground truth) written as an .avi, through ``python -m mstrack.cli sim``: exit 0, one CSV row per
   frame, report bit-exact, every CSV row equal to the fixed-point model's result decoded the same
   way (raw word included), the box on the target, an overlay video of as many frames.
@@ -32,14 +32,14 @@ import numpy as np
 import pytest
 
 from mstrack import cli
-from mstrack.cosim import COMPARED_FIELDS, CoreConfig, expected_results
-from mstrack.data import VideoSource
+from mstrack.hw.cosim import COMPARED_FIELDS, CoreConfig, expected_results
+from mstrack.io.data import VideoSource
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import round_box
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, pack_result
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 from mstrack.simcli import SIM_CSV_FIELDS, bitexact_report, decode_row, report_line
-from mstrack.synthetic import make_scene, write_video
+from mstrack.io.synthetic import make_scene, write_video
 
 REPO = Path(__file__).resolve().parents[1]
 SEQ_ROOT = REPO.parent / "shared" / "data" / "sequences"
@@ -161,9 +161,9 @@ def test_sim_real_sequence(tmp_path, capsys):
 
 @pytest.mark.verilator
 def test_sim_detects_mismatch(video, tmp_path, monkeypatch, capsys):
-    import mstrack.cosim
+    import mstrack.hw.cosim
 
-    real = mstrack.cosim.expected_results
+    real = mstrack.hw.cosim.expected_results
     bad_frame, bad_field = 5, "rho_c"
 
     def corrupted(*a, **kw):
@@ -171,7 +171,7 @@ def test_sim_detects_mismatch(video, tmp_path, monkeypatch, capsys):
         exp[bad_frame][bad_field] ^= 1                       # one bit of one field of one frame
         return exp
 
-    monkeypatch.setattr(mstrack.cosim, "expected_results", corrupted)
+    monkeypatch.setattr(mstrack.hw.cosim, "expected_results", corrupted)
     out = tmp_path / "out"
     rc = cli.main(["sim", str(video), "--box", "50,40,30,30", "--max-frames", "8", "--out", str(out), "--quiet"])
     cap = capsys.readouterr()

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from mstrack import synth
+from mstrack.hw import synth
 
 LIMITS_BEGIN = "<!-- perf-limits:begin -->"
 LIMITS_END = "<!-- perf-limits:end -->"

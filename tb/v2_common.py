@@ -35,7 +35,7 @@ def record_v2_calls(names: Sequence[str] = REAL_SEQS, frames: int = 40) -> dict[
     ms_loss_flag (rho_s, rho0, con_s, share, loss_rho, loss_contrast),
     ms_confidence (rho, share, rho_ref, share_ref), ms_ref_update (ref, x, k)."""
     import mstrack.fixed.tracker_v2 as tv2
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
 
     args_of: dict[str, Callable[..., tuple]] = {
         "ms_share": lambda st: (st.nt_in, st.n_in),

@@ -10,8 +10,8 @@ import pytest
 
 import mstrack
 from mstrack import Box, Status, Tracker, TrackerMeanShift, TrackerParams
-from mstrack.metrics import iou
-from mstrack.synthetic import make_scene
+from mstrack.eval.metrics import iou
+from mstrack.io.synthetic import make_scene
 
 
 @pytest.fixture(scope="module")

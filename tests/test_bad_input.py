@@ -1,4 +1,4 @@
-"""Bad input, for both models (documented behaviour: mstrack/frames.py docstring)."""
+"""Bad input, for both models (documented behaviour: mstrack/track/frames.py docstring)."""
 from __future__ import annotations
 
 import math
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from mstrack import FrameError, Status, Tracker
-from mstrack.agreement import shift_scene
+from mstrack.eval.agreement import shift_scene
 
 MODELS = ["float", "fixed"]
 W, H = 160, 120
@@ -175,7 +175,7 @@ def test_never_nan(model, features, kernel, scene):
 # ----------------------------------------------------------------------------- data readers
 def test_data_reader_errors(tmp_path):
     """A couple of reader errors (the data helper's tests cover the rest)."""
-    data = pytest.importorskip("mstrack.data")
+    data = pytest.importorskip("mstrack.io.data")
     (tmp_path / "img").mkdir()
     (tmp_path / "groundtruth_rect.txt").write_text("1,1,10,10\n")
     with pytest.raises(data.DataError):
@@ -195,7 +195,7 @@ def test_data_reader_errors(tmp_path):
                                  (10, 10, 20, None), iter((10, 10, 20, 20))])
 def test_box_must_be_four_real_numbers(box):
     """Strings and bytes iterate as digits, a set has no order: none of them is a box."""
-    from mstrack.types import Box
+    from mstrack.track.types import Box
     with pytest.raises(ValueError, match="box must be"):
         Box.of(box)
 
@@ -208,7 +208,7 @@ def test_tracker_refuses_non_numeric_box(model, box, scene):
 
 
 def test_box_accepts_numpy_and_python_numbers():
-    from mstrack.types import Box
+    from mstrack.track.types import Box
     assert Box.of(np.array([1, 2, 3, 4], np.int32)) == Box.of((1.0, 2, np.float32(3), np.int64(4))) == Box(1, 2, 3, 4)
 
 
@@ -231,7 +231,7 @@ PARAM_CASES = [({"max_iter": 1.5}, "max_iter must be an integer"), ({"colour_bit
 @pytest.mark.parametrize("kw,msg", PARAM_CASES)
 def test_param_types_checked_in_both_models(model, kw, msg):
     """Same check, same message, at construction, in both models (one shared class)."""
-    from mstrack.params import ParamTypeError
+    from mstrack.track.params import ParamTypeError
     with pytest.raises(ParamTypeError, match=msg) as ei:
         Tracker(model=model, **kw)
     assert isinstance(ei.value, TypeError) and isinstance(ei.value, ValueError)
@@ -240,13 +240,13 @@ def test_param_types_checked_in_both_models(model, kw, msg):
 @pytest.mark.parametrize("kw", [{"max_half": 63.0}, {"margin": True}, {"centre_frac": 8.5}, {"rho_frac": None}])
 def test_fixed_param_types_checked(kw):
     from mstrack.fixed import FixedParams
-    from mstrack.params import ParamTypeError
+    from mstrack.track.params import ParamTypeError
     with pytest.raises(ParamTypeError, match=next(iter(kw))):
         FixedParams(**kw)
 
 
 def test_numpy_integer_params_are_accepted_as_int(scene):
-    from mstrack.params import TrackerParams
+    from mstrack.track.params import TrackerParams
     tp = TrackerParams(colour_bits=np.int64(3), max_iter=np.int32(20), eps2=np.float32(1.0))
     assert type(tp.colour_bits) is int and type(tp.max_iter) is int and type(tp.eps2) is float
     assert tp == TrackerParams()

@@ -1,7 +1,7 @@
 """Issue 9, "Bad input": clear one-line errors, nothing lost (CLI, data readers, eval harness).
 
 Each case was reproduced on main first; the test asserts the message and that files written
-earlier are still there.  Tiny synthetic data (mstrack.synthetic)."""
+earlier are still there.  Tiny synthetic data (mstrack.io.synthetic)."""
 from __future__ import annotations
 
 import json
@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from mstrack import cli
-from mstrack.data import DataError, load_dataset, load_sequence, parse_gt
-from mstrack.evaluate import evaluate
-from mstrack.synthetic import make_scene, write_otb_sequence, write_video
-from mstrack.types import Box, Status, TrackResult
+from mstrack.io.data import DataError, load_dataset, load_sequence, parse_gt
+from mstrack.eval.evaluate import evaluate
+from mstrack.io.synthetic import make_scene, write_otb_sequence, write_video
+from mstrack.track.types import Box, Status, TrackResult
 
 FAST = ["--trackers", "opencv-camshift", "--quiet"]
 
@@ -80,7 +80,7 @@ class _CountingTracker:
 
 
 def test_eval_cache_is_keyed_by_tracker_parameters(tmp_path):
-    from mstrack.params import TrackerParams
+    from mstrack.track.params import TrackerParams
     seqs = load_dataset(_dataset(tmp_path / "ds", 1))
     run = lambda tp: evaluate(seqs, ["mstrack-colour-flat"], tmp_path / "out", quiet=True,  # noqa: E731
                               factory=lambda name, model: _CountingTracker(tp))
@@ -125,7 +125,7 @@ def test_meta_name_cannot_escape_the_cache(tmp_path, capsys, name):
 
 
 def test_cache_path_refuses_path_names(tmp_path):
-    from mstrack.evaluate import cache_path
+    from mstrack.eval.evaluate import cache_path
     with pytest.raises(ValueError, match="cannot name a cache file"):
         cache_path(tmp_path, "opencv-camshift", "../../x")
 

@@ -12,11 +12,11 @@ The floors below leave a margin under those numbers.
 import numpy as np
 import pytest
 
-from mstrack.frames import FrameError
-from mstrack.types import Status
-from mstrack import baselines
-from mstrack.metrics import centre_error, iou
-from mstrack.synthetic import make_scene
+from mstrack.track.frames import FrameError
+from mstrack.track.types import Status
+from mstrack.eval import baselines
+from mstrack.eval.metrics import centre_error, iou
+from mstrack.io.synthetic import make_scene
 
 FLOORS = {"meanshift": (0.85, 60), "camshift": (0.30, 60), "kcf": (0.75, 60), "csrt": (0.65, 30)}
 

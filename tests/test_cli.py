@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from mstrack import cli
-from mstrack.evaluate import Evaluation, evaluate, run_sequence
-from mstrack.data import load_dataset, load_sequence
-from mstrack.synthetic import make_scene, write_otb_sequence, write_video
-from mstrack.types import Box
+from mstrack.eval.evaluate import Evaluation, evaluate, run_sequence
+from mstrack.io.data import load_dataset, load_sequence
+from mstrack.io.synthetic import make_scene, write_otb_sequence, write_video
+from mstrack.track.types import Box
 
-HAVE_TRACKER = importlib.util.find_spec("mstrack.tracker") is not None
-needs_tracker = pytest.mark.skipif(not HAVE_TRACKER, reason="mstrack.tracker not importable yet")
+HAVE_TRACKER = importlib.util.find_spec("mstrack.track.tracker") is not None
+needs_tracker = pytest.mark.skipif(not HAVE_TRACKER, reason="mstrack.track.tracker not importable yet")
 FAST = "opencv-meanshift,opencv-camshift"
 
 
@@ -90,7 +90,7 @@ def test_track_requires_box_for_video(tiny_video, tmp_path, capsys):
 def test_bad_frames_are_recorded_as_error(tmp_path):
     frames, gt = make_scene(6, 96, 72, seed=1)
     seq = [frames[0], frames[1], None, frames[3][:40, :40], frames[4], frames[5]]   # unreadable + wrong size
-    from mstrack.baselines import meanshift
+    from mstrack.eval.baselines import meanshift
     rows, info = cli.track_frames(meanshift(), seq, Box.of(gt[0]), tmp_path)
     assert [r["status"] for r in rows] == ["init", "ok", "error", "error", "ok", "ok"]
     assert rows[2]["x"] == rows[1]["x"]                      # previous box kept
@@ -204,7 +204,7 @@ def test_load_dataset_of_tiny(tiny_dataset):
 
 
 def test_eval_cache_invalidated_by_code_change(tiny_dataset, tmp_path, monkeypatch):
-    from mstrack import evaluate as ev_mod
+    from mstrack.eval import evaluate as ev_mod
     seqs = load_dataset(tiny_dataset, ["seq0"])
     evaluate(seqs, ["opencv-meanshift"], tmp_path, quiet=True)
     cached = tmp_path / "results" / "opencv-meanshift" / "seq0.json"
@@ -242,7 +242,7 @@ def _video_size(path):
 def occluded_small_seq(tmp_path_factory):
     """128x96 (Girl's size) sequence, a 24x24 target moving right, hidden by background in frames
     10..17 (v2: LOST there, REACQUIRED on frame 18 or 19)."""
-    from mstrack.synthetic import render_scene
+    from mstrack.io.synthetic import render_scene
     n = 30
     t = np.arange(n)
     gt = np.stack([30 + t, np.full(n, 36), np.full(n, 24), np.full(n, 24)], axis=1).astype(float)

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from mstrack import cli
-from mstrack.synthetic import make_scene, write_otb_sequence, write_video
-from mstrack.types import Box
+from mstrack.io.synthetic import make_scene, write_otb_sequence, write_video
+from mstrack.track.types import Box
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +34,7 @@ def _help(capsys, *argv):
 
 
 def test_track_help_lists_tracker_names_and_explains_model(capsys):
-    from mstrack.evaluate import tracker_names
+    from mstrack.eval.evaluate import tracker_names
     text = _help(capsys, "track")
     for name in tracker_names():
         assert name in text.replace("- ", "-"), name   # argparse may wrap at a hyphen
@@ -130,7 +130,7 @@ def test_compile_notice_printed_once_before_a_numba_compile():
 
 
 def test_progress_bar_has_total_and_eta(tiny_video, tmp_path, capsys):
-    from mstrack.data import VideoSource
+    from mstrack.io.data import VideoSource
     src = VideoSource(tiny_video[0])
     cli.track_frames(cli_tracker(), src.frames(), Box.of(tiny_video[1][0]), tmp_path, progress=True, source=src)
     err = capsys.readouterr().err
@@ -141,7 +141,7 @@ def test_progress_bar_has_total_and_eta(tiny_video, tmp_path, capsys):
 
 
 def cli_tracker():
-    from mstrack.evaluate import make_tracker
+    from mstrack.eval.evaluate import make_tracker
     return make_tracker("opencv-camshift")
 
 

@@ -5,9 +5,9 @@ import cv2
 import numpy as np
 import pytest
 
-from mstrack.data import (DataError, DataWarning, VideoSource, load_dataset, load_sequence, normalise_attribute,
+from mstrack.io.data import (DataError, DataWarning, VideoSource, load_dataset, load_sequence, normalise_attribute,
                           parse_gt)
-from mstrack.synthetic import make_scene, write_otb_sequence, write_video
+from mstrack.io.synthetic import make_scene, write_otb_sequence, write_video
 
 SEQ_DIR = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "sequences"
 

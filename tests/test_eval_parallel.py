@@ -10,9 +10,9 @@ import json
 import pytest
 
 from mstrack import cli
-from mstrack.data import load_dataset
-from mstrack.evaluate import evaluate
-from mstrack.synthetic import make_scene, write_otb_sequence
+from mstrack.io.data import load_dataset
+from mstrack.eval.evaluate import evaluate
+from mstrack.io.synthetic import make_scene, write_otb_sequence
 
 TRACKERS = "mstrack-v2,mstrack-colour-flat,opencv-camshift"
 HAVE_DASK = importlib.util.find_spec("distributed") is not None

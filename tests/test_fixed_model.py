@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from mstrack import Status, Tracker
-from mstrack.agreement import shift_scene
+from mstrack.eval.agreement import shift_scene
 from mstrack.fixed import FixedParams, FixedTracker, RESULT_FIELDS, widths
 from mstrack.fixed import doc
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 
 def _run(frames, box, trace=False, **params):

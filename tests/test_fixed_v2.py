@@ -18,8 +18,8 @@ from mstrack.fixed.blocks_v2 import (ONE, ms_bg_model, ms_box_size, ms_confidenc
                                      ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share,
                                      ms_spread,
                                      ms_target_stats, ms_window_size, rate_shift, sixteenths, TargetStats)
-from mstrack.float_v2 import FloatTrackerV2
-from mstrack.params import TrackerParams
+from mstrack.track.float_v2 import FloatTrackerV2
+from mstrack.track.params import TrackerParams
 
 SEQ_ROOT = Path(__file__).resolve().parents[2] / "shared" / "data" / "sequences"
 V2 = TrackerParams(preset="v2")
@@ -233,7 +233,7 @@ def test_fixed_v2_status_from_loss_flag():
     status from ms_loss_flag on its raw integers (rho and share - ring_share, each smoothed by
     s + floor((x - s) / 2), against rho at init)."""
     from mstrack.fixed.tracker_v2 import STATUS_CODES_V2
-    from mstrack.types import Status
+    from mstrack.track.types import Status
     frames, boxes = _scene(30)
     for f in frames[12:18]:  # the target leaves for 6 frames
         f[:] = frames[0][0, 0]
@@ -346,8 +346,8 @@ def test_fixed_v2_large_target_is_decimated_not_shrunk():
 @pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (../shared absent)")
 def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
     """Issue target: the fixed model (= hardware) within 0.01 AUC of float v2, whole dev set."""
-    from mstrack.data import load_dataset
-    from mstrack.metrics import iou, valid_gt, IOU_THRESHOLDS
+    from mstrack.io.data import load_dataset
+    from mstrack.eval.metrics import iou, valid_gt, IOU_THRESHOLDS
 
     res = {}
     for model in ("float", "fixed"):
@@ -372,8 +372,8 @@ def test_v2_loss_flag_on_the_dev_set():
     """Loss signal floors, both models, whole dev set (docs/results_loss.md): recall (off-target
     frames, IoU = 0, not ok) and false alarms (IoU >= 0.5, not ok).  Measured 2026-11-23: float
     0.556 / 0.041, fixed 0.581 / 0.048 (issue target 0.6 / 0.05: recall not reached)."""
-    from mstrack.data import load_dataset
-    from mstrack.metrics import iou, loss_detection, valid_gt
+    from mstrack.io.data import load_dataset
+    from mstrack.eval.metrics import iou, loss_detection, valid_gt
 
     for model in ("float", "fixed"):
         ious, oks = [], []
@@ -390,15 +390,15 @@ def test_v2_loss_flag_on_the_dev_set():
 
 
 def test_v2_budget_section_is_current():
-    """docs/fixed_point.md's v2 budget table is generated (python -m mstrack.synth --v2-budget --write)."""
-    from mstrack.synth import render_v2_budget
+    """docs/fixed_point.md's v2 budget table is generated (python -m mstrack.hw.synth --v2-budget --write)."""
+    from mstrack.hw.synth import render_v2_budget
     doc = Path(__file__).resolve().parents[1] / "docs" / "fixed_point.md"
     text = doc.read_text()
-    assert render_v2_budget(text) == text, "stale: run python -m mstrack.synth --v2-budget --write"
+    assert render_v2_budget(text) == text, "stale: run python -m mstrack.hw.synth --v2-budget --write"
 
 
 def test_v2_worst_frames_fit_1080p60_blanking_with_lanes_4():
-    from mstrack.synth import v2_cycle_budget
+    from mstrack.hw.synth import v2_cycle_budget
     rows = v2_cycle_budget(4)
     assert len(rows) == 3 and all(r["clocks"] <= 99000 for r in rows), rows
 
@@ -494,7 +494,7 @@ def test_fixed_v2_joint_gate_tracks_like_float():
     centre; the gated scale test vetoes the growth here: the padded window already holds the whole
     target, and rho is not larger at x1.05, so both stay near the init size, docs/results_v2_mean.md);
     the fixed model refuses the options it does not have."""
-    from mstrack.metrics import iou
+    from mstrack.eval.metrics import iou
     frames, gt = _scene()
     gt = np.array(gt, np.float64)
     kw = dict(orient_T=64, scale_test=0.05, scale_test_gate=True)

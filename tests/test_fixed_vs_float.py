@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from mstrack import Tracker
-from mstrack.agreement import (AUC_DIFF_MAX, DEFAULT_ROOT, MEAN_DIFF_MAX, compare_all, shift_scene)
+from mstrack.eval.agreement import (AUC_DIFF_MAX, DEFAULT_ROOT, MEAN_DIFF_MAX, compare_all, shift_scene)
 
 INT_SHIFTS = [(3, -2), (-6, 4), (8, 8), (0, 0)]
 SUB_SHIFTS = [(0.5, -0.25), (2.75, 1.5), (-1.25, -3.5)]
@@ -120,7 +120,7 @@ def test_real_data_issue_target(agreement):
 
 
 def test_write_table_replaces_marked_section(tmp_path):
-    from mstrack.agreement import write_table
+    from mstrack.eval.agreement import write_table
 
     p = tmp_path / "r.md"
     p.write_text("# title\n\ntext\n")
@@ -138,7 +138,7 @@ def test_grid_analysis_reproduces_window_quantisation():
     """The grid analysis of docs/results_fixed.md: snapping only the float window to the 1 px grid
     moves the float tracker by about as much as the fixed model differs; a finer grid moves it less.
     Grid 0 must be the unmodified float tracker (the snap is undone after the call)."""
-    from mstrack.agreement import DEFAULT_ROOT, float_on_grid
+    from mstrack.eval.agreement import DEFAULT_ROOT, float_on_grid
 
     seq = DEFAULT_ROOT / "Girl"
     if not seq.is_dir():

@@ -1,6 +1,6 @@
-"""Tests of the float reference tracker (mstrack/float_model.py).
+"""Tests of the float reference tracker (mstrack/track/float_model.py).
 
-Synthetic scenes come from :func:`mstrack.agreement.shift_scene` (seeded): an
+Synthetic scenes come from :func:`mstrack.eval.agreement.shift_scene` (seeded): an
 elliptical red/yellow checkerboard target moved by (dx, dy) over a smooth
 bluish background.  The convergence tests use ``eps2 = 0.01`` px^2 so that
 the loop runs to the optimum rather than stopping at the default 1 px step.
@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from mstrack import Tracker
-from mstrack import float_model as fm
-from mstrack.agreement import shift_scene
-from mstrack.params import TrackerParams
-from mstrack.types import FeatureResult
+from mstrack.track import float_model as fm
+from mstrack.eval.agreement import shift_scene
+from mstrack.track.params import TrackerParams
+from mstrack.track.types import FeatureResult
 
 SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
 INT_SHIFTS = [(3, -2), (-6, 4), (8, 8)]
@@ -186,10 +186,10 @@ def test_tracker_alphas_sum_to_one_and_follow_rhos(dx, dy):
 
 
 # ----------------------------------------------------------------------------- real data
-#: AUC floors, fused tracker, flat kernel, defaults.  OTB AUC (mstrack.metrics:
+#: AUC floors, fused tracker, flat kernel, defaults.  OTB AUC (mstrack.eval.metrics:
 #: mean over 21 IoU thresholds linspace(0, 1, 21) of the fraction of frames
 #: with IoU > t), frame 0 (the init box) INCLUDED.  Measured 2026-11-21 with
-#: `python -m mstrack.agreement` (same runs): Crossing 0.305, Girl 0.570,
+#: `python -m mstrack.eval.agreement` (same runs): Crossing 0.305, Girl 0.570,
 #: Deer 0.198; floor = measured - 0.05.
 AUC_FLOORS = {"Crossing": (0.305, 0.255), "Girl": (0.570, 0.520), "Deer": (0.198, 0.148)}
 
@@ -198,8 +198,8 @@ AUC_FLOORS = {"Crossing": (0.305, 0.255), "Girl": (0.570, 0.520), "Deer": (0.198
 @pytest.mark.parametrize("name", sorted(AUC_FLOORS))
 def test_auc_floor_real_sequences(name):
     """Fused/flat/defaults AUC on Crossing (measured 0.305, floor 0.255), Girl (0.570, 0.520), Deer (0.198, 0.148)."""
-    from mstrack.data import load_sequence
-    from mstrack.metrics import score
+    from mstrack.io.data import load_sequence
+    from mstrack.eval.metrics import score
 
     seq = load_sequence(SEQ_ROOT / name)
     trk = Tracker(model="float", preset="paper")

@@ -1,7 +1,7 @@
-"""Tests of tracker v2, float reference (mstrack/float_v2.py; docs/algorithm.md, "Tracker v2").
+"""Tests of tracker v2, float reference (mstrack/track/float_v2.py; docs/algorithm.md, "Tracker v2").
 
 Pieces against their definitions (brute force), then synthetic scenes with exact ground truth
-drawn by :func:`mstrack.synthetic.render_scene` (the red/yellow checkerboard target of
+drawn by :func:`mstrack.io.synthetic.render_scene` (the red/yellow checkerboard target of
 ``make_scene`` at a given box per frame, optionally hidden by a background-textured patch),
 then bad input, then a floor on the real sequences.
 
@@ -19,11 +19,11 @@ import numpy as np
 import pytest
 
 from mstrack import FrameError, Status, Tracker
-from mstrack import float_v2 as v2
-from mstrack.agreement import shift_scene
-from mstrack.metrics import iou
-from mstrack.params import TrackerParams
-from mstrack.synthetic import render_scene
+from mstrack.track import float_v2 as v2
+from mstrack.eval.agreement import shift_scene
+from mstrack.eval.metrics import iou
+from mstrack.track.params import TrackerParams
+from mstrack.io.synthetic import render_scene
 
 SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
 SEEDS = [0, 1, 2]
@@ -594,8 +594,8 @@ V2_AUC_FLOOR = 0.50
 
 @pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (CI has them)")
 def test_real_sequences_auc_floor_and_beats_paper():
-    from mstrack.data import load_dataset
-    from mstrack.evaluate import aggregate, make_tracker, run_sequence
+    from mstrack.io.data import load_dataset
+    from mstrack.eval.evaluate import aggregate, make_tracker, run_sequence
 
     seqs = load_dataset(SEQ_ROOT)
     assert len(seqs) == 10, [s.name for s in seqs]
@@ -617,7 +617,7 @@ def test_real_sequences_auc_floor_and_beats_paper():
 def test_rescale_scale_test_options():
     """rescale with a rho-test estimate (experimental, docs/results_v2_mean.md): mix blends it with
     the spread estimate; the gate keeps the spread estimate only where both move the same way."""
-    from mstrack.float_v2 import rescale
+    from mstrack.track.float_v2 import rescale
     shape, size0 = (480, 640), (40.0, 20.0)
     spread_up = 1.21  # sqrt -> est 1.1 (the bound)
     base = TrackerParams(preset="v2")

@@ -16,12 +16,12 @@ import cv2
 import numpy as np
 import pytest
 
-from mstrack import float_model as fm
-from mstrack import float_v2 as v2
-from mstrack.data import load_dataset
-from mstrack.params import TrackerParams
-from mstrack.synthetic import make_scene
-from mstrack.types import Status
+from mstrack.track import float_model as fm
+from mstrack.track import float_v2 as v2
+from mstrack.io.data import load_dataset
+from mstrack.track.params import TrackerParams
+from mstrack.io.synthetic import make_scene
+from mstrack.track.types import Status
 
 SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
 # numba installed and not switched off: the self-check must pass (a failure is a test failure, not a skip)

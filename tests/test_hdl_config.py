@@ -1,4 +1,4 @@
-"""mstrack.hdl_config: user-level choices -> every generic of ms_tracker, refusals with one-line reasons.
+"""mstrack.hw.hdl_config: user-level choices -> every generic of ms_tracker, refusals with one-line reasons.
 
 The RTL side (the same relations asserted at elaboration) is tested with GHDL in
 tb/test_ms_tracker_file_tb.py (test_config_elaborates / test_wrong_generic_refused).
@@ -13,8 +13,8 @@ import pytest
 from mstrack.cli import main
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.hdl_config import (ConfigError, CoreChoices, derive, entity_generics, generic_map, render)
-from mstrack.params import TrackerParams
+from mstrack.hw.hdl_config import (ConfigError, CoreChoices, derive, entity_generics, generic_map, render)
+from mstrack.track.params import TrackerParams
 
 
 def test_default_choices_give_the_default_generics():

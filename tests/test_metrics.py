@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from mstrack.metrics import (CE_THRESHOLDS, IOU_THRESHOLDS, centre_error, concat_scores, iou, precision_curve,
+from mstrack.eval.metrics import (CE_THRESHOLDS, IOU_THRESHOLDS, centre_error, concat_scores, iou, precision_curve,
                              score, success_curve, valid_gt)
 
 

@@ -1,4 +1,4 @@
-"""Generated packaging files are current: rtl/files.txt, mstrack.core, tb/vhdl/data/ (mstrack.packaging).
+"""Generated packaging files are current: rtl/files.txt, mstrack.core, tb/vhdl/data/ (mstrack.hw.packaging).
 
 Regenerate with ``mstrack hdl files``.  The FuseSoC sim target itself runs in
 tb/test_ms_tracker_file_tb.py (test_fusesoc_target).
@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from mstrack import packaging
-from mstrack.hdl import REPO_ROOT, rtl_sources
+from mstrack.hw import packaging
+from mstrack.hw.hdl import REPO_ROOT, rtl_sources
 
 
 @pytest.mark.parametrize("path", sorted(packaging.generated(), key=str), ids=lambda p: p.name)

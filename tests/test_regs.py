@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from mstrack import regs
+from mstrack.hw import regs
 from mstrack.fixed import (RESULT_FLAGS, core_generics, pack_result, pack_result_v2, result_layout,
                            result_layout_v2, result_width, result_width_v2, unpack_result, unpack_result_v2)
 

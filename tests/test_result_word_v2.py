@@ -14,7 +14,7 @@ from mstrack import Tracker
 from mstrack.fixed.tracker_v2 import RESULT_FIELDS_V2, STATUS_CODES_V2
 from mstrack.fixed.vhdl_pkg import (RESULT_FLAGS, STATUS_V2, pack_result_v2, result_fields_v2, result_layout_v2,
                                     result_width_v2, unpack_result_v2)
-from mstrack.synthetic import make_scene
+from mstrack.io.synthetic import make_scene
 
 SEQ_ROOT = Path(__file__).resolve().parents[2] / "shared" / "data" / "sequences"
 
@@ -105,7 +105,7 @@ def test_large_target_and_frame_edge_values_fit():
 @pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (../shared absent)")
 @pytest.mark.parametrize("name", ["MotorRolling", "Girl", "Suv"])
 def test_real_sequence_results_fit_and_decode(name):
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
     seq = load_sequence(SEQ_ROOT / name)
     res = _track(seq.frames(), seq.init_box(), n=120)
     _check_frames(res)

@@ -1,6 +1,6 @@
 """The float tracker's fast paths give the reference path's results, bit for bit.
 
-mstrack/float_model.py has three ways to compute the same numbers (docs/bench.md):
+mstrack/track/float_model.py has three ways to compute the same numbers (docs/bench.md):
 "reference" (whole-frame bins, ``meanshift``), "numpy" (bins of a search area only,
 ``_meanshift_area``) and "numba" (the same loop compiled, ``_nb_meanshift``).  These
 tests hold the fast paths to the reference on real sequences (../shared/data/sequences,
@@ -17,11 +17,11 @@ import cv2
 import numpy as np
 import pytest
 
-from mstrack import float_model as fm
-from mstrack.agreement import shift_scene
-from mstrack.data import load_dataset
-from mstrack.params import TrackerParams
-from mstrack.synthetic import make_scene
+from mstrack.track import float_model as fm
+from mstrack.eval.agreement import shift_scene
+from mstrack.io.data import load_dataset
+from mstrack.track.params import TrackerParams
+from mstrack.io.synthetic import make_scene
 
 SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
 HAVE_NUMBA = fm._numba_ready()
@@ -218,7 +218,7 @@ def test_target_at_the_frame_border(path, corner):
 
 
 def test_replaced_kernel_window_selects_the_reference_path(monkeypatch):
-    """mstrack.agreement's window-grid analysis replaces kernel_window: the tracker must call it."""
+    """mstrack.eval.agreement's window-grid analysis replaces kernel_window: the tracker must call it."""
     calls = []
     orig = fm.kernel_window
 

@@ -16,11 +16,11 @@ from pathlib import Path
 
 import pytest
 
-from mstrack.cosim import COMPARED_FIELDS, expected_results
+from mstrack.hw.cosim import COMPARED_FIELDS, expected_results
 from mstrack.fixed import (FixedParams, core_generics, pack_result, result_layout, result_layout_v2,
                            unpack_result, unpack_result_v2)
-from mstrack.params import TrackerParams
-from mstrack.regs import REPO, register_map
+from mstrack.track.params import TrackerParams
+from mstrack.hw.regs import REPO, register_map
 
 SW = REPO / "sw"
 CFLAGS = ["-Wall", "-Wextra", "-Werror", "-std=c99"]
@@ -70,18 +70,18 @@ def _words(word: int) -> str:
 
 def model_words() -> list[int]:
     """Result words of the fixed-point model: a synthetic scene, real frames and vectors records."""
-    from mstrack.synthetic import make_scene
+    from mstrack.io.synthetic import make_scene
     tp, fp = TrackerParams(), FixedParams()
     frames, _ = make_scene(6, 96, 72, seed=1)
     res = expected_results(frames, (36, 24, 20, 18), tp, fp)
     if SEQ.is_dir():
         import cv2
         files = sorted((SEQ / "img").glob("*.jpg"))[:6]
-        from mstrack.data import load_sequence
+        from mstrack.io.data import load_sequence
         from mstrack.fixed.blocks import round_box
         box = round_box(*[float(v) for v in load_sequence(SEQ).gt[0]])
         res += expected_results([cv2.imread(str(f)) for f in files], box, tp, fp, first_count=65530)
-        from mstrack.vectors import generate
+        from mstrack.hw.vectors import generate
         it = generate(SEQ, [0, 3, 5])
         next(it)
         for rec in it:

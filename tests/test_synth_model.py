@@ -1,11 +1,11 @@
-"""mstrack.synth without tools: cycle model, critical-path parsing, doc sections."""
+"""mstrack.hw.synth without tools: cycle model, critical-path parsing, doc sections."""
 from __future__ import annotations
 
 import json
 
 import pytest
 
-from mstrack import synth
+from mstrack.hw import synth
 
 
 def test_pixel_pass_cycles_box_and_rows():

@@ -1,4 +1,4 @@
-"""mstrack.tb_files: the files of the standalone VHDL testbench (format version 1), and
+"""mstrack.hw.tb_files: the files of the standalone VHDL testbench (format version 1), and
 ``mstrack vectors --format vhdl-files``.  The testbench itself runs in tb/test_ms_tracker_file_tb.py."""
 from __future__ import annotations
 
@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from mstrack.cli import main
-from mstrack.cosim import CoreConfig, expected_results
+from mstrack.hw.cosim import CoreConfig, expected_results
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import unpack_result
-from mstrack.params import TrackerParams
-from mstrack.synthetic import make_scene
-from mstrack.tb_files import (expected_words, frames_text, pack_pixels, read_words, result_word,
+from mstrack.track.params import TrackerParams
+from mstrack.io.synthetic import make_scene
+from mstrack.hw.tb_files import (expected_words, frames_text, pack_pixels, read_words, result_word,
                               write_tb_files)
 
 CFG = CoreConfig(TrackerParams(), FixedParams(max_half=15, margin=8), lanes=4, max_frame_w=1024)

@@ -1,4 +1,4 @@
-"""Test vectors (mstrack/vectors.py): reproducible files that match a rerun of the model."""
+"""Test vectors (mstrack/hw/vectors.py): reproducible files that match a rerun of the model."""
 from __future__ import annotations
 
 import gzip
@@ -10,9 +10,9 @@ import pytest
 from mstrack import Tracker
 from mstrack.fixed import FixedParams, FixedTracker
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.params import TrackerParams
-from mstrack.synthetic import make_scene, write_otb_sequence
-from mstrack.vectors import FORMAT, VERSION, dump_vectors, load_vectors, main
+from mstrack.track.params import TrackerParams
+from mstrack.io.synthetic import make_scene, write_otb_sequence
+from mstrack.hw.vectors import FORMAT, VERSION, dump_vectors, load_vectors, main
 
 FRAMES = [0, 1, 5]
 
@@ -49,7 +49,7 @@ def test_header(seq_dir, tmp_path):
 
 def test_reload_equals_rerun(seq_dir, tmp_path):
     """Every number in the file equals a fresh run of the model with trace=True."""
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
 
     out = dump_vectors(seq_dir, FRAMES, tmp_path / "v.jsonl.gz")
     head, recs = load_vectors(out)
@@ -66,7 +66,7 @@ def test_reload_equals_rerun(seq_dir, tmp_path):
 
 def test_trace_contents_consistent(seq_dir, tmp_path):
     """The intermediates are self-consistent: sums from the per-bin values, result from the iterations."""
-    from mstrack.data import load_sequence
+    from mstrack.io.data import load_sequence
 
     head, recs = load_vectors(dump_vectors(seq_dir, FRAMES, tmp_path / "v.jsonl.gz"))
     init = recs[0]["trace"]
@@ -118,7 +118,7 @@ def test_errors(seq_dir, tmp_path):
 def test_cli_extension(seq_dir, tmp_path):
     """`mstrack vectors` and `mstrack agree` register through mstrack.cli's extension list."""
     cli = pytest.importorskip("mstrack.cli")
-    parser = cli.build_parser(extensions=["mstrack.vectors:register_cli", "mstrack.agreement:register_cli"])
+    parser = cli.build_parser(extensions=["mstrack.hw.vectors:register_cli", "mstrack.eval.agreement:register_cli"])
     out = tmp_path / "ext.jsonl.gz"
     args = parser.parse_args(["vectors", str(seq_dir), "--frames", "0,1,5", "--out", str(out)])
     assert args.func(args) == 0

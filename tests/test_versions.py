@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from mstrack import cli, versions
-from mstrack.synthetic import make_scene, write_otb_sequence
+from mstrack.io.synthetic import make_scene, write_otb_sequence
 
 REPO = Path(__file__).resolve().parents[1]
 PY_LINE = f"Tools: numpy {np.__version__}, OpenCV {cv2.__version__}, numba "
@@ -33,7 +33,7 @@ def test_missing_tool_is_not_installed(monkeypatch):
     try:
         monkeypatch.setattr(versions.metadata, "version", missing)
         monkeypatch.setattr("shutil.which", lambda name: None)
-        monkeypatch.setattr("mstrack.hdl.verilator_root", lambda: None)
+        monkeypatch.setattr("mstrack.versions.verilator_root", lambda: None)
         v = versions.tool_versions()
         assert v["cocotb"] == v["GHDL"] == v["Verilator"] == v["yosys"] == v["nextpnr"] == "not installed"
         assert v["OpenCV"] == cv2.__version__                 # cv2 itself still answers
@@ -74,14 +74,14 @@ def test_bench_docs_name_tools(tmp_path, capsys):
 
 
 def test_agreement_section_names_tools(tmp_path):
-    from mstrack.agreement import write_table
-    p = write_table("| a |\n|---|\n| 1 |", path=tmp_path / "r.md", command="python -m mstrack.agreement --write")
+    from mstrack.eval.agreement import write_table
+    p = write_table("| a |\n|---|\n| 1 |", path=tmp_path / "r.md", command="python -m mstrack.eval.agreement --write")
     text = p.read_text()
     assert PY_LINE in text and text.index("Tools:") < text.index("| a |")
 
 
 def test_synth_section_names_tools(tmp_path):
-    from mstrack.synth import write_section
+    from mstrack.hw.synth import write_section
     p = write_section("| x |", "ecp5", "mstrack synth --write", path=tmp_path / "perf.md")
     assert versions.tools_line(versions.SYNTH_TOOLS) in p.read_text()
     p = write_section("| y |", "ecp5", "mstrack synth --write", path=p, tools="Tools: GHDL 9.")

@@ -28,10 +28,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mstrack.data import load_dataset  # noqa: E402
-from mstrack.metrics import iou, valid_gt  # noqa: E402
-from mstrack.tracker import Tracker  # noqa: E402
-from mstrack.types import Status  # noqa: E402
+from mstrack.io.data import load_dataset  # noqa: E402
+from mstrack.eval.metrics import iou, valid_gt  # noqa: E402
+from mstrack.track.tracker import Tracker  # noqa: E402
+from mstrack.track.types import Status  # noqa: E402
 
 OUT = ROOT / "out" / "loss_study"
 DOC = ROOT / "docs" / "results_loss.md"
@@ -100,10 +100,10 @@ def main_search(root: str) -> None:
     """Float v2 with the search state driven by the loss flag: AUC (overall, mean) and loss signal."""
     import json
 
-    import mstrack.float_v2 as fv
-    from mstrack.metrics import IOU_THRESHOLDS, loss_detection
-    from mstrack.params import TrackerParams
-    from mstrack.types import Status
+    import mstrack.track.float_v2 as fv
+    from mstrack.eval.metrics import IOU_THRESHOLDS, loss_detection
+    from mstrack.track.params import TrackerParams
+    from mstrack.track.types import Status
 
     base = fv.decide_status
 
@@ -297,7 +297,7 @@ def main_report() -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from mstrack.params import TrackerParams
+    from mstrack.track.params import TrackerParams
     p = TrackerParams(preset="v2")
     L: list[str] = []
     L += ["# Loss signal of tracker v2 (issue 10)", "",

@@ -44,9 +44,9 @@ def loss_section(seq_root: Path) -> list[str]:
     import numpy as np
 
     sys.path.insert(0, str(REPO))
-    from mstrack.data import load_dataset
-    from mstrack.evaluate import SequenceRun
-    from mstrack.metrics import iou, loss_detection, valid_gt
+    from mstrack.io.data import load_dataset
+    from mstrack.eval.evaluate import SequenceRun
+    from mstrack.eval.metrics import iou, loss_detection, valid_gt
 
     seqs = {s.name: s for s in load_dataset(seq_root)}
     rows, per_seq, conf_io = [], {}, {}
@@ -131,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
            "OTB one-pass evaluation (init on frame 0 with the ground truth, no re-init) of mstrack "
            "(float reference and bit-accurate fixed-point model = the hardware) and four OpenCV "
            "baselines on every sequence of `../shared/data/sequences` (10 OTB/VOT sequences, 2490 "
-           "frames). Metrics: `mstrack/metrics.py` (success AUC over IoU thresholds 0:0.05:1, "
+           "frames). Metrics: `mstrack/eval/metrics.py` (success AUC over IoU thresholds 0:0.05:1, "
            "precision at 20 px; frame-weighted). Regenerate with `make results` "
            "(runs the two commands below, then `python tools/results_doc.py`).", ""]
     for name, run in RUNS.items():

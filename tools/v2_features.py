@@ -1,8 +1,8 @@
 """Tracker v2: edge feature and fusion variants, measured (issue 10, item 5).
 
-Runs tracker v2 variants (mstrack/features_v2.py) over every sequence of a
+Runs tracker v2 variants (mstrack/track/features_v2.py) over every sequence of a
 dataset, one-pass (OPE), and scores them exactly as ``mstrack eval`` does
-(mstrack.evaluate.run_sequence + aggregate: frame-weighted AUC over all
+(mstrack.eval.evaluate.run_sequence + aggregate: frame-weighted AUC over all
 frames, the mean of the per-sequence AUCs, and the per-sequence AUCs).
 
 The baseline row is FloatTrackerV2 itself (``Tracker(model="float",
@@ -36,11 +36,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from dataclasses import replace  # noqa: E402
 
-from mstrack.data import load_dataset  # noqa: E402
-from mstrack.metrics import valid_gt  # noqa: E402
-from mstrack.types import Box  # noqa: E402
-from mstrack.evaluate import aggregate, run_sequence  # noqa: E402
-from mstrack.features_v2 import Feature, MultiFeatureV2  # noqa: E402
+from mstrack.io.data import load_dataset  # noqa: E402
+from mstrack.eval.metrics import valid_gt  # noqa: E402
+from mstrack.track.types import Box  # noqa: E402
+from mstrack.eval.evaluate import aggregate, run_sequence  # noqa: E402
+from mstrack.track.features_v2 import Feature, MultiFeatureV2  # noqa: E402
 
 THRESHOLDS = (16, 32, 64, 128)
 FUSIONS = ("rho", "disc", "disc_frame", "wta", "tie")
@@ -147,7 +147,7 @@ def _run_robust(job):
 
 
 def robust(a, names) -> str:
-    from mstrack.metrics import concat_scores, score
+    from mstrack.eval.metrics import concat_scores, score
     vs = variants()
     jobs = [(label, vs[label][1], kind, a.data) for label in ROBUST for kind in PERTURB]
     res: dict = {}

@@ -1,7 +1,7 @@
 """Issue 10, last accuracy target: mean AUC over the dev sequences of tracker v2 variants.
 
 Every variant runs on every sequence with the same parameters (no per-sequence choice), one
-pass (OPE), scored as ``mstrack eval`` (mstrack.evaluate.run_sequence + aggregate).  Prints the
+pass (OPE), scored as ``mstrack eval`` (mstrack.eval.evaluate.run_sequence + aggregate).  Prints the
 overall (frame-weighted) AUC, the mean of the per-sequence AUCs, the per-sequence AUCs and the
 wins / losses against the default v2 on the sequences (docs/results_v2_mean.md).
 
@@ -30,10 +30,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mstrack import Tracker  # noqa: E402
-from mstrack.data import load_dataset  # noqa: E402
-from mstrack.evaluate import aggregate, run_sequence  # noqa: E402
-from mstrack.features_v2 import Feature, MultiFeatureV2  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.io.data import load_dataset  # noqa: E402
+from mstrack.eval.evaluate import aggregate, run_sequence  # noqa: E402
+from mstrack.track.features_v2 import Feature, MultiFeatureV2  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 BASELINE = "v2 default (float)"
 
@@ -126,7 +126,7 @@ def _run_robust(job):
 
 def robust(a, labels: list[str]) -> str:
     from v2_features import PERTURB
-    from mstrack.metrics import concat_scores, score
+    from mstrack.eval.metrics import concat_scores, score
     vs = variants()
     labels = [BASELINE] + [x for x in labels if x != BASELINE]
     jobs = [(lb, *vs[lb], k, a.data) for lb in labels for k in PERTURB]
@@ -153,7 +153,7 @@ def loss_figures(runs: dict, seqs) -> tuple[float, float]:
     """The loss flag on the frames after init (as tools/loss_study.py scores it, with the default
     thresholds; MultiFeatureV2 reports the search state instead): recall = share of off-target
     frames (IoU = 0) not ok, false alarms = share of on-target frames (IoU >= 0.5) not ok."""
-    from mstrack.metrics import iou, valid_gt
+    from mstrack.eval.metrics import iou, valid_gt
     off = on = off_f = on_f = 0
     for s in seqs:
         r = runs[s.name]
@@ -169,7 +169,7 @@ def loss_figures(runs: dict, seqs) -> tuple[float, float]:
 
 
 def loss_grid(a, labels: list[str]) -> str:
-    from mstrack.metrics import iou, valid_gt
+    from mstrack.eval.metrics import iou, valid_gt
     seqs = load_dataset(a.data)
     vs = variants()
     lines = ["| variant | loss_rho | loss_contrast | recall | false alarms |", "|---|---:|---:|---:|---:|"]

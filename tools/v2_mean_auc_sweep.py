@@ -15,8 +15,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mstrack import Tracker  # noqa: E402
-from mstrack.data import load_dataset  # noqa: E402
-from mstrack.metrics import IOU_THRESHOLDS, iou, valid_gt  # noqa: E402
+from mstrack.io.data import load_dataset  # noqa: E402
+from mstrack.eval.metrics import IOU_THRESHOLDS, iou, valid_gt  # noqa: E402
 
 VARIANTS = [("default", {})] + [(f"{k} {v}", {k: v}) for k, vals in (
     ("pad", (0.1875, 0.3125, 0.375)), ("scale_gain", (0.2, 0.4)), ("scale_reg", (0.05, 0.2)),

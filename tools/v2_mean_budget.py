@@ -1,5 +1,5 @@
 """Worst-frame clocks of the docs/results_v2_mean.md candidate (joint colour x orientation bins,
-gated scale test) with the paper engine's pass costs, as ``mstrack.synth.v2_cycle_budget`` counts
+gated scale test) with the paper engine's pass costs, as ``mstrack.hw.synth.v2_cycle_budget`` counts
 the v2 default (an estimate until core v2 exists).
 
 The joint histogram has 512 x 9 = 4608 bins: every bin pass (one per mean-shift pass) walks
@@ -18,8 +18,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from mstrack import synth  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.hw import synth  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 
 def budget(lanes: int, n_bins: int, max_iter: int, scale_test: bool) -> list[tuple[str, int]]:

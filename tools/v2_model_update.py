@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from mstrack.data import load_dataset
-from mstrack.metrics import iou, valid_gt, IOU_THRESHOLDS
-from mstrack.float_v2 import FloatTrackerV2, window_pixels
-from mstrack.params import TrackerParams
-from mstrack.types import Status
+from mstrack.io.data import load_dataset
+from mstrack.eval.metrics import iou, valid_gt, IOU_THRESHOLDS
+from mstrack.track.float_v2 import FloatTrackerV2, window_pixels
+from mstrack.track.params import TrackerParams
+from mstrack.track.types import Status
 beta=float(sys.argv[1]); cmin=float(sys.argv[2])
 class Upd(FloatTrackerV2):
     def update(self, frame):

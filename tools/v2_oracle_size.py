@@ -6,8 +6,8 @@ Usage: PYTHONPATH=. python tools/v2_oracle_size.py
 """
 import numpy as np
 from mstrack import Tracker
-from mstrack.data import load_dataset
-from mstrack.metrics import IOU_THRESHOLDS, iou, valid_gt
+from mstrack.io.data import load_dataset
+from mstrack.eval.metrics import IOU_THRESHOLDS, iou, valid_gt
 from pathlib import Path
 seqs = load_dataset(str(Path(__file__).resolve().parents[2] / "shared/data/sequences"))
 def auc(io): return float(np.mean([(io > th).mean() for th in IOU_THRESHOLDS]))

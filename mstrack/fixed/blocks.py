@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..params import TrackerParams
+from ..track.params import TrackerParams
 from .formats import FixedParams
 from .primitives import ms_divider, ms_isqrt, round_div_signed
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import TrackerParams
+from ..track.params import TrackerParams
 from .blocks import ms_kernel
 from .primitives import ms_divider, ms_isqrt
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..params import TrackerParams
+from ..track.params import TrackerParams
 from .formats import FixedParams, widths
 from .primitives import bits_for
 from .vhdl_pkg import core_generics

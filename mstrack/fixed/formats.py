@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from ..params import TrackerParams, check_param_types
+from ..track.params import TrackerParams, check_param_types
 from .primitives import bits_for
 
 

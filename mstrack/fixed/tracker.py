@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from ..frames import check_frame
-from ..params import TrackerParams
-from ..types import Box, Status, TrackResult
+from ..track.frames import check_frame
+from ..track.params import TrackerParams
+from ..track.types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, IntBox, Region, ms_box_clip, ms_fusion, ms_histogram, ms_kernel,
                      ms_meanshift, ms_region, ms_region_capture, ms_rho_out, ms_round_centre,
                      clamp_centre, init_centre, round_box)

@@ -1,4 +1,4 @@
-"""Fixed-point tracker v2: the executable specification of core v2 (float: mstrack/float_v2.py).
+"""Fixed-point tracker v2: the executable specification of core v2 (float: mstrack/track/float_v2.py).
 
 Per frame (all integer; blocks in :mod:`mstrack.fixed.blocks_v2` and :mod:`mstrack.fixed.blocks`):
 
@@ -23,9 +23,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..frames import check_frame
-from ..params import TrackerParams
-from ..types import Box, Status, TrackResult
+from ..track.frames import check_frame
+from ..track.params import TrackerParams
+from ..track.types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_grey, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
 from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from ..params import TrackerParams
+from ..track.params import TrackerParams
 from .formats import FixedParams, widths
 from .primitives import bits_for
 
@@ -246,7 +246,7 @@ def result_layout_v2(g: dict[str, int] | None = None) -> list[tuple[str, int, in
     ``flags`` and ``err_code`` as in result word v1 (stream errors); ``frame_count``.
     """
     if g is None:
-        from ..params import TrackerParams
+        from ..track.params import TrackerParams
         g = core_generics(TrackerParams(preset="v2"))
     size_w = g["COORD_W"] + 8
     fields_ = [("cx", g["CENTRE_ABS_W"]), ("cy", g["CENTRE_ABS_W"]), ("w8", size_w), ("h8", size_w),

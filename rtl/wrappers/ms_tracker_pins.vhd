@@ -11,7 +11,7 @@
 -- Every result bit stays observable, so synthesis removes nothing of the core.
 -- Cost over the core: 6 (COORD_W + 2) + RESULT_W + clog2(RESULT_W) + 1 flip-flops and a few
 -- LUTs per bit (ECP5, default generics: +234 FF, +87 LUT4, +19 CCU2C); no RAM, no multiplier.
--- Resource figures of the core itself come from synthesising ms_tracker (mstrack/synth.py);
+-- Resource figures of the core itself come from synthesising ms_tracker (mstrack/hw/synth.py);
 -- this top is only for nextpnr.
 -- Generics: exactly those of ms_tracker (passed through).
 library ieee;

@@ -7,7 +7,7 @@
 -- vhdl-files`) and fails on any mismatch.  Plain VHDL-2008 (std.textio, ieee only): runs in
 -- GHDL, Questa, Riviera-PRO, xsim, ... with no Python at simulation time.
 --
--- FRAMES_FILE format (mstrack.tb_files, docs/packaging.md "Simulating without Python"):
+-- FRAMES_FILE format (mstrack.hw.tb_files, docs/packaging.md "Simulating without Python"):
 -- text, one record per line, '#' lines and empty lines ignored:
 --   mstrack-frames 1          magic and version (first record)
 --   packing P                 the s_axis_tdata layout of the pixel words (must equal RGB_PACKING)

@@ -1,6 +1,6 @@
 // cosim_main.cpp: Verilator C++ co-simulation harness of ms_tracker (no cocotb, no Python per cycle).
 //
-// Built and driven by mstrack.fastsim (docs/performance.md, "Real-time check (1080p60)"): the
+// Built and driven by mstrack.hw.fastsim (docs/performance.md, "Real-time check (1080p60)"): the
 // GHDL netlist of ms_tracker (generics baked in) is verilated with --prefix Vms_tracker and
 // linked with this file.  It resets the core, gives the init box on s_init_*, streams the
 // frames on s_axis_* (1 pixel per clock, tuser on each frame's first pixel, tlast on each
@@ -14,7 +14,7 @@
 //   width, height     frame size (px); frame_width/frame_height ports
 //   frames            number of frames in the pixel file
 //   pixels            path of the pixel file: frames x height x width little-endian uint32,
-//                     R << 16 | G << 8 | B (mstrack.cosim.frame_words)
+//                     R << 16 | G << 8 | B (mstrack.hw.cosim.frame_words)
 //   init              1: give the init box before the first frame (default 1)
 //   init_x, init_y    init box, two's complement already masked to the port width by the caller
 //   init_w, init_h    init box size

@@ -3,7 +3,7 @@
     .venv/bin/python tools/hdl/synth_probe/probe.py
 
 For each probe entity: GHDL analysis+elaboration for simulation (mcode),
-`ghdl --synth --out=verilog` (through mstrack.hdl.ghdl_to_verilog), then Yosys
+`ghdl --synth --out=verilog` (through mstrack.hw.hdl.ghdl_to_verilog), then Yosys
 reading the Verilog (`synth_ecp5` for cell counts).  Prints one line per probe;
 logs under build/synth_probe/.  Results are recorded in docs/hdl_flow.md.
 """
@@ -17,7 +17,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[2]))
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 
 PROBES = ["p_record_port", "p_unconstrained", "p_unconstrained_top", "p_arith", "p_ram_rdw", "p_2008", "p_2008_sel", "p_2008_casem",
           "p_fixed", "p_mathreal", "p_mathreal_sqrt"]

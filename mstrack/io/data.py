@@ -1,6 +1,6 @@
 """Sequence and video readers.
 
-Boxes follow the convention of :mod:`mstrack.types` (0-based ``x, y, w, h``).
+Boxes follow the convention of :mod:`mstrack.track.types` (0-based ``x, y, w, h``).
 OTB ground truth is 1-based, VOT ground truth 0-based; :func:`load_sequence`
 converts both to 0-based.
 
@@ -37,7 +37,7 @@ from typing import Any, Iterator
 import cv2
 import numpy as np
 
-from .types import Box
+from ..track.types import Box
 
 IMAGE_EXTS = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".ppm", ".pgm")
 VIDEO_EXTS = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".mpg", ".mpeg", ".webm")

@@ -20,7 +20,7 @@ from typing import Any
 
 from .evaluate import Evaluation
 from .metrics import CE_THRESHOLDS, IOU_THRESHOLDS, PRECISION_AT, Scores
-from .versions import PYTHON_TOOLS, tool_versions, tools_line
+from ..versions import PYTHON_TOOLS, tool_versions, tools_line
 
 
 def _f(v: float, nd: int = 3) -> str:

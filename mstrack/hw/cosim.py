@@ -10,11 +10,11 @@ from typing import Iterable, Sequence
 
 import numpy as np
 
-from .fixed import FixedParams, FixedTracker
-from .fixed.blocks import init_centre, ms_box_clip
-from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, core_generics, result_layout
-from .params import TrackerParams
-from .types import Status
+from ..fixed import FixedParams, FixedTracker
+from ..fixed.blocks import init_centre, ms_box_clip
+from ..fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, core_generics, result_layout
+from ..track.params import TrackerParams
+from ..track.types import Status
 
 COMPARED_FIELDS = ("cx", "cy", "rho_c", "rho_e", "alpha_c", "iter_c", "iter_e", "stop_c", "stop_e",
                    "flags", "err_code", "box_w", "box_h", "frame_count")

@@ -5,7 +5,7 @@ checkerboard with noise, so it has both a distinctive colour histogram and
 internal edges) moving smoothly over a textured blue-green background.  The
 scene is deterministic for a given seed.  :func:`render_scene` draws the same
 kind of target at any given box per frame (size changes, jumps) with optional
-full occlusion by a background-textured patch.  Boxes follow :mod:`mstrack.types`
+full occlusion by a background-textured patch.  Boxes follow :mod:`mstrack.track.types`
 (0-based ``x, y, w, h``).
 """
 from __future__ import annotations
@@ -178,6 +178,6 @@ def write_otb_sequence(frames: np.ndarray, gt: np.ndarray, folder: str | Path,
     h, w = frames.shape[1:3]
     meta = {"name": name or d.name, "format": "otb", "gt_coordinate_base": 1,
             "attributes": list(attributes or []), "width": int(w), "height": int(h),
-            "frames": int(len(frames)), "source": "mstrack.synthetic.make_scene"}
+            "frames": int(len(frames)), "source": "mstrack.io.synthetic.make_scene"}
     (d / "meta.json").write_text(json.dumps(meta, indent=1) + "\n")
     return d

@@ -22,8 +22,8 @@ JSON lines with sorted keys.  Line 1 is the header::
 
 then one line per chosen frame: ``{"frame": i, "kind": "init" | "update", "trace": ...}``.
 
-Command line: ``python -m mstrack.vectors SEQ_DIR --frames 0,1,5 --out FILE [--param NAME=VALUE]``,
-or ``mstrack vectors ...`` once ``"mstrack.vectors:register_cli"`` is in ``mstrack.cli.EXTENSIONS``.
+Command line: ``python -m mstrack.hw.vectors SEQ_DIR --frames 0,1,5 --out FILE [--param NAME=VALUE]``,
+or ``mstrack vectors ...`` once ``"mstrack.hw.vectors:register_cli"`` is in ``mstrack.cli.EXTENSIONS``.
 """
 from __future__ import annotations
 
@@ -37,12 +37,12 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from .data import load_sequence
-from .fixed import FixedParams, FixedTracker
-from .fixed.blocks import round_box
-from .fixed.vhdl_pkg import DEFAULT_LANES, core_generics
-from .params import TrackerParams
-from .types import Box
+from ..io.data import load_sequence
+from ..fixed import FixedParams, FixedTracker
+from ..fixed.blocks import round_box
+from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
+from ..track.params import TrackerParams
+from ..track.types import Box
 
 FORMAT = "mstrack-vectors"
 VERSION = 1
@@ -143,7 +143,7 @@ def _parse_frames(s: str) -> list[int]:
 
 
 def add_arguments(ap: argparse.ArgumentParser) -> None:
-    """Arguments of ``python -m mstrack.vectors`` and ``mstrack vectors``."""
+    """Arguments of ``python -m mstrack.hw.vectors`` and ``mstrack vectors``."""
     ap.add_argument("seq_dir", help="sequence folder (or, with --format vhdl-files and --box, any video "
                                     "or image folder)")
     ap.add_argument("--frames", type=_parse_frames, default=[0, 1], help="comma separated, e.g. 0,1,5 "
@@ -154,7 +154,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--lanes", type=int, default=DEFAULT_LANES)
     ap.add_argument("--format", choices=("jsonl", "vhdl-files"), default="jsonl",
                     help="jsonl: every fixed-point intermediate (default); vhdl-files: frames.txt, "
-                         "expected.txt, generics.json for tb/vhdl/ms_tracker_file_tb.vhd (mstrack.tb_files)")
+                         "expected.txt, generics.json for tb/vhdl/ms_tracker_file_tb.vhd (mstrack.hw.tb_files)")
     ap.add_argument("--box", help="vhdl-files: init box x,y,w,h (integers; default: the ground truth of frame 0)")
     ap.add_argument("--max-frame-width", type=int, default=2048, help="vhdl-files: MAX_FRAME_W (default 2048)")
     ap.add_argument("--rgb-packing", choices=("mstrack", "ug934"), default="mstrack",
@@ -164,7 +164,7 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Handler of ``mstrack vectors`` / ``python -m mstrack.vectors``."""
+    """Handler of ``mstrack vectors`` / ``python -m mstrack.hw.vectors``."""
     params: dict[str, Any] = {}
     for it in args.param:
         k, sep, v = it.partition("=")
@@ -188,11 +188,11 @@ def run(args: argparse.Namespace) -> int:
 def dump_vhdl_files(source: str | Path, n_frames: int, out: str | Path, lanes: int = DEFAULT_LANES,
                     box: str | None = None, max_frame_w: int = 2048, packing: str = "mstrack",
                     **params: Any) -> Path:
-    """Files of the standalone VHDL testbench (:func:`mstrack.tb_files.write_tb_files`) for the
+    """Files of the standalone VHDL testbench (:func:`mstrack.hw.tb_files.write_tb_files`) for the
     first ``n_frames`` frames of ``source`` (sequence folder, video or image folder); init box
     ``box`` ("x,y,w,h") or the sequence's ground truth on frame 0.  Returns the folder."""
     from .cosim import CoreConfig
-    from .data import VideoSource
+    from ..io.data import VideoSource
     from .tb_files import write_tb_files
 
     src = VideoSource(source)
@@ -220,7 +220,7 @@ def dump_vhdl_files(source: str | Path, n_frames: int, out: str | Path, lanes: i
 
 
 def register_cli(sub: argparse._SubParsersAction) -> None:
-    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.vectors:register_cli"``): ``mstrack vectors``."""
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.hw.vectors:register_cli"``): ``mstrack vectors``."""
     p = sub.add_parser("vectors", help="dump RTL test vectors (every fixed-point intermediate) of chosen frames",
                        description=__doc__.split("\n\n")[0])
     add_arguments(p)
@@ -228,7 +228,7 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mstrack.vectors", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m mstrack.hw.vectors", description=__doc__.split("\n\n")[0])
     add_arguments(ap)
     return run(ap.parse_args(argv))
 

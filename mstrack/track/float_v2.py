@@ -35,8 +35,9 @@ import cv2
 import numpy as np
 
 from . import float_model as _fm
-from .float_model import (_SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3, check_frame, clip_box,
-                          colour_bins)
+from .features import colour_bins
+from .frames import check_frame, clip_box
+from .numba_kernels import _SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -342,8 +343,8 @@ def joint_bins_area(frame: np.ndarray, d: int, bits: int, T: int, x0: int, x1: i
     decimated image's [y0, y1) x [x0, x1), from the frame's pixels around them only.
 
     The Sobel runs on the grey of a strip of frame rows and SOBEL_ALIGN-aligned columns, as
-    :func:`~mstrack.float_model.edge_bins_area` does, so Gx, Gy equal the whole frame's bit for
-    bit; the frame's 1-px border is flat (bin 8), as :func:`~mstrack.features_v2.sobel` makes it.
+    :func:`~mstrack.track.float_model.edge_bins_area` does, so Gx, Gy equal the whole frame's bit for
+    bit; the frame's 1-px border is flat (bin 8), as :func:`~mstrack.track.features_v2.sobel` makes it.
     """
     from .features_v2 import orientation_bins
     height, width = frame.shape[:2]

@@ -10,6 +10,13 @@ Two front ends over the same trackers:
 
 Both default to tracker v2 (``preset="v2"``), the best mstrack tracker measured (docs/results.md);
 the paper's algorithm, which the RTL core implements today, is ``preset="paper"``.
+
+Layout (README.md, "Package layout"): this module belongs to :mod:`mstrack.track`, which
+:mod:`mstrack.fixed` builds on (params, types, frame checks), so ``Tracker(model="fixed")`` imports
+the fixed-point model inside :meth:`Tracker.__init__`, not at module level: importing the float
+tracker never loads the fixed model, there is no import cycle, and fixed still imports only
+mstrack.track.  The float models are imported there too, so ``import mstrack`` stays light
+(tests/test_layout.py allows track -> fixed only inside a function).
 """
 from __future__ import annotations
 
@@ -46,7 +53,7 @@ class Tracker:
     **kwargs
         :class:`TrackerParams` fields (``preset``, ``features``, ``kernel``,
         ``colour_bits``, ...; string values accept the aliases of
-        :data:`mstrack.params.ALIASES`, e.g. ``kernel="epan"``, ``features="color"``) and, for
+        :data:`mstrack.track.params.ALIASES`, e.g. ``kernel="epan"``, ``features="color"``) and, for
         model="fixed", :class:`mstrack.fixed.FixedParams` fields.  ``preset`` defaults to
         :data:`DEFAULT_PRESET` ("v2"); ``preset="paper"`` is the paper's algorithm
         (``features="fused"`` by default, also "colour" or "edge").
@@ -83,12 +90,12 @@ class Tracker:
                 from .float_model import FloatTracker
                 self._impl = FloatTracker(tp)
         elif model == "fixed":
-            from .fixed import FixedParams, FixedTracker
+            from ..fixed import FixedParams, FixedTracker
             fp, rest = FixedParams.split(rest)
             if rest:
                 raise TypeError(f"unknown parameters: {sorted(rest)}")
             if tp.preset == "v2":
-                from .fixed.tracker_v2 import FixedTrackerV2
+                from ..fixed.tracker_v2 import FixedTrackerV2
                 self._impl = FixedTrackerV2(tp, fp)
             else:
                 self._impl = FixedTracker(tp, fp)
@@ -105,7 +112,7 @@ class Tracker:
         frame : ndarray, shape (H, W, 3), uint8
             BGR image (OpenCV's channel order).
         box : Box or sequence of 4 numbers
-            ``(x, y, w, h)``: left, top, width, height in 0-based pixels (see :mod:`mstrack.types`).
+            ``(x, y, w, h)``: left, top, width, height in 0-based pixels (see :mod:`mstrack.track.types`).
 
         Returns
         -------

@@ -21,7 +21,7 @@ the latter two frame-weighted (the per-frame values of all sequences are
 concatenated, as the OTB toolkit does).
 
 Any object with ``init(frame, box)`` and ``update(frame)`` returning a
-:class:`~mstrack.types.TrackResult`, a :class:`~mstrack.types.Box` or an
+:class:`~mstrack.track.types.TrackResult`, a :class:`~mstrack.track.types.Box` or an
 ``(x, y, w, h)`` sequence can be run with :func:`run_sequence`.
 """
 from __future__ import annotations
@@ -38,9 +38,9 @@ import numpy as np
 from tqdm import tqdm
 
 from . import baselines
-from .data import DataError, Sequence
+from ..io.data import DataError, Sequence
 from .metrics import Scores, concat_scores, score, valid_gt
-from .types import Box, Status
+from ..track.types import Box, Status
 
 CACHE_VERSION = 3
 MODELS = ("float", "fixed")
@@ -48,7 +48,7 @@ MODELS = ("float", "fixed")
 
 def _mstrack(features: str | None, kernel: str, preset: str = "paper") -> Callable[[str], Any]:
     def make(model: str = "float") -> Any:
-        from .tracker import Tracker  # imported late: written separately, may be absent
+        from ..track.tracker import Tracker  # imported late: written separately, may be absent
         return Tracker(model=model, features=features, kernel=kernel, preset=preset)  # type: ignore[arg-type]
     make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r})"
     return make
@@ -135,7 +135,7 @@ def result_status(result: Any) -> str:
 def frame_error_types() -> tuple[type[BaseException], ...]:
     """Exception types meaning "bad frame, go on" (``mstrack.FrameError`` once it exists)."""
     try:
-        from .frames import FrameError
+        from ..track.frames import FrameError
     except ImportError:
         return ()
     return (FrameError,)
@@ -268,22 +268,21 @@ def params_key(tracker: Any) -> str:
 def tracker_fingerprint(name: str) -> str:
     """Short hash of the code behind tracker ``name``, stored with cached runs.
 
-    mstrack trackers: the sources of the tracker modules (``tracker``,
-    ``float_model``, ``params``, ``frames``, ``types``, ``fixed/``); OpenCV
-    baselines: ``baselines.py`` and the OpenCV version.  A cached run whose
+    mstrack trackers: the sources of the track layer (``mstrack/track/*.py``:
+    tracker, float models, params, frames, types; and ``mstrack/fixed/*.py``); OpenCV
+    baselines: ``eval/baselines.py`` and the OpenCV version.  A cached run whose
     fingerprint differs is recomputed, so editing the tracker invalidates it.
     """
     import hashlib
 
     import cv2
 
-    pkg = Path(__file__).resolve().parent
+    pkg = Path(__file__).resolve().parents[1]  # mstrack/
     if uses_model(name):
-        files = [pkg / f"{m}.py" for m in ("tracker", "float_model", "float_v2", "params", "frames", "types")]
-        files += sorted((pkg / "fixed").glob("*.py"))
+        files = sorted((pkg / "track").glob("*.py")) + sorted((pkg / "fixed").glob("*.py"))
         extra = ""
     else:
-        files, extra = [pkg / "baselines.py"], cv2.__version__
+        files, extra = [pkg / "eval" / "baselines.py"], cv2.__version__
     h = hashlib.sha1(extra.encode())
     for f in files:
         if f.is_file():
@@ -328,9 +327,9 @@ class Evaluation:
     runs : dict
         ``runs[label][seq]`` -> :class:`SequenceRun`.
     per_sequence, per_attribute : dict
-        ``[label][seq or attribute]`` -> :class:`~mstrack.metrics.Scores`.
+        ``[label][seq or attribute]`` -> :class:`~mstrack.eval.metrics.Scores`.
     overall : dict
-        ``[label]`` -> frame-weighted :class:`~mstrack.metrics.Scores`.
+        ``[label]`` -> frame-weighted :class:`~mstrack.eval.metrics.Scores`.
     fps : dict
         ``[label]`` -> total updates / total update time.
     failed : dict
@@ -531,7 +530,7 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
         if model == "float" and any(uses_model(t[0][1]) for t in todo):
             # compile (or load) the numba kernels here first: a first run compiles once, with the
             # CLI's notice, and the workers of this machine then load them from numba's disk cache
-            from .float_v2 import _numba_ready
+            from ..track.float_v2 import _numba_ready
             _numba_ready()
     if progress and todo:
         print(f"eval: {len(done)} runs cached, {len(todo)} to run on {pool.where}", file=sys.stderr)

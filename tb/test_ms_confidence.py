@@ -79,7 +79,7 @@ async def confidence_stream(dut, gap_prob):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import v2_scale_generics  # noqa: E402
 
 TOP = "ms_confidence"

@@ -83,7 +83,7 @@ async def loss_filter_stream(dut, gap_prob):
 
 import pytest  # noqa: E402
 
-from mstrack import hdl  # noqa: E402
+from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import v2_scale_generics  # noqa: E402
 
 TOP = "ms_loss_filter"

@@ -91,7 +91,7 @@ import pytest  # noqa: E402
 
 from mstrack.hw import hdl  # noqa: E402
 from mstrack.fixed.vhdl_pkg import v2_scale_generics  # noqa: E402
-from mstrack.params import TrackerParams  # noqa: E402
+from mstrack.track.params import TrackerParams  # noqa: E402
 
 TOP = "ms_loss_flag"
 MODULE = "test_ms_loss_flag"

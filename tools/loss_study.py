@@ -169,7 +169,16 @@ def signals(d: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
             "share / share_ref": d["share"] / d["share_ref"], "rho / rho0": d["rho"] / d["rho0"],
             "share / share0": d["share"] / d["share_ref"][0], "rho": d["rho"], "share": share,
             "contrast = share - ring_share": share - ring, "1 - ring_share / share": 1 - ring / np.maximum(share, 1e-9),
-            "-|log(w / w0)|": -np.abs(np.log(d["scale"])), "-jump (box diameters)": -d["jump"]}
+            "-|log(w / w0)|": -np.abs(np.log(d["scale"])), "-jump (box diameters)": -d["jump"],
+            "-|log(w / w_prev)| (scale change per frame)": -np.abs(np.diff(np.log(d["scale"]), prepend=0.0)),
+            "-iterations": -d["iters"],
+            "rho / rho0 change over 8 frames": _trend(d["rho"] / d["rho0"], 1.0, 8),
+            "contrast change over 8 frames": _trend(share - ring, d["con0"][0], 8)}
+
+
+def _trend(x: np.ndarray, x0: float, k: int) -> np.ndarray:
+    """x_i - x_(i - k), x before the first frame taken as x0."""
+    return x - np.concatenate([np.full(k, x0), x[:-k]])[:len(x)]
 
 
 def smooth(x: np.ndarray, x0: float, rate: float) -> np.ndarray:
@@ -286,6 +295,136 @@ def latch_study(seqs: list[dict]) -> tuple[tuple, tuple[float, float], tuple[flo
     return LATCH_GRID[j], rate(C[j]), rate(loo)
 
 
+# ----------------------------------------------------------------------------- session 5: rules tried
+def _hyst(rs: np.ndarray, con: np.ndarray, z: np.ndarray, a: float, b: float, ha: float, hb: float) -> np.ndarray:
+    """Hysteresis: enter on rs < a and con < b; stay while rs < a + ha and con < b + hb (z: share = 0)."""
+    out = np.zeros(len(rs), bool)
+    f = False
+    for i in range(len(rs)):
+        f = bool(z[i] or (rs[i] < a + ha and con[i] < b + hb) if f else z[i] or (rs[i] < a and con[i] < b))
+        out[i] = f
+    return out
+
+
+def _persist(rs: np.ndarray, con: np.ndarray, z: np.ndarray, a: float, b: float, k: int) -> np.ndarray:
+    """Flagged when rs < a and con < b held on this and the k - 1 frames before (or share = 0)."""
+    c = (rs < a) & (con < b)
+    run = np.zeros(len(c), int)
+    r = 0
+    for i, v in enumerate(c):
+        r = r + 1 if v else 0
+        run[i] = r
+    return z | (run >= k)
+
+
+def _running_max(x: np.ndarray, x0: float, k: int) -> np.ndarray:
+    """m <- max(x, m - (m - x) / 2**k) from m = x0 (a peak that decays toward x)."""
+    y = np.empty_like(x)
+    m = x0
+    for i, v in enumerate(x):
+        m = max(v, m - (m - v) / 2 ** k)
+        y[i] = m
+    return y
+
+
+def tried_signals(model: str) -> list[dict]:
+    """Per sequence: the adopted filters' values (rs = rho_s / rho0, con_s), share = 0, and the extra
+    signals the session-5 rules use (all re-computed in float from the dumped raw values)."""
+    out = []
+    for name, d in load(model).items():
+        share = d["nt_in"] / np.maximum(d["n_in"], 1)
+        sh0 = d["share_ref"][0]
+        q = {"name": name, "off": d["iou"] == 0, "on": d["iou"] >= 0.5, "z": d["share"] == 0,
+             "rs": d["rho_s"] / d["rho0"], "con": d["con_s"],
+             "sh": smooth(share, sh0, 0.5) / max(sh0, 1e-9),
+             "drop16": d["rho_s"] / smooth(d["rho"], d["rho0"][0], 1 / 16),
+             "peak": d["rho_s"] / _running_max(d["rho_s"], d["rho0"][0], 5)}
+        out.append(q)
+    return out
+
+
+GA = np.round(np.arange(0.70, 1.001, 0.01), 2)   # rho_s / rho0 thresholds
+GB = np.round(np.arange(0.00, 0.401, 0.01), 2)   # contrast thresholds
+GA2 = np.round(np.arange(0.70, 1.001, 0.02), 2)  # coarser grids for the 3-parameter rules
+GB2 = np.round(np.arange(0.00, 0.401, 0.02), 2)
+GC2 = np.round(np.arange(0.30, 1.001, 0.02), 2)
+
+
+def tried_rules() -> list[tuple[str, object, list[tuple]]]:
+    """(description, rule(q, *g) -> flags, grid) of every rule measured in session 5."""
+    import itertools as it
+    P2, P3 = list(it.product(GA, GB)), list(it.product(GA2, GB2, GC2))
+    base = lambda q, a, b: q["z"] | ((q["rs"] < a) & (q["con"] < b))  # noqa: E731
+    R = [("adopted rule (rs < a and con < b)", base, P2),
+         ("adopted rule, grid steps 0.02", base, list(it.product(GA2, GB2)))]
+    for ha, hb in ((0.02, 0.0), (0.05, 0.0), (0.0, 0.02), (0.02, 0.02), (0.05, 0.05)):
+        R.append((f"hysteresis: stays flagged while rs < a + {ha:g} and con < b + {hb:g}",
+                  lambda q, a, b, ha=ha, hb=hb: _hyst(q["rs"], q["con"], q["z"], a, b, ha, hb), P2))
+    for k in (2, 3):
+        R.append((f"persistence: the adopted condition on {k} frames in a row",
+                  lambda q, a, b, k=k: _persist(q["rs"], q["con"], q["z"], a, b, k), P2))
+    R += [("share drop as 2nd cue: rs < a and (con < b or share_s / share0 < c)",
+           lambda q, a, b, c: q["z"] | ((q["rs"] < a) & ((q["con"] < b) | (q["sh"] < c))), P3),
+          ("drift-following reference: rho_s < a rho_slow (rate 1/16) and con < b",
+           lambda q, a, b: q["z"] | ((q["drop16"] < a) & (q["con"] < b)), P2),
+          ("sudden drop added: adopted or (rho_s < c rho_slow (rate 1/16) and con < b)",
+           lambda q, a, b, c: q["z"] | (((q["rs"] < a) | (q["drop16"] < c)) & (q["con"] < b)), P3),
+          ("below the recent peak too: adopted and rho_s < c peak (decay 1/32)",
+           lambda q, a, b, c: q["z"] | ((q["rs"] < a) & (q["con"] < b) & (q["peak"] < c)), P3),
+          ("linear: rs + con < t (a = t, the contrast weight 1)",
+           lambda q, t, _b: q["z"] | (q["rs"] + q["con"] < t), list(it.product(np.round(np.arange(0.5, 1.301, 0.01), 2), (0.0,))))]
+    return R
+
+
+def _best(C: np.ndarray) -> int:
+    """Grid index of max recall with FA <= 0.05 (ties: lower FA) of counts C (grid, seq, 4)."""
+    t = C.sum(1)
+    r, f = t[:, 0] / np.maximum(t[:, 1], 1), t[:, 2] / np.maximum(t[:, 3], 1)
+    score = np.where(f <= FA_MAX, r - 1e-6 * f, -1.0)
+    return int(np.argmax(score)) if score.max() >= 0 else -1
+
+
+def _best_joint(CF: np.ndarray, CX: np.ndarray) -> int:
+    """Grid index of the highest lower recall of float and fixed, both FA <= 0.05."""
+    tf, tx = CF.sum(1), CX.sum(1)
+    rf, ff = tf[:, 0] / np.maximum(tf[:, 1], 1), tf[:, 2] / tf[:, 3]
+    rx, fx = tx[:, 0] / np.maximum(tx[:, 1], 1), tx[:, 2] / tx[:, 3]
+    score = np.where((ff <= FA_MAX) & (fx <= FA_MAX), np.minimum(rf, rx) - 1e-6 * (ff + fx), -1.0)
+    return int(np.argmax(score)) if score.max() >= 0 else -1
+
+
+def _scored(C: np.ndarray, picks: list[int]) -> np.ndarray:
+    """Counts summed over sequences, sequence i scored at grid index picks[i] (-1: nothing flagged,
+    no grid point met the false-alarm bound)."""
+    return sum(C[k, i] if k >= 0 else C[0, i] * np.array([0, 1, 0, 1]) for i, k in enumerate(picks))
+
+
+def tried_table() -> list[str]:
+    """Markdown rows: per rule, per model (own thresholds) in sample and leave one sequence out, and the
+    thresholds shared by float and fixed (as the defaults are chosen) in sample and leave one out.
+    Where no grid point keeps false alarms <= 0.05 the rule flags nothing (recall 0)."""
+    S = {m: tried_signals(m) for m in ("float", "fixed")}
+    rows = []
+    for name, rule, grid in tried_rules():
+        C = {m: np.array([counts([rule(q, *g) for q in S[m]], S[m]) for g in grid]) for m in S}
+        cells = []
+        nseq = C["float"].shape[1]
+        for m in ("float", "fixed"):
+            j = _best(C[m])
+            loo = _scored(C[m], [_best(np.delete(C[m], i, 1)) for i in range(nseq)])
+            (ri, fi), (rl, fl) = rate(_scored(C[m], [j] * nseq)), rate(loo)
+            cells.append(f"{ri:.3f} / {fi:.3f} | {rl:.3f} / {fl:.3f}")
+        j = _best_joint(C["float"], C["fixed"])
+        pk = [_best_joint(np.delete(C["float"], i, 1), np.delete(C["fixed"], i, 1)) for i in range(nseq)]
+        g = ", ".join(f"{v:g}" for v in grid[j]) if j >= 0 else "none"
+        (a, b), (c, d) = rate(_scored(C["float"], [j] * nseq)), rate(_scored(C["fixed"], [j] * nseq))
+        (e, f_), (h, k) = rate(_scored(C["float"], pk)), rate(_scored(C["fixed"], pk))
+        rows.append(f"| {name} | {len(grid)} | " + " | ".join(cells) +
+                    f" | {g} | {a:.3f} / {b:.3f} | {c:.3f} / {d:.3f} | {e:.3f} / {f_:.3f} | {h:.3f} / {k:.3f} |")
+        print(rows[-1], flush=True)
+    return rows
+
+
 def fmt(x: float) -> str:
     return "-" if x != x else f"{x:.2f}"
 
@@ -397,7 +536,7 @@ def main_report() -> None:
           "with false alarms <= 0.05 (in sample): recall.", "", "| signal | float | fixed |", "|---|---:|---:|"]
     for k in S["float"][0]["sig"]:
         L.append(f"| {k} | {single_best(S['float'], k)[0]:.3f} | {single_best(S['fixed'], k)[0]:.3f} |")
-    L += ["", "The references of the confidence (rho_ref, share_ref) follow the drift: on MotorRolling and "
+    L += ["", "The last four rows were added in session 5 (recall near 0.1 at the bound, where a signal unrelated to the loss gives 0.05; the mean-shift loop reaches max_iter on fewer than 1 % of the on- and of the off-target frames).  The references of the confidence (rho_ref, share_ref) follow the drift: on MotorRolling and "
           "Girl the tracker stays `ok` for tens of frames while it slides off the target, so by the time it is "
           "off, rho / rho_ref is near 1 again.  rho against its init value does not drift, but alone it flags "
           "the on-target frames of Crossing and bag_vot (appearance change).  The contrast alone flags Suv, "
@@ -423,6 +562,53 @@ def main_report() -> None:
         L += ["", "  (AUC here over the frames after the init frame.)  The wide search, started on frames where the "
               "target has drifted but is still partly in the window, jumps to background: the confidence "
               "stays the search trigger.", ""]
+    # session 5
+    L += ["## Rules tried, session 5", "",
+          "Issue 10 item 4 (target recall >= 0.6 at false alarms <= 0.05, float and fixed, in and out of sample) "
+          "is not met by the adopted rule.  Session 5 measured the cheap alternatives below on the same dumped "
+          "signals (`python tools/loss_study.py report` recomputes this table; the rules are `tried_rules()` in "
+          "tools/loss_study.py).  rs = rho_s / rho0 and con = contrast_s are the adopted filters' values (rate "
+          "1/2); share = 0 flags in every rule.  Per rule: its grid size; per model, thresholds chosen on that "
+          "model (max recall with false alarms <= 0.05): in sample and leave one sequence out; then one set of "
+          "thresholds for both models (the highest lower recall, both false-alarm rates <= 0.05, as the defaults "
+          "are chosen): the thresholds, in sample, and leave one sequence out (the shared choice made on 9 "
+          "sequences).  Cells: recall / false alarms.", "",
+          "| rule | grid | float, in sample | float, leave one out | fixed, in sample | fixed, leave one out | "
+          "shared thresholds | float | fixed | float, leave one out | fixed, leave one out |",
+          "|---|---:|---|---|---|---|---|---|---|---|---|"]
+    L += tried_table()
+    hyst_now = ", ".join(f"{m} {r_:.3f} / {f_:.3f}" for m in models for r_, f_ in [rate(counts(
+        [_hyst(q["rs"], q["con"], q["z"], p.loss_rho, p.loss_contrast, 0.02, 0.0) for q in tried_signals(m)],
+        tried_signals(m)))])
+    L += ["", "Findings:", "",
+          "* No rule beats the adopted one clearly out of sample.  The best is hysteresis on rho (once flagged, "
+          "the flag stays while rs < a + 0.02 and con < b): with shared thresholds it adds a few frames of recall "
+          "in and out of sample (fixed reaches 0.6 in sample), but with thresholds chosen per model its float "
+          "leave-one-out recall falls far below the adopted rule's; it moves along the same recall / "
+          "false-alarm frontier as the thresholds themselves (a wider margin or a contrast margin buys recall "
+          "with false alarms at the same rate; added to today's defaults 0.88, 0.19 without re-choosing them, "
+          f"it takes fixed over the false-alarm bound: {hyst_now}).  Not adopted: the evidence is a handful of frames, and "
+          "ms_loss_flag's RTL would need a state bit.",
+          "* The per-model leave-one-out figures are noisy: the same adopted rule on a grid of step 0.02 "
+          "instead of 0.01 drops float out-of-sample recall from about 0.53 to about 0.37, because the "
+          "off-target frames sit mostly in two sequences (Girl, MotorRolling) and leaving one out moves the "
+          "choice along a flat frontier.  Differences of a few hundredths between rules are within that noise.",
+          "* References that follow the track (a slow running rho, or a decaying peak of rho_s) do worse than "
+          "rho0: on Girl and MotorRolling the tracker slides onto the distractor over tens of frames, so there "
+          "is no sudden drop to detect, and on Girl (float) rho is lower on the last on-target frames than on the "
+          "first off-target ones.",
+          "* The share's drop against its init value as an alternative second cue (share_s / share0 < c) "
+          "does not add recall at the false-alarm bound: the on-target frames of Crossing, Subway and bag_vot "
+          "(deformation, illumination) lose target-coloured share as much as Girl's off-target frames do.",
+          "* Persistence (the condition on 2 or 3 frames in a row) reaches less recall at the bound than the "
+          "adopted rule, in and out of sample; a single linear cut rs + con < t is worse than the two "
+          "thresholds.",
+          "* Limits of colour cues: in fixed Subway the tracker sits on a region that matches the model better "
+          "than the init box did (rho / rho0 about 1.1 on its off-target frames), and on Girl the "
+          "distractor is another face of the target's colours with a high contrast to its ring.  Neither can be "
+          "flagged from rho, share or the ring; the centre jump and the scale change (\"Single signals\") do "
+          "not separate them either, and the mean-shift iteration count has the median 1 on both the on- and "
+          "the off-target frames of Girl and Subway (it stops at once: the distractor is a mode).", ""]
     # plot
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6), sharey=True)
     for ax, m in zip(axes, models):

@@ -50,6 +50,18 @@ TOP = "ms_tracker"
 #: 280 horizontal blanking), 1125 lines per frame (1080 active + 45 vertical blanking lines).
 HD1080P60 = {"hblank": 280, "vblank": 45 * 2200}
 
+#: CEA-861 video modes at one pixel per clock: active size, pixel clock (MHz) and the blanking the
+#: harness streams (``hblank`` clocks after each line, ``vblank`` after each frame).  A mode is
+#: real time for the core when the core clock reaches ``mhz`` (Fmax) and no frame's work overruns
+#: ``hblank + vblank`` clocks (tb/test_realtime.py; docs/performance.md "Operating points").
+VIDEO_MODES: dict[str, dict[str, int | float]] = {
+    "720p60": {"w": 1280, "h": 720, "mhz": 74.25, "hblank": 370, "vblank": 30 * 1650},
+    "1080p30": {"w": 1920, "h": 1080, "mhz": 74.25, "hblank": 280, "vblank": 45 * 2200},
+    "1080p60": {"w": 1920, "h": 1080, "mhz": 148.5, "hblank": 280, "vblank": 45 * 2200},
+    "2160p30": {"w": 3840, "h": 2160, "mhz": 297.0, "hblank": 560, "vblank": 90 * 4400},
+    "2160p60": {"w": 3840, "h": 2160, "mhz": 594.0, "hblank": 560, "vblank": 90 * 4400},
+}
+
 #: C++ optimisation of the model and the harness (-CFLAGS: comes after Verilator's own
 #: OPT_FAST = -Os, so it wins, and also reaches the harness, which is otherwise built without -O).
 #: Measured on Crossing (40 frames, default generics): -O3 0.80M clocks per CPU second, -O2 0.67-0.77M.
@@ -335,5 +347,5 @@ def compare(results: Sequence[dict], expected: Sequence[dict],
     return out
 
 
-__all__ = ["FastsimRun", "FastsimError", "HD1080P60", "build", "simulate", "run_fastsim", "compare",
+__all__ = ["FastsimRun", "FastsimError", "HD1080P60", "VIDEO_MODES", "build", "simulate", "run_fastsim", "compare",
            "default_watchdog"]

@@ -907,13 +907,18 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
 
 # ----------------------------------------------------------------------------- tracker v2 budget
 #: per-frame v2 arithmetic after the mean shift, issued one after the other into one iterative
-#: divider (Q bits + 2 clocks each): share (17), spread (40), rho / rho_ref (34), share /
-#: share_ref (34), spread ratio (40), w / w0 (40), ring share (17, the loss flag's
-#: ms_ring_share; its ms_loss_flag is one multiplier and two compares); one isqrt of 56 bits (28 clocks); the model
-#: scaling Qw = Qn K >> 16 rides in the bin pass (one multiplier, no clock); kernel tables for a
-#: new window size: the worst start -> done of ms_kernel_tables with KA/KB (:func:`kernel_tables_clocks`;
-#: they can also be built while the next frame streams in, so this is conservative).
-V2_DIVISIONS_Q = (17, 40, 34, 34, 40, 40, 17)
+#: divider (Q bits + 2 clocks each): share (17), spread (40), spread ratio (40), w / w0 (40); one
+#: isqrt of 56 bits (28 clocks); the model scaling Qw = Qn K >> 16 rides in the bin pass (one
+#: multiplier, no clock); kernel tables for a new window size: the worst start -> done of
+#: ms_kernel_tables with KA/KB (:func:`kernel_tables_clocks`; they can also be built while the next
+#: frame streams in, so this is conservative).  Confidence and loss flag: the latencies of their
+#: RTL blocks (:data:`V2_BLOCK_CLOCKS`), one after the other.
+V2_DIVISIONS_Q = (17, 40, 40, 40)
+#: start -> done clocks of the v2 confidence / loss blocks, as their cocotb tests assert them
+#: (tb/test_ms_confidence.py etc.; docs/blocks/): confidence (two 17-bit-quotient divisions and a
+#: product), ring share, the two loss filters (rho, contrast), the loss flag, the reference update.
+V2_BLOCK_CLOCKS = {"ms_confidence": 57, "ms_ring_share": 18, "ms_loss_filter": 2, "ms_loss_flag": 20,
+                   "ms_ref_update": 1}
 V2_ISQRT = 28
 
 
@@ -927,7 +932,8 @@ def kernel_tables_clocks(max_half: int = 63, half_w: int = 6, kval_w: int = 9) -
 
 def v2_frame_overhead(max_half: int = 63, half_w: int = 6, kval_w: int = 9) -> int:
     """Clocks per frame that v2 adds to the paper's engine (estimate for core v2, issue 11)."""
-    return sum(q + 2 for q in V2_DIVISIONS_Q) + V2_ISQRT + kernel_tables_clocks(max_half, half_w, kval_w)
+    return (sum(q + 2 for q in V2_DIVISIONS_Q) + sum(V2_BLOCK_CLOCKS.values()) + V2_ISQRT
+            + kernel_tables_clocks(max_half, half_w, kval_w))
 
 
 def v2_cycle_budget(lanes: int | None = None) -> list[dict[str, Any]]:
@@ -963,7 +969,7 @@ def v2_cycle_budget(lanes: int | None = None) -> list[dict[str, Any]]:
     w2 = (w + 1) // 2
     pp2, e_s = run(w2, tp.search_iter)
     out.append({"case": f"lost: wide search at 2D, {w2}x{w2} window, 9 start points x {tp.search_iter} iterations",
-                "pixel_pass": pp2, "clocks": FRONT + 9 * e_s + ov + 3})
+                "pixel_pass": pp2, "clocks": FRONT + 9 * e_s + ov + 8 * V2_BLOCK_CLOCKS["ms_confidence"] + 3})
     pp, _ = run(w, 0)
     learn = engine_cycles_learn(g, pp, nc) + 3 * bin_pass_cycles(g, nc, learn=True)
     out.append({"case": f"init, {w}x{w} window (learn pass + 3 model bin passes)", "pixel_pass": pp,
@@ -976,7 +982,7 @@ def v2_budget_table(lanes: int | None = None) -> str:
     g = CONFIGS["default"].generics()
     L = lanes or g["LANES"]
     lines = [f"LANES = {L}, colour only (512 bins), default generics; 1080p60 vertical blanking = 99,000 "
-             f"clocks at 148.5 MHz.  Per-frame v2 overhead (divisions, isqrt, kernel tables): "
+             f"clocks at 148.5 MHz.  Per-frame v2 overhead (divisions, isqrt, confidence and loss blocks, kernel tables): "
              f"{v2_frame_overhead(g['MAX_HALF'], g['HALF_W'], g['KERNEL_BITS'] + 1)} clocks.", "",
              "| frame | pixel pass | worst clocks | vs 99,000 |", "|---|---:|---:|---|"]
     for r in v2_cycle_budget(L):

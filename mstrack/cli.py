@@ -749,6 +749,7 @@ EXTENSIONS: list[str] = [
     "mstrack.agreement:register_cli",   # agree: float vs fixed-point agreement
     "mstrack.synth:register_cli",       # synth: open synthesis, Fmax, cycle figures (performance.md)
     "mstrack.hdl_config:register_cli",  # hdl config / hdl files: core configuration, file lists (packaging.md)
+    "mstrack.explore:register_cli",     # explore: design-space sweep, accuracy vs resources (explore.md)
     # "mstrack.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
 ]
 

@@ -35,6 +35,7 @@ from typing import Any, Callable, Sequence
 from .fixed.formats import FixedParams
 from .fixed.vhdl_pkg import DEFAULT_LANES, core_generics
 from .params import ALIASES, TrackerParams, canonical
+from .synth import VBLANK_1080P60
 
 # ----------------------------------------------------------------------------- grid
 #: grid key -> (where, field, help).  "tp": TrackerParams, "fp": FixedParams, "hw": generic only.
@@ -249,21 +250,27 @@ class PointFactory:
 # ----------------------------------------------------------------------------- resource estimate
 #: DP16KD (18 kbit) aspect ratios yosys' ECP5 memory library uses (pseudo dual port for x36).
 DP16KD_SHAPES = ((16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36))
-#: Memories this deep or shallower are mapped to distributed RAM (TRELLIS_DPR16X4, 16 x 4) by yosys,
-#: as the 64-entry XR table and the 16-bin edge histogram are in the measured core.
-LUTRAM_MAX_DEPTH = 64
+#: yosys' ECP5 memory library costs (share/lattice/brams_16kd.txt, lutrams_trellis.txt): DP16KD 128,
+#: TRELLIS_DPR16X4 (16 x 4 distributed RAM) 4; yosys maps each memory to the cheaper.  Distributed
+#: RAM deeper than 16 words also needs a read multiplexer, counted here as 2 per DPR16X4 (fitted to
+#: the mappings seen in the measured netlists: 64 x 56 histogram banks -> DP16KD, 64 x 14 model Q,
+#: 64 x 6 XR and 64 x 9 KA/KB tables and 16 x 56 edge histogram banks -> DPR16X4, 512 x 1 T tables
+#: -> DP16KD).
+COST_DP16KD, COST_DPR16X4, COST_DPR16X4_MUX = 128, 4, 2
 #: Frame line buffer of ms_sobel: three RAMs of MAX_FRAME_W (2048) words of up to 9 bits.
 LINE_BUFFER = (3, 2048, 9)
 
 
 def dp16kd_tiles(depth: int, width: int) -> tuple[int, int]:
-    """(DP16KD, DPR16X4) for one depth x width memory with one read port: distributed RAM up to
-    :data:`LUTRAM_MAX_DEPTH` words, else the cheapest DP16KD tiling of :data:`DP16KD_SHAPES`."""
+    """(DP16KD, DPR16X4) for one depth x width memory with one read port: the cheapest DP16KD
+    tiling of :data:`DP16KD_SHAPES` or distributed RAM, whichever costs less (:data:`COST_DP16KD`)."""
     if depth <= 0 or width <= 0:
         return 0, 0
-    if depth <= LUTRAM_MAX_DEPTH:
-        return 0, -(-depth // 16) * -(-width // 4)
-    return min(-(-depth // d) * -(-width // w) for d, w in DP16KD_SHAPES), 0
+    bram = min(-(-depth // d) * -(-width // w) for d, w in DP16KD_SHAPES)
+    dpr = -(-depth // 16) * -(-width // 4)
+    if dpr * (COST_DPR16X4 + (COST_DPR16X4_MUX if depth > 16 else 0)) < bram * COST_DP16KD:
+        return 0, dpr
+    return bram, 0
 
 
 @dataclass(frozen=True)
@@ -454,29 +461,34 @@ class Measured:
     lanes: int = DEFAULT_LANES
     block: str | None = None            # None: the whole core; else the block alone (per engine)
     values: dict = field(default_factory=dict)
-    calibration: bool = False           # used to set the estimate (so not a test of it)
+    calibration: tuple[str, ...] = ()   # quantities that set the estimate (so do not test it)
 
+
+ALL = ("LUT4", "FF", "DP16KD", "MULT18X18D")
+#: yosys synth_ecp5 of the core, RTL d6f83cc (docs/explore.md, "The estimate")
+_EXPLORE_MD = "docs/explore.md (yosys synth_ecp5, RTL d6f83cc)"
 
 #: Measured configurations (docs/performance.md, docs/blocks/ms_pixel_pass.md, docs/explore.md).
 MEASURED: tuple[Measured, ...] = (
-    Measured("default core", "docs/performance.md ECP5 table (8671c1f)", block=None,
-             values={"LUT4": 8657, "FF": 12187, "DP16KD": 44, "MULT18X18D": 6}, calibration=True),
-    Measured("default core (3f94c5f, + pin wrapper ~90 LUT4 / ~234 FF)", "docs/performance.md limits table",
+    Measured("default core", "docs/performance.md ECP5 table (8671c1f)",
+             values={"LUT4": 8657, "FF": 12187, "DP16KD": 44, "MULT18X18D": 6}, calibration=ALL),
+    Measured("default core (3f94c5f, less the pin wrapper's ~90 LUT4 / ~234 FF)", "docs/performance.md limits table",
              values={"LUT4": 8622 - 90, "FF": 12505 - 234, "DP16KD": 44, "MULT18X18D": 6}),
-    Measured("lanes2 core", "docs/explore.md (mstrack synth --config lanes2 --no-pnr --no-xilinx, d6f83cc)",
-             lanes=2, values={}),
-    Measured("small core", "docs/explore.md (mstrack synth --config small --no-pnr --no-xilinx, d6f83cc)",
-             fp={"max_half": 31, "margin": 16}, values={}),
+    Measured("lanes2 core", _EXPLORE_MD, lanes=2, values={"LUT4": 7051, "FF": 10980, "DP16KD": 36, "MULT18X18D": 6}),
+    Measured("small core (MAX_HALF 31, MARGIN 16)", _EXPLORE_MD, fp={"max_half": 31, "margin": 16},
+             values={"LUT4": 7492, "FF": 11053, "DP16KD": 24, "MULT18X18D": 6}),
+    Measured("bins=4 core (64 colour bins)", _EXPLORE_MD, tp={"colour_bits": 2},
+             values={"LUT4": 8482, "FF": 12162, "DP16KD": 43, "MULT18X18D": 6}, calibration=("DP16KD",)),
     Measured("ms_pixel_pass default", "docs/blocks/ms_pixel_pass.md", block="ms_pixel_pass",
-             values={"LUT4": 1499, "FF": 1524, "DP16KD": 8}, calibration=True),
+             values={"LUT4": 1499, "FF": 1524, "DP16KD": 8}, calibration=("LUT4", "FF")),
     Measured("ms_pixel_pass lanes2", "docs/blocks/ms_pixel_pass.md", lanes=2, block="ms_pixel_pass",
-             values={"LUT4": 720, "FF": 906, "DP16KD": 4}, calibration=True),
+             values={"LUT4": 720, "FF": 906, "DP16KD": 4}, calibration=("FF",)),
     Measured("ms_pixel_pass small", "docs/blocks/ms_pixel_pass.md", fp={"max_half": 31, "margin": 16},
              block="ms_pixel_pass", values={"LUT4": 1331, "FF": 1356, "DP16KD": 8}),
     Measured("ms_pixel_pass epan", "docs/blocks/ms_pixel_pass.md", tp={"kernel": "epanechnikov"},
-             block="ms_pixel_pass", values={"LUT4": 2282, "FF": 2180, "DP16KD": 12}, calibration=True),
+             block="ms_pixel_pass", values={"LUT4": 2282, "FF": 2180, "DP16KD": 12}, calibration=("LUT4", "FF")),
     Measured("ms_region_ram default (colour)", "docs/performance.md blocks table (468ea34)", block="ms_region_ram",
-             values={"LUT4": 285, "FF": 79, "DP16KD": 20}, calibration=True),
+             values={"LUT4": 285, "FF": 79, "DP16KD": 20}, calibration=("LUT4", "FF")),
     Measured("ms_bin_pass default (colour)", "docs/performance.md blocks table (468ea34)", block="ms_bin_pass",
              values={"DP16KD": 1}),
     Measured("ms_bin_pass_edge default", "docs/performance.md blocks table (468ea34)", block="ms_bin_pass_edge",
@@ -516,7 +528,7 @@ def check_table() -> list[dict[str, Any]]:
         for q, v in m.values.items():
             rel = (est[q] - v) / v if v else float(est[q] != v)
             rows.append({"config": m.name, "source": m.source, "quantity": q, "measured": v, "estimate": est[q],
-                         "error": rel, "calibration": m.calibration})
+                         "error": rel, "calibration": q in m.calibration})
     return rows
 
 
@@ -570,6 +582,7 @@ class Row:
     ram_kbit: float
     mult18: int
     cycles_64: int
+    fits: bool = True
     yosys: dict[str, Any] | None = None
     pareto_lut: bool = False
     pareto_dp16kd: bool = False
@@ -588,6 +601,10 @@ def pareto_front(points: Sequence[tuple[float, float]]) -> list[bool]:
                         for j, (c2, a2) in enumerate(points) if c2 == c2 and a2 == a2)
         out.append(not dominated)
     return out
+
+
+#: Default cycle budget of a frame: the 1080p60 vertical blanking (99,000 clocks at 148.5 MHz).
+BUDGET = VBLANK_1080P60
 
 
 def worst_frame_cycles(tp: TrackerParams, fp: FixedParams, lanes: int) -> int:
@@ -614,10 +631,15 @@ def yosys_counts(p: Point) -> dict[str, Any]:
 
 def explore(sequences: Sequence[Any], points: Sequence[Point], out_dir: str | Path, model: str = "fixed",
             jobs: int = 1, scheduler: str | None = None, force: bool = False, quiet: bool = False,
-            max_frames: int | None = None, yosys: bool = False,
+            max_frames: int | None = None, yosys: bool = False, budget: int | None = None,
             log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> list[Row]:
     """Evaluate every point (one :func:`mstrack.evaluate.evaluate` call over the distinct accuracy
-    runs) and estimate its cost; returns the rows with their Pareto flags set."""
+    runs) and estimate its cost; returns the rows with their Pareto flags set.
+
+    ``budget``: clocks a 20-iteration frame of a 64x64 target may take (default
+    :data:`BUDGET`, the 1080p60 vertical blanking); points over it are marked (``fits`` False)
+    and left out of the Pareto fronts."""
+    budget = BUDGET if budget is None else budget
     from .evaluate import evaluate, run_label
     factory = PointFactory.of(points)
     names = list(dict.fromkeys(p.run_name for p in points))
@@ -641,11 +663,13 @@ def explore(sequences: Sequence[Any], points: Sequence[Point], out_dir: str | Pa
             t0 = time.monotonic()
             y = yosys_counts(p)
             log(f"explore: yosys {p.label}: {y} ({time.monotonic() - t0:.0f} s)")
+        cyc = worst_frame_cycles(tp, fp, p.lanes)
         rows.append(Row(p.label, p.tracker, {k: _show(k, v) for k, v in p.grid}, p.lanes, float(sc.auc),
                         float(sc.precision20), rec, fa, int(sc.n_frames), e.lut4, e.ff, e.dp16kd,
-                        round(e.ram_bits / 1024, 1), e.mult18, worst_frame_cycles(tp, fp, p.lanes), y))
-    lut = [float(r.yosys["LUT4"]) if r.yosys else float(r.lut4) for r in rows]
-    dp = [float(r.yosys["DP16KD"]) if r.yosys else float(r.dp16kd) for r in rows]
+                        round(e.ram_bits / 1024, 1), e.mult18, cyc, cyc < budget, y))
+    nan = float("nan")
+    lut = [(float(r.yosys["LUT4"]) if r.yosys else float(r.lut4)) if r.fits else nan for r in rows]
+    dp = [(float(r.yosys["DP16KD"]) if r.yosys else float(r.dp16kd)) if r.fits else nan for r in rows]
     for r, a, b in zip(rows, pareto_front([(c, r.auc) for c, r in zip(lut, rows)]),
                        pareto_front([(c, r.auc) for c, r in zip(dp, rows)])):
         r.pareto_lut, r.pareto_dp16kd = a, b
@@ -654,7 +678,7 @@ def explore(sequences: Sequence[Any], points: Sequence[Point], out_dir: str | Pa
 
 # ----------------------------------------------------------------------------- outputs
 COLUMNS = ("point", "tracker", "lanes", "auc", "p20", "loss_recall", "false_alarms", "frames", "lut4", "ff",
-           "dp16kd", "ram_kbit", "mult18", "cycles_64", "yosys_lut4", "yosys_ff", "yosys_dp16kd",
+           "dp16kd", "ram_kbit", "mult18", "cycles_64", "fits", "yosys_lut4", "yosys_ff", "yosys_dp16kd",
            "pareto_lut", "pareto_dp16kd")
 
 
@@ -676,7 +700,8 @@ def _f(v: Any, nd: int = 3) -> str:
 
 
 def markdown_table(rows: Sequence[Row]) -> str:
-    """Rows sorted by AUC (best first); * = on the Pareto front (AUC vs LUT4 / vs DP16KD)."""
+    """Rows sorted by AUC (best first); * = on the Pareto front (AUC vs LUT4 / vs DP16KD); "over" =
+    the worst 64x64 frame takes more clocks than the budget (not on any front)."""
     ys = any(r.yosys for r in rows)
     head = ["point", "AUC", "P@20", "loss recall", "false alarms", "LUT4 (est.)", "FF (est.)", "DP16KD",
             "RAM kbit", "MULT18", "worst frame, 64x64 (clk)"] + (["yosys LUT4 / FF / DP16KD"] if ys else []) \
@@ -684,7 +709,7 @@ def markdown_table(rows: Sequence[Row]) -> str:
     out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in sorted(rows, key=lambda r: (-r.auc, r.lut4)):
         cells = [r.point, _f(r.auc), _f(r.p20), _f(r.loss_recall), _f(r.false_alarms), _f(r.lut4), _f(r.ff),
-                 _f(r.dp16kd), _f(r.ram_kbit, 1), _f(r.mult18), _f(r.cycles_64)]
+                 _f(r.dp16kd), _f(r.ram_kbit, 1), _f(r.mult18), _f(r.cycles_64) + ("" if r.fits else " (over)")]
         if ys:
             y = r.yosys or {}
             cells.append(" / ".join(_f(y.get(k)) for k in ("LUT4", "TRELLIS_FF", "DP16KD")) if y else "-")
@@ -697,7 +722,7 @@ def check_markdown() -> str:
     """The estimate against the measured configurations (:func:`check_table`)."""
     out = ["| configuration | quantity | measured | estimate | error | source |", "|---|---|---:|---:|---:|---|"]
     for r in check_table():
-        out.append(f"| {r['config']}{' (calibration)' if r['calibration'] else ''} | {r['quantity']} | "
+        out.append(f"| {r['config']} | {r['quantity']}{' (calibration)' if r['calibration'] else ''} | "
                    f"{r['measured']:,} | {r['estimate']:,} | {100 * r['error']:+.1f} % | {r['source']} |")
     return "\n".join(out)
 
@@ -715,15 +740,19 @@ def plot_pareto(rows: Sequence[Row], path: str | Path, title: str = "") -> Path:
         xs = [cost(r) for r in rows]
         ys = [r.auc for r in rows]
         on = [getattr(r, flag) for r in rows]
-        ax.scatter([x for x, o in zip(xs, on) if not o], [y for y, o in zip(ys, on) if not o], c="0.6", s=28,
-                   label="dominated")
+        fit = [r.fits for r in rows]
+        ax.scatter([x for x, o, f in zip(xs, on, fit) if not o and f], [y for y, o, f in zip(ys, on, fit) if not o and f],
+                   c="0.6", s=28, label="dominated")
+        if not all(fit):
+            ax.scatter([x for x, f in zip(xs, fit) if not f], [y for y, f in zip(ys, fit) if not f], marker="x",
+                       c="0.45", s=30, label="over the cycle budget")
         front = sorted((x, y) for x, y, o in zip(xs, ys, on) if o)
         if front:
             ax.step([f[0] for f in front], [f[1] for f in front], where="post", c="C3", lw=1.2)
             ax.scatter([f[0] for f in front], [f[1] for f in front], c="C3", s=46, zorder=3, label="Pareto front")
         for x, y, r, o in zip(xs, ys, rows, on):
             if o:
-                ax.annotate(r.point.split(" ", 1)[-1], (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+                ax.annotate(r.point, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
         ax.set_xlabel(what)
         ax.set_ylabel("AUC")
         ax.grid(alpha=0.3)
@@ -765,7 +794,7 @@ def write_outputs(rows: Sequence[Row], out_dir: str | Path, command: str = "", p
 # ----------------------------------------------------------------------------- CLI
 def add_arguments(ap: argparse.ArgumentParser) -> None:
     from .cli import _positive_int
-    ap.add_argument("dataset", metavar="DATASET_DIR", help="folder of OTB/VOT sequence folders")
+    ap.add_argument("dataset", metavar="DATASET_DIR", nargs="?", help="folder of OTB/VOT sequence folders")
     ap.add_argument("--grid", default=DEFAULT_GRID,
                     help=f"KEY=V1,V2;KEY=... (default {DEFAULT_GRID!r}); keys: "
                          + "; ".join(f"{k}: {h}" for k, (_, _, h) in GRID_KEYS.items()))
@@ -782,6 +811,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="Dask distributed scheduler (as mstrack eval, docs/distributed.md)")
     ap.add_argument("--yosys", action="store_true",
                     help="also real yosys synth_ecp5 counts per distinct core (cached; 3-7 min each)")
+    ap.add_argument("--budget", type=_positive_int, default=BUDGET, metavar="CLOCKS",
+                    help=f"a 20-iteration 64x64 frame must take fewer clocks (default {BUDGET:,}, the 1080p60 "
+                         "vertical blanking); points over it are marked and kept off the Pareto fronts")
     ap.add_argument("--force", action="store_true", help="ignore cached runs")
     ap.add_argument("--quiet", action="store_true", help="no progress bars")
     ap.add_argument("--no-plot", action="store_true", help="no PNG")
@@ -795,6 +827,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     from .cli import _csv_list, check_out_dir
     from .data import load_dataset
+    if not args.dataset:
+        raise ValueError("DATASET_DIR is missing (only --check runs without it)")
     grid = parse_grid(args.grid)
     trackers = _csv_list(args.trackers) or list(DEFAULT_TRACKERS)
     points = make_points(trackers, grid, args.model)
@@ -804,7 +838,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"explore: {len(points)} points, {n_runs} accuracy runs x {len(seqs)} sequences ({args.model} model)",
           file=sys.stderr)
     rows = explore(seqs, points, args.out, model=args.model, jobs=args.jobs, scheduler=args.scheduler,
-                   force=args.force, quiet=args.quiet, max_frames=args.max_frames, yosys=args.yosys)
+                   force=args.force, quiet=args.quiet, max_frames=args.max_frames, yosys=args.yosys,
+                   budget=args.budget)
     paths = write_outputs(rows, args.out, command=getattr(args, "command_line", ""), plot=not args.no_plot)
     print(markdown_table(rows))
     print("outputs: " + ", ".join(str(p) for p in paths.values()))

@@ -69,6 +69,11 @@ def test_dp16kd_tiles():
     assert dp16kd_tiles(9168, 4) == (3, 0)         # 4096 x 4
     assert dp16kd_tiles(16, 56) == (0, 14)         # distributed RAM
     assert dp16kd_tiles(512, 14) == (1, 0)
+    # the mappings seen in measured netlists (distributed RAM when cheaper at yosys' costs)
+    assert dp16kd_tiles(64, 56) == (2, 0)          # histogram bank, 64 colour bins
+    assert dp16kd_tiles(64, 14)[0] == 0            # model Q, 64 bins
+    assert dp16kd_tiles(64, 6) == (0, 8)           # XR table
+    assert dp16kd_tiles(512, 1) == (1, 0)          # v2 T table
 
 
 @pytest.mark.parametrize("field, values", [("colour_bits", [1, 2, 3, 4, 5]), ("edge_bins_log2", [3, 4, 5, 6, 7])])
@@ -165,6 +170,13 @@ def test_end_to_end_jobs(tiny_dataset, tmp_path):
         assert len(pair) == 2 and pair[0]["auc"] == pair[1]["auc"] and pair[0]["lut4"] != pair[1]["lut4"]
     # at least one point on each front; a dominated point is not
     assert any(r["pareto_lut"] == "True" for r in t1) and any(r["pareto_dp16kd"] == "True" for r in t1)
-    # the runs were cached per (point, sequence): a second run reads them
     runs = sorted(p.parent.name for p in (outs[1] / "results").rglob("*.json"))
-    assert len(runs) == 2 * 8
+    assert len(runs) == 2 * 8                                     # cached per (accuracy run, sequence)
+    # a budget no point meets: every point marked, no front (the runs come from the cache)
+    before = {p: p.stat().st_mtime_ns for p in (outs[1] / "results").rglob("*.json")}
+    assert cli.main(["explore", str(tiny_dataset), "--grid", GRID, "--trackers", "mstrack-fused-flat,mstrack-v2",
+                     "--out", str(outs[1]), "--quiet", "--budget", "1000", "--no-plot"]) == 0
+    assert {p: p.stat().st_mtime_ns for p in (outs[1] / "results").rglob("*.json")} == before
+    t3 = _table(outs[1])
+    assert all(r["fits"] == "False" and r["pareto_lut"] == "False" for r in t3)
+    assert [r["auc"] for r in t3] == [r["auc"] for r in t1]

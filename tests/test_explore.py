@@ -1,6 +1,7 @@
 """``mstrack explore`` (mstrack/explore.py): grid parsing, the resource estimate, the Pareto front and
 an end-to-end run on two tiny synthetic sequences (``--jobs 2`` gives the numbers of ``--jobs 1``)."""
 import csv
+import importlib.util
 import json
 
 import pytest
@@ -180,3 +181,15 @@ def test_end_to_end_jobs(tiny_dataset, tmp_path):
     t3 = _table(outs[1])
     assert all(r["fits"] == "False" and r["pareto_lut"] == "False" for r in t3)
     assert [r["auc"] for r in t3] == [r["auc"] for r in t1]
+
+
+@pytest.mark.skipif(importlib.util.find_spec("distributed") is None, reason="Dask distributed not installed (extra 'dist')")
+def test_dask_local_cluster_same_table(tiny_dataset, tmp_path):
+    """The point factory travels to Dask workers; the table is the one of one process."""
+    outs = []
+    for extra in ([], ["--scheduler", "--jobs", "2"]):
+        out = tmp_path / ("dask" if extra else "one")
+        assert cli.main(["explore", str(tiny_dataset), "--grid", "bins=4,8;lanes=2", "--out", str(out), "--quiet",
+                         "--no-plot", *extra]) == 0
+        outs.append(_table(out))
+    assert len(outs[0]) == 2 and outs[0] == outs[1]

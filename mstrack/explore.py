@@ -721,8 +721,8 @@ def _f(v: Any, nd: int = 3) -> str:
 
 
 def markdown_table(rows: Sequence[Row]) -> str:
-    """Rows sorted by AUC (best first); * = on the Pareto front (AUC vs LUT4 / vs DP16KD); "over" =
-    the worst 64x64 frame takes more clocks than the budget (not on any front)."""
+    """Rows sorted by AUC (best first); * = on the Pareto front (AUC vs LUT4 / vs DP16KD, yosys counts
+    where run); "over" = the worst 64x64 frame takes more clocks than the budget (not on any front)."""
     ys = any(r.yosys for r in rows)
     head = ["point", "AUC", "P@20", "loss recall", "false alarms", "LUT4 (est.)", "FF (est.)", "DP16KD",
             "RAM kbit", "MULT18", "worst frame, 64x64 (clk)"] + (["yosys LUT4 / FF / DP16KD"] if ys else []) \
@@ -755,9 +755,12 @@ def plot_pareto(rows: Sequence[Row], path: str | Path, title: str = "") -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), constrained_layout=True)
+    ys = any(r.yosys for r in rows)
     for ax, (what, cost, flag) in zip(axes, (
-            ("LUT4 (estimate)", lambda r: r.yosys["LUT4"] if r.yosys else r.lut4, "pareto_lut"),
-            ("DP16KD", lambda r: r.yosys["DP16KD"] if r.yosys else r.dp16kd, "pareto_dp16kd"))):
+            ("LUT4 (yosys)" if ys else "LUT4 (estimate)", lambda r: r.yosys["LUT4"] if r.yosys else r.lut4,
+             "pareto_lut"),
+            ("DP16KD (yosys)" if ys else "DP16KD", lambda r: r.yosys["DP16KD"] if r.yosys else r.dp16kd,
+             "pareto_dp16kd"))):
         xs = [cost(r) for r in rows]
         ys = [r.auc for r in rows]
         on = [getattr(r, flag) for r in rows]
@@ -808,7 +811,8 @@ def write_outputs(rows: Sequence[Row], out_dir: str | Path, command: str = "", p
     md = [f"# mstrack explore\n\nCommand: `{command}`\n", markdown_table(rows)]
     paths["md"].write_text("\n".join(md) + "\n")
     if plot and rows:
-        paths["png"] = plot_pareto(rows, out / "explore_pareto.png", title=command[:120])
+        import textwrap
+        paths["png"] = plot_pareto(rows, out / "explore_pareto.png", title=textwrap.fill(command, 160))
     return paths
 
 

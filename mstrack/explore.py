@@ -770,11 +770,11 @@ def plot_pareto(rows: Sequence[Row], path: str | Path, title: str = "") -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), constrained_layout=True)
-    ys = any(r.yosys for r in rows)
+    have_yosys = any(r.yosys for r in rows)
     for ax, (what, cost, flag) in zip(axes, (
-            ("LUT4 (yosys)" if ys else "LUT4 (estimate)", lambda r: r.yosys["LUT4"] if r.yosys else r.lut4,
+            ("LUT4 (yosys)" if have_yosys else "LUT4 (estimate)", lambda r: r.yosys["LUT4"] if r.yosys else r.lut4,
              "pareto_lut"),
-            ("DP16KD (yosys)" if ys else "DP16KD", lambda r: r.yosys["DP16KD"] if r.yosys else r.dp16kd,
+            ("DP16KD (yosys)" if have_yosys else "DP16KD", lambda r: r.yosys["DP16KD"] if r.yosys else r.dp16kd,
              "pareto_dp16kd"))):
         xs = [cost(r) for r in rows]
         ys = [r.auc for r in rows]

@@ -749,6 +749,7 @@ EXTENSIONS: list[str] = [
     "mstrack.eval.agreement:register_cli",   # agree: float vs fixed-point agreement
     "mstrack.hw.synth:register_cli",       # synth: open synthesis, Fmax, cycle figures (performance.md)
     "mstrack.hw.hdl_config:register_cli",  # hdl config / hdl files: core configuration, file lists (packaging.md)
+    "mstrack.explore:register_cli",     # explore: design-space sweep, accuracy vs resources (explore.md)
     "mstrack.simcli:register_cli",      # sim: the RTL core co-simulated on a video, bit-exact check (integration.md)
     # "mstrack.hw.hdl:register_cli",       # synth / cosim (HDL helpers add their line here)
 ]

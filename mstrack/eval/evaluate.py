@@ -517,7 +517,8 @@ def evaluate(sequences: list[Sequence], trackers: Iterable[str], out_dir: str | 
         m = model if uses_model(name) else "float"
         n = len(seq) if max_frames is None else min(len(seq), max_frames)
         path = cache_path(out_dir, label, seq.name)
-        fp = tracker_fingerprint(name) if name in TRACKERS else None
+        # mstrack trackers under other names (mstrack explore's points) depend on the same code
+        fp = tracker_fingerprint(name) if name in TRACKERS or uses_model(name) else None
         key = {"fingerprint": fp, "content": sequence_digest(seq, n), "params": params_key(factory(name, model))}
         run = None if force else load_cached(path, n, m, **key)
         if run is not None:

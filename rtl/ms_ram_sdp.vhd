@@ -1,7 +1,8 @@
 -- ms_ram_sdp: simple dual-port RAM (one write port, one read port, one clock), initialised to zero.
 --
 -- Write: we, waddr, wdata -> word waddr at the clock edge (addresses >= DEPTH write nothing).
--- Read : raddr sampled at edge s -> rdata valid after edge s + RD_LAT (read latency RD_LAT clocks);
+-- Read : raddr in cycle t (sampled by edge s) -> rdata in cycle t + RD_LAT (after edge
+--        s + RD_LAT - 1): read latency RD_LAT clocks;
 --        a read of an address >= DEPTH returns the previous read's data (the output holds); a read of
 --        the address written at the same edge returns the OLD word in this architecture (on ECP5 the
 --        DP16KD port collision is undefined: users must not read a word while writing it).

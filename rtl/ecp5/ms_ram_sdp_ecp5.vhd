@@ -6,11 +6,14 @@
 -- Tiling: mode width WM = the narrowest DP16KD width in (1, 2, 4, 9, 18) >= DATA_W (18 above), so
 -- a block holds BW = 16384 / WM words (1024 for x18); NCOL = ceil(DATA_W / WM) blocks side by side,
 -- NROW = ceil(DEPTH / BW) rows.  Port A writes, port B reads (WEB = 0).
--- Read pipeline (edge s samples raddr): s: DP16KD address register; s + 1: DP16KD output register
--- (REGMODE_B = "OUTREG": clock-to-out ~1 ns instead of ~5.8 ns); s + 2: row multiplexer (row index
--- and in-range flag of raddr delayed three clocks) -> output register, loaded only for reads
--- < DEPTH (the output holds otherwise, as in `inferred`); RD_LAT - 3 more plain registers.
--- RD_LAT < 3: the inferred RAM of rtl/ms_ram_sdp.vhd (yosys maps it, without the output register).
+-- Read pipeline (edge s samples raddr): s: DP16KD address register (CEB = raddr < DEPTH, so the
+-- read latch holds on reads >= DEPTH, as in `inferred`); s + 1: DP16KD output register
+-- (REGMODE_B = "OUTREG": clock-to-out ~1 ns instead of ~5.8 ns).  One row (NROW = 1): that is
+-- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (row index and in-range flag of raddr
+-- delayed two clocks) -> output register, loaded only for reads < DEPTH; RD_LAT >= 3.  RD_LAT - 3
+-- (- 2 with one row) more plain registers.
+-- RD_LAT = 1, or 2 with several rows: the inferred RAM of rtl/ms_ram_sdp.vhd (yosys maps it,
+-- without the output register).
 -- Write/read of the same word at the same edge: undefined (DP16KD port collision).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -78,8 +81,9 @@ architecture ecp5 of ms_ram_sdp is
   constant LO    : natural  := 14 - ABITS;                  -- DP16KD address pins below the word address
 
   type rows_t is array (0 to NROW - 1) of std_logic_vector(NCOL * WM - 1 downto 0);
-  type sel_t is array (1 to 3) of natural range 0 to NROW - 1;
-  type pipe_t is array (3 to RD_LAT) of std_logic_vector(DATA_W - 1 downto 0);
+  type sel_t is array (1 to 2) of natural range 0 to NROW - 1;
+  constant MUX_LAT : positive := 2 + boolean'pos(NROW > 1);  -- DP16KD path: 2 (one row) or 3 clocks
+  constant USE_BRAM : boolean := RD_LAT >= MUX_LAT;
 
   -- word address inside a block, as the DP16KD pins AD13..AD0 (x18: AD1..AD0 = byte enables = 1)
   function ad_pins(a : unsigned) return std_logic_vector is
@@ -102,7 +106,7 @@ architecture ecp5 of ms_ram_sdp is
 begin
   assert 2 ** ADDR_W >= DEPTH report "ms_ram_sdp: ADDR_W too small for DEPTH" severity failure;
 
-  g_inferred : if RD_LAT < 3 generate
+  g_inferred : if not USE_BRAM generate
     type ram_t is array (0 to DEPTH - 1) of std_logic_vector(DATA_W - 1 downto 0);
     type lat_t is array (1 to RD_LAT) of std_logic_vector(DATA_W - 1 downto 0);
     signal ram  : ram_t := (others => (others => '0'));
@@ -125,19 +129,19 @@ begin
     rdata <= lat(RD_LAT);
   end generate;
 
-  g_dp16kd : if RD_LAT >= 3 generate
+  g_dp16kd : if USE_BRAM generate
     signal ada, adb : std_logic_vector(13 downto 0);
     signal wrow     : natural range 0 to NROW - 1;
     signal wr_ok    : std_logic;
+    signal rd_ok    : std_logic;
     signal dout     : rows_t;
-    signal sel      : sel_t := (others => 0);
-    signal inr      : std_logic_vector(1 to 3) := (others => '0');
-    signal pipe     : pipe_t := (others => (others => '0'));
+    signal head     : std_logic_vector(DATA_W - 1 downto 0);  -- the read data after MUX_LAT clocks
   begin
     ada   <= ad_pins(waddr);
     adb   <= ad_pins(raddr);
     wrow  <= row_of(waddr);
     wr_ok <= we when waddr < DEPTH else '0';
+    rd_ok <= '1' when raddr < DEPTH else '0';
 
     g_row : for r in 0 to NROW - 1 generate
       g_col : for c in 0 to NCOL - 1 generate
@@ -163,7 +167,7 @@ begin
             CSDECODE_B => "0b000", WRITEMODE_A => "NORMAL", WRITEMODE_B => "NORMAL", GSR => "DISABLED")
           port map (
             CEA => '1', OCEA => '1', CLKA => clk, WEA => wea, RSTA => '0', CSA2 => '0', CSA1 => '0', CSA0 => '0',
-            CEB => '1', OCEB => '1', CLKB => clk, WEB => '0', RSTB => '0', CSB2 => '0', CSB1 => '0', CSB0 => '0',
+            CEB => rd_ok, OCEB => '1', CLKB => clk, WEB => '0', RSTB => '0', CSB2 => '0', CSB1 => '0', CSB0 => '0',
           DIA0 => dia(0), DIA1 => dia(1), DIA2 => dia(2), DIA3 => dia(3), DIA4 => dia(4), DIA5 =>
           dia(5), DIA6 => dia(6), DIA7 => dia(7), DIA8 => dia(8), DIA9 => dia(9), DIA10 => dia(10),
           DIA11 => dia(11), DIA12 => dia(12), DIA13 => dia(13), DIA14 => dia(14), DIA15 => dia(15),
@@ -191,21 +195,50 @@ begin
       end generate;
     end generate;
 
-    p_out : process (clk)
+    -- one row: the DP16KD output register is the data after 2 clocks
+    g_one : if NROW = 1 generate
+      head <= dout(0)(DATA_W - 1 downto 0);
+    end generate;
+
+    -- several rows: the row multiplexer behind the output registers, then a register
+    g_mux : if NROW > 1 generate
+      signal sel  : sel_t := (others => 0);
+      signal inr  : std_logic_vector(1 to 2) := (others => '0');
+      signal mux_q : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
     begin
-      if rising_edge(clk) then
-        sel(1) <= row_of(raddr);
-        sel(2 to 3) <= sel(1 to 2);
-        inr(1) <= '1' when raddr < DEPTH else '0';
-        inr(2 to 3) <= inr(1 to 2);
-        if inr(3) = '1' then
-          pipe(3) <= dout(sel(3))(DATA_W - 1 downto 0);
+      p_mux : process (clk)
+      begin
+        if rising_edge(clk) then
+          sel(1) <= row_of(raddr);     -- edge s: the read's row ...
+          sel(2) <= sel(1);            -- ... edge s + 1, beside the DP16KD output register
+          inr(1) <= rd_ok;
+          inr(2) <= inr(1);
+          if inr(2) = '1' then         -- edge s + 2: the output registers hold the read of edge s
+            mux_q <= dout(sel(2))(DATA_W - 1 downto 0);
+          end if;
         end if;
-        for i in 4 to RD_LAT loop
-          pipe(i) <= pipe(i - 1);
-        end loop;
-      end if;
-    end process;
-    rdata <= pipe(RD_LAT);
+      end process;
+      head <= mux_q;
+    end generate;
+
+    g_lat : if RD_LAT = MUX_LAT generate
+      rdata <= head;
+    end generate;
+
+    g_ext : if RD_LAT > MUX_LAT generate
+      type ext_t is array (1 to RD_LAT - MUX_LAT) of std_logic_vector(DATA_W - 1 downto 0);
+      signal ext : ext_t := (others => (others => '0'));
+    begin
+      p_ext : process (clk)
+      begin
+        if rising_edge(clk) then
+          ext(1) <= head;
+          for i in 2 to RD_LAT - MUX_LAT loop
+            ext(i) <= ext(i - 1);
+          end loop;
+        end if;
+      end process;
+      rdata <= ext(RD_LAT - MUX_LAT);
+    end generate;
   end generate;
 end architecture;

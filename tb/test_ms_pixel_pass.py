@@ -131,6 +131,7 @@ class TB:
         d = self.dut
         d.win_x.value = wx
         d.win_y.value = wy
+        await RisingEdge(d.clk)  # win_y stable from the clock before start (ms_window_scan)
         d.start.value = 1
         await RisingEdge(d.clk)  # this edge samples start
         d.start.value = 0

@@ -1,6 +1,7 @@
 -- ms_ram_sdp: simple dual-port RAM (one write port, one read port, one clock), initialised to zero.
 --
--- Write: we, waddr, wdata -> word waddr at the clock edge (addresses >= DEPTH write nothing).
+-- Write: we, waddr, wdata -> word waddr at the clock edge that samples them (WR_LAT = 0) or at the
+--        next one (WR_LAT = 1: the write port is registered first); addresses >= DEPTH write nothing.
 -- Read : raddr in cycle t (sampled by edge s) -> rdata in cycle t + RD_LAT (after edge
 --        s + RD_LAT - 1): read latency RD_LAT clocks;
 --        a read of an address >= DEPTH returns the previous read's data (the output holds); a read of
@@ -25,7 +26,10 @@ entity ms_ram_sdp is
     DEPTH  : positive := 1024;  -- words
     DATA_W : positive := 9;     -- word width
     ADDR_W : positive := 10;    -- address width, 2**ADDR_W >= DEPTH
-    RD_LAT : positive := 1      -- read latency (clocks); the ecp5 architecture needs >= 3
+    RD_LAT : positive := 1;     -- read latency (clocks); the ecp5 architecture's DP16KD path needs >= 2 / 3
+    WR_LAT : natural  := 0      -- 0 or 1: clocks from the write port to the RAM (1 registers the port:
+                                -- on ECP5 the DP16KD write enable, address and data come from flip-flops;
+                                -- costs ADDR_W + DATA_W + 1 FF)
   );
   port (
     clk   : in  std_logic;                              -- clock
@@ -42,8 +46,29 @@ architecture inferred of ms_ram_sdp is
   type pipe_t is array (1 to RD_LAT) of std_logic_vector(DATA_W - 1 downto 0);
   signal ram  : ram_t := (others => (others => '0'));
   signal pipe : pipe_t := (others => (others => '0'));  -- pipe(1): RAM read register
+  signal w_en   : std_logic := '0';                       -- the write port after WR_LAT clocks
+  signal w_addr : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+  signal w_data : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
 begin
   assert 2 ** ADDR_W >= DEPTH report "ms_ram_sdp: ADDR_W too small for DEPTH" severity failure;
+  assert WR_LAT <= 1 report "ms_ram_sdp: WR_LAT must be 0 or 1" severity failure;
+
+  g_wr0 : if WR_LAT = 0 generate
+    w_en   <= we;
+    w_addr <= waddr;
+    w_data <= wdata;
+  end generate;
+
+  g_wr1 : if WR_LAT = 1 generate
+    p_wr : process (clk)
+    begin
+      if rising_edge(clk) then
+        w_en   <= we;
+        w_addr <= waddr;
+        w_data <= wdata;
+      end if;
+    end process;
+  end generate;
 
   p_ram : process (clk)
   begin
@@ -54,8 +79,8 @@ begin
       for i in 2 to RD_LAT loop
         pipe(i) <= pipe(i - 1);
       end loop;
-      if we = '1' and waddr < DEPTH then
-        ram(to_integer(waddr)) <= wdata;
+      if w_en = '1' and w_addr < DEPTH then
+        ram(to_integer(w_addr)) <= w_data;
       end if;
     end if;
   end process;

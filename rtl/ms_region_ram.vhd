@@ -7,7 +7,9 @@
 -- (1: the RAM's read register only; 3: what ms_ram_sdp's ecp5 architecture
 -- needs to use the DP16KD output register and register its depth multiplexer;
 -- ms_tracker uses 3).  A read of an address >= DEPTH keeps the previous data.
--- Reads of the word written in the same clock are undefined on ECP5 (the
+-- WR_LAT = 1 registers the write port (on ECP5 after the bank / row decode: the
+-- DP16KD write enables, addresses and data come from flip-flops); ms_tracker uses
+-- 1.  Reads of a word in the clock it is written are undefined on ECP5 (the
 -- tracker reads a region only after its capture has ended).
 -- Throughput: 1 write + LANES reads per clock.  No reset (RAM contents only).
 -- Python model: the arrays returned by mstrack.fixed.blocks.ms_region_capture,
@@ -23,7 +25,8 @@ entity ms_region_ram is
     DEPTH  : natural := 18336; -- words per bank (REGION_MAX * STRIDE = 191 * 96 by default)
     DATA_W : natural := 9;    -- word width (bin index)
     ADDR_W : natural := 15;   -- address width, 2**ADDR_W >= DEPTH
-    RD_LAT : positive := 1    -- read latency in clocks (each clock above 1 costs LANES * DATA_W FF)
+    RD_LAT : positive := 1;   -- read latency in clocks (each clock above 1 costs LANES * DATA_W FF)
+    WR_LAT : natural  := 0    -- 0 or 1: a write reaches the RAM WR_LAT clocks after the port (1: registered)
   );
   port (
     clk   : in  std_logic;                                      -- clock
@@ -48,7 +51,7 @@ begin
     bank_we <= we when LANES = 1 or wbank = to_unsigned(b, wbank'length) else '0';
 
     u_bank : entity work.ms_ram_sdp
-      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT)
+      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT, WR_LAT => WR_LAT)
       port map (clk => clk, we => bank_we, waddr => waddr, wdata => wdata,
                 raddr => unsigned(raddr((b + 1) * ADDR_W - 1 downto b * ADDR_W)),
                 rdata => rdata((b + 1) * DATA_W - 1 downto b * DATA_W));

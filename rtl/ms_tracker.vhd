@@ -119,6 +119,9 @@ architecture rtl of ms_tracker is
   -- region RAM read latency: 3 lets ms_ram_sdp's ecp5 architecture use the DP16KD output register
   -- and register its depth multiplexer; the pixel pass hides it (no cycle more, results unchanged)
   constant REGION_RD_LAT : positive := 3;
+  -- region RAM write port registered (bank / row decode off the DP16KD write-enable path); the
+  -- engines read a region only well after its capture's last write
+  constant REGION_WR_LAT : natural := 1;
   constant DRAIN       : natural := 63;           -- clocks the front end needs to drain a frame
   constant A_ONE       : natural := 2 ** AF;
   constant FLAGS_W     : natural := 8;
@@ -421,13 +424,13 @@ begin
 
   u_ram_c : entity work.ms_region_ram
     generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
-                 RD_LAT => REGION_RD_LAT)
+                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
     port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
               raddr => ram_c_addr, rdata => ram_c_data);
 
   u_ram_e : entity work.ms_region_ram
     generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W,
-                 RD_LAT => REGION_RD_LAT)
+                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
     port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_e,
               raddr => ram_e_addr, rdata => ram_e_data);
 

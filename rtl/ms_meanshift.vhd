@@ -52,7 +52,8 @@ entity ms_meanshift is
     CENTRE_ABS_W : natural := 20;     -- absolute centre bits (COORD_W + CF)
     MAX_ITER     : natural := 20;     -- iteration limit
     ITER_W       : natural := 5;      -- iteration counter bits
-    EPS2         : natural := 65536   -- shift stop threshold, Q.2CF px^2
+    EPS2         : natural := 65536;  -- shift stop threshold, Q.2CF px^2
+    RAM_LAT      : positive := 1      -- region RAM read latency (ms_pixel_pass, 1 .. 3; cycles do not change)
   );
   port (
     clk       : in  std_logic;                                    -- clock
@@ -146,7 +147,7 @@ begin
     generic map (LANES => LANES, BIN_W => BIN_W, HALF_W => HALF_W, REGION_W => REGION_W,
                  STRIDE => STRIDE, ADDR_W => ADDR_W, KERNEL_EPAN => KERNEL_EPAN,
                  KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
-                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W)
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, RAM_LAT => RAM_LAT)
     port map (clk => clk, rst => rst, ready => pp_ready, start => pp_start, win_x => win_x, win_y => win_y,
               ex => ex, ey => ey, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d,

@@ -4,7 +4,7 @@
 -- half extents ex, ey) LANES pixels per clock (ms_window_scan: in each row only the
 -- LANES-aligned groups that reach the kernel ellipse, |dx| <= XR[|dy|], with a
 -- per-lane mask of the pixels inside it), reads the bins from the external region
--- RAM (LANES banks, data 1 clock after the address), evaluates the kernel value of
+-- RAM (LANES banks, data RAM_LAT clocks after the address), evaluates the kernel value of
 -- each lane (LANES x ms_kernel, private KA/KB copies written through the kt_* port;
 -- the scan keeps the XR table) and accumulates H, N, SX, SY of the inside pixels
 -- into the per-bin accumulators (ms_histogram).
@@ -18,7 +18,8 @@
 -- Cycle count: if rising edge s samples start = '1', done = '1' is sampled by
 -- edge s + C (done is high during the cycle before that edge), with
 --   C = sum over dy = -ey .. ey of G(dy) + PASS_LAT, PASS_LAT = 10
---   (scan row pipeline 2, kernel 4 (the RAM read overlaps it), histogram 4: see docs/blocks/ms_pixel_pass.md),
+--   (scan row pipeline 2, kernel 4 (the RAM read, RAM_LAT <= 3 clocks, overlaps it), histogram 4:
+--   see docs/blocks/ms_pixel_pass.md; PASS_LAT does not depend on RAM_LAT),
 --   G(dy) = floor((win_x + XR[|dy|]) / LANES) - floor((win_x - XR[|dy|]) / LANES) + 1.
 -- Throughput: LANES pixels per clock, no stall.  Handshake: `start` is a pulse,
 -- accepted only when idle (after `done` of the previous pass) and ready = '1';
@@ -27,7 +28,7 @@
 -- be stable during a pass.
 -- Scan tap (px_*): the scan's beat (valid, lane mask, lane-0 dx, dy, last) in the cycle its
 -- ram_addr is out, for ms_target_stats (v2), which reads the same beat's bins from ram_data one
--- clock later; wires from the scan's registers, the pass itself is unchanged.
+-- clock later (so with RAM_LAT = 1 only); wires from the scan's registers, the pass itself is unchanged.
 -- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -47,7 +48,8 @@ entity ms_pixel_pass is
     KD_W        : natural := 29;  -- width of TA, TB, D (unused ports)
     HIST_W      : natural := 14;  -- width of H
     COUNT_W     : natural := 14;  -- width of N
-    POSSUM_W    : natural := 21   -- width of the signed SX, SY
+    POSSUM_W    : natural := 21;  -- width of the signed SX, SY
+    RAM_LAT     : positive := 1   -- region RAM read latency, 1 .. 3 (3: ms_ram_sdp on ECP5): no clock more, 2 bin delay stages fewer
   );
   port (
     clk          : in  std_logic;                                    -- clock
@@ -71,7 +73,7 @@ entity ms_pixel_pass is
     kd_d         : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2 (unused: row-extent mask)
     -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
     ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
-    ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, 1 clock after ram_addr
+    ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, RAM_LAT clocks after ram_addr
     -- scan tap (ms_target_stats sits beside the pass on it; the bins of a beat are ram_data one clock later)
     px_valid     : out std_logic;                                    -- beat valid (the beat whose ram_addr is out now)
     px_mask      : out std_logic_vector(LANES - 1 downto 0);          -- lane l inside the kernel ellipse
@@ -92,7 +94,6 @@ end entity;
 architecture rtl of ms_pixel_pass is
   constant D_W        : natural := REGION_W + 1;
   constant KERNEL_LAT : natural := 4;   -- ms_kernel
-  constant RAM_LAT    : natural := 1;   -- region RAM: data 1 clock after the address
 
   -- scan outputs (cycle t)
   signal sc_valid, sc_last : std_logic;
@@ -113,6 +114,8 @@ architecture rtl of ms_pixel_pass is
   signal h_valid           : std_logic_vector(LANES - 1 downto 0);
   signal h_dx              : std_logic_vector(LANES * D_W - 1 downto 0);
 begin
+  assert RAM_LAT < KERNEL_LAT report "ms_pixel_pass: RAM_LAT must be below the kernel latency (4)" severity failure;
+
   u_scan : entity work.ms_window_scan
     generic map (LANES => LANES, HALF_W => HALF_W, REGION_W => REGION_W, STRIDE => STRIDE, ADDR_W => ADDR_W)
     port map (

@@ -1,11 +1,16 @@
 -- ms_region_ram: banked search-region RAM (bins of the captured region).
 --
 -- LANES banks (LANES a power of two), each DEPTH words of DATA_W bits, one
--- inferred simple dual-port block RAM per bank, initialised to zero.
+-- simple dual-port block RAM (ms_ram_sdp) per bank, initialised to zero.
 -- Write port (shared): we, wbank, waddr, wdata -> bank wbank, word waddr.
--- Read port per bank: raddr(b) -> rdata(b) registered, exactly 1 clock of
--- latency; a read of the address written in the same clock returns the OLD
--- word (read-before-write).
+-- Read port per bank: raddr(b) -> rdata(b), exactly RD_LAT clocks of latency
+-- (1: the RAM's read register only; 3: what ms_ram_sdp's ecp5 architecture
+-- needs to use the DP16KD output register and register its depth multiplexer;
+-- ms_tracker uses 3).  A read of an address >= DEPTH keeps the previous data.
+-- WR_LAT = 1 registers the write port (on ECP5 after the bank / row decode: the
+-- DP16KD write enables, addresses and data come from flip-flops); ms_tracker uses
+-- 1.  Reads of a word in the clock it is written are undefined on ECP5 (the
+-- tracker reads a region only after its capture has ended).
 -- Throughput: 1 write + LANES reads per clock.  No reset (RAM contents only).
 -- Python model: the arrays returned by mstrack.fixed.blocks.ms_region_capture,
 -- region pixel (rx, ry) at bank rx mod LANES, address ry * STRIDE + rx / LANES.
@@ -19,7 +24,9 @@ entity ms_region_ram is
     LANES  : natural := 2;    -- banks (power of two); one read port each
     DEPTH  : natural := 18336; -- words per bank (REGION_MAX * STRIDE = 191 * 96 by default)
     DATA_W : natural := 9;    -- word width (bin index)
-    ADDR_W : natural := 15    -- address width, 2**ADDR_W >= DEPTH
+    ADDR_W : natural := 15;   -- address width, 2**ADDR_W >= DEPTH
+    RD_LAT : positive := 1;   -- read latency in clocks (each clock above 1 costs LANES * DATA_W FF)
+    WR_LAT : natural  := 0    -- 0 or 1: a write reaches the RAM WR_LAT clocks after the port (1: registered)
   );
   port (
     clk   : in  std_logic;                                      -- clock
@@ -28,7 +35,7 @@ entity ms_region_ram is
     waddr : in  unsigned(ADDR_W - 1 downto 0);                  -- word to write
     wdata : in  std_logic_vector(DATA_W - 1 downto 0);          -- data to write
     raddr : in  std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- read address of bank b at (b+1)*ADDR_W-1 downto b*ADDR_W
-    rdata : out std_logic_vector(LANES * DATA_W - 1 downto 0)   -- read data of bank b, 1 clock after raddr
+    rdata : out std_logic_vector(LANES * DATA_W - 1 downto 0)   -- read data of bank b, RD_LAT clocks after raddr
   );
 end entity;
 
@@ -39,24 +46,14 @@ begin
   assert 2 ** ADDR_W >= DEPTH report "ms_region_ram: ADDR_W too small for DEPTH" severity failure;
 
   g_bank : for b in 0 to LANES - 1 generate
-    type ram_t is array (0 to DEPTH - 1) of std_logic_vector(DATA_W - 1 downto 0);
-    signal ram : ram_t := (others => (others => '0'));
     signal bank_we : std_logic;
   begin
     bank_we <= we when LANES = 1 or wbank = to_unsigned(b, wbank'length) else '0';
 
-    p_bank : process (clk)
-    begin
-      if rising_edge(clk) then
-        -- out-of-range addresses (>= DEPTH) read nothing (the register keeps its value)
-        if unsigned(raddr((b + 1) * ADDR_W - 1 downto b * ADDR_W)) < DEPTH then
-          rdata((b + 1) * DATA_W - 1 downto b * DATA_W) <=
-            ram(to_integer(unsigned(raddr((b + 1) * ADDR_W - 1 downto b * ADDR_W))));
-        end if;
-        if bank_we = '1' and waddr < DEPTH then
-          ram(to_integer(waddr)) <= wdata;
-        end if;
-      end if;
-    end process;
+    u_bank : entity work.ms_ram_sdp
+      generic map (DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RD_LAT, WR_LAT => WR_LAT)
+      port map (clk => clk, we => bank_we, waddr => waddr, wdata => wdata,
+                raddr => unsigned(raddr((b + 1) * ADDR_W - 1 downto b * ADDR_W)),
+                rdata => rdata((b + 1) * DATA_W - 1 downto b * DATA_W));
   end generate;
 end architecture;

@@ -7,18 +7,17 @@
 --   ip_ebin = min(2**EDGE_BINS_LOG2 - 1, (|Gx| + |Gy|) >> EDGE_SHIFT)
 --   Gx = right column - left column, Gy = bottom row - top row (weights 1 2 1)
 -- of the 3x3 grey neighbourhood centred on (x-1, y-1).
--- Storage: an inferred simple dual-port line buffer of MAX_FRAME_W words
--- holding, per column, rows y-1 (grey + colour bin) and y-2 (grey): 16 +
--- 3*COLOUR_BITS bits, as three RAMs (grey y-2, grey y-1, colour bin y-1; no
--- RAM split in depth, so no multiplexer behind a RAM).  Read at x when the
--- pixel's position arrives (in_valid, in_x, in_y: ONE CLOCK BEFORE its grey
--- and colour bin, in_grey / in_cbin), the read word registered once more (rq:
--- nothing between the DP16KD, ~5.8 ns clock-to-out, and a flip-flop), and
--- written back on the FALLING edge 1.5 clocks after the read, once rq, the
--- grey and the colour bin are registered (read-modify-write of the same
--- column; the next column is read meanwhile, never the same address; a
--- rising-edge write would make yosys add a read-before-write bypass
--- multiplexer behind the RAM).  A 3x3 window of registers shifts on each pixel.
+-- Storage: a simple dual-port line buffer of MAX_FRAME_W words holding, per
+-- column, rows y-1 (grey + colour bin) and y-2 (grey): 16 + 3*COLOUR_BITS
+-- bits, as three ms_ram_sdp (grey y-2, grey y-1, colour bin y-1; <= 9 bits
+-- each, so one DP16KD of 2048 x 9 each by default and no depth multiplexer)
+-- with a read latency of 2 (on ECP5 the DP16KD output register).  Read at x
+-- when the pixel's position arrives (in_valid, in_x, in_y: ONE CLOCK BEFORE
+-- its grey and colour bin, in_grey / in_cbin), the word (rq) there 2 clocks
+-- later, and written back 2 clocks after the read, once rq, the grey and the
+-- colour bin are registered (read-modify-write of the same column; columns
+-- x+1 and x+2 are read meanwhile, never the same address).  A 3x3 window of
+-- registers shifts on each pixel.
 -- The input pixels must arrive in raster order, x counting 0 .. W-1 within a
 -- line with no pixel missing (as ms_stream_check delivers them), W <= MAX_FRAME_W.
 -- Pipeline: 0 position registered + line buffer read, 1 grey / colour bin and
@@ -69,13 +68,8 @@ architecture rtl of ms_sobel is
 
   -- the word is kept in three RAMs of <= 9 bits (one DP16KD of 2048 x 9 each by default),
   -- so that no RAM is split in depth (no output multiplexer between RAM and register)
-  type ram_g_t is array (0 to MAX_FRAME_W - 1) of std_logic_vector(7 downto 0);
-  type ram_c_t is array (0 to MAX_FRAME_W - 1) of std_logic_vector(CB_W - 1 downto 0);
-  signal lbuf_t : ram_g_t := (others => (others => '0'));  -- grey y-2
-  signal lbuf_m : ram_g_t := (others => (others => '0'));  -- grey y-1
-  signal lbuf_c : ram_c_t := (others => (others => '0'));  -- colour bin y-1
-  signal rdata : std_logic_vector(LB_W - 1 downto 0);  -- RAM read (DP16KD data latch)
-  signal rq    : std_logic_vector(LB_W - 1 downto 0);  -- its output register
+  signal rq    : std_logic_vector(LB_W - 1 downto 0);  -- the line buffer word, 2 clocks after the read
+  signal ra    : unsigned(LA_W - 1 downto 0);          -- read address (the column of in_x)
 
   -- stage 0: position registered, line buffer read
   signal v0, e0   : std_logic := '0';
@@ -107,32 +101,22 @@ begin
   assert MAX_FRAME_W >= 3 report "ms_sobel: MAX_FRAME_W must be >= 3" severity failure;
   assert 2 ** LA_W <= 2 ** COORD_W report "ms_sobel: COORD_W too small for MAX_FRAME_W" severity failure;
 
-  -- line buffer: simple dual port, registered read + one more register (read in stage 0,
-  -- written back on the falling edge in stage 1)
-  p_lbuf_rd : process (clk)
-    variable ra : natural range 0 to MAX_FRAME_W - 1;
-  begin
-    if rising_edge(clk) then
-      ra := to_integer(in_x(LA_W - 1 downto 0));
-      rdata <= lbuf_t(ra) & lbuf_m(ra) & lbuf_c(ra);
-      rq    <= rdata;
-    end if;
-  end process;
+  -- line buffer: three simple dual-port RAMs, read latency 2 (read in stage 0, data in rq when
+  -- stage 1's registers are out; written back at the edge after stage 1)
+  ra <= in_x(LA_W - 1 downto 0);
 
-  -- write on the falling edge (half a clock after stage 1's registers): the write and the
-  -- read are then in different clock domains for yosys, which otherwise emulates the
-  -- read-before-write order of a same-address collision (never happens here) with a
-  -- bypass multiplexer between the RAM output and rq
-  p_lbuf_wr : process (clk)
-  begin
-    if falling_edge(clk) then
-      if v1 = '1' then
-        lbuf_t(to_integer(wa1)) <= rq(LB_W - 9 downto CB_W);
-        lbuf_m(to_integer(wa1)) <= std_logic_vector(g1);
-        lbuf_c(to_integer(wa1)) <= c1;
-      end if;
-    end if;
-  end process;
+  u_lbuf_t : entity work.ms_ram_sdp   -- grey y-2
+    generic map (DEPTH => MAX_FRAME_W, DATA_W => 8, ADDR_W => LA_W, RD_LAT => 2)
+    port map (clk => clk, we => v1, waddr => wa1, wdata => rq(LB_W - 9 downto CB_W),
+              raddr => ra, rdata => rq(LB_W - 1 downto LB_W - 8));
+  u_lbuf_m : entity work.ms_ram_sdp   -- grey y-1
+    generic map (DEPTH => MAX_FRAME_W, DATA_W => 8, ADDR_W => LA_W, RD_LAT => 2)
+    port map (clk => clk, we => v1, waddr => wa1, wdata => std_logic_vector(g1),
+              raddr => ra, rdata => rq(LB_W - 9 downto CB_W));
+  u_lbuf_c : entity work.ms_ram_sdp   -- colour bin y-1
+    generic map (DEPTH => MAX_FRAME_W, DATA_W => CB_W, ADDR_W => LA_W, RD_LAT => 2)
+    port map (clk => clk, we => v1, waddr => wa1, wdata => c1,
+              raddr => ra, rdata => rq(CB_W - 1 downto 0));
 
   p_pipe : process (clk)
     variable dxp, dxn, dyp, dyn : unsigned(MAG_W - 1 downto 0);  -- differences, bit SUM_W = borrow

@@ -116,6 +116,12 @@ architecture rtl of ms_tracker is
   constant BIN_C_W     : natural := 3 * COLOUR_BITS;
   constant BIN_E_W     : natural := EDGE_BINS_LOG2;
   constant DEPTH       : natural := REGION_MAX * STRIDE;
+  -- region RAM read latency: 3 lets ms_ram_sdp's ecp5 architecture use the DP16KD output register
+  -- and register its depth multiplexer; the pixel pass hides it (no cycle more, results unchanged)
+  constant REGION_RD_LAT : positive := 3;
+  -- region RAM write port registered (bank / row decode off the DP16KD write-enable path); the
+  -- engines read a region only well after its capture's last write
+  constant REGION_WR_LAT : natural := 1;
   constant DRAIN       : natural := 63;           -- clocks the front end needs to drain a frame
   constant A_ONE       : natural := 2 ** AF;
   constant FLAGS_W     : natural := 8;
@@ -417,12 +423,14 @@ begin
               wdata_colour => cap_c, wdata_edge => cap_e, done => cap_done);
 
   u_ram_c : entity work.ms_region_ram
-    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W)
+    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
+                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
     port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
               raddr => ram_c_addr, rdata => ram_c_data);
 
   u_ram_e : entity work.ms_region_ram
-    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W)
+    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W,
+                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
     port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_e,
               raddr => ram_e_addr, rdata => ram_e_data);
 
@@ -459,7 +467,7 @@ begin
                  RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
                  RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
-                 ITER_W => ITER_W, EPS2 => EPS2)
+                 ITER_W => ITER_W, EPS2 => EPS2, RAM_LAT => REGION_RD_LAT)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
               reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
@@ -475,7 +483,7 @@ begin
                  RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
                  RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
-                 ITER_W => ITER_W, EPS2 => EPS2)
+                 ITER_W => ITER_W, EPS2 => EPS2, RAM_LAT => REGION_RD_LAT)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
               reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,

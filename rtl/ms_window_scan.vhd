@@ -31,8 +31,12 @@
 -- Latency: the first beat is valid SCAN_LAT = 3 clocks after the clock edge
 -- that samples start = '1' (two cycles fill the row pipeline).
 -- Throughput: one beat (LANES pixels) per clock; no back-pressure.
--- Handshake: `start` is a one-cycle pulse, ignored while busy = '1'.  The caller
--- guarantees win_x >= ex, win_y >= ey and that the window fits in the region
+-- Handshake: `start` is a one-cycle pulse, ignored while busy = '1'.  win_y and ey
+-- must be stable from the clock before start on (the first row's base
+-- (win_y - ey) * STRIDE is computed from win_y - ey registered one clock ahead, so
+-- that the subtraction and the multiplier are not in one clock; ms_meanshift sets
+-- win_y one clock before its start pulse; a simulation assertion checks it).  The
+-- caller guarantees win_x >= ex, win_y >= ey and that the window fits in the region
 -- (the model asserts the same: ms_histogram raises on a window outside the region),
 -- and that the XR table (written at init) is stable during a scan.
 -- Model: the scan order of mstrack.fixed.blocks.ms_histogram (sums are order free).
@@ -102,6 +106,7 @@ architecture rtl of ms_window_scan is
   -- row pipeline, stage A: XR of its row, RAM base of its row, |dy| of the row after it
   signal xr_a         : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal rb_a         : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+  signal ysub         : unsigned(REGION_W - 1 downto 0) := (others => '0');  -- win_y - ey, every clock
   signal ra           : unsigned(HALF_W - 1 downto 0) := (others => '0');
   signal ra_dn        : std_logic := '0';                                     -- |dy| still falling
   -- row pipeline, stage B: first address, lane-0 dx and groups - 1 of its row
@@ -118,6 +123,10 @@ architecture rtl of ms_window_scan is
   signal lm_row       : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- lanes inside in the row's last group
 begin
   assert LANES >= 1 and 2 ** SH = LANES report "ms_window_scan: LANES must be a power of 2" severity failure;
+
+  -- win_y and ey stable since the clock before start (ysub is then win_y - ey)
+  assert not (rising_edge(clk) and state = S_IDLE and start = '1' and ysub /= win_y - resize(ey, REGION_W))
+    report "ms_window_scan: win_y or ey changed in the clock of start" severity failure;
 
   p_table : process (clk)
   begin
@@ -138,6 +147,7 @@ begin
     variable lo_l, hi_l : natural range 0 to LANES - 1;  -- lane of the row's first / last pixel
   begin
     if rising_edge(clk) then
+      ysub <= win_y - resize(ey, REGION_W);   -- the first row of a start in the next clock
       -- defaults (no don't-care values in the netlist)
       lo   := (others => '0');
       hi   := (others => '0');
@@ -162,7 +172,7 @@ begin
           wx    <= win_x;
           ey_s  <= signed(resize(ey, D_W));
           xr_a  <= xr_ram(to_integer(rd_a));
-          rb_a  <= resize((win_y - resize(ey, REGION_W)) * to_unsigned(STRIDE, ADDR_W), ADDR_W);
+          rb_a  <= resize(ysub * to_unsigned(STRIDE, ADDR_W), ADDR_W);
           if ey /= 0 then
             ra    <= ey - 1;
             ra_dn <= '1';

@@ -66,6 +66,7 @@ class TB:
         self.n_bins = 1 << self.bw
         self.kernel = "epanechnikov" if c["KERNEL_EPAN"] else "flat"
         self.kb = c["KERNEL_BITS"]
+        self.ram_lat = c.get("RAM_LAT", 1)
         self.mem = [dict() for _ in range(self.L)]
         dut.rst.value = Immediate(1)
         for name in ("start", "kt_we", "bin_rd_en"):
@@ -74,16 +75,18 @@ class TB:
         cocotb.start_soon(self._ram_and_counter())
 
     async def _ram_and_counter(self):
-        """Region RAM model (registered read: data 1 clock after the address) and a cycle counter."""
+        """Region RAM model (registered read: data RAM_LAT clocks after the address) and a cycle counter."""
         L, aw, bw = self.L, self.aw, self.bw
         amask = (1 << aw) - 1
+        pipe = [0] * self.ram_lat          # pipe[0]: read at this edge; pipe[-1]: on ram_data now
         while True:
             await RisingEdge(self.dut.clk)
             a = int(self.dut.ram_addr.value)
             d = 0
             for lane in range(L):
                 d |= self.mem[lane].get((a >> (lane * aw)) & amask, 0) << (lane * bw)
-            self.dut.ram_data.value = d
+            pipe = [d] + pipe[:-1]
+            self.dut.ram_data.value = pipe[-1]
 
     def load_region(self, bins: np.ndarray, rng: random.Random):
         """bins (rmax, rmax) -> bank memories; padding words get random bins (must be masked)."""
@@ -128,6 +131,7 @@ class TB:
         d = self.dut
         d.win_x.value = wx
         d.win_y.value = wy
+        await RisingEdge(d.clk)  # win_y stable from the clock before start (ms_window_scan)
         d.start.value = 1
         await RisingEdge(d.clk)  # this edge samples start
         d.start.value = 0
@@ -304,6 +308,17 @@ def test_row_extent_is_inside_test():
 @pytest.mark.parametrize("kernel,lanes", CASES)
 def test_ms_pixel_pass_small(kernel, lanes, hdl_waves):
     gen, cfg = pass_generics(TrackerParams(colour_bits=2, kernel=kernel), SMALL_FP, lanes)
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+                 extra_env={CFG_ENV: json.dumps(cfg)})
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("kernel,lanes,ram_lat", [("flat", 4, 3), ("epanechnikov", 2, 3), ("flat", 1, 2)])
+def test_ms_pixel_pass_ram_lat(kernel, lanes, ram_lat, hdl_waves):
+    """Region RAM read latency RAM_LAT > 1 (ms_tracker uses 3, ms_ram_sdp's ecp5 architecture):
+    same sums and the same PASS_LAT (the read hides in the kernel pipeline)."""
+    gen, cfg = pass_generics(TrackerParams(colour_bits=2, kernel=kernel), SMALL_FP, lanes)
+    gen["RAM_LAT"] = cfg["RAM_LAT"] = ram_lat
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
                  extra_env={CFG_ENV: json.dumps(cfg)})
 

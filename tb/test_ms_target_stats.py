@@ -300,6 +300,7 @@ async def attached_real_windows(dut):
         wx, wy = rw["win"]
         dut.win_x.value = wx
         dut.win_y.value = wy
+        await RisingEdge(dut.clk)    # win_y stable from the clock before start (ms_window_scan)
         dut.start.value = 1
         await RisingEdge(dut.clk)
         dut.start.value = 0

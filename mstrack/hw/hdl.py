@@ -449,7 +449,7 @@ def ghdl_to_verilog(
     srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
     out = Path(out_path) if out_path else BUILD_DIR / "verilog" / f"{toplevel}_{_generics_tag(generics)}.v"
     out.parent.mkdir(parents=True, exist_ok=True)
-    digest = _hash_inputs(toplevel, generics, srcs, extra="fix2")
+    digest = _hash_inputs(toplevel, generics, srcs, extra="fix3")
     stamp = out.with_suffix(out.suffix + ".hash")
     if out.is_file() and stamp.is_file() and stamp.read_text().strip() == digest:
         return out
@@ -465,6 +465,10 @@ def ghdl_to_verilog(
         raise HdlError(f"ghdl --synth of {toplevel} failed (exit {r.returncode}), log {log}:\n{r.stderr[-4000:]}")
     text, nfix = fix_ghdl_verilog(r.stdout)
     notes = [f"rewrote {nfix} wide string-literal constants as N'b... literals"] if nfix else []
+    text, boxes = fix_ghdl_blackboxes(text)
+    if boxes:
+        notes.append(f"dropped GHDL's empty modules of the vendor primitives {', '.join(boxes)} "
+                     "(the synthesis tool's own cells) and gave their string generics back as strings")
     if _PMUX_RE.search(text):
         # GHDL 2.0 drops the `others` input of every pmux (VHDL `case`) in its
         # Verilog; take it from the VHDL netlist of the same design.
@@ -558,6 +562,52 @@ def fix_ghdl_verilog(text: str) -> tuple[str, int]:
     character (Verilator and Yosys then compute wrong values silently).  Rewrites
     them as sized binary literals (``33'b0...0111``).  Returns (text, count)."""
     return _WIDE_CONST_RE.subn(lambda m: f"{len(m.group(1))}'b{m.group(1).lower()}", text)
+
+
+_MODULE_RE = re.compile(r"^module (\w+)\b.*?^endmodule\n", re.M | re.S)
+_BIN_PARAM_RE = re.compile(r"\.(\w+)\((\d+)'b([01]+)\)")
+
+
+def fix_ghdl_blackboxes(text: str) -> tuple[str, list[str]]:
+    """Vendor primitives instantiated through an unbound VHDL component (e.g. DP16KD in
+    rtl/ecp5/ms_ram_sdp_ecp5.vhd): GHDL 2.0 writes an empty Verilog module for each (which would
+    replace the tool's own cell) and prints string generics as bit vectors (``48'b0100...`` for
+    ``"OUTREG"``, which nextpnr reads as a number).  Drops the empty modules (port list only)
+    and rewrites the byte-sized, printable bit-vector parameters of their instances as strings.
+    Returns (text, names of the primitives)."""
+    boxes = [m.group(1) for m in _MODULE_RE.finditer(text) if m.group(0).count(";") == 1]
+    if not boxes:
+        return text, []
+    text = _MODULE_RE.sub(lambda m: "" if m.group(1) in boxes else m.group(0), text)
+
+    def as_string(m: re.Match) -> str:
+        n, bits = int(m.group(2)), m.group(3)
+        if n % 8 or len(bits) != n:
+            return m.group(0)
+        chars = [int(bits[i:i + 8], 2) for i in range(0, n, 8)]
+        if not all(32 <= c < 127 and c != 34 for c in chars):
+            return m.group(0)
+        return f'.{m.group(1)}("{"".join(map(chr, chars))}")'
+
+    inst_re = re.compile(r"^\s*(?:%s) #\((?:.|\n)*?\)\s*\w+ \(" % "|".join(map(re.escape, boxes)), re.M)
+    text = inst_re.sub(lambda m: _BIN_PARAM_RE.sub(as_string, m.group(0)), text)
+    return text, boxes
+
+
+def vendor_sources(sources: Sequence[Path | str], vendor: str) -> list[Path]:
+    """*sources* with each file's vendor architecture (``<dir>/<vendor>/<stem>_<vendor>.vhd``,
+    e.g. rtl/ecp5/ms_ram_sdp_ecp5.vhd) inserted right after it: analysed last, it becomes the
+    entity's default architecture for this build.  Idempotent."""
+    out: list[Path] = []
+    for s in sources:
+        f = Path(s).resolve()
+        if f in out:
+            continue
+        out.append(f)
+        v = f.parent / vendor / f"{f.stem}_{vendor}.vhd"
+        if v.is_file() and v not in out:
+            out.append(v)
+    return out
 
 
 # --------------------------------------------------------------------------
@@ -804,7 +854,7 @@ def synth_ecp5(
     All top-level ports become I/O pins: the design must fit the package.
     """
     d = _synth_dir("ecp5", toplevel, generics, name)
-    srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
+    srcs = vendor_sources(sources if sources is not None else rtl_sources(toplevel), "ecp5")
     t0 = time.monotonic()
     v = ghdl_to_verilog(toplevel, generics, srcs, out_path=d / f"{toplevel}.v")
     secs = {"ghdl": round(time.monotonic() - t0, 2)}
@@ -934,6 +984,6 @@ def synth_xilinx(
 
 __all__ = [
     "REPO_ROOT", "RTL_DIR", "TB_DIR", "BUILD_DIR", "TOOLS_HDL_DIR", "HdlError", "HdlTestFailure",
-    "rtl_sources", "run_ghdl", "run_ghdl_plain", "run_verilator", "run_verilator_axis", "verilog_ports", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "synth_ecp5", "synth_xilinx", "synth_nexus", "nexus_fix_carry_in",
+    "rtl_sources", "run_ghdl", "run_ghdl_plain", "run_verilator", "run_verilator_axis", "verilog_ports", "ghdl_to_verilog", "fix_ghdl_verilog", "fix_ghdl_pmux", "fix_ghdl_blackboxes", "vendor_sources", "synth_ecp5", "synth_xilinx", "synth_nexus", "nexus_fix_carry_in",
     "ghdl_backend", "have_ghdl", "dut_generics", "GENERICS_ENV", "have_verilator", "verilator_root",
 ]

@@ -278,6 +278,8 @@ def yosys_cached(kind: str, top: str, g: dict, sources_: Sequence[Path] | None, 
     from . import hdl
     d = SYNTH_DIR / name
     srcs = [Path(x) for x in (sources_ if sources_ is not None else sources(top))]
+    if kind == "ecp5":
+        srcs = hdl.vendor_sources(srcs, "ecp5")     # rtl/ecp5/*: DP16KD with output register
     v = hdl.ghdl_to_verilog(top, g, srcs, out_path=d / f"{top}.v")      # cached by GHDL inputs
     script = hdl._template({"ecp5": "ecp5.ys", "nexus": "nexus.ys"}.get(kind, "xilinx.ys"), VERILOG=v.name, TOP=top,
                            FAMILY="xc7")

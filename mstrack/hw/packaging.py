@@ -172,6 +172,8 @@ def run_verilog_generator(input_yml: Path, out_dir: Path | None = None) -> Path:
     from .hdl import ghdl_to_verilog, rtl_sources, vendor_sources
 
     cfg = yaml.safe_load(Path(input_yml).read_text())
+    if not isinstance(cfg, dict) or "vlnv" not in cfg:
+        raise ValueError(f"{input_yml}: not a FuseSoC generator input (GAPI 1.0: vlnv, parameters, files_root)")
     par = cfg.get("parameters") or {}
     top = str(par.get("toplevel", TOP))
     srcs = rtl_sources(top)

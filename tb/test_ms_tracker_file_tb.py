@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -202,3 +203,44 @@ def test_fusesoc_target(target, tmp_path):
     assert r.returncode == 0, log[-3000:]
     if target == "sim":
         assert "ms_tracker_file_tb: PASSED: 3 results" in log
+
+
+def _yosys_log_cells(log: str) -> dict[str, int]:
+    """Cell counts of the last `stat` (synth_ecp5's "Printing statistics") in a yosys log."""
+    last = log.rsplit("Printing statistics.", 1)[-1]
+    block = last.split("Number of cells:", 1)[1].split("\n\n", 1)[0]
+    return {m.group(1): int(m.group(2)) for m in re.finditer(r"^\s+(\w+)\s+(\d+)$", block, re.M)}
+
+
+@pytest.mark.synth
+def test_fusesoc_synth_target(tmp_path):
+    """`fusesoc run --target synth`: the generator ghdl_verilog writes the Verilog netlist (fix-ups applied,
+    ECP5 RAM architecture), edalize's yosys (Debian's, Tcl) maps it with synth_ecp5 to ms_tracker.json.
+    About 1 min on the full core (docs/packaging.md)."""
+    yosys = shutil.which("yosys")
+    if yosys is None:
+        if os.environ.get("MSTRACK_REQUIRE_TOOLS", "") not in ("", "0"):
+            pytest.fail("yosys (with Tcl) not installed (tools/setup.sh: apt-get install yosys)")
+        pytest.skip("yosys (with Tcl) not installed: apt-get install yosys (tools/setup.sh does)")
+    build = tmp_path / "build"
+    cmd = [_fusesoc(), "--cores-root", str(REPO), "run", "--build-root", str(build),
+           "--target", "synth", "mstrack:mstrack:ms_tracker"]
+    # the generator's interpreter is `python3`: this venv's, first on PATH
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
+    r = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, env=env)
+    out = r.stdout + r.stderr
+    assert r.returncode == 0, out[-3000:]
+    work = build / "mstrack_mstrack_ms_tracker_0.1.0" / "synth-yosys"
+    (v,) = work.glob("generator_cache/*/ms_tracker.v")
+    text = v.read_text()
+    assert text.count("\nmodule ms_tracker\n") == 1
+    assert "module DP16KD" not in text, "GHDL's empty DP16KD module was not dropped (fix_ghdl_blackboxes)"
+    assert re.search(r"^\s*DP16KD #\(", text, re.M), "no DP16KD instance: ECP5 architecture of ms_ram_sdp not used"
+    log = (work / "yosys.log").read_text()
+    cells = _yosys_log_cells(log)
+    version = re.search(r"Yosys \d+\.\d+", log)
+    print(f"\nfusesoc synth ({version.group(0) if version else 'yosys'}): {cells}")
+    assert cells.get("DP16KD", 0) >= 1 and cells.get("LUT4", 0) > 1000 and cells.get("TRELLIS_FF", 0) > 1000, cells
+    assert not any(k.startswith("$") and k != "$scopeinfo" for k in cells), f"unmapped cells: {cells}"
+    netlist = json.loads((work / "ms_tracker.json").read_text())
+    assert "ms_tracker" in netlist["modules"]

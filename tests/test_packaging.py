@@ -1,7 +1,7 @@
 """Generated packaging files are current: rtl/files.txt, mstrack.core, tb/vhdl/data/ (mstrack.hw.packaging).
 
-Regenerate with ``mstrack hdl files``.  The FuseSoC sim target itself runs in
-tb/test_ms_tracker_file_tb.py (test_fusesoc_target).
+Regenerate with ``mstrack hdl files``.  The FuseSoC targets themselves run in
+tb/test_ms_tracker_file_tb.py (test_fusesoc_target: sim, lint; test_fusesoc_synth_target: synth).
 """
 from __future__ import annotations
 
@@ -32,11 +32,35 @@ def test_core_file_lists_the_same_files():
     core = yaml.safe_load(packaging.CORE_FILE.read_text().split("\n", 1)[1])   # after "CAPI=2:"
     assert core["name"] == packaging.CORE_NAME
     assert core["filesets"]["rtl"]["files"] == packaging.core_files()
-    assert set(core["targets"]) == {"default", "sim", "lint"}
+    assert set(core["targets"]) == {"default", "sim", "lint", "synth"}
     assert core["targets"]["sim"]["toplevel"] == "ms_tracker_file_tb"
+    # synth: every generate entry names a generator of this core whose script exists
+    for name in core["targets"]["synth"]["generate"]:
+        gen = core["generators"][core["generate"][name]["generator"]]
+        assert (REPO_ROOT / gen["command"]).is_file() and REPO_ROOT / gen["command"] == packaging.GENERATOR_SCRIPT
+    assert core["targets"]["synth"]["tools"]["yosys"]["arch"] == "ecp5"
 
 
 def test_check_mode_reports_stale(tmp_path, monkeypatch):
     monkeypatch.setattr(packaging, "FILES_TXT", tmp_path / "files.txt")
     stale = packaging.write_generated(check=True)
     assert stale == [tmp_path / "files.txt"] and not (tmp_path / "files.txt").exists()
+
+
+def test_verilog_generator_writes_core(tmp_path):
+    """The synth target's generator alone (FuseSoC GAPI 1.0 input -> <top>.v + a core naming it), with generics."""
+    yaml = pytest.importorskip("yaml")
+    from mstrack.hw.hdl import have_ghdl
+    if not have_ghdl():
+        pytest.skip("ghdl not installed (tools/setup.sh)")
+    inp = tmp_path / "in.yml"
+    inp.write_text(yaml.safe_dump({"gapi": "1.0", "vlnv": "x:y:ms_fifo-gen:1", "files_root": str(REPO_ROOT),
+                                   "parameters": {"toplevel": "ms_fifo", "generics": {"WIDTH": 5, "DEPTH": 4}}}))
+    core = packaging.run_verilog_generator(inp, tmp_path)
+    c = yaml.safe_load(core.read_text().split("\n", 1)[1])
+    assert c["name"] == "x:y:ms_fifo-gen:1" and c["targets"]["default"]["toplevel"] == "ms_fifo"
+    (v,) = c["filesets"]["verilog"]["files"]
+    text = (tmp_path / v).read_text()
+    assert "module ms_fifo" in text and "[4:0]" in text      # WIDTH 5 baked in
+    with pytest.raises(ValueError, match="not a FuseSoC generator input"):
+        packaging.run_verilog_generator(tmp_path / "ms_fifo.v.hash", tmp_path)

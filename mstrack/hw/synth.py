@@ -762,6 +762,19 @@ def _fmt(v: Any, nd: int = 1) -> str:
     return f"{v:,}" if isinstance(v, int) else str(v)
 
 
+def _fit(pnr_runs: Sequence[dict], *columns: tuple[str, ...]) -> str:
+    """"yes: a % / b % / ..." from the first nextpnr run's utilisation, one share per column (the first
+    of its bel names that nextpnr reports; 0 % if none); "-" without a place-and-route run."""
+    if not pnr_runs:
+        return "-"
+    u = pnr_runs[0]["utilization"]
+
+    def pct(keys: tuple[str, ...]) -> str:
+        k = next((k for k in keys if k in u), None)
+        return f"{100 * u[k][0] / u[k][1]:.0f} %" if k else "0 %"
+    return "yes: " + " / ".join(pct(c) for c in columns)
+
+
 def ecp5_table(rows: Iterable[dict]) -> str:
     head = ("| config | LUT4 | FF | CCU2C | DP16KD | MULT18X18D | DPR16X4 | Fmax per seed (MHz) | max | median "
             "| fits (P&R: comb / FF / DP16KD / MULT) |\n|---|---|---|---|---|---|---|---|---|---|---|")
@@ -770,13 +783,7 @@ def ecp5_table(rows: Iterable[dict]) -> str:
         e = s["ecp5"]
         pn = s.get("pnr") or []
         per = " / ".join(f"{p['fmax_mhz']:.1f}" for p in pn) or "-"
-        fit = "-"
-        if pn:
-            u = pn[0]["utilization"]
-
-            def pct(k: str) -> str:
-                return f"{100 * u[k][0] / u[k][1]:.0f} %" if k in u else "0 %"
-            fit = f"yes: {pct('TRELLIS_COMB')} / {pct('TRELLIS_FF')} / {pct('DP16KD')} / {pct('MULT18X18D')}"
+        fit = _fit(pn, ("TRELLIS_COMB",), ("TRELLIS_FF",), ("DP16KD",), ("MULT18X18D",))
         out.append(f"| {s['config']} | {_fmt(e['LUT4'])} | {_fmt(e['TRELLIS_FF'])} | {_fmt(e['CCU2C'])} | "
                    f"{e['DP16KD']} | {e['MULT18X18D']} | {e['TRELLIS_DPR16X4']} | {per} | "
                    f"{_fmt(s.get('fmax_max_mhz'))} | {_fmt(s.get('fmax_median_mhz'))} | {fit} |")
@@ -794,17 +801,7 @@ def nexus_table(rows: Iterable[dict]) -> str:
         n = s["nexus"]
         pn = s.get("nexus_pnr") or []
         per = " / ".join(f"{p['fmax_mhz']:.1f}" for p in pn) or "-"
-        fit = "-"
-        if pn:
-            u = pn[0]["utilization"]
-
-            def pct(*keys: str) -> str:
-                for k in keys:
-                    if k in u:
-                        return f"{100 * u[k][0] / u[k][1]:.0f} %"
-                return "0 %"
-            fit = (f"yes: {pct('OXIDE_COMB')} / {pct('OXIDE_FF')} / {pct('OXIDE_EBR')} / "
-                   f"{pct('MULT18_CORE', 'OXIDE_DSP', 'MULT18')}")
+        fit = _fit(pn, ("OXIDE_COMB",), ("OXIDE_FF",), ("OXIDE_EBR",), ("MULT18_CORE", "OXIDE_DSP", "MULT18"))
         out.append(f"| {s['config']} | {_fmt(n['LUT4'])} | {_fmt(n['FF'])} | {_fmt(n['CCU2'])} | {n['EBR']} | "
                    f"{n['LRAM']} | {n['MULT']:g} | {n['DPR16X4']} | {per} | {_fmt(s.get('nexus_fmax_max_mhz'))} | "
                    f"{_fmt(s.get('nexus_fmax_median_mhz'))} | {fit} |")

@@ -566,22 +566,17 @@ def loss_rates(runs: dict[str, Any], sequences: Sequence[Any]) -> tuple[float, f
     valid ground truth, recall = share of off-target frames (IoU = 0) with ok false, false alarms =
     share of on-target frames (IoU >= 0.5) with ok false."""
     import numpy as np
-    from .eval.metrics import iou, valid_gt
+    from .eval.metrics import iou, loss_detection, valid_gt
     by = {s.name: s for s in sequences}
-    off_flag = off = on_flag = on = 0
+    ious, oks = [], []
     for name, r in runs.items():
         gt = by[name].gt[: r.n_frames]
-        ok = r.ok
         v = valid_gt(gt)
         v[0] = False
-        i = np.zeros(len(gt))
-        i[v] = iou(r.boxes[v], gt[v])
-        off_m, on_m = v & (i <= 0), v & (i >= 0.5)
-        off += int(off_m.sum())
-        on += int(on_m.sum())
-        off_flag += int((off_m & ~ok).sum())
-        on_flag += int((on_m & ~ok).sum())
-    return (off_flag / off if off else float("nan"), on_flag / on if on else float("nan"), off, on)
+        ious.append(iou(r.boxes[v], gt[v]))
+        oks.append(np.asarray(r.ok, dtype=bool)[v])
+    d = loss_detection(np.concatenate(ious) if ious else np.zeros(0), np.concatenate(oks) if oks else np.zeros(0, bool))
+    return d.recall, d.false_alarm, d.off, d.on
 
 
 def has_ok_flag(tp: TrackerParams) -> bool:

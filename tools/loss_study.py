@@ -448,7 +448,8 @@ def main_report() -> None:
           "signals in out/loss_study/), `python tools/loss_study.py search` (float v2 with the search "
           "started by the flag), `python tools/loss_study.py report` (this page and its plots).  The search "
           "state of v2 does not depend on the flag, so the boxes, and every signal below, are those of "
-          "the v2 runs of docs/results.md.", ""]
+          "the v2 runs of docs/results.md.  Session 6 measured two more cues (a ceiling on rho, a "
+          "grey-template check): docs/results_loss_cues.md.", ""]
     models = ("float", "fixed")
     S = {m: sequences(m) for m in models}
     # --- the rule as adopted

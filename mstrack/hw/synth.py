@@ -394,7 +394,8 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
 # ----------------------------------------------------------------------------- blocks
 def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
     """Generics of each sub-block as ms_tracker / ms_meanshift map them (colour engine blocks
-    with the colour bin width; ``ms_bin_pass_edge`` is the edge engine's bin pass)."""
+    with the colour bin width; ``ms_bin_pass_edge`` is the edge engine's bin pass, ITERATIVE = 1
+    when ms_tracker maps it so: :func:`edge_bins_iterative`)."""
     cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
     g = cfg.generics()
     pick = lambda *ks: {k: g[k] for k in ks}  # noqa: E731
@@ -413,7 +414,8 @@ def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
         "ms_pixel_pass": {"BIN_W": bin_c, **pick("LANES", "HALF_W", "REGION_W", "STRIDE", "ADDR_W", "KERNEL_EPAN",
                                                  "KERNEL_BITS", "KVAL_W", "KD_W", "HIST_W", "COUNT_W", "POSSUM_W")},
         "ms_bin_pass": {"BIN_W": bin_c, "BIN_RD_LAT": 3, **bp},
-        "ms_bin_pass_edge": {"BIN_W": bin_e, "BIN_RD_LAT": 3, **bp},
+        "ms_bin_pass_edge": {"BIN_W": bin_e, "BIN_RD_LAT": 3, **bp,
+                             **({"ITERATIVE": 1} if edge_bins_iterative() else {})},
         "ms_centre": pick("SW_W", "SWX_W", "SHIFT_Q_W", "CF", "REGION_W", "CENTRE_W"),
         "ms_fusion": pick("FEATURES", "RHO_SUM_W", "HIST_W", "CENTRE_ABS_W", "AF", "ALPHA_W", "RF",
                           "RHO_OUT_FRAC", "RHO_OUT_W"),

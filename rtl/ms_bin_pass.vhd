@@ -374,6 +374,7 @@ begin
     signal dv_q    : unsigned(RATIO_Q_W - 1 downto 0);
     signal pr      : unsigned(2 * HIST_W downto 0);         -- product high part & multiplier bits left
     signal k1      : natural range 0 to HIST_W := 0;        -- product steps still to do
+    signal k1_zero : std_logic := '1';                      -- k1 = 0, registered (decided a clock ahead)
     signal s1_full : std_logic := '0';                      -- quotient ready
     signal s2_busy : std_logic := '0';
     signal k2      : natural range 0 to S2_LEN - 1 := 0;
@@ -397,13 +398,18 @@ begin
       port map (clk => clk, rst => rst, in_valid => va, in_n => div_n, in_d => h_a, busy => open,
                 out_valid => dv_ov, out_q => dv_q);
 
-    take    <= s1_full and not s2_busy when k1 = 0 else '0';
+    take    <= s1_full and k1_zero and not s2_busy;
     it_take <= take;
 
     p_s1 : process (clk)
       variable v : unsigned(2 * HIST_W downto 0);
     begin
       if rising_edge(clk) then
+        if va = '0' and k1 <= 1 then                       -- k1 = 0 after this edge
+          k1_zero <= '1';
+        else
+          k1_zero <= '0';
+        end if;
         if va = '1' then                                   -- product register: 0 & Q
           pr <= resize(q_a, 2 * HIST_W + 1);
           k1 <= HIST_W;
@@ -422,6 +428,7 @@ begin
         end if;
         if rst = '1' then
           k1      <= 0;
+          k1_zero <= '1';
           s1_full <= '0';
         end if;
       end if;

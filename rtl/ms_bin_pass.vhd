@@ -23,12 +23,26 @@
 -- memory (2**ceil(log2(DLY)) x (COUNT_W + 2 POSSUM_W), DLY = the two latencies) and two
 -- registers, read out beside the weight.
 --
--- Latency    : learn: done 2 + N_BINS + BIN_RD_LAT clocks after start;
---              track: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 1 + M(HIST_W),
+-- ITERATIVE = 1 (for few bins, e.g. the 16 edge bins): same results, ports and handshake, with
+-- iterative arithmetic: one bin at a time is requested (the next when the previous leaves stage
+-- 1; learn passes still read one bin per clock).  Stage 1: one ms_divider_iter (one quotient bit
+-- per clock) and H Q by shift-and-add; stage 2 (overlapping stage 1 of the next bin): the rho
+-- and weight roots digit by digit (one root bit per clock each, as ms_scale), w N, w SX, w SY
+-- added into the accumulators bit by bit of w.  No ms_divider, ms_isqrt, ms_mult_r4, no delay
+-- memory: stage A's registers hold the bin until it leaves stage 1.
+--
+-- Latency    : learn (both): done 2 + N_BINS + BIN_RD_LAT clocks after start;
+--              track, ITERATIVE = 0: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 1 + M(HIST_W),
 --              RATIO_Q_W + RATIO_Q_W/2 + 2 + M(WEIGHT_W)) clocks after start (rho path: product +
---              isqrt; weight path: divider + isqrt + multiply; core flat: 3 + N_BINS + BIN_RD_LAT + 29)
+--              isqrt; weight path: divider + isqrt + multiply; core flat: 3 + N_BINS + BIN_RD_LAT + 29);
+--              track, ITERATIVE = 1: done T1 + (N_BINS - 1) P + S2 + 2 clocks after start, with
+--              T1 = BIN_RD_LAT + max(RATIO_Q_W + 4, HIST_W + 3) (request -> the bin leaves stage 1),
+--              S2 = max(SQRT_IN_W/2 + 1, RATIO_Q_W) (stage 2 clocks), P = max(T1, S2 + 1) (clocks
+--              per bin); core flat, edge engine (16 bins, BIN_RD_LAT 3): 23 + 15 * 23 + 23 = 391
 --              (start in cycle c, done high in cycle c + latency; tb/test_ms_bin_pass.py asserts it).
--- Throughput : one bin per clock; a pass takes N_BINS + pipeline latency clocks.
+-- Throughput : ITERATIVE = 0: one bin per clock; a pass takes N_BINS + pipeline latency clocks.
+--              ITERATIVE = 1: one bin per P clocks in track passes (whatever the read latency: one
+--              request outstanding, the histogram's later answers only delay the pass).
 -- Handshake  : start/learn sampled when busy = 0; done is a one-clock pulse; s_sum, sw, swx,
 --              swy, k_sum are stable from done until the next accepted start.
 -- Reset      : synchronous, active high; control state only (the Q RAM keeps its contents).
@@ -51,7 +65,8 @@ entity ms_bin_pass is
     RF         : natural := 6;   -- rho fraction bits
     SW_W       : natural := 22;  -- sw bits (unsigned sum w N)
     SWX_W      : natural := 29;  -- swx, swy bits (signed sums w SX, w SY)
-    BIN_RD_LAT : natural := 2    -- latency of the histogram read port (checking only, >= 1)
+    BIN_RD_LAT : natural := 2;   -- latency of the histogram read port (checking only, >= 1)
+    ITERATIVE  : natural := 0    -- 0: one bin per clock (pipelined); 1: iterative arithmetic (see above)
   );
   port (
     clk          : in  std_logic;                             -- clock
@@ -139,6 +154,16 @@ architecture rtl of ms_bin_pass is
   signal wn_m      : unsigned(SW_W - 1 downto 0);
   signal wsx_m     : signed(SWX_W - 1 downto 0);
   signal wsy_m     : signed(SWX_W - 1 downto 0);
+  -- accumulator inputs (from either arithmetic path)
+  signal add_s_en  : std_logic;                                -- s_acc += add_s
+  signal add_s     : unsigned(SQRT_IN_W / 2 - 1 downto 0);
+  signal add_w_en  : std_logic;                                -- sw/swx/swy_acc += add_wn/wsx/wsy
+  signal add_wn    : unsigned(SW_W - 1 downto 0);
+  signal add_wsx   : signed(SWX_W - 1 downto 0);
+  signal add_wsy   : signed(SWX_W - 1 downto 0);
+  signal fin_s     : std_logic;                                -- last bin's term added (rho)
+  signal fin_w     : std_logic;                                -- last bin's terms added (weights)
+  signal it_take   : std_logic;                                -- ITERATIVE: a bin leaves stage 1
   -- accumulators and completion
   signal s_acc     : unsigned(RHO_SUM_W - 1 downto 0);
   signal sw_acc    : unsigned(SW_W - 1 downto 0);
@@ -169,10 +194,18 @@ begin
           learn_r   <= learn;
           rd_en_r   <= '1';
           rd_addr_r <= (others => '0');
-        elsif rd_en_r = '1' then
-          if rd_addr_r = N_BINS - 1 then
-            rd_en_r <= '0';
-          else
+        elsif ITERATIVE = 0 or learn_r = '1' then
+          if rd_en_r = '1' then
+            if rd_addr_r = N_BINS - 1 then
+              rd_en_r <= '0';
+            else
+              rd_addr_r <= rd_addr_r + 1;
+            end if;
+          end if;
+        else                                   -- ITERATIVE track: next bin when one leaves stage 1
+          rd_en_r <= '0';
+          if it_take = '1' and rd_addr_r /= N_BINS - 1 then
+            rd_en_r   <= '1';
             rd_addr_r <= rd_addr_r + 1;
           end if;
         end if;
@@ -226,19 +259,24 @@ begin
         end if;
         va <= bin_rd_valid and not learn_r;
       end if;
-      if ret_cnt = N_BINS - 1 then
-        last_a <= '1';
-      else
-        last_a <= '0';
+      if ITERATIVE = 0 or bin_rd_valid = '1' then   -- ITERATIVE: held until the next bin
+        if ret_cnt = N_BINS - 1 then
+          last_a <= '1';
+        else
+          last_a <= '0';
+        end if;
+        h_a  <= bin_h;
+        q_a  <= unsigned(q_rd);
+        n_a  <= bin_n;
+        sx_a <= bin_sx;
+        sy_a <= bin_sy;
       end if;
-      h_a  <= bin_h;
-      q_a  <= unsigned(q_rd);
-      n_a  <= bin_n;
-      sx_a <= bin_sx;
-      sy_a <= bin_sy;
     end if;
   end process;
 
+  div_n <= shift_left(resize(q_a, DN_W), 2 * WF);
+
+  g_pipe : if ITERATIVE = 0 generate
   ---------------------------------------------------------------- rho path: H Q -> isqrt
   u_mult_hq : entity work.ms_mult_r4
     generic map (A_W => HIST_W, B_W => HIST_W, B_SIGNED => false, P_W => PW, TAG_W => 1)
@@ -253,7 +291,6 @@ begin
               out_valid => sq_ov, out_r => sq_r, out_tag => sq_tag);
 
   ---------------------------------------------------------------- weight path: divide, isqrt, multiply
-  div_n     <= shift_left(resize(q_a, DN_W), 2 * WF);
   div_tag_i <= last_a & (nor h_a);
 
   u_div : entity work.ms_divider
@@ -308,6 +345,177 @@ begin
               in_b => dly_o(POSSUM_W - 1 downto 0), in_tag => "0",
               out_valid => open, signed(out_p) => wsy_m, out_tag => open);
 
+  add_s_en <= sq_ov;
+  add_s    <= sq_r;
+  fin_s    <= sq_ov and sq_tag(0);
+  add_w_en <= vm;
+  add_wn   <= wn_m;
+  add_wsx  <= wsx_m;
+  add_wsy  <= wsy_m;
+  fin_w    <= vm and last_m;
+  it_take  <= '0';
+  end generate;
+
+  ---------------------------------------------------------------- ITERATIVE = 1
+  -- Stage 1 (the bin in stage A, held there): ms_divider_iter (Q << 2WF) / H, RATIO_Q_W + 1
+  -- clocks, and beside it H Q by shift-and-add (HIST_W clocks, multiplier Q in the low half of
+  -- the product register).  Stage 2 (taken when the quotient is out and stage 2 is free; the
+  -- next bin is requested then): the rho root, digit by digit on (H Q) << 2RF, one root bit per
+  -- clock (SQRT_IN_W / 2 clocks), then s_acc += root; beside it the weight root (RATIO_Q_W / 2
+  -- clocks) and w N, w SX, w SY added into the accumulators bit by bit of w, LSB first, with
+  -- N, SX, SY doubling each clock (RATIO_Q_W / 2 clocks).
+  g_iter : if ITERATIVE /= 0 generate
+    constant RR_W   : natural := SQRT_IN_W / 2;             -- rho root bits (steps)
+    constant RRM_W  : natural := RR_W + 3;                  -- its remainder / trial bits
+    constant WR_W   : natural := RATIO_Q_W / 2;             -- weight root bits (steps)
+    constant WRM_W  : natural := WR_W + 3;
+    constant S2_LEN : natural := max(RR_W + 1, 2 * WR_W);   -- stage 2 clocks
+    signal dv_ov   : std_logic;
+    signal dv_q    : unsigned(RATIO_Q_W - 1 downto 0);
+    signal pr      : unsigned(2 * HIST_W downto 0);         -- product high part & multiplier bits left
+    signal k1      : natural range 0 to HIST_W := 0;        -- product steps still to do
+    signal k1_zero : std_logic := '1';                      -- k1 = 0, registered (decided a clock ahead)
+    signal s1_full : std_logic := '0';                      -- quotient ready
+    signal s2_busy : std_logic := '0';
+    signal k2      : natural range 0 to S2_LEN - 1 := 0;
+    signal last2   : std_logic;
+    signal rx      : unsigned(PW - 1 downto 0);             -- H Q, consumed two bits per step
+    signal rrem    : unsigned(RRM_W - 1 downto 0);
+    signal rroot   : unsigned(RR_W - 1 downto 0);
+    signal wx      : unsigned(RATIO_Q_W - 1 downto 0);      -- ratio, consumed two bits per step
+    signal wrem    : unsigned(WRM_W - 1 downto 0);
+    signal wroot   : unsigned(WR_W - 1 downto 0);           -- w, then shifted out LSB first
+    signal an      : unsigned(SW_W - 1 downto 0);           -- N 2**k
+    signal asx     : signed(SWX_W - 1 downto 0);            -- SX 2**k
+    signal asy     : signed(SWX_W - 1 downto 0);            -- SY 2**k
+    signal take    : std_logic;
+  begin
+    assert 2 * HIST_W >= PW
+      report "ms_bin_pass: ITERATIVE needs SQRT_IN_W - 2 RF <= 2 HIST_W" severity failure;
+
+    u_div : entity work.ms_divider_iter
+      generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W)
+      port map (clk => clk, rst => rst, in_valid => va, in_n => div_n, in_d => h_a, busy => open,
+                out_valid => dv_ov, out_q => dv_q);
+
+    take    <= s1_full and k1_zero and not s2_busy;
+    it_take <= take;
+
+    p_s1 : process (clk)
+      variable v : unsigned(2 * HIST_W downto 0);
+    begin
+      if rising_edge(clk) then
+        if va = '0' and k1 <= 1 then                       -- k1 = 0 after this edge
+          k1_zero <= '1';
+        else
+          k1_zero <= '0';
+        end if;
+        if va = '1' then                                   -- product register: 0 & Q
+          pr <= resize(q_a, 2 * HIST_W + 1);
+          k1 <= HIST_W;
+        elsif k1 /= 0 then                                 -- LSB of the multiplier: add H above it
+          v := pr;
+          if v(0) = '1' then
+            v(2 * HIST_W downto HIST_W) := v(2 * HIST_W downto HIST_W) + resize(h_a, HIST_W + 1);
+          end if;
+          pr <= shift_right(v, 1);
+          k1 <= k1 - 1;
+        end if;
+        if dv_ov = '1' then
+          s1_full <= '1';
+        elsif take = '1' then
+          s1_full <= '0';
+        end if;
+        if rst = '1' then
+          k1      <= 0;
+          k1_zero <= '1';
+          s1_full <= '0';
+        end if;
+      end if;
+    end process;
+
+    p_s2 : process (clk)
+      variable rm, tr : unsigned(RRM_W - 1 downto 0);
+      variable dr     : unsigned(RRM_W downto 0);
+      variable wm, tw : unsigned(WRM_W - 1 downto 0);
+      variable dw     : unsigned(WRM_W downto 0);
+    begin
+      if rising_edge(clk) then
+        if take = '1' then
+          rx    <= resize(pr(2 * HIST_W - 1 downto 0), PW);
+          rrem  <= (others => '0');
+          rroot <= (others => '0');
+          if h_a = 0 then                                  -- H = 0: ratio 0 (the divider saturates)
+            wx <= (others => '0');
+          else
+            wx <= dv_q;
+          end if;
+          wrem  <= (others => '0');
+          wroot <= (others => '0');
+          an    <= resize(n_a, SW_W);
+          asx   <= resize(sx_a, SWX_W);
+          asy   <= resize(sy_a, SWX_W);
+          last2 <= last_a;
+          k2    <= 0;
+          s2_busy <= '1';
+        elsif s2_busy = '1' then
+          if k2 < RR_W then                                -- rho root bit (zeros after H Q: << 2RF)
+            rm := shift_left(rrem, 2);
+            rm(1 downto 0) := rx(PW - 1 downto PW - 2);
+            tr := shift_left(resize(rroot, RRM_W), 2);
+            tr(0) := '1';
+            dr := resize(rm, RRM_W + 1) - resize(tr, RRM_W + 1);
+            if dr(RRM_W) = '0' then
+              rrem  <= dr(RRM_W - 1 downto 0);
+              rroot <= shift_left(rroot, 1) or to_unsigned(1, RR_W);
+            else
+              rrem  <= rm;
+              rroot <= shift_left(rroot, 1);
+            end if;
+            rx <= shift_left(rx, 2);
+          end if;
+          if k2 < WR_W then                                -- weight root bit
+            wm := shift_left(wrem, 2);
+            wm(1 downto 0) := wx(RATIO_Q_W - 1 downto RATIO_Q_W - 2);
+            tw := shift_left(resize(wroot, WRM_W), 2);
+            tw(0) := '1';
+            dw := resize(wm, WRM_W + 1) - resize(tw, WRM_W + 1);
+            if dw(WRM_W) = '0' then
+              wrem  <= dw(WRM_W - 1 downto 0);
+              wroot <= shift_left(wroot, 1) or to_unsigned(1, WR_W);
+            else
+              wrem  <= wm;
+              wroot <= shift_left(wroot, 1);
+            end if;
+            wx <= shift_left(wx, 2);
+          elsif k2 < 2 * WR_W then                         -- w bit k2 - WR_W: terms added (add_w_en)
+            wroot <= shift_right(wroot, 1);
+            an    <= shift_left(an, 1);
+            asx   <= shift_left(asx, 1);
+            asy   <= shift_left(asy, 1);
+          end if;
+          if k2 = S2_LEN - 1 then
+            s2_busy <= '0';
+          else
+            k2 <= k2 + 1;
+          end if;
+        end if;
+        if rst = '1' then
+          s2_busy <= '0';
+        end if;
+      end if;
+    end process;
+
+    add_s_en <= '1' when s2_busy = '1' and k2 = RR_W else '0';
+    add_s    <= rroot;
+    fin_s    <= add_s_en and last2;
+    add_w_en <= wroot(0) when s2_busy = '1' and k2 >= WR_W and k2 < 2 * WR_W else '0';
+    add_wn   <= an;
+    add_wsx  <= asx;
+    add_wsy  <= asy;
+    fin_w    <= last2 when s2_busy = '1' and k2 = 2 * WR_W - 1 else '0';
+  end generate;
+
   ---------------------------------------------------------------- accumulators and done
   p_acc : process (clk)
   begin
@@ -322,13 +530,13 @@ begin
         if bin_rd_valid = '1' then
           k_acc <= k_acc + bin_h;
         end if;
-        if sq_ov = '1' then
-          s_acc <= s_acc + resize(sq_r, RHO_SUM_W);
+        if add_s_en = '1' then
+          s_acc <= s_acc + resize(add_s, RHO_SUM_W);
         end if;
-        if vm = '1' then
-          sw_acc  <= sw_acc + wn_m;
-          swx_acc <= swx_acc + wsx_m;
-          swy_acc <= swy_acc + wsy_m;
+        if add_w_en = '1' then
+          sw_acc  <= sw_acc + add_wn;
+          swx_acc <= swx_acc + add_wsx;
+          swy_acc <= swy_acc + add_wsy;
         end if;
       end if;
       if rst = '1' then
@@ -346,10 +554,10 @@ begin
           if bin_rd_valid = '1' and ret_cnt = N_BINS - 1 then
             k_fin <= '1';
           end if;
-          if sq_ov = '1' and sq_tag(0) = '1' then
+          if fin_s = '1' then
             s_fin <= '1';
           end if;
-          if vm = '1' and last_m = '1' then
+          if fin_w = '1' then
             w_fin <= '1';
           end if;
           if busy_r = '1' and done_r = '0' and k_fin = '1'

@@ -13,7 +13,8 @@
 -- Learn mode (learn = 1): one pixel pass at round(clamp(start)); the bin pass stores H as
 -- the model histogram Q and returns K = sum H.
 -- A "pass" = ms_pixel_pass (window bounding box, LANES px/clock) then ms_bin_pass (one bin
--- per clock).  Cycles per iteration: the pixel pass (sum over the window rows of the LANES
+-- per clock; ITER_BINS = 1: iterative arithmetic, one bin per ~23 clocks, see its header).
+-- Cycles per iteration: the pixel pass (sum over the window rows of the LANES
 -- groups of each row's ellipse extent, + 6) + the bin pass (N_BINS + ~35) + ms_centre
 -- (SHIFT_Q_W + 6) + 6 of control; docs/realtime.md, docs/performance.md.
 -- Handshake: `start` pulse while `busy` = 0; `done` pulse with the results (held).
@@ -53,7 +54,8 @@ entity ms_meanshift is
     MAX_ITER     : natural := 20;     -- iteration limit
     ITER_W       : natural := 5;      -- iteration counter bits
     EPS2         : natural := 65536;  -- shift stop threshold, Q.2CF px^2
-    RAM_LAT      : positive := 1      -- region RAM read latency (ms_pixel_pass, 1 .. 3; cycles do not change)
+    RAM_LAT      : positive := 1;     -- region RAM read latency (ms_pixel_pass, 1 .. 3; cycles do not change)
+    ITER_BINS    : natural := 0       -- ms_bin_pass ITERATIVE: 1 = iterative arithmetic (few bins; slower pass)
   );
   port (
     clk       : in  std_logic;                                    -- clock
@@ -159,7 +161,7 @@ begin
     generic map (BIN_W => BIN_W, HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W,
                  SQRT_IN_W => SQRT_IN_W, RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W,
                  WEIGHT_W => WEIGHT_W, WF => WF, RF => RF, SW_W => SW_W, SWX_W => SWX_W,
-                 BIN_RD_LAT => BIN_RD_LAT)
+                 BIN_RD_LAT => BIN_RD_LAT, ITERATIVE => ITER_BINS)
     port map (clk => clk, rst => rst, start => bp_start, learn => learn_r, busy => open,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,

@@ -42,6 +42,12 @@ def test_bin_pass_and_centre_latencies():
     g = synth.CONFIGS["default"].generics()
     assert synth.bin_pass_cycles(g, 512) == 547 and synth.bin_pass_cycles(g, 16) == 51
     assert synth.bin_pass_cycles(g, 512, learn=True) == 517
+    # ITERATIVE = 1 (the edge engine): T1 + 15 P + S2 + 2 = 23 + 15 x 23 + 23, learn unchanged
+    assert synth.bin_pass_cycles(g, 16, iterative=True) == 391
+    assert synth.bin_pass_cycles(g, 16, learn=True, iterative=True) == 21
+    assert synth.edge_bins_iterative()
+    f = synth.cycle_figures("default")
+    assert f.bin_pass_e == 391 and f.iteration_e < f.iteration_c      # the colour loop still decides
     assert synth.centre_cycles(g) == 20
 
 

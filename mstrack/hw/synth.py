@@ -394,7 +394,8 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
 # ----------------------------------------------------------------------------- blocks
 def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
     """Generics of each sub-block as ms_tracker / ms_meanshift map them (colour engine blocks
-    with the colour bin width; ``ms_bin_pass_edge`` is the edge engine's bin pass)."""
+    with the colour bin width; ``ms_bin_pass_edge`` is the edge engine's bin pass, ITERATIVE = 1
+    when ms_tracker maps it so: :func:`edge_bins_iterative`)."""
     cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
     g = cfg.generics()
     pick = lambda *ks: {k: g[k] for k in ks}  # noqa: E731
@@ -413,7 +414,8 @@ def block_generics(cfg: Config | str) -> dict[str, dict[str, int]]:
         "ms_pixel_pass": {"BIN_W": bin_c, **pick("LANES", "HALF_W", "REGION_W", "STRIDE", "ADDR_W", "KERNEL_EPAN",
                                                  "KERNEL_BITS", "KVAL_W", "KD_W", "HIST_W", "COUNT_W", "POSSUM_W")},
         "ms_bin_pass": {"BIN_W": bin_c, "BIN_RD_LAT": 3, **bp},
-        "ms_bin_pass_edge": {"BIN_W": bin_e, "BIN_RD_LAT": 3, **bp},
+        "ms_bin_pass_edge": {"BIN_W": bin_e, "BIN_RD_LAT": 3, **bp,
+                             **({"ITERATIVE": 1} if edge_bins_iterative() else {})},
         "ms_centre": pick("SW_W", "SWX_W", "SHIFT_Q_W", "CF", "REGION_W", "CENTRE_W"),
         "ms_fusion": pick("FEATURES", "RHO_SUM_W", "HIST_W", "CENTRE_ABS_W", "AF", "ALPHA_W", "RF",
                           "RHO_OUT_FRAC", "RHO_OUT_W"),
@@ -576,16 +578,32 @@ def pixel_pass_cycles(ex: int, ey: int, lanes: int, wx_rel: int | None = None,
     return at(wx_rel)
 
 
-def bin_pass_cycles(g: dict[str, int], n_bins: int, learn: bool = False) -> int:
-    """ms_bin_pass: start -> done (docs/blocks/ms_bin_pass.md) for N_BINS = n_bins."""
+def bin_pass_cycles(g: dict[str, int], n_bins: int, learn: bool = False, iterative: bool = False) -> int:
+    """ms_bin_pass: start -> done (docs/blocks/ms_bin_pass.md) for N_BINS = n_bins; ``iterative``:
+    generic ITERATIVE = 1 (iterative arithmetic, one bin per P clocks in track passes)."""
     if learn:
         return 2 + n_bins + BIN_RD_LAT
+    if iterative:   # T1 + (N_BINS - 1) P + S2 + 2 (header of rtl/ms_bin_pass.vhd)
+        t1 = BIN_RD_LAT + max(g["RATIO_Q_W"] + 4, g["HIST_W"] + 3)
+        s2 = max(g["SQRT_IN_W"] // 2 + 1, g["RATIO_Q_W"])
+        return t1 + (n_bins - 1) * max(t1, s2 + 1) + s2 + 2
     def mult(a_w: int) -> int:   # ms_mult_r4 latency, 1 + max(1, ceil(log2(ceil(A_W / 2))))
         return 1 + max(1, (((a_w + 1) // 2) - 1).bit_length())
     if "ms_mult_r4" not in _rtl_text("ms_bin_pass"):     # RTL before the LUT multipliers
         return 3 + n_bins + BIN_RD_LAT + max(g["SQRT_IN_W"] // 2 + 2, g["RATIO_Q_W"] + g["RATIO_Q_W"] // 2 + 3)
     return 3 + n_bins + BIN_RD_LAT + max(g["SQRT_IN_W"] // 2 + 1 + mult(g["HIST_W"]),
                                          g["RATIO_Q_W"] + g["RATIO_Q_W"] // 2 + 2 + mult(g["WEIGHT_W"]))
+
+
+def edge_bins_iterative() -> bool:
+    """True when the modelled RTL (working tree or --rtl-commit) maps the edge engine's bin pass
+    with iterative arithmetic (``ITER_BINS => 1`` in ms_tracker's u_edge, ms_bin_pass ITERATIVE)."""
+    t = _rtl_text("ms_tracker")
+    i = t.find("u_edge : entity work.ms_meanshift")
+    if i < 0:
+        return False
+    j = t.find("port map", i)
+    return re.search(r"ITER_BINS\s*=>\s*1\b", t[i:j]) is not None
 
 
 def centre_cycles(g: dict[str, int]) -> int:
@@ -601,7 +619,7 @@ def n_bins(g: dict[str, int]) -> tuple[int, int]:
 
 
 def engine_cycles(g: dict[str, int], pixel_passes: Sequence[int], bins: int, iterations: int,
-                  stop: str = "max_iter") -> int:
+                  stop: str = "max_iter", iterative: bool = False) -> int:
     """One ms_meanshift run in track mode: clocks from the cycle of its ``start`` pulse to the
     cycle of its ``done`` pulse (the blocks' convention: start in cycle c, done in cycle c + N).
 
@@ -610,9 +628,9 @@ def engine_cycles(g: dict[str, int], pixel_passes: Sequence[int], bins: int, ite
     per pass P + L (+ 1 handshake into ms_bin_pass); first centre + 4 (S_BIN_WAIT -> ms_centre,
     S_CENTRE_WAIT, S_PASS); each further iteration C + L + K + ITER_OVERHEAD (adds S_DIFF,
     S_DECIDE); the last pass leaves from S_DECIDE through S_FINISH (+ 5).  "lost" leaves from
-    S_CENTRE_WAIT through S_FINISH.
+    S_CENTRE_WAIT through S_FINISH.  ``iterative``: the engine's ms_bin_pass has ITERATIVE = 1.
     """
-    L = bin_pass_cycles(g, bins)
+    L = bin_pass_cycles(g, bins, iterative=iterative)
     K = centre_cycles(g)
     n = iterations
     if stop == "lost":
@@ -686,12 +704,13 @@ def cycle_figures(cfg: Config | str, w: int = 64, h: int = 64, iterations: int |
     tp, fp = cfg.params()
     xr = row_extents(w, h, tp.kernel, fp.kernel_bits) if scan_kind() == "rows" else None
     pp = pixel_pass_cycles(ex, ey, g["LANES"], None, xr)
+    it_e = edge_bins_iterative()
     ec = engine_cycles(g, [pp] * (n + 1), nc, n)
-    ee = engine_cycles(g, [pp] * (n + 1), ne, n)
+    ee = engine_cycles(g, [pp] * (n + 1), ne, n, iterative=it_e)
     return CycleFigures(cfg.name, w, h, (2 * ex + 1) * (2 * ey + 1), pp, bin_pass_cycles(g, nc),
-                        bin_pass_cycles(g, ne), centre_cycles(g),
+                        bin_pass_cycles(g, ne, iterative=it_e), centre_cycles(g),
                         pp + bin_pass_cycles(g, nc) + centre_cycles(g) + ITER_OVERHEAD,
-                        pp + bin_pass_cycles(g, ne) + centre_cycles(g) + ITER_OVERHEAD,
+                        pp + bin_pass_cycles(g, ne, iterative=it_e) + centre_cycles(g) + ITER_OVERHEAD,
                         frame_latency(g, ec, ee))
 
 
@@ -709,6 +728,7 @@ def model_latencies(frames: Sequence, box: tuple[int, int, int, int], cfg: Confi
     nc, ne = n_bins(g)
     tr = FixedTracker(tp, fp)
     rows = scan_kind() == "rows"
+    it_e = edge_bins_iterative()
     out = []
     for i, fr in enumerate(frames):
         if i == 0:
@@ -726,7 +746,7 @@ def model_latencies(frames: Sequence, box: tuple[int, int, int, int], cfg: Confi
         eng = {}
         for f, key, nb in (("c", "iter_colour", nc), ("e", "iter_edge", ne)):
             passes = [pixel_pass_cycles(ker.ex, ker.ey, L, p["win"][0] - t["region"][0], xr) for p in t[key]]
-            eng[f] = engine_cycles(g, passes, nb, e[f"iter_{f}"], e[f"stop_{f}_name"])
+            eng[f] = engine_cycles(g, passes, nb, e[f"iter_{f}"], e[f"stop_{f}_name"], iterative=f == "e" and it_e)
         out.append({"latency": frame_latency(g, eng["c"], eng["e"]), "iter_c": e["iter_c"], "iter_e": e["iter_e"],
                     "engine_c": eng["c"], "engine_e": eng["e"]})
     return out

@@ -28,9 +28,7 @@
 --
 -- Not built yet (status): the lost state (D x 2, the wider region, the 8 search start points,
 -- re-acquisition): while lost this core keeps tracking as if not lost, so frames after the first
--- `lost` search state differ from the model.  The decimated frame's border row / column (pixel 0
--- and Wd - 1) do not reach ms_bg_model (the front end streams the frame interior only): an init
--- whose background ring reaches the decimated border differs from the model.
+-- `lost` search state differ from the model.
 --
 -- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
 -- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
@@ -245,7 +243,11 @@ architecture rtl of ms_tracker_v2 is
   signal bg_rst, bg_rst_p, bg_start, bg_busy, bg_counting, bg_done : std_logic := '0';
   signal bg_got       : std_logic := '0';
   signal bg_cx, bg_cy : unsigned(COORD_W - 1 downto 0) := (others => '0');
-  signal bg_px_valid, bg_px_last : std_logic;
+  signal bg_px_valid, bg_px_last : std_logic := '0';
+  signal bg_px_bin    : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal av_valid     : std_logic;
+  signal av_x, av_y   : unsigned(COORD_W - 1 downto 0);
+  signal av_cbin      : std_logic_vector(BIN_C_W - 1 downto 0);
   signal bg_px_x, bg_px_y : unsigned(COORD_W - 1 downto 0);
   signal m_rd_addr    : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
   signal m_qn         : unsigned(16 downto 0);
@@ -424,7 +426,8 @@ begin
               in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
               ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
               frame_start => fe_start, frame_end => fe_end, frame_error => fe_error,
-              error_now => fe_err_now, err_code => fe_code);
+              error_now => fe_err_now, err_code => fe_code,
+              av_valid => av_valid, av_x => av_x, av_y => av_y, av_cbin => av_cbin);
 
   u_dec : entity work.ms_decimate
     generic map (COORD_W => COORD_W, LOG2_D_MAX => 4, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2)
@@ -453,12 +456,35 @@ begin
               raddr => ram_addr, rdata => ram_data);
 
   ---------------------------------------------------------------------------- background model
-  -- the decimated interior pixels; one extra beat at dp_end (coordinates all ones: outside the box
-  -- and its ring) carries px_last
-  bg_px_valid <= dp_valid or dp_end;
-  bg_px_last  <= dp_end;
-  bg_px_x     <= (others => '1') when dp_end = '1' else dp_x;
-  bg_px_y     <= (others => '1') when dp_end = '1' else dp_y;
+  -- every pixel (x, y) of the decimated frame frame[::D, ::D] (x mod D = 0, y mod D = 0, border
+  -- included: the front end's av_* stream), at (x / D, y / D); one extra beat at dp_end, after the
+  -- frame's last pixel (coordinates all ones: outside the box and its ring), carries px_last
+  p_bgpx : process(clk)
+    variable m : unsigned(COORD_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      m := shift_left(to_unsigned(1, COORD_W), to_integer(l2d)) - 1;
+      if dp_end = '1' then
+        bg_px_valid <= '1';
+        bg_px_last <= '1';
+        bg_px_x <= (others => '1');
+        bg_px_y <= (others => '1');
+      else
+        bg_px_valid <= '0';
+        if av_valid = '1' and (av_x and m) = 0 and (av_y and m) = 0 then
+          bg_px_valid <= '1';
+        end if;
+        bg_px_last <= '0';
+        bg_px_x <= shift_right(av_x, to_integer(l2d));
+        bg_px_y <= shift_right(av_y, to_integer(l2d));
+      end if;
+      bg_px_bin <= av_cbin;
+      if rst = '1' then
+        bg_px_valid <= '0';
+        bg_px_last <= '0';
+      end if;
+    end if;
+  end process;
   bg_rst      <= rst or bg_rst_p;
 
   u_bg : entity work.ms_bg_model
@@ -467,7 +493,7 @@ begin
     port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy,
               wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1), ring16 => to_unsigned(RING16, 5),
               busy => bg_busy, counting => bg_counting, done => bg_done,
-              px_valid => bg_px_valid, px_bin => unsigned(dp_cbin), px_x => bg_px_x, px_y => bg_px_y,
+              px_valid => bg_px_valid, px_bin => unsigned(bg_px_bin), px_x => bg_px_x, px_y => bg_px_y,
               px_last => bg_px_last, n_box => open, n_ring => open, o_min => open, qv_sum => open,
               m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t);
 

@@ -193,3 +193,11 @@ def test_tracker_v2_synthetic(variant, tmp_path):
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
     _run(job, f"ms_tracker_v2_synth_{variant}")
+
+
+def test_tracker_v2_real_frames(tmp_path):
+    """GHDL, default v2 generics: init + tracking frames of a real sequence (Girl, 128x96; the
+    background ring of the init box reaches the frame border)."""
+    seq = _seq("Girl")
+    job = {"seq": str(seq), "n": 5, "box": list(_gt_box(seq)), "report": str(tmp_path / "r.json")}
+    _run(job, "ms_tracker_v2_real")

@@ -113,7 +113,10 @@ entity ms_tracker_v2 is
     CONF_REACQUIRE : natural := 32768;
     SPREAD_DEFAULT : natural := 2581110;  -- spread_ref when the init spread is 0: (128 << (KB + 16)) / (16 + PAD16)**2
     BG_Q_W         : natural := 14;
-    BG_O_W         : natural := 17
+    BG_O_W         : natural := 17;
+    SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
+    STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
+    MARGIN_MAX     : natural := 255       -- largest region margin (MARGIN + the search offset)
   );
   port (
     clk                  : in  std_logic;
@@ -162,7 +165,8 @@ architecture rtl of ms_tracker_v2 is
   constant ST_ERROR  : unsigned(2 downto 0) := "110";
 
   type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BG_RST, T_BG_START, T_BG_WAIT,
-                    T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_STATS0, T_STATS, T_CONF,
+                    T_REGION, T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
+                    T_CNEXT, T_STATS0, T_STATS, T_CONF,
                     T_DECIDE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
   signal state : tstate_t := T_PREP;
 
@@ -174,6 +178,7 @@ architecture rtl of ms_tracker_v2 is
   signal rho_s, con_s : signed(CON_W - 1 downto 0) := (others => '0');
   signal spread_ref   : unsigned(SPREAD_W - 1 downto 0) := (others => '0');
   signal lost_st, reported_lost : std_logic := '0';
+  signal lost_st_frame : std_logic := '0';             -- lost_st of the frame being finished
   signal tgt_w, tgt_h : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
   signal in_fw, in_fh : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
 
@@ -185,6 +190,15 @@ architecture rtl of ms_tracker_v2 is
   signal ex_r, ey_r   : unsigned(HALF_W - 1 downto 0) := to_unsigned(1, HALF_W);
   signal s8x, s8y     : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');      -- start centre (decimated)
   signal k_acc        : unsigned(HIST_W - 1 downto 0) := (others => '0');
+  signal margin_r     : unsigned(COORD_W - 1 downto 0) := to_unsigned(MARGIN, COORD_W);  -- region margin of this frame
+  signal ox_r, oy_r   : unsigned(COORD_W - 1 downto 0) := (others => '0');                -- search offsets (decimated px)
+  -- start points: 0 the last centre, 1 .. 8 (while lost) the centre +- (ox, oy)
+  signal cand         : unsigned(3 downto 0) := (others => '0');
+  signal eng_cx, eng_cy : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
+  signal eng_max_it   : unsigned(ITER_W - 1 downto 0) := to_unsigned(MAX_ITER, ITER_W);
+  signal best_cx, best_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal best_s       : unsigned(RHO_SUM_W - 1 downto 0);
+  signal best_conf    : unsigned(16 downto 0);
   signal region_ok    : std_logic := '0';
   signal rg_valid_in, rg_valid : std_logic := '0';
   signal rg_x, rg_y   : unsigned(COORD_W - 1 downto 0);
@@ -299,7 +313,7 @@ architecture rtl of ms_tracker_v2 is
     nt, n_in, nt_in : unsigned(COUNT_W - 1 downto 0);
     st2 : unsigned(ST2_W - 1 downto 0);
   end record;
-  signal st_cur, st_prev, st_fin : stats_t;
+  signal st_cur, st_prev, st_fin, best_st : stats_t;
 
   -- per-frame results
   signal r_cx, r_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
@@ -528,13 +542,6 @@ begin
               clip_x => bc_x, clip_y => bc_y, clip_w => bc_w, clip_h => bc_h, ex => open,
               ey => open, cx => bc_cx, cy => bc_cy);
 
-  u_region : entity work.ms_region
-    generic map (COORD_W => COORD_W, HALF_W => HALF_W, REGION_W => REGION_W, MARGIN => MARGIN, CF => CF)
-    port map (clk => clk, rst => rst, in_valid => rg_valid_in, cx => s8x, cy => s8y, ex => ex_r,
-              ey => ey_r, frame_w => dw, frame_h => dh, out_valid => rg_valid,
-              reg_x => rg_x, reg_y => rg_y, reg_w => rg_w, reg_h => rg_h, hi_x => rg_hi_x,
-              hi_y => rg_hi_y);
-
   u_tables : entity work.ms_kernel_tables
     generic map (HALF_W => HALF_W, KERNEL_EPAN => 1, KERNEL_BITS => KERNEL_BITS, KVAL_W => KT_W, KD_W => KD_W)
     port map (clk => clk, rst => rst, start => kt_start, w => resize(wd, HALF_W + 1),
@@ -563,10 +570,10 @@ begin
               kt_tb => kt_tb, kt_ka => kt_ka(KVAL_W - 1 downto 0), kt_kb => kt_kb(KVAL_W - 1 downto 0),
               kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
               reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
-              learn => '0', start_cx => s8x, start_cy => s8y, busy => c_busy, done => c_done,
+              learn => '0', start_cx => eng_cx, start_cy => eng_cy, busy => c_busy, done => c_done,
               res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
               res_k => c_k, ram_addr => ram_addr, ram_data => ram_data,
-              single => eng_single, max_it => to_unsigned(MAX_ITER, ITER_W),
+              single => eng_single, max_it => eng_max_it,
               q_ext_we => ms_out_valid, q_ext_addr => unsigned(ms_out_tag), q_ext_data => ms_out_qw,
               px_valid => px_valid, px_mask => px_mask, px_dx => px_dx, px_dy => px_dy, px_last => px_last);
 
@@ -690,6 +697,31 @@ begin
     variable srch  : unsigned(2 downto 0);
     variable stat  : unsigned(2 downto 0);
     variable lost_now : std_logic;
+    variable mx       : unsigned(COORD_W - 1 downto 0);
+    variable srch4    : unsigned(3 downto 0);
+    variable rst_v, rn_v, rh_v : unsigned(COORD_W - 1 downto 0);
+    variable sxo, syo : signed(CENTRE_ABS_W + 1 downto 0);
+    -- one axis of ms_region: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
+    -- hi (region-relative) = n - 1 - e
+    procedure region_axis(c : unsigned; e : unsigned; sz : unsigned; m : unsigned;
+                          variable st, n, hi : out unsigned(COORD_W - 1 downto 0)) is
+      constant SW : natural := COORD_W + 3;
+      variable es, ss, ms, rc, na, nn, t, a : signed(SW - 1 downto 0);
+    begin
+      es := signed(resize(e, SW));
+      ss := signed(resize(sz, SW));
+      ms := signed(resize(m, SW));
+      rc := signed(resize(shift_right(c + to_unsigned(2 ** (CF - 1), c'length), CF), SW));
+      na := shift_left(es, 1) + shift_left(ms, 1) + 1;
+      if na < ss - 2 then nn := na; else nn := ss - 2; end if;
+      a := rc - es - ms;
+      t := ss - 1 - nn;
+      if a > t then a := t; end if;
+      if a < 1 then a := to_signed(1, SW); end if;
+      st := unsigned(a(COORD_W - 1 downto 0));
+      n := unsigned(nn(COORD_W - 1 downto 0));
+      hi := unsigned(resize(nn - 1 - es, COORD_W));
+    end procedure;
   begin
     if rising_edge(clk) then
       bc_valid <= '0';
@@ -740,7 +772,11 @@ begin
 
         when T_DEC_WAIT =>
           if dec_out_valid = '1' then
-            l2d <= resize(dec_l2, 3);
+            if lost_st = '1' then                -- while lost: D x 2
+              l2d <= resize(dec_l2, 3) + 1;
+            else
+              l2d <= resize(dec_l2, 3);
+            end if;
             state <= T_DEC;
           end if;
 
@@ -763,14 +799,32 @@ begin
             ey_r <= resize(shift_right(ws_h - 1, 1), HALF_W);
             wb <= bs_w;
             hb <= bs_h;
-            rg_valid_in <= '1';
-            state <= T_REGION_WAIT;
+            -- search offsets ox, oy = (step16 wd) >> 4, (step16 hd) >> 4; the region margin grows by
+            -- max(ox, oy) while lost (at most MARGIN_MAX)
+            ox_r <= resize(shift_right(resize(ws_w, COORD_W + 6) * STEP16, 4), COORD_W);
+            oy_r <= resize(shift_right(resize(ws_h, COORD_W + 6) * STEP16, 4), COORD_W);
+            state <= T_REGION;
           end if;
 
-        when T_REGION_WAIT =>
-          if rg_valid = '1' then
-            reg_x <= rg_x; reg_y <= rg_y; reg_w <= rg_w; reg_h <= rg_h;
-            hi_x <= rg_hi_x; hi_y <= rg_hi_y;
+        when T_REGION =>
+          if lost_st = '1' then
+            if ox_r >= oy_r then mx := ox_r; else mx := oy_r; end if;
+            if mx + MARGIN > MARGIN_MAX then
+              margin_r <= to_unsigned(MARGIN_MAX, COORD_W);
+            else
+              margin_r <= mx + MARGIN;
+            end if;
+          else
+            margin_r <= to_unsigned(MARGIN, COORD_W);
+          end if;
+          state <= T_REGION_WAIT;
+
+        when T_REGION_WAIT =>                  -- mstrack.fixed.blocks.ms_region with this margin
+          region_axis(s8x, ex_r, dw, margin_r, rst_v, rn_v, rh_v);
+          reg_x <= rst_v; reg_w <= resize(rn_v, REGION_W); hi_x <= resize(rh_v, REGION_W);
+          region_axis(s8y, ey_r, dh, margin_r, rst_v, rn_v, rh_v);
+          reg_y <= rst_v; reg_h <= resize(rn_v, REGION_W); hi_y <= resize(rh_v, REGION_W);
+          if true then
             if init_pending = '1' then
               state <= T_BOX;
             else
@@ -916,18 +970,78 @@ begin
           end if;
           if ql_seen = N_BINS then
             eng_single <= init_pending;
+            eng_cx <= s8x;
+            eng_cy <= s8y;
+            if lost_st = '1' then
+              eng_max_it <= to_unsigned(SEARCH_ITER, ITER_W);
+            else
+              eng_max_it <= to_unsigned(MAX_ITER, ITER_W);
+            end if;
+            cand <= (others => '0');
             eng_start <= '1';
             state <= T_RUN;
           end if;
 
         when T_RUN =>
           if c_done = '1' then
-            r_cx <= c_cx; r_cy <= c_cy; r_s <= c_s; r_iter <= c_iter; r_stop <= c_stop;
+            r_cx <= c_cx; r_cy <= c_cy; r_s <= c_s;
+            if cand = 0 then                     -- iterations and stop of the centre's run
+              r_iter <= c_iter; r_stop <= c_stop;
+            end if;
             if c_stop = STOP_RHO then
               st_fin <= st_prev;
             else
               st_fin <= st_cur;
             end if;
+            state <= T_C0;
+          end if;
+
+        -- confidence of this start point's result; the best (the centre, then strictly better) wins
+        when T_C0 =>
+          got <= (others => '0');
+          fu_start <= '1'; sh_start <= '1';
+          state <= T_C1;
+
+        when T_C1 =>
+          if fu_done = '1' then got(0) <= '1'; rho <= fu_rho; end if;
+          if sh_done = '1' then got(1) <= '1'; share <= sh_share; end if;
+          if got(1 downto 0) = "11" then
+            cf_start <= '1';
+            state <= T_C2;
+          end if;
+
+        when T_C2 =>
+          if cf_done = '1' then
+            if cand = 0 or conf > best_conf then
+              best_cx <= r_cx; best_cy <= r_cy; best_s <= r_s; best_st <= st_fin; best_conf <= conf;
+            end if;
+            state <= T_CNEXT;
+          end if;
+
+        when T_CNEXT =>
+          if lost_st = '1' and init_pending = '0' and cand /= 8 then
+            -- next start point (sx, sy) in (-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)
+            sxo := signed(resize(s8x, CENTRE_ABS_W + 2));
+            syo := signed(resize(s8y, CENTRE_ABS_W + 2));
+            case to_integer(cand) is
+              when 0 | 3 | 5 => sxo := sxo - signed(resize(shift_left(resize(ox_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when 2 | 4 | 7 => sxo := sxo + signed(resize(shift_left(resize(ox_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when others => null;
+            end case;
+            case to_integer(cand) is
+              when 0 | 1 | 2 => syo := syo - signed(resize(shift_left(resize(oy_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when 5 | 6 | 7 => syo := syo + signed(resize(shift_left(resize(oy_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when others => null;
+            end case;
+            if sxo < 0 then sxo := (others => '0'); end if;
+            if syo < 0 then syo := (others => '0'); end if;
+            eng_cx <= unsigned(sxo(CENTRE_ABS_W - 1 downto 0));
+            eng_cy <= unsigned(syo(CENTRE_ABS_W - 1 downto 0));
+            cand <= cand + 1;
+            eng_start <= '1';
+            state <= T_RUN;
+          else
+            r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s; st_fin <= best_st;
             state <= T_STATS0;
           end if;
 
@@ -994,6 +1108,7 @@ begin
             if reported_lost = '1' then stat := ST_REACQ; else stat := ST_OK; end if;
           end if;
           status_r <= stat;
+          lost_st_frame <= lost_st;
           lost_st <= lost_now;
           if stat = ST_LOST or (stat = ST_UNC and reported_lost = '1') then
             reported_lost <= '1';
@@ -1046,7 +1161,8 @@ begin
                              "000", frame_count);
           else
             if status_r = ST_LOST then lost_now := '1'; else lost_now := '0'; end if;
-            res_word <= pack(c8x, c8y, w8, h8, rho, conf, status_r, r_iter, r_stop, l2d, to_unsigned(0, 4),
+            if lost_st_frame = '1' then srch := "000"; srch4 := to_unsigned(8, 4); else srch4 := to_unsigned(0, 4); end if;
+            res_word <= pack(c8x, c8y, w8, h8, rho, conf, status_r, r_iter, r_stop, l2d, srch4,
                              flags_of('0', '0', lost_now, '0', rejected_pending, '0', overflow),
                              "000", frame_count);
           end if;

@@ -311,5 +311,21 @@ class CoreConfigV2:
         g["CONF_REACQUIRE"] = q16(tp.conf_reacquire)
         g["SPREAD_DEFAULT"] = (128 << (fp.kernel_bits + 16)) // (16 + pad16) ** 2
         g["RESULT_W"] = result_width_v2(core_generics(tp, fp, self.lanes))
+        # the lost state: start points +- search_step windows, the region margin grows by that offset
+        # (at most 255, as the model); the region RAM and the engine's region widths hold the widest
+        # such region (or the widest frame's interior)
+        step16 = sixteenths(tp.search_step, "search_step")
+        g["SEARCH_ITER"] = tp.search_iter
+        g["STEP16"] = step16
+        g["MARGIN_MAX"] = 255
+        win = 2 * fp.max_half + 1
+        rmax = min(win + 2 * min(fp.margin + ((step16 * win) >> 4), 255), self.max_frame_w - 2)
+        rmax = max(rmax, g["REGION_MAX"])
+        stride = -(-rmax // self.lanes)
+        g["REGION_MAX"] = rmax
+        g["REGION_W"] = rmax.bit_length()
+        g["STRIDE"] = stride
+        g["ADDR_W"] = (rmax * stride - 1).bit_length()
+        g["CENTRE_W"] = g["REGION_W"] + fp.centre_frac
         g["MAX_FRAME_W"] = self.max_frame_w
         return g

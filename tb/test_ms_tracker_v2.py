@@ -199,7 +199,7 @@ def test_tracker_v2_real_frames(tmp_path):
     """GHDL, default v2 generics: init + tracking frames of a real sequence (Girl, 128x96; the
     background ring of the init box reaches the frame border)."""
     seq = _seq("Girl")
-    job = {"seq": str(seq), "n": 5, "box": list(_gt_box(seq)), "report": str(tmp_path / "r.json")}
+    job = {"seq": str(seq), "n": 3, "box": list(_gt_box(seq)), "report": str(tmp_path / "r.json")}
     _run(job, "ms_tracker_v2_real")
 
 
@@ -237,3 +237,16 @@ def test_tracker_v2_fastsim_real(name, start, n, pin, pout):
     exp = expected_results_v2(frames, box)
     diffs = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
     assert not diffs, "\n".join(diffs[:10])
+
+
+#: the long run (issue 11: >= 1,500 real frames): whole sequences, 1,545 frames in all
+LONG_RUNS = [("Girl", 500), ("Couple", 140), ("Crossing", 120), ("Subway", 175), ("Football1", 74),
+             ("Deer", 71), ("MotorRolling", 164), ("bag_vot", 196), ("ball1_vot", 105)]
+
+
+@pytest.mark.skipif(not os.environ.get("MSTRACK_V2_LONG"), reason="long run: set MSTRACK_V2_LONG=1")
+@pytest.mark.parametrize("name,n", LONG_RUNS, ids=[r[0] for r in LONG_RUNS])
+def test_tracker_v2_fastsim_long(name, n):
+    """Verilator: whole real sequences through ms_tracker_v2 (1,545 frames), bit-exact, 1080p-like
+    horizontal blanking off (frames back to back)."""
+    test_tracker_v2_fastsim_real(name, 0, n, 0, 0)

@@ -2,20 +2,24 @@
 -- bit for bit, on the ports and stream behaviour of ms_tracker, with result word v2.
 --
 -- Computes, per video frame (docs/blocks/ms_tracker_v2.md, docs/architecture.md "Core v2"):
---   before the frame (between frames, input closed): log2 D = ms_decimation(w8, h8) (+ 1 while lost:
---   not built yet, see below), the decimated frame size ((W - 1) >> log2 D) + 1, the window
---   diameters wd, hd = ms_window_size, the region ms_region(c8 >> log2 D, (wd - 1) / 2, (hd - 1) / 2)
---   in decimated px; on an init frame also the box (ms_box_size, centre clamped into the decimated
---   interior) and the start of ms_bg_model (it counts the init frame's pixels);
+--   before the frame (between frames, input closed): log2 D = ms_decimation(w8, h8) (+ 1 while the
+--   search state is lost: D x 2), the decimated frame size ((W - 1) >> log2 D) + 1, the window
+--   diameters wd, hd = ms_window_size, the search offsets ox, oy = (STEP16 wd, hd) >> 4, the region
+--   (mstrack.fixed.blocks.ms_region, inline: margin MARGIN, + max(ox, oy) while lost, at most
+--   MARGIN_MAX) around c8 >> log2 D, in decimated px; on an init frame also the box (ms_box_size,
+--   centre clamped into the decimated interior) and the start of ms_bg_model;
 --   during the frame: ms_frontend -> ms_decimate -> ms_region_capture (colour region RAM) and,
---   on the init frame, ms_bg_model;
+--   on the init frame, every pixel of the decimated frame (border included: ms_frontend av_*)
+--   into ms_bg_model;
 --   after the frame: ms_kernel_tables (wd, hd; flat pass tables + the KA/KB of ms_target_stats;
 --   K = the window's pixel count summed from the row extents XR), Qw = ms_model_scale(Qn, K)
 --   written into the engine's Q RAM (and T into ms_target_stats), ms_meanshift from c8 >> log2 D
 --   (init frame: one pass without moving, `single`), ms_target_stats on the pixel-pass tap (the
---   statistics of the pass at the result centre), then rho (ms_fusion, colour only), ms_share,
---   ms_spread, ms_ring_share, ms_confidence, ms_loss_filter x 2, ms_loss_flag, the search state and
---   the reported status, ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
+--   statistics of the pass at the result centre), rho (ms_fusion, colour only), ms_share and
+--   ms_confidence of the result; while lost 8 more start points (c +- (ox, oy)) x SEARCH_ITER
+--   iterations in the same region, the best confidence wins; then for the winner ms_spread,
+--   ms_ring_share, ms_loss_filter x 2, ms_loss_flag, the search state and the reported status,
+--   ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
 -- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
 -- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
 --
@@ -26,14 +30,15 @@
 -- init frame (a frame cut by a new start of frame while the init is pending is not handled: that
 -- next frame's first pixels are missed by the model).
 --
--- Not built yet (status): the lost state (D x 2, the wider region, the 8 search start points,
--- re-acquisition): while lost this core keeps tracking as if not lost, so frames after the first
--- `lost` search state differ from the model.
+-- Status: bit-exact with the model on generated scenes (GHDL) and real sequences (Verilator),
+-- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Not timed or
+-- synthesised yet (the inline region computation is one combinational clock).
 --
 -- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
 -- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
--- statistics and about 230 of confidence, loss flag, scale and resize; on the init frame
--- ms_bg_model's 3 N_BINS + 61 clocks first.  Throughput: 1 pixel per clock while a frame streams;
+-- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
+-- shifts with their confidence; on the init frame ms_bg_model's 3 N_BINS + 61 clocks first.
+-- Measured: docs/blocks/ms_tracker_v2.md (tools/v2_latency.py).  Throughput: 1 pixel per clock while a frame streams;
 -- the input is closed from a frame's last pixel until its result is in the FIFO (as ms_tracker).
 -- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1).
 library ieee;
@@ -200,10 +205,6 @@ architecture rtl of ms_tracker_v2 is
   signal best_s       : unsigned(RHO_SUM_W - 1 downto 0);
   signal best_conf    : unsigned(16 downto 0);
   signal region_ok    : std_logic := '0';
-  signal rg_valid_in, rg_valid : std_logic := '0';
-  signal rg_x, rg_y   : unsigned(COORD_W - 1 downto 0);
-  signal rg_w, rg_h   : unsigned(REGION_W - 1 downto 0);
-  signal rg_hi_x, rg_hi_y : unsigned(REGION_W - 1 downto 0);
   signal reg_x, reg_y : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal hi_x, hi_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
@@ -704,7 +705,7 @@ begin
     -- one axis of ms_region: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
     -- hi (region-relative) = n - 1 - e
     procedure region_axis(c : unsigned; e : unsigned; sz : unsigned; m : unsigned;
-                          variable st, n, hi : out unsigned(COORD_W - 1 downto 0)) is
+                          variable o_st, o_n, o_hi : out unsigned(COORD_W - 1 downto 0)) is
       constant SW : natural := COORD_W + 3;
       variable es, ss, ms, rc, na, nn, t, a : signed(SW - 1 downto 0);
     begin
@@ -718,16 +719,15 @@ begin
       t := ss - 1 - nn;
       if a > t then a := t; end if;
       if a < 1 then a := to_signed(1, SW); end if;
-      st := unsigned(a(COORD_W - 1 downto 0));
-      n := unsigned(nn(COORD_W - 1 downto 0));
-      hi := unsigned(resize(nn - 1 - es, COORD_W));
+      o_st := unsigned(a(COORD_W - 1 downto 0));
+      o_n := unsigned(nn(COORD_W - 1 downto 0));
+      o_hi := unsigned(resize(nn - 1 - es, COORD_W));
     end procedure;
   begin
     if rising_edge(clk) then
       bc_valid <= '0';
       kt_start <= '0';
       eng_start <= '0';
-      rg_valid_in <= '0';
       fifo_valid <= '0';
       dec_in_valid <= '0';
       ws_in_valid <= '0';

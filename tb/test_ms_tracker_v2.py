@@ -187,9 +187,9 @@ def _run(job: dict, build_name: str) -> None:
 
 @pytest.mark.parametrize("variant", ["plain", "throttled"])
 def test_tracker_v2_synthetic(variant, tmp_path):
-    """GHDL: init (background-weighted model) + tracking frames of a generated 96x72 scene, full
+    """GHDL: init (background-weighted model) + 3 tracking frames of a generated 96x72 scene, full
     speed and throttled (random input gaps, result back-pressure)."""
-    job = {"synthetic": {"n": 6, "w": 96, "h": 72, "seed": 3}, "box": [17, 34, 24, 24],
+    job = {"synthetic": {"n": 4, "w": 96, "h": 72, "seed": 3}, "box": [17, 34, 24, 24],
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
     _run(job, f"ms_tracker_v2_synth_{variant}")

@@ -89,7 +89,11 @@ entity ms_bin_pass is
     sw           : out unsigned(SW_W - 1 downto 0);           -- sum w N (track)
     swx          : out signed(SWX_W - 1 downto 0);            -- sum w SX (track)
     swy          : out signed(SWX_W - 1 downto 0);            -- sum w SY (track)
-    k_sum        : out unsigned(HIST_W - 1 downto 0)          -- sum H (K in learn mode)
+    k_sum        : out unsigned(HIST_W - 1 downto 0);         -- sum H (K in learn mode)
+    -- external Q write port (core v2 loads Qw = ms_model_scale(Qn, K) per frame; only while idle)
+    q_ext_we     : in  std_logic := '0';                      -- write Q[q_ext_addr]
+    q_ext_addr   : in  unsigned(BIN_W - 1 downto 0) := (others => '0');
+    q_ext_data   : in  unsigned(HIST_W - 1 downto 0) := (others => '0')
   );
 end entity;
 
@@ -118,6 +122,7 @@ architecture rtl of ms_bin_pass is
   signal ret_nx    : unsigned(BIN_W - 1 downto 0) := to_unsigned(1, BIN_W);  -- ret_cnt + 1
   signal q_we      : std_logic;                                -- Q RAM write (learn)
   signal q_addr_p  : unsigned(BIN_W - 1 downto 0);             -- Q RAM address (write or read)
+  signal q_wdata   : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM write data (H, or q_ext_data)
   signal q_a       : unsigned(HIST_W - 1 downto 0);            -- Q of the bin in stage A
   signal va        : std_logic := '0';                        -- stage A valid (track bins)
   signal last_a    : std_logic;
@@ -228,14 +233,16 @@ begin
   -- the same single port at ret_cnt (read data unused in learn), so the RAM is single-port
   -- (read-before-write within the port): no write/read collision logic after the block RAM,
   -- whose output register then holds q_a.
-  q_we     <= bin_rd_valid and learn_r;
-  q_addr_p <= ret_nx when bin_rd_valid = '1' and learn_r = '0' else ret_cnt;
+  q_we     <= (bin_rd_valid and learn_r) or q_ext_we;
+  q_addr_p <= q_ext_addr when q_ext_we = '1' else
+              ret_nx when bin_rd_valid = '1' and learn_r = '0' else ret_cnt;
+  q_wdata  <= std_logic_vector(q_ext_data) when q_ext_we = '1' else std_logic_vector(bin_h);
 
   p_ram : process (clk)
   begin
     if rising_edge(clk) then
       if q_we = '1' then
-        q_ram(to_integer(q_addr_p)) <= std_logic_vector(bin_h);
+        q_ram(to_integer(q_addr_p)) <= q_wdata;
       end if;
       q_rd <= q_ram(to_integer(q_addr_p));
     end if;

@@ -54,7 +54,13 @@ entity ms_frontend is
     frame_end    : out std_logic;                                       -- pulse: good frame complete, after its last ip_valid
     frame_error  : out std_logic;                                       -- pulse: protocol error (delayed), no frame_end for that frame
     error_now    : out std_logic;                                       -- pulse: the same error, undelayed (1 clock after the bad beat)
-    err_code     : out std_logic_vector(ERR_CODE_W - 1 downto 0)        -- ERR_* (ms_stream_pkg), with frame_error
+    err_code     : out std_logic_vector(ERR_CODE_W - 1 downto 0);       -- ERR_* (ms_stream_pkg), with frame_error
+    -- every pixel of the frame (border included), colour bin only, 1 clock after ms_stream_check
+    -- (core v2: ms_bg_model counts the ring up to the frame border; the paper core leaves it open)
+    av_valid     : out std_logic;                                       -- a pixel of the frame
+    av_x         : out unsigned(COORD_W - 1 downto 0);                  -- its column (0 .. W-1)
+    av_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (0 .. H-1)
+    av_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0)   -- its colour bin
   );
 end entity;
 
@@ -114,6 +120,11 @@ begin
       end if;
     end if;
   end process;
+
+  av_valid <= pv1;
+  av_x     <= x1;
+  av_y     <= y1;
+  av_cbin  <= cb_bin;
 
   u_sobel : entity work.ms_sobel
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,

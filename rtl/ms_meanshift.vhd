@@ -91,7 +91,18 @@ entity ms_meanshift is
     res_k     : out unsigned(HIST_W - 1 downto 0);                -- K (learn mode)
     -- region RAM read port (one address per bank, data 1 clock later)
     ram_addr  : out std_logic_vector(LANES * ADDR_W - 1 downto 0);
-    ram_data  : in  std_logic_vector(LANES * BIN_W - 1 downto 0)
+    ram_data  : in  std_logic_vector(LANES * BIN_W - 1 downto 0);
+    -- core v2 (all optional; the paper core leaves them at their defaults / open):
+    single    : in  std_logic := '0';                             -- with start: one track pass, no iteration (iter 0)
+    max_it    : in  unsigned(ITER_W - 1 downto 0) := to_unsigned(MAX_ITER, ITER_W);  -- iteration limit (1 .. MAX_ITER)
+    q_ext_we  : in  std_logic := '0';                             -- write Q[q_ext_addr] (while idle)
+    q_ext_addr: in  unsigned(BIN_W - 1 downto 0) := (others => '0');
+    q_ext_data: in  unsigned(HIST_W - 1 downto 0) := (others => '0');
+    px_valid  : out std_logic;                                    -- pixel-pass scan tap (ms_pixel_pass)
+    px_mask   : out std_logic_vector(LANES - 1 downto 0);
+    px_dx     : out signed(REGION_W downto 0);
+    px_dy     : out signed(REGION_W downto 0);
+    px_last   : out std_logic
   );
 end entity;
 
@@ -104,6 +115,8 @@ architecture rtl of ms_meanshift is
   signal state : state_t := S_IDLE;
 
   signal learn_r          : std_logic;
+  signal single_r         : std_logic := '0';
+  signal max_it_r         : unsigned(ITER_W - 1 downto 0);
   signal c_in_x, c_in_y   : sc_t;
   signal c0x, c0y         : unsigned(CENTRE_W - 1 downto 0);
   signal c1x, c1y         : unsigned(CENTRE_W - 1 downto 0);
@@ -155,7 +168,8 @@ begin
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d,
               ram_addr => ram_addr, ram_data => ram_data, done => pp_done,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
-              bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);
+              bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
+              px_valid => px_valid, px_mask => px_mask, px_dx => px_dx, px_dy => px_dy, px_last => px_last);
 
   u_bins : entity work.ms_bin_pass
     generic map (BIN_W => BIN_W, HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W,
@@ -166,7 +180,7 @@ begin
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
               done => bp_done, s_sum => bp_s, sw => bp_sw, swx => bp_swx, swy => bp_swy,
-              k_sum => bp_k);
+              k_sum => bp_k, q_ext_we => q_ext_we, q_ext_addr => q_ext_addr, q_ext_data => q_ext_data);
 
   u_centre : entity work.ms_centre
     generic map (SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
@@ -208,6 +222,8 @@ begin
         when S_IDLE =>
           if start = '1' then
             learn_r <= learn;
+            single_r <= single and not learn;
+            max_it_r <= max_it;
             c_in_x <= signed(resize(start_cx, SCW)) - signed(resize(shift_left(resize(reg_x, CENTRE_ABS_W), CF), SCW));
             c_in_y <= signed(resize(start_cy, SCW)) - signed(resize(shift_left(resize(reg_y, CENTRE_ABS_W), CF), SCW));
             first <= '1';
@@ -258,7 +274,7 @@ begin
 
         when S_BIN_WAIT =>
           if bp_done = '1' then
-            if learn_r = '1' then
+            if learn_r = '1' or single_r = '1' then
               res_k <= bp_k;
               s0 <= bp_s;
               it <= (others => '0');
@@ -311,7 +327,7 @@ begin
             stop_now := true;
             if shift_small = '1' then
               res_stop <= STOP_SHIFT;
-            elsif it = MAX_ITER then
+            elsif it = max_it_r then
               res_stop <= STOP_MAX_ITER;
             else
               stop_now := false;

@@ -22,9 +22,11 @@ def test_generated_file_is_current(path):
 
 def test_files_txt_is_the_compile_order():
     lines = [ln for ln in packaging.FILES_TXT.read_text().splitlines() if ln and not ln.startswith("#")]
-    assert lines == [p.relative_to(REPO_ROOT).as_posix() for p in rtl_sources("ms_tracker")]
+    # the paper core's top and core v2's (ms_tracker_v2, issue 11) with every block they use
+    assert lines == [p.relative_to(REPO_ROOT).as_posix() for p in rtl_sources("ms_tracker", "ms_tracker_v2")]
     assert all((REPO_ROOT / f).is_file() for f in lines)
-    assert lines[-1] == "rtl/ms_tracker.vhd" and all(Path(f).name.startswith("ms_") for f in lines)
+    assert set(lines[-2:]) == {"rtl/ms_tracker.vhd", "rtl/ms_tracker_v2.vhd"}
+    assert all(Path(f).name.startswith("ms_") for f in lines)
 
 
 def test_core_file_lists_the_same_files():

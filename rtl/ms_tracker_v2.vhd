@@ -1,0 +1,1220 @@
+-- ms_tracker_v2: the sequencer of core v2 (issue 11): tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2)
+-- bit for bit, on the ports and stream behaviour of ms_tracker, with result word v2.
+--
+-- Computes, per video frame (docs/blocks/ms_tracker_v2.md, docs/architecture.md "Core v2"):
+--   before the frame (between frames, input closed): log2 D = ms_decimation(w8, h8) (+ 1 while the
+--   search state is lost: D x 2), the decimated frame size ((W - 1) >> log2 D) + 1, the window
+--   diameters wd, hd = ms_window_size, the search offsets ox, oy = (STEP16 wd, hd) >> 4, the region
+--   (mstrack.fixed.blocks.ms_region, inline: margin MARGIN, + max(ox, oy) while lost, at most
+--   MARGIN_MAX) around c8 >> log2 D, in decimated px; on an init frame also the box (ms_box_size,
+--   centre clamped into the decimated interior) and the start of ms_bg_model;
+--   during the frame: ms_frontend -> ms_decimate -> ms_region_capture (colour region RAM) and,
+--   on the init frame, every pixel of the decimated frame (border included: ms_frontend av_*)
+--   into ms_bg_model;
+--   after the frame: ms_kernel_tables (wd, hd; flat pass tables + the KA/KB of ms_target_stats;
+--   K = the window's pixel count summed from the row extents XR), Qw = ms_model_scale(Qn, K)
+--   written into the engine's Q RAM (and T into ms_target_stats), ms_meanshift from c8 >> log2 D
+--   (init frame: one pass without moving, `single`), ms_target_stats on the pixel-pass tap (the
+--   statistics of the pass at the result centre), rho (ms_fusion, colour only), ms_share and
+--   ms_confidence of the result; while lost 8 more start points (c +- (ox, oy)) x SEARCH_ITER
+--   iterations in the same region, the best confidence wins; then for the winner ms_spread,
+--   ms_ring_share, ms_loss_filter x 2, ms_loss_flag, the search state and the reported status,
+--   ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
+-- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
+-- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
+--
+-- Init box (s_init, between frames): clipped to the frame interior (ms_box_clip, no shrink: large
+-- targets are decimated); rejected as in ms_tracker.  Protocol errors and a frame of another size
+-- than the target's: error result (status 6 "error", flag error, err_code), state unchanged, as in
+-- ms_tracker.  A stream error on the init frame resets ms_bg_model and the next good frame is the
+-- init frame (a frame cut by a new start of frame while the init is pending is not handled: that
+-- next frame's first pixels are missed by the model).
+--
+-- Status: bit-exact with the model on generated scenes (GHDL) and real sequences (Verilator),
+-- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Not timed or
+-- synthesised yet (the inline region computation is one combinational clock).
+--
+-- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
+-- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
+-- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
+-- shifts with their confidence; on the init frame ms_bg_model's 3 N_BINS + 61 clocks first.
+-- Measured: docs/blocks/ms_tracker_v2.md (tools/v2_latency.py).  Throughput: 1 pixel per clock while a frame streams;
+-- the input is closed from a frame's last pixel until its result is in the FIFO (as ms_tracker).
+-- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1).
+library ieee;
+use ieee.std_logic_1164.all;
+use ieee.numeric_std.all;
+use work.ms_pkg.all;
+use work.ms_stream_pkg.all;
+
+entity ms_tracker_v2 is
+  generic (
+    MAX_FRAME_W    : natural := 2048;     -- widest frame
+    RGB_PACKING    : natural := 0;        -- s_axis_tdata layout (as ms_tracker)
+    LANES          : natural := 4;        -- pixels per clock of a pixel pass
+    COLOUR_BITS    : natural := 3;        -- bits per channel of the colour bin
+    EDGE_BINS_LOG2 : natural := 4;        -- (front end; unused by v2)
+    EDGE_SHIFT     : natural := 5;        -- (front end; unused by v2)
+    FEATURES       : natural := 1;        -- must be 1 (colour)
+    KERNEL_EPAN    : natural := 0;        -- must be 0 (flat)
+    KERNEL_BITS    : natural := 8;        -- KA/KB scale of the target statistics
+    MAX_HALF       : natural := 63;       -- largest window half extent (max_window = 2 MAX_HALF + 1)
+    MARGIN         : natural := 32;       -- search margin (decimated px)
+    COORD_W        : natural := 12;       -- frame coordinate bits
+    CF             : natural := 8;        -- centre fraction bits
+    WI             : natural := 4;
+    WF             : natural := 4;
+    RF             : natural := 6;
+    AF             : natural := 8;
+    RHO_OUT_FRAC   : natural := 16;
+    MAX_ITER       : natural := 20;
+    EPS2           : natural := 65536;
+    HALF_W         : natural := 6;
+    REGION_MAX     : natural := 191;
+    REGION_W       : natural := 8;
+    STRIDE         : natural := 48;
+    ADDR_W         : natural := 14;
+    KVAL_W         : natural := 1;
+    HIST_W         : natural := 14;
+    COUNT_W        : natural := 14;
+    POSSUM_W       : natural := 21;
+    KD_W           : natural := 29;
+    SQRT_IN_W      : natural := 40;
+    RHO_SUM_W      : natural := 21;
+    RATIO_Q_W      : natural := 16;
+    WEIGHT_W       : natural := 8;
+    SW_W           : natural := 22;
+    SWX_W          : natural := 29;
+    SHIFT_Q_W      : natural := 14;
+    CENTRE_W       : natural := 16;
+    CENTRE_ABS_W   : natural := 20;
+    ITER_W         : natural := 5;
+    RHO_OUT_W      : natural := 17;
+    ALPHA_W        : natural := 9;
+    WIN_W          : natural := 7;
+    RESULT_W       : natural := 160;
+    -- v2 (mstrack.hw.cosim.CoreConfigV2.generics)
+    PAD16          : natural := 4;        -- pad in 1/16
+    RING16         : natural := 10;       -- bg_ring in 1/16
+    MAX_WINDOW     : natural := 127;      -- largest window diameter (decimated px)
+    KT_W           : natural := 9;        -- KA/KB width (KERNEL_BITS + 1)
+    ST2_W          : natural := 23;
+    SHARE_W        : natural := 17;
+    SPREAD_W       : natural := 25;
+    SIZE_W         : natural := 20;       -- w8, h8 bits (COORD_W + 8)
+    SCALE_W        : natural := 17;
+    SCALE_GAIN     : natural := 19661;
+    SCALE_REG      : natural := 6554;
+    SCALE_STEP     : natural := 6554;
+    SCALE_RATIO_Q_W: natural := 17;
+    WR_Q_W         : natural := 27;
+    CON_W          : natural := 18;
+    LOSS_K         : natural := 1;
+    REF_K          : natural := 6;
+    LOSS_RHO       : natural := 57672;
+    LOSS_CONTRAST  : integer := 12452;
+    CONF_LOST      : natural := 26214;    -- round(conf_lost 2**16)
+    CONF_UNCERTAIN : natural := 32768;
+    CONF_REACQUIRE : natural := 32768;
+    SPREAD_DEFAULT : natural := 2581110;  -- spread_ref when the init spread is 0: (128 << (KB + 16)) / (16 + PAD16)**2
+    BG_Q_W         : natural := 14;
+    BG_O_W         : natural := 17;
+    SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
+    STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
+    MARGIN_MAX     : natural := 255       -- largest region margin (MARGIN + the search offset)
+  );
+  port (
+    clk                  : in  std_logic;
+    rst                  : in  std_logic;
+    frame_width          : in  unsigned(COORD_W - 1 downto 0);
+    frame_height         : in  unsigned(COORD_W - 1 downto 0);
+    s_init_tvalid        : in  std_logic;
+    s_init_tready        : out std_logic;
+    s_init_x             : in  signed(COORD_W + 1 downto 0);
+    s_init_y             : in  signed(COORD_W + 1 downto 0);
+    s_init_w             : in  unsigned(COORD_W downto 0);
+    s_init_h             : in  unsigned(COORD_W downto 0);
+    s_axis_tdata         : in  std_logic_vector(23 downto 0);
+    s_axis_tvalid        : in  std_logic;
+    s_axis_tready        : out std_logic;
+    s_axis_tlast         : in  std_logic;
+    s_axis_tuser         : in  std_logic;
+    m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);
+    m_axis_result_tvalid : out std_logic;
+    m_axis_result_tready : in  std_logic;
+    m_axis_result_tlast  : out std_logic;
+    busy                 : out std_logic
+  );
+end entity;
+
+architecture rtl of ms_tracker_v2 is
+  constant BIN_C_W   : natural := 3 * COLOUR_BITS;
+  constant N_BINS    : natural := 2 ** BIN_C_W;
+  constant DEPTH     : natural := REGION_MAX * STRIDE;
+  constant REGION_RD_LAT : positive := 3;
+  constant REGION_WR_LAT : natural := 1;
+  constant DRAIN     : natural := 63;
+  constant FLAGS_W   : natural := 8;
+  constant ERR_W     : natural := 3;
+  constant FCOUNT_W  : natural := 16;
+  constant ONE16     : natural := 65536;
+  constant BOX_HALF_W : natural := COORD_W - 1;     -- ms_box_clip without shrink: MAX_HALF 2**(COORD_W-1) - 1
+  constant MS_LAT    : natural := 4;                -- ms_model_scale latency (HIST_W = 14)
+  -- status codes (mstrack.fixed.vhdl_pkg.STATUS_V2)
+  constant ST_OK     : unsigned(2 downto 0) := "000";
+  constant ST_UNC    : unsigned(2 downto 0) := "001";
+  constant ST_LOST   : unsigned(2 downto 0) := "010";
+  constant ST_REACQ  : unsigned(2 downto 0) := "011";
+  constant ST_INIT   : unsigned(2 downto 0) := "100";
+  constant ST_CLIP   : unsigned(2 downto 0) := "101";
+  constant ST_ERROR  : unsigned(2 downto 0) := "110";
+
+  type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BG_RST, T_BG_START, T_BG_WAIT,
+                    T_REGION, T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
+                    T_CNEXT, T_STATS0, T_STATS, T_CONF,
+                    T_DECIDE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
+  signal state : tstate_t := T_PREP;
+
+  -- target state (one record per target)
+  signal target_valid, init_pending, init_clipped, rejected_pending : std_logic := '0';
+  signal c8x, c8y     : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
+  signal w8, h8, w0_8 : unsigned(SIZE_W - 1 downto 0) := (others => '0');
+  signal rho_ref, share_ref, rho0 : unsigned(SHARE_W - 1 downto 0) := (others => '0');
+  signal rho_s, con_s : signed(CON_W - 1 downto 0) := (others => '0');
+  signal spread_ref   : unsigned(SPREAD_W - 1 downto 0) := (others => '0');
+  signal lost_st, reported_lost : std_logic := '0';
+  signal lost_st_frame : std_logic := '0';             -- lost_st of the frame being finished
+  signal tgt_w, tgt_h : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
+  signal in_fw, in_fh : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
+
+  -- per-frame geometry
+  signal l2d          : unsigned(2 downto 0) := (others => '0');
+  signal dw, dh       : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);   -- decimated frame size
+  signal wd, hd       : unsigned(WIN_W - 1 downto 0) := to_unsigned(3, WIN_W);
+  signal wb, hb       : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
+  signal ex_r, ey_r   : unsigned(HALF_W - 1 downto 0) := to_unsigned(1, HALF_W);
+  signal s8x, s8y     : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');      -- start centre (decimated)
+  signal k_acc        : unsigned(HIST_W - 1 downto 0) := (others => '0');
+  signal margin_r     : unsigned(COORD_W - 1 downto 0) := to_unsigned(MARGIN, COORD_W);  -- region margin of this frame
+  signal ox_r, oy_r   : unsigned(COORD_W - 1 downto 0) := (others => '0');                -- search offsets (decimated px)
+  -- start points: 0 the last centre, 1 .. 8 (while lost) the centre +- (ox, oy)
+  signal cand         : unsigned(3 downto 0) := (others => '0');
+  signal eng_cx, eng_cy : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
+  signal eng_max_it   : unsigned(ITER_W - 1 downto 0) := to_unsigned(MAX_ITER, ITER_W);
+  signal best_cx, best_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal best_s       : unsigned(RHO_SUM_W - 1 downto 0);
+  signal best_conf    : unsigned(16 downto 0);
+  signal region_ok    : std_logic := '0';
+  signal reg_x, reg_y : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  signal hi_x, hi_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  signal reg_w_c, reg_h_c : unsigned(COORD_W - 1 downto 0);
+  signal lim_w, lim_h : unsigned(COORD_W - 1 downto 0);
+  signal lim_wn, lim_hn : unsigned(WIN_W - 1 downto 0);
+
+  -- stream gate (as ms_tracker)
+  signal accept, beat : std_logic;
+  signal gate_closed, in_frame, err_hold : std_logic := '0';
+  signal line_cnt     : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal drain_cnt    : natural range 0 to DRAIN := 0;
+  signal fr_w, fr_h   : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal size_ok, init_take, fe_err_now, init_ready : std_logic;
+
+  -- front end, decimation, capture, RAM
+  signal ip_valid     : std_logic;
+  signal ip_x, ip_y   : unsigned(COORD_W - 1 downto 0);
+  signal ip_cbin      : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal ip_ebin      : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal fe_start, fe_end, fe_error : std_logic;
+  signal fe_code      : std_logic_vector(ERR_CODE_W - 1 downto 0);
+  signal dp_start, dp_end, dp_error, dp_valid : std_logic;
+  signal dp_x, dp_y   : unsigned(COORD_W - 1 downto 0);
+  signal dp_cbin      : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal dp_ebin      : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal cap_we       : std_logic;
+  signal cap_bank     : unsigned(clog2(LANES) - 1 downto 0);
+  signal cap_addr     : unsigned(ADDR_W - 1 downto 0);
+  signal cap_c        : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal cap_done     : std_logic;
+  signal ram_addr     : std_logic_vector(LANES * ADDR_W - 1 downto 0);
+  signal ram_data     : std_logic_vector(LANES * BIN_C_W - 1 downto 0);
+
+  -- geometry blocks
+  signal dec_in_valid, dec_out_valid : std_logic := '0';
+  signal dec_l2       : unsigned(1 downto 0);
+  signal ws_in_valid, ws_w_valid, ws_h_valid : std_logic := '0';
+  signal ws_w, ws_h   : unsigned(WIN_W - 1 downto 0);
+  signal bs_w_valid, bs_h_valid : std_logic;
+  signal bs_w, bs_h   : unsigned(COORD_W - 1 downto 0);
+
+  -- init path
+  signal bc_valid, bc_out_valid, bc_rejected, bc_clipped : std_logic := '0';
+  signal bc_x, bc_y, bc_w, bc_h : unsigned(COORD_W - 1 downto 0);
+  signal bc_cx, bc_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal in_x, in_y   : signed(COORD_W + 1 downto 0);
+  signal in_w, in_h   : unsigned(COORD_W downto 0);
+
+  -- background model
+  signal bg_rst, bg_rst_p, bg_start, bg_busy, bg_counting, bg_done : std_logic := '0';
+  signal bg_got       : std_logic := '0';
+  signal bg_cx, bg_cy : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal bg_px_valid, bg_px_last : std_logic := '0';
+  signal bg_px_bin    : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal av_valid     : std_logic;
+  signal av_x, av_y   : unsigned(COORD_W - 1 downto 0);
+  signal av_cbin      : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal bg_px_x, bg_px_y : unsigned(COORD_W - 1 downto 0);
+  signal m_rd_addr    : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
+  signal m_qn         : unsigned(16 downto 0);
+  signal m_t          : std_logic;
+
+  -- kernel tables
+  signal kt_start, kt_done, kt_we : std_logic := '0';
+  signal kt_addr, kt_xr, kt_ex, kt_ey : unsigned(HALF_W - 1 downto 0);
+  signal kt_ta, kt_tb, kd_d : unsigned(KD_W - 1 downto 0);
+  signal kt_ka, kt_kb : unsigned(KT_W - 1 downto 0);
+
+  -- Qw load
+  signal ql_cnt       : unsigned(BIN_C_W downto 0) := (others => '0');
+  signal ql_issue, ql_v1 : std_logic := '0';
+  signal ql_bin1      : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
+  signal ms_out_valid : std_logic;
+  signal ms_out_qw    : unsigned(HIST_W - 1 downto 0);
+  signal ms_out_tag   : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal ms_in_tag    : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal ql_seen      : unsigned(BIN_C_W downto 0) := (others => '0');
+
+  -- engine
+  signal eng_start, eng_single : std_logic := '0';
+  signal c_busy, c_done : std_logic;
+  signal c_cx, c_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal c_s          : unsigned(RHO_SUM_W - 1 downto 0);
+  signal c_iter       : unsigned(ITER_W - 1 downto 0);
+  signal c_stop       : std_logic_vector(1 downto 0);
+  signal c_k          : unsigned(HIST_W - 1 downto 0);
+  signal px_valid, px_last : std_logic;
+  signal px_mask      : std_logic_vector(LANES - 1 downto 0);
+  signal px_dx, px_dy : signed(REGION_W downto 0);
+  type tap_t is record
+    v, l : std_logic;
+    m    : std_logic_vector(LANES - 1 downto 0);
+    dx, dy : signed(REGION_W downto 0);
+  end record;
+  type tap_arr_t is array (1 to REGION_RD_LAT - 1) of tap_t;
+  signal tap          : tap_arr_t;
+  signal t_we         : std_logic := '0';
+  signal t_addr       : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
+  signal t_data       : std_logic := '0';
+
+  -- statistics of the last two passes
+  signal st_done      : std_logic;
+  signal st_nt, st_n_in, st_nt_in : unsigned(COUNT_W - 1 downto 0);
+  signal st_st2       : unsigned(ST2_W - 1 downto 0);
+  type stats_t is record
+    nt, n_in, nt_in : unsigned(COUNT_W - 1 downto 0);
+    st2 : unsigned(ST2_W - 1 downto 0);
+  end record;
+  signal st_cur, st_prev, st_fin, best_st : stats_t;
+
+  -- per-frame results
+  signal r_cx, r_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal r_iter       : unsigned(ITER_W - 1 downto 0);
+  signal r_stop       : std_logic_vector(1 downto 0);
+  signal r_s          : unsigned(RHO_SUM_W - 1 downto 0);
+  signal rho, share, ring : unsigned(SHARE_W - 1 downto 0) := (others => '0');
+  signal spread       : unsigned(SPREAD_W - 1 downto 0) := (others => '0');
+  signal conf         : unsigned(16 downto 0) := (others => '0');
+  signal lflag        : std_logic := '0';
+  signal rho_s_n, con_s_n : signed(CON_W - 1 downto 0);
+  signal scale_s      : unsigned(SCALE_W - 1 downto 0);
+  signal w8_n, h8_n   : unsigned(SIZE_W - 1 downto 0);
+  signal rr_rho, rr_share : unsigned(SHARE_W - 1 downto 0);
+  signal status_r     : unsigned(2 downto 0) := (others => '0');
+  signal got          : std_logic_vector(3 downto 0) := (others => '0');
+
+  -- block handshakes
+  signal fu_start, fu_done, sh_start, sh_done, sp_start, sp_done, rs_start, rs_done : std_logic := '0';
+  signal cf_start, cf_done, lf_start, lf_done, fl_start, fl_done : std_logic := '0';
+  signal ru_d         : std_logic := '0';
+  signal ru_start, sc_start, sc_done, rz_start, rzw_done, rzh_done : std_logic := '0';
+  signal fu_rho       : unsigned(RHO_OUT_W - 1 downto 0);
+  signal sh_share, rs_ring : unsigned(SHARE_W - 1 downto 0);
+  signal sp_spread    : unsigned(SPREAD_W - 1 downto 0);
+  signal con_x        : signed(CON_W - 1 downto 0);
+
+  -- results
+  signal res_word     : std_logic_vector(RESULT_W - 1 downto 0);
+  signal fifo_valid, fifo_ready : std_logic;
+  signal frame_count  : unsigned(FCOUNT_W - 1 downto 0) := (others => '0');
+  signal err_pending, overflow : std_logic := '0';
+  signal err_code_r   : std_logic_vector(ERR_CODE_W - 1 downto 0);
+
+  function pack(cx, cy, bw, bh : unsigned; rh, cn : unsigned; st : unsigned; it : unsigned;
+                sp : std_logic_vector; dl : unsigned; srch : unsigned; flags : std_logic_vector;
+                err : std_logic_vector; fc : unsigned) return std_logic_vector is
+    variable v : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
+    variable o : natural := 0;
+  begin
+    v(o + CENTRE_ABS_W - 1 downto o) := std_logic_vector(resize(cx, CENTRE_ABS_W)); o := o + CENTRE_ABS_W;
+    v(o + CENTRE_ABS_W - 1 downto o) := std_logic_vector(resize(cy, CENTRE_ABS_W)); o := o + CENTRE_ABS_W;
+    v(o + SIZE_W - 1 downto o) := std_logic_vector(resize(bw, SIZE_W)); o := o + SIZE_W;
+    v(o + SIZE_W - 1 downto o) := std_logic_vector(resize(bh, SIZE_W)); o := o + SIZE_W;
+    v(o + RHO_OUT_W - 1 downto o) := std_logic_vector(resize(rh, RHO_OUT_W)); o := o + RHO_OUT_W;
+    v(o + 16 downto o) := std_logic_vector(resize(cn, 17)); o := o + 17;
+    v(o + 2 downto o) := std_logic_vector(st); o := o + 3;
+    v(o + ITER_W - 1 downto o) := std_logic_vector(resize(it, ITER_W)); o := o + ITER_W;
+    v(o + 1 downto o) := sp; o := o + 2;
+    v(o + 2 downto o) := std_logic_vector(dl); o := o + 3;
+    v(o + 3 downto o) := std_logic_vector(resize(srch, 4)); o := o + 4;
+    v(o + FLAGS_W - 1 downto o) := flags; o := o + FLAGS_W;
+    v(o + ERR_W - 1 downto o) := err; o := o + ERR_W;
+    v(o + FCOUNT_W - 1 downto o) := std_logic_vector(fc);
+    return v;
+  end function;
+
+  -- flags: 0 init, 1 clipped, 2 lost, 3 error, 4 rejected, 5 no_target, 6 overflow
+  function flags_of(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector is
+  begin
+    return '0' & ovf & notgt & rej & err & lost & clipped & init;
+  end function;
+
+  function umin(a, b : unsigned) return unsigned is
+  begin
+    if a < b then return a; else return b; end if;
+  end function;
+begin
+  assert FEATURES = 1 and KERNEL_EPAN = 0
+    report "ms_tracker_v2: tracker v2 is colour only with the flat kernel (FEATURES 1, KERNEL_EPAN 0)"
+    severity failure;
+  assert RESULT_W = 160 report "ms_tracker_v2: RESULT_W must be 160 (result word v2)" severity failure;
+
+  ---------------------------------------------------------------------------- video input gate
+  size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
+  accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
+                     and fe_err_now = '0' and init_take = '0' else '0';
+  s_axis_tready <= accept;
+  beat <= s_axis_tvalid and accept;
+
+  p_gate : process(clk)
+  begin
+    if rising_edge(clk) then
+      if beat = '1' then
+        if s_axis_tuser = '1' then
+          in_frame <= size_ok;
+          fr_w <= frame_width;
+          fr_h <= frame_height;
+          line_cnt <= (others => '0');
+        elsif in_frame = '1' and s_axis_tlast = '1' then
+          line_cnt <= line_cnt + 1;
+        end if;
+        if in_frame = '1' and s_axis_tuser = '0' and s_axis_tlast = '1' and line_cnt = fr_h - 1 then
+          gate_closed <= '1';
+          in_frame <= '0';
+        end if;
+      end if;
+      if gate_closed = '1' and state = T_IDLE then
+        if drain_cnt = DRAIN then
+          gate_closed <= '0';
+          drain_cnt <= 0;
+        else
+          drain_cnt <= drain_cnt + 1;
+        end if;
+      else
+        drain_cnt <= 0;
+      end if;
+      if state = T_PUSH and fifo_ready = '1' then
+        gate_closed <= '0';
+      end if;
+      if rst = '1' then
+        gate_closed <= '0';
+        in_frame <= '0';
+        drain_cnt <= 0;
+      end if;
+    end if;
+  end process;
+
+  ---------------------------------------------------------------------------- front end, decimation, capture
+  u_fe : entity work.ms_frontend
+    generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, RGB_PACKING => RGB_PACKING)
+    port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
+              in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
+              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
+              frame_start => fe_start, frame_end => fe_end, frame_error => fe_error,
+              error_now => fe_err_now, err_code => fe_code,
+              av_valid => av_valid, av_x => av_x, av_y => av_y, av_cbin => av_cbin);
+
+  u_dec : entity work.ms_decimate
+    generic map (COORD_W => COORD_W, LOG2_D_MAX => 4, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2)
+    port map (clk => clk, rst => rst, dec_log2 => l2d, frame_start => fe_start, frame_end => fe_end,
+              frame_error => fe_error, ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin,
+              ip_ebin => ip_ebin, dp_start => dp_start, dp_end => dp_end, dp_error => dp_error,
+              dp_valid => dp_valid, dp_x => dp_x, dp_y => dp_y, dp_cbin => dp_cbin, dp_ebin => dp_ebin,
+              dec_q => open);
+
+  reg_w_c <= resize(reg_w, COORD_W);
+  reg_h_c <= resize(reg_h, COORD_W);
+
+  u_cap : entity work.ms_region_capture
+    generic map (LANES => LANES, COORD_W => COORD_W, REGION_MAX => REGION_MAX, STRIDE => STRIDE,
+                 ADDR_W => ADDR_W, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2)
+    port map (clk => clk, rst => rst, frame_start => dp_start, frame_end => dp_end,
+              frame_error => dp_error, reg_x => reg_x, reg_y => reg_y, reg_w => reg_w_c,
+              reg_h => reg_h_c, ip_valid => dp_valid, ip_x => dp_x, ip_y => dp_y, ip_cbin => dp_cbin,
+              ip_ebin => dp_ebin, we => cap_we, wbank => cap_bank, waddr => cap_addr,
+              wdata_colour => cap_c, wdata_edge => open, done => cap_done);
+
+  u_ram : entity work.ms_region_ram
+    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
+                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
+    port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
+              raddr => ram_addr, rdata => ram_data);
+
+  ---------------------------------------------------------------------------- background model
+  -- every pixel (x, y) of the decimated frame frame[::D, ::D] (x mod D = 0, y mod D = 0, border
+  -- included: the front end's av_* stream), at (x / D, y / D); one extra beat at dp_end, after the
+  -- frame's last pixel (coordinates all ones: outside the box and its ring), carries px_last
+  p_bgpx : process(clk)
+    variable m : unsigned(COORD_W - 1 downto 0);
+  begin
+    if rising_edge(clk) then
+      m := shift_left(to_unsigned(1, COORD_W), to_integer(l2d)) - 1;
+      if dp_end = '1' then
+        bg_px_valid <= '1';
+        bg_px_last <= '1';
+        bg_px_x <= (others => '1');
+        bg_px_y <= (others => '1');
+      else
+        bg_px_valid <= '0';
+        if av_valid = '1' and (av_x and m) = 0 and (av_y and m) = 0 then
+          bg_px_valid <= '1';
+        end if;
+        bg_px_last <= '0';
+        bg_px_x <= shift_right(av_x, to_integer(l2d));
+        bg_px_y <= shift_right(av_y, to_integer(l2d));
+      end if;
+      bg_px_bin <= av_cbin;
+      if rst = '1' then
+        bg_px_valid <= '0';
+        bg_px_last <= '0';
+      end if;
+    end if;
+  end process;
+  bg_rst      <= rst or bg_rst_p;
+
+  u_bg : entity work.ms_bg_model
+    generic map (BIN_W => BIN_C_W, HALF_W => HALF_W, COORD_W => COORD_W, RING_W => 5, Q_W => BG_Q_W,
+                 O_W => BG_O_W, KD_W => KD_W)
+    port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy,
+              wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1), ring16 => to_unsigned(RING16, 5),
+              busy => bg_busy, counting => bg_counting, done => bg_done,
+              px_valid => bg_px_valid, px_bin => unsigned(bg_px_bin), px_x => bg_px_x, px_y => bg_px_y,
+              px_last => bg_px_last, n_box => open, n_ring => open, o_min => open, qv_sum => open,
+              m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t);
+
+  ---------------------------------------------------------------------------- geometry
+  u_decim : entity work.ms_decimation
+    generic map (S8_W => SIZE_W, PAD16 => PAD16, MAX_WINDOW => MAX_WINDOW)
+    port map (clk => clk, rst => rst, in_valid => dec_in_valid, w8 => w8, h8 => h8,
+              out_valid => dec_out_valid, log2_d => dec_l2);
+
+  u_wsw : entity work.ms_window_size
+    generic map (S8_W => SIZE_W, PAD16 => PAD16, N_W => WIN_W)
+    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => w8, log2_d => l2d, limit => lim_wn,
+              out_valid => ws_w_valid, n => ws_w);
+  u_wsh : entity work.ms_window_size
+    generic map (S8_W => SIZE_W, PAD16 => PAD16, N_W => WIN_W)
+    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => h8, log2_d => l2d, limit => lim_hn,
+              out_valid => ws_h_valid, n => ws_h);
+  u_bsw : entity work.ms_box_size
+    generic map (S8_W => SIZE_W, N_W => COORD_W)
+    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => w8, log2_d => l2d, limit => lim_w,
+              out_valid => bs_w_valid, n => bs_w);
+  u_bsh : entity work.ms_box_size
+    generic map (S8_W => SIZE_W, N_W => COORD_W)
+    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => h8, log2_d => l2d, limit => lim_h,
+              out_valid => bs_h_valid, n => bs_h);
+
+  u_clip : entity work.ms_box_clip
+    generic map (COORD_W => COORD_W, HALF_W => BOX_HALF_W, MAX_HALF => 2 ** BOX_HALF_W - 1, CF => CF)
+    port map (clk => clk, rst => rst, in_valid => bc_valid, box_x => in_x, box_y => in_y,
+              box_w => in_w, box_h => in_h, frame_w => in_fw, frame_h => in_fh,
+              out_valid => bc_out_valid, rejected => bc_rejected, clipped => bc_clipped,
+              clip_x => bc_x, clip_y => bc_y, clip_w => bc_w, clip_h => bc_h, ex => open,
+              ey => open, cx => bc_cx, cy => bc_cy);
+
+  u_tables : entity work.ms_kernel_tables
+    generic map (HALF_W => HALF_W, KERNEL_EPAN => 1, KERNEL_BITS => KERNEL_BITS, KVAL_W => KT_W, KD_W => KD_W)
+    port map (clk => clk, rst => rst, start => kt_start, w => resize(wd, HALF_W + 1),
+              h => resize(hd, HALF_W + 1), busy => open, done => kt_done,
+              ex => kt_ex, ey => kt_ey, kd_d => kd_d, kt_we => kt_we, kt_addr => kt_addr,
+              kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr);
+
+  ---------------------------------------------------------------------------- Qw = ms_model_scale(Qn, K)
+  ms_in_tag <= std_logic_vector(ql_bin1);
+  u_mscale : entity work.ms_model_scale
+    generic map (HIST_W => HIST_W, QN_FRAC => 16, TAG_W => BIN_C_W)
+    port map (clk => clk, rst => rst, in_valid => ql_v1, in_qn => m_qn, in_k => k_acc, in_tag => ms_in_tag,
+              out_valid => ms_out_valid, out_qw => ms_out_qw, out_tag => ms_out_tag);
+
+  ---------------------------------------------------------------------------- engine + statistics
+  u_colour : entity work.ms_meanshift
+    generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
+                 STRIDE => STRIDE, ADDR_W => ADDR_W, COORD_W => COORD_W, KERNEL_EPAN => 0,
+                 KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, SQRT_IN_W => SQRT_IN_W,
+                 RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
+                 RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
+                 CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
+                 ITER_W => ITER_W, EPS2 => EPS2, RAM_LAT => REGION_RD_LAT)
+    port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
+              kt_tb => kt_tb, kt_ka => kt_ka(KVAL_W - 1 downto 0), kt_kb => kt_kb(KVAL_W - 1 downto 0),
+              kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
+              reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
+              learn => '0', start_cx => eng_cx, start_cy => eng_cy, busy => c_busy, done => c_done,
+              res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
+              res_k => c_k, ram_addr => ram_addr, ram_data => ram_data,
+              single => eng_single, max_it => eng_max_it,
+              q_ext_we => ms_out_valid, q_ext_addr => unsigned(ms_out_tag), q_ext_data => ms_out_qw,
+              px_valid => px_valid, px_mask => px_mask, px_dx => px_dx, px_dy => px_dy, px_last => px_last);
+
+  -- the tap is aligned with ram_addr; ms_target_stats wants the bins one clock after it
+  p_tap : process(clk)
+  begin
+    if rising_edge(clk) then
+      tap(1) <= (v => px_valid, l => px_last, m => px_mask, dx => px_dx, dy => px_dy);
+      for i in 2 to REGION_RD_LAT - 1 loop
+        tap(i) <= tap(i - 1);
+      end loop;
+      if rst = '1' then
+        for i in 1 to REGION_RD_LAT - 1 loop
+          tap(i).v <= '0';
+          tap(i).l <= '0';
+        end loop;
+      end if;
+    end if;
+  end process;
+
+  u_stats : entity work.ms_target_stats
+    generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
+                 KERNEL_BITS => KERNEL_BITS, KT_W => KT_W, PAD16 => PAD16, COUNT_W => COUNT_W, ST2_W => ST2_W)
+    port map (clk => clk, rst => rst, t_we => t_we, t_addr => t_addr, t_data => t_data,
+              kt_we => kt_we, kt_addr => kt_addr, kt_ka => kt_ka, kt_kb => kt_kb,
+              px_valid => tap(REGION_RD_LAT - 1).v, px_mask => tap(REGION_RD_LAT - 1).m,
+              px_dx => tap(REGION_RD_LAT - 1).dx, px_dy => tap(REGION_RD_LAT - 1).dy,
+              px_last => tap(REGION_RD_LAT - 1).l,
+              ram_data => ram_data, done => st_done, nt => st_nt, st2 => st_st2, n_in => st_n_in,
+              nt_in => st_nt_in);
+
+  busy <= c_busy;
+
+  ---------------------------------------------------------------------------- per-frame arithmetic
+  u_rho : entity work.ms_fusion
+    generic map (FEATURES => 1, RHO_SUM_W => RHO_SUM_W, HIST_W => HIST_W,
+                 CENTRE_ABS_W => CENTRE_ABS_W, AF => AF, ALPHA_W => ALPHA_W, RF => RF,
+                 RHO_OUT_FRAC => RHO_OUT_FRAC, RHO_OUT_W => RHO_OUT_W)
+    port map (clk => clk, rst => rst, start => fu_start, s_c => r_s, s_e => (others => '0'), c_cx => r_cx,
+              c_cy => r_cy, e_cx => r_cx, e_cy => r_cy, k_sum => k_acc, done => fu_done, cx => open,
+              cy => open, alpha_c => open, rho_c => fu_rho, rho_e => open);
+
+  u_share : entity work.ms_share
+    generic map (COUNT_W => COUNT_W, SHARE_W => SHARE_W)
+    port map (clk => clk, rst => rst, start => sh_start, nt_in => st_fin.nt_in, n_in => st_fin.n_in,
+              busy => open, done => sh_done, share => sh_share);
+
+  u_spread : entity work.ms_spread
+    generic map (COUNT_W => COUNT_W, ST2_W => ST2_W, SPREAD_W => SPREAD_W)
+    port map (clk => clk, rst => rst, start => sp_start, st2 => st_fin.st2, nt => st_fin.nt,
+              busy => open, done => sp_done, spread => sp_spread);
+
+  u_ring : entity work.ms_ring_share
+    generic map (COUNT_W => COUNT_W, SHARE_W => SHARE_W)
+    port map (clk => clk, rst => rst, start => rs_start, nt => st_fin.nt, nt_in => st_fin.nt_in,
+              n_in => st_fin.n_in, k => resize(k_acc, COUNT_W), busy => open, done => rs_done,
+              ring_share => rs_ring);
+
+  u_conf : entity work.ms_confidence
+    generic map (W => SHARE_W)
+    port map (clk => clk, rst => rst, start => cf_start, rho => rho, share => share, rho_ref => rho_ref,
+              share_ref => share_ref, busy => open, done => cf_done, conf => conf);
+
+  con_x <= signed(resize(share, CON_W)) - signed(resize(ring, CON_W));
+  u_lf_rho : entity work.ms_loss_filter
+    generic map (W => CON_W, K_SHIFT => LOSS_K)
+    port map (clk => clk, rst => rst, start => lf_start, s => rho_s, x => signed(resize(rho, CON_W)),
+              busy => open, done => lf_done, s_next => rho_s_n);
+  u_lf_con : entity work.ms_loss_filter
+    generic map (W => CON_W, K_SHIFT => LOSS_K)
+    port map (clk => clk, rst => rst, start => lf_start, s => con_s, x => con_x,
+              busy => open, done => open, s_next => con_s_n);
+
+  u_flag : entity work.ms_loss_flag
+    generic map (RHO_W => SHARE_W, CON_W => CON_W, LOSS_RHO => LOSS_RHO, LOSS_CONTRAST => LOSS_CONTRAST)
+    port map (clk => clk, rst => rst, start => fl_start, rho_s => unsigned(rho_s(SHARE_W - 1 downto 0)),
+              rho0 => rho0, con_s => con_s, share => share, busy => open, done => fl_done, lost => lflag);
+
+  u_ref_rho : entity work.ms_ref_update
+    generic map (W => SHARE_W, K_SHIFT => REF_K)
+    port map (clk => clk, rst => rst, start => ru_start, ref_in => rho_ref, x => rho, busy => open,
+              done => open, ref_next => rr_rho);
+  u_ref_share : entity work.ms_ref_update
+    generic map (W => SHARE_W, K_SHIFT => REF_K)
+    port map (clk => clk, rst => rst, start => ru_start, ref_in => share_ref, x => share, busy => open,
+              done => open, ref_next => rr_share);
+
+  u_scale : entity work.ms_scale
+    generic map (SPREAD_W => SPREAD_W, SIZE_W => SIZE_W, SCALE_W => SCALE_W, SCALE_GAIN => SCALE_GAIN,
+                 SCALE_REG => SCALE_REG, SCALE_STEP => SCALE_STEP, RATIO_Q_W => SCALE_RATIO_Q_W,
+                 WR_Q_W => WR_Q_W)
+    port map (clk => clk, rst => rst, start => sc_start, spread => spread, spread_ref => spread_ref,
+              w8 => w8, w0_8 => w0_8, busy => open, done => sc_done, s => scale_s);
+
+  u_rz_w : entity work.ms_resize
+    generic map (SIZE_W => SIZE_W, SCALE_W => SCALE_W, COORD_W => COORD_W)
+    port map (clk => clk, rst => rst, start => rz_start, s8 => w8, s => scale_s, frame_size => tgt_w,
+              busy => open, done => rzw_done, s8_out => w8_n);
+  u_rz_h : entity work.ms_resize
+    generic map (SIZE_W => SIZE_W, SCALE_W => SCALE_W, COORD_W => COORD_W)
+    port map (clk => clk, rst => rst, start => rz_start, s8 => h8, s => scale_s, frame_size => tgt_h,
+              busy => open, done => rzh_done, s8_out => h8_n);
+
+  ---------------------------------------------------------------------------- results
+  u_fifo : entity work.ms_fifo
+    generic map (WIDTH => RESULT_W, DEPTH => 4)
+    port map (clk => clk, rst => rst, s_valid => fifo_valid, s_ready => fifo_ready, s_data => res_word,
+              m_valid => m_axis_result_tvalid, m_ready => m_axis_result_tready, m_data => m_axis_result_tdata);
+  m_axis_result_tlast <= '1';
+
+  -- window-size limits: min(MAX_WINDOW, decimated size - 2)
+  lim_w  <= umin(dw - 2, to_unsigned(MAX_WINDOW, COORD_W));
+  lim_h  <= umin(dh - 2, to_unsigned(MAX_WINDOW, COORD_W));
+  lim_wn <= resize(lim_w, WIN_W);
+  lim_hn <= resize(lim_h, WIN_W);
+
+  ---------------------------------------------------------------------------- control
+  p_ctrl : process(clk)
+    variable hx, hy, lo, hi : unsigned(COORD_W - 1 downto 0);
+    variable k_add : unsigned(HIST_W - 1 downto 0);
+    variable srch  : unsigned(2 downto 0);
+    variable stat  : unsigned(2 downto 0);
+    variable lost_now : std_logic;
+    variable mx       : unsigned(COORD_W - 1 downto 0);
+    variable srch4    : unsigned(3 downto 0);
+    variable rst_v, rn_v, rh_v : unsigned(COORD_W - 1 downto 0);
+    variable sxo, syo : signed(CENTRE_ABS_W + 1 downto 0);
+    -- one axis of ms_region: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
+    -- hi (region-relative) = n - 1 - e
+    procedure region_axis(c : unsigned; e : unsigned; sz : unsigned; m : unsigned;
+                          variable o_st, o_n, o_hi : out unsigned(COORD_W - 1 downto 0)) is
+      constant SW : natural := COORD_W + 3;
+      variable es, ss, ms, rc, na, nn, t, a : signed(SW - 1 downto 0);
+    begin
+      es := signed(resize(e, SW));
+      ss := signed(resize(sz, SW));
+      ms := signed(resize(m, SW));
+      rc := signed(resize(shift_right(c + to_unsigned(2 ** (CF - 1), c'length), CF), SW));
+      na := shift_left(es, 1) + shift_left(ms, 1) + 1;
+      if na < ss - 2 then nn := na; else nn := ss - 2; end if;
+      a := rc - es - ms;
+      t := ss - 1 - nn;
+      if a > t then a := t; end if;
+      if a < 1 then a := to_signed(1, SW); end if;
+      o_st := unsigned(a(COORD_W - 1 downto 0));
+      o_n := unsigned(nn(COORD_W - 1 downto 0));
+      o_hi := unsigned(resize(nn - 1 - es, COORD_W));
+    end procedure;
+  begin
+    if rising_edge(clk) then
+      bc_valid <= '0';
+      kt_start <= '0';
+      eng_start <= '0';
+      fifo_valid <= '0';
+      dec_in_valid <= '0';
+      ws_in_valid <= '0';
+      bg_start <= '0';
+      bg_rst_p <= '0';
+      fu_start <= '0'; sh_start <= '0'; sp_start <= '0'; rs_start <= '0';
+      cf_start <= '0'; lf_start <= '0'; fl_start <= '0'; ru_start <= '0';
+      sc_start <= '0'; rz_start <= '0';
+      ql_v1 <= '0';
+
+      if fe_err_now = '1' then
+        err_hold <= '1';
+      end if;
+      if fe_error = '1' then
+        if err_pending = '1' then
+          overflow <= '1';
+        end if;
+        err_pending <= '1';
+        err_code_r <= fe_code;
+      end if;
+      if bg_done = '1' then
+        bg_got <= '1';
+      end if;
+      -- statistics of the last two passes
+      if st_done = '1' then
+        st_prev <= st_cur;
+        st_cur <= (nt => st_nt, n_in => st_n_in, nt_in => st_nt_in, st2 => st_st2);
+      end if;
+
+      case state is
+        ------------------------------------------------------------ before a frame: geometry
+        when T_PREP =>
+          region_ok <= '0';
+          if init_pending = '1' or target_valid = '1' then
+            dec_in_valid <= '1';
+            state <= T_DEC_WAIT;
+          else
+            l2d <= (others => '0');
+            state <= T_IDLE;
+            region_ok <= '1';
+          end if;
+
+        when T_DEC_WAIT =>
+          if dec_out_valid = '1' then
+            if lost_st = '1' then                -- while lost: D x 2
+              l2d <= resize(dec_l2, 3) + 1;
+            else
+              l2d <= resize(dec_l2, 3);
+            end if;
+            state <= T_DEC;
+          end if;
+
+        when T_DEC =>
+          dw <= shift_right(tgt_w - 1, to_integer(l2d)) + 1;
+          dh <= shift_right(tgt_h - 1, to_integer(l2d)) + 1;
+          s8x <= shift_right(c8x, to_integer(l2d));
+          s8y <= shift_right(c8y, to_integer(l2d));
+          state <= T_SIZE;
+
+        when T_SIZE =>                         -- lim_* follow dw, dh (registered in T_DEC)
+          ws_in_valid <= '1';
+          state <= T_SIZE_WAIT;
+
+        when T_SIZE_WAIT =>
+          if ws_w_valid = '1' then
+            wd <= ws_w;
+            hd <= ws_h;
+            ex_r <= resize(shift_right(ws_w - 1, 1), HALF_W);
+            ey_r <= resize(shift_right(ws_h - 1, 1), HALF_W);
+            wb <= bs_w;
+            hb <= bs_h;
+            -- search offsets ox, oy = (step16 wd) >> 4, (step16 hd) >> 4; the region margin grows by
+            -- max(ox, oy) while lost (at most MARGIN_MAX)
+            ox_r <= resize(shift_right(resize(ws_w, COORD_W + 6) * STEP16, 4), COORD_W);
+            oy_r <= resize(shift_right(resize(ws_h, COORD_W + 6) * STEP16, 4), COORD_W);
+            state <= T_REGION;
+          end if;
+
+        when T_REGION =>
+          if lost_st = '1' then
+            if ox_r >= oy_r then mx := ox_r; else mx := oy_r; end if;
+            if mx + MARGIN > MARGIN_MAX then
+              margin_r <= to_unsigned(MARGIN_MAX, COORD_W);
+            else
+              margin_r <= mx + MARGIN;
+            end if;
+          else
+            margin_r <= to_unsigned(MARGIN, COORD_W);
+          end if;
+          state <= T_REGION_WAIT;
+
+        when T_REGION_WAIT =>                  -- mstrack.fixed.blocks.ms_region with this margin
+          region_axis(s8x, ex_r, dw, margin_r, rst_v, rn_v, rh_v);
+          reg_x <= rst_v; reg_w <= resize(rn_v, REGION_W); hi_x <= resize(rh_v, REGION_W);
+          region_axis(s8y, ey_r, dh, margin_r, rst_v, rn_v, rh_v);
+          reg_y <= rst_v; reg_h <= resize(rn_v, REGION_W); hi_y <= resize(rh_v, REGION_W);
+          if true then
+            if init_pending = '1' then
+              state <= T_BOX;
+            else
+              region_ok <= '1';
+              state <= T_IDLE;
+            end if;
+          end if;
+
+        when T_BOX =>                          -- init box centre in the decimated interior
+          hx := shift_right(resize(wb, COORD_W) - 1, 1);
+          hy := shift_right(resize(hb, COORD_W) - 1, 1);
+          lo := resize(shift_right(shift_right(c8x, to_integer(l2d)) + 2 ** (CF - 1), CF), COORD_W);
+          hi := resize(shift_right(shift_right(c8y, to_integer(l2d)) + 2 ** (CF - 1), CF), COORD_W);
+          if lo < hx + 1 then lo := hx + 1; end if;
+          if lo > dw - 2 - hx then lo := dw - 2 - hx; end if;
+          if hi < hy + 1 then hi := hy + 1; end if;
+          if hi > dh - 2 - hy then hi := dh - 2 - hy; end if;
+          bg_cx <= lo;
+          bg_cy <= hi;
+          bg_rst_p <= '1';
+          state <= T_BG_RST;
+
+        when T_BG_RST =>                       -- (bg_rst_p high this clock)
+          state <= T_BG_START;
+
+        when T_BG_START =>
+          if bg_busy = '0' then
+            bg_start <= '1';
+            state <= T_BG_WAIT;
+          end if;
+
+        when T_BG_WAIT =>
+          if bg_counting = '1' then
+            bg_got <= '0';
+            region_ok <= '1';
+            state <= T_IDLE;
+          end if;
+
+        ------------------------------------------------------------ waiting for a frame / init
+        when T_IDLE =>
+          if cap_done = '1' then
+            if (init_pending = '1' or target_valid = '1') and (fr_w /= tgt_w or fr_h /= tgt_h) then
+              res_word <= pack(c8x, c8y, w8, h8, to_unsigned(0, 17), to_unsigned(0, 17), ST_ERROR,
+                               to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
+                               flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
+                               ERR_SIZE_CHANGED, frame_count);
+              state <= T_PUSH;
+            elsif init_pending = '1' then
+              state <= T_BGDONE;
+            elsif target_valid = '1' then
+              kt_start <= '1';
+              k_acc <= (others => '0');
+              state <= T_TABLES;
+            else
+              res_word <= pack(c8x, c8y, w8, h8, to_unsigned(0, 17), to_unsigned(0, 17), ST_OK,
+                               to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
+                               flags_of('0', '0', '0', '0', rejected_pending, '1', overflow),
+                               "000", frame_count);
+              state <= T_PUSH;
+            end if;
+          elsif err_pending = '1' and fifo_ready = '1' then
+            res_word <= pack(c8x, c8y, w8, h8, to_unsigned(0, 17), to_unsigned(0, 17), ST_ERROR,
+                             to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
+                             flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
+                             err_code_r, frame_count);
+            fifo_valid <= '1';
+            frame_count <= frame_count + 1;
+            overflow <= '0';
+            rejected_pending <= '0';
+            if fe_error = '0' then
+              err_pending <= '0';
+              if fe_err_now = '0' then
+                err_hold <= '0';
+              end if;
+              if init_pending = '1' then       -- the init frame broke: learn again on the next one
+                state <= T_PREP;
+              end if;
+            end if;
+          elsif init_take = '1' then
+            in_x <= s_init_x; in_y <= s_init_y; in_w <= s_init_w; in_h <= s_init_h;
+            in_fw <= frame_width; in_fh <= frame_height;
+            bc_valid <= '1';
+            state <= T_CLIP;
+          end if;
+
+        when T_CLIP =>
+          if bc_out_valid = '1' then
+            if bc_rejected = '1' or in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W then
+              rejected_pending <= '1';
+              state <= T_IDLE;
+            else
+              c8x <= bc_cx;
+              c8y <= bc_cy;
+              w8 <= shift_left(resize(bc_w, SIZE_W), 8);
+              h8 <= shift_left(resize(bc_h, SIZE_W), 8);
+              w0_8 <= shift_left(resize(bc_w, SIZE_W), 8);
+              tgt_w <= in_fw;
+              tgt_h <= in_fh;
+              init_pending <= '1';
+              init_clipped <= bc_clipped;
+              target_valid <= '0';
+              lost_st <= '0';
+              reported_lost <= '0';
+              state <= T_PREP;
+            end if;
+          end if;
+
+        ------------------------------------------------------------ after a frame
+        when T_BGDONE =>
+          if bg_got = '1' then
+            kt_start <= '1';
+            k_acc <= (others => '0');
+            state <= T_TABLES;
+          end if;
+
+        when T_TABLES =>                       -- K = sum over rows |dy| <= ey of (2 XR + 1)
+          if kt_we = '1' and kt_addr <= ey_r then
+            k_add := resize(shift_left(resize(kt_xr, HIST_W), 1) + 1, HIST_W);
+            if kt_addr = 0 then
+              k_acc <= k_acc + k_add;
+            else
+              k_acc <= k_acc + shift_left(k_add, 1);
+            end if;
+          end if;
+          if kt_done = '1' then
+            ql_cnt <= (others => '0');
+            ql_seen <= (others => '0');
+            state <= T_QLOAD;
+          end if;
+
+        when T_QLOAD =>                        -- Qn, T read -> ms_model_scale -> Q RAM; T -> stats
+          if ql_cnt(BIN_C_W) = '0' then
+            m_rd_addr <= ql_cnt(BIN_C_W - 1 downto 0);
+            ql_cnt <= ql_cnt + 1;
+            ql_issue <= '1';
+          else
+            ql_issue <= '0';
+          end if;
+          ql_v1 <= ql_issue;                   -- m_qn / m_t of m_rd_addr (1 clock)
+          ql_bin1 <= m_rd_addr;
+          if ms_out_valid = '1' then
+            ql_seen <= ql_seen + 1;
+          end if;
+          if ql_seen = N_BINS then
+            eng_single <= init_pending;
+            eng_cx <= s8x;
+            eng_cy <= s8y;
+            if lost_st = '1' then
+              eng_max_it <= to_unsigned(SEARCH_ITER, ITER_W);
+            else
+              eng_max_it <= to_unsigned(MAX_ITER, ITER_W);
+            end if;
+            cand <= (others => '0');
+            eng_start <= '1';
+            state <= T_RUN;
+          end if;
+
+        when T_RUN =>
+          if c_done = '1' then
+            r_cx <= c_cx; r_cy <= c_cy; r_s <= c_s;
+            if cand = 0 then                     -- iterations and stop of the centre's run
+              r_iter <= c_iter; r_stop <= c_stop;
+            end if;
+            if c_stop = STOP_RHO then
+              st_fin <= st_prev;
+            else
+              st_fin <= st_cur;
+            end if;
+            state <= T_C0;
+          end if;
+
+        -- confidence of this start point's result; the best (the centre, then strictly better) wins
+        when T_C0 =>
+          got <= (others => '0');
+          fu_start <= '1'; sh_start <= '1';
+          state <= T_C1;
+
+        when T_C1 =>
+          if fu_done = '1' then got(0) <= '1'; rho <= fu_rho; end if;
+          if sh_done = '1' then got(1) <= '1'; share <= sh_share; end if;
+          if got(1 downto 0) = "11" then
+            cf_start <= '1';
+            state <= T_C2;
+          end if;
+
+        when T_C2 =>
+          if cf_done = '1' then
+            if cand = 0 or conf > best_conf then
+              best_cx <= r_cx; best_cy <= r_cy; best_s <= r_s; best_st <= st_fin; best_conf <= conf;
+            end if;
+            state <= T_CNEXT;
+          end if;
+
+        when T_CNEXT =>
+          if lost_st = '1' and init_pending = '0' and cand /= 8 then
+            -- next start point (sx, sy) in (-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)
+            sxo := signed(resize(s8x, CENTRE_ABS_W + 2));
+            syo := signed(resize(s8y, CENTRE_ABS_W + 2));
+            case to_integer(cand) is
+              when 0 | 3 | 5 => sxo := sxo - signed(resize(shift_left(resize(ox_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when 2 | 4 | 7 => sxo := sxo + signed(resize(shift_left(resize(ox_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when others => null;
+            end case;
+            case to_integer(cand) is
+              when 0 | 1 | 2 => syo := syo - signed(resize(shift_left(resize(oy_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when 5 | 6 | 7 => syo := syo + signed(resize(shift_left(resize(oy_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
+              when others => null;
+            end case;
+            if sxo < 0 then sxo := (others => '0'); end if;
+            if syo < 0 then syo := (others => '0'); end if;
+            eng_cx <= unsigned(sxo(CENTRE_ABS_W - 1 downto 0));
+            eng_cy <= unsigned(syo(CENTRE_ABS_W - 1 downto 0));
+            cand <= cand + 1;
+            eng_start <= '1';
+            state <= T_RUN;
+          else
+            r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s; st_fin <= best_st;
+            state <= T_STATS0;
+          end if;
+
+        when T_STATS0 =>                       -- rho, share, spread, ring share side by side
+          got <= (others => '0');
+          fu_start <= '1'; sh_start <= '1'; sp_start <= '1'; rs_start <= '1';
+          state <= T_STATS;
+
+        when T_STATS =>
+          if fu_done = '1' then got(0) <= '1'; rho <= fu_rho; end if;
+          if sh_done = '1' then got(1) <= '1'; share <= sh_share; end if;
+          if sp_done = '1' then got(2) <= '1'; spread <= sp_spread; end if;
+          if rs_done = '1' then got(3) <= '1'; ring <= rs_ring; end if;
+          if got = "1111" then
+            if init_pending = '1' then
+              state <= T_RESULT;
+            else
+              cf_start <= '1';
+              lf_start <= '1';
+              got <= (others => '0');
+              state <= T_CONF;
+            end if;
+          end if;
+
+        when T_CONF =>
+          if lf_done = '1' then
+            rho_s <= rho_s_n;
+            con_s <= con_s_n;
+            got(1) <= '1';
+          end if;
+          if cf_done = '1' then
+            got(0) <= '1';
+          end if;
+          if got(1) = '1' and got(2) = '0' then
+            fl_start <= '1';
+            got(2) <= '1';
+          end if;
+          if fl_done = '1' then
+            got(3) <= '1';
+          end if;
+          if got(0) = '1' and got(3) = '1' then
+            state <= T_DECIDE;
+          end if;
+
+        when T_DECIDE =>
+          -- search state from the confidence
+          if (lost_st = '1' and conf < CONF_REACQUIRE) or (lost_st = '0' and conf < CONF_LOST) then
+            lost_now := '1';
+            srch := ST_LOST;
+          elsif lost_st = '1' then
+            lost_now := '0';
+            srch := ST_REACQ;
+          elsif conf < CONF_UNCERTAIN then
+            lost_now := '0';
+            srch := ST_UNC;
+          else
+            lost_now := '0';
+            srch := ST_OK;
+          end if;
+          -- reported status from the loss flag
+          if lflag = '1' then
+            if lost_now = '1' then stat := ST_LOST; else stat := ST_UNC; end if;
+          else
+            if reported_lost = '1' then stat := ST_REACQ; else stat := ST_OK; end if;
+          end if;
+          status_r <= stat;
+          lost_st_frame <= lost_st;
+          lost_st <= lost_now;
+          if stat = ST_LOST or (stat = ST_UNC and reported_lost = '1') then
+            reported_lost <= '1';
+          else
+            reported_lost <= '0';
+          end if;
+          c8x <= shift_left(r_cx, to_integer(l2d));
+          c8y <= shift_left(r_cy, to_integer(l2d));
+          if srch = ST_OK then
+            ru_start <= '1';
+          end if;
+          if SCALE_GAIN > 0 and st_fin.nt /= 0 then
+            sc_start <= '1';
+            state <= T_SCALE;
+          else
+            state <= T_RESULT;
+          end if;
+
+        when T_SCALE =>
+          if sc_done = '1' then
+            rz_start <= '1';
+            state <= T_RESIZE;
+          end if;
+
+        when T_RESIZE =>
+          if rzw_done = '1' then
+            w8 <= w8_n;
+            h8 <= h8_n;
+            state <= T_RESULT;
+          end if;
+
+        when T_RESULT =>
+          if init_pending = '1' then
+            rho_ref <= rho;
+            share_ref <= share;
+            rho0 <= rho;
+            rho_s <= signed(resize(rho, CON_W));
+            con_s <= con_x;
+            if spread /= 0 then
+              spread_ref <= spread;
+            else
+              spread_ref <= to_unsigned(SPREAD_DEFAULT, SPREAD_W);
+            end if;
+            target_valid <= '1';
+            init_pending <= '0';
+            if init_clipped = '1' then stat := ST_CLIP; else stat := ST_INIT; end if;
+            res_word <= pack(c8x, c8y, w8, h8, rho, to_unsigned(ONE16, 17), stat, to_unsigned(0, ITER_W),
+                             "00", l2d, to_unsigned(0, 4),
+                             flags_of(not init_clipped, init_clipped, '0', '0', rejected_pending, '0', overflow),
+                             "000", frame_count);
+          else
+            if status_r = ST_LOST then lost_now := '1'; else lost_now := '0'; end if;
+            if lost_st_frame = '1' then srch := "000"; srch4 := to_unsigned(8, 4); else srch4 := to_unsigned(0, 4); end if;
+            res_word <= pack(c8x, c8y, w8, h8, rho, conf, status_r, r_iter, r_stop, l2d, srch4,
+                             flags_of('0', '0', lost_now, '0', rejected_pending, '0', overflow),
+                             "000", frame_count);
+          end if;
+          state <= T_PUSH;
+
+        when T_PUSH =>
+          if fifo_ready = '1' then
+            fifo_valid <= '1';
+            frame_count <= frame_count + 1;
+            overflow <= '0';
+            rejected_pending <= '0';
+            state <= T_PREP;
+          end if;
+      end case;
+
+      -- the references follow OK frames (ms_ref_update: one clock after ru_start)
+      ru_d <= ru_start;
+      if ru_d = '1' then
+        rho_ref <= rr_rho;
+        share_ref <= rr_share;
+      end if;
+
+      if rst = '1' then
+        state <= T_PREP;
+        region_ok <= '0';
+        target_valid <= '0';
+        init_pending <= '0';
+        rejected_pending <= '0';
+        err_pending <= '0';
+        err_hold <= '0';
+        overflow <= '0';
+        frame_count <= (others => '0');
+        w8 <= (others => '0');
+        h8 <= (others => '0');
+        tgt_w <= to_unsigned(3, COORD_W);
+        tgt_h <= to_unsigned(3, COORD_W);
+        c8x <= (others => '0');
+        c8y <= (others => '0');
+        lost_st <= '0';
+        reported_lost <= '0';
+        ql_issue <= '0';
+      end if;
+    end if;
+  end process;
+
+  init_ready <= '1' when state = T_IDLE and cap_done = '0' and err_pending = '0' and in_frame = '0'
+                         and gate_closed = '0' and err_hold = '0' and fe_err_now = '0' else '0';
+  init_take <= s_init_tvalid and init_ready;
+  s_init_tready <= init_ready;
+
+  -- T table of ms_target_stats: written with the Qw load (T of the bin read the clock before)
+  t_we   <= ql_v1;
+  t_addr <= ql_bin1;
+  t_data <= m_t;
+end architecture;

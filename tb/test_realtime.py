@@ -131,6 +131,55 @@ def test_realtime_1080p60(lanes):
                            f"(budget {BUDGET}):\n" + "\n".join(misses))
 
 
+#: core v2 at 1080p60: MotorRolling 30-39 x3 (1920x1080, GT box x3, D = 4): the model tracks frames
+#: 31-36, its confidence falls below conf_lost in frame 37 (search state lost), frame 38 runs the
+#: wide search at D = 8 (region + search offset, 8 more start points) and re-acquires, frame 39 tracks
+#: at D = 4 again (the model run is printed in the report).
+V2_RT_START, V2_RT_FRAMES = 30, 10
+
+
+@pytest.mark.verilator
+def test_realtime_v2_1080p60():
+    """Core v2 (ms_tracker_v2, LANES 4) at 1080p60 timing on real footage with a loss, a wide search and
+    a re-acquisition: bit-exact (every field of result word v2), no input stall, every result before
+    the next frame's first pixel.  The analytic worst case (largest window, max_iter, the search) is
+    the v2 cycle budget of docs/fixed_point.md ("Hardware cost of v2")."""
+    import cv2
+    from mstrack.hw.cosim import COMPARED_FIELDS_V2, expected_results_v2
+    from mstrack.io.data import load_sequence
+    seq = SEQ_ROOT / "MotorRolling"
+    if not seq.is_dir():
+        pytest.skip(f"{seq} not found: the v2 real-time check needs ../shared/data/sequences")
+    s = load_sequence(seq)
+    frames = [cv2.resize(cv2.imread(str(f), cv2.IMREAD_COLOR), (HD_W, HD_H), interpolation=cv2.INTER_LINEAR)
+              for f in s.img_files[V2_RT_START:V2_RT_START + V2_RT_FRAMES]]
+    box = tuple(int(round(float(v) * 3)) for v in s.gt[V2_RT_START])
+    tp, fp = TrackerParams(preset="v2"), FixedParams()
+    exp = expected_results_v2(frames, box, tp, fp)
+    assert any(e["searched"] == 8 for e in exp), "the clip must contain a wide-search frame (model)"
+    run = fastsim.simulate(frames, box, tp, fp, lanes=DEFAULT_LANES, hblank=HBLANK, vblank=VBLANK, lead=VBLANK,
+                           max_frame_w=HD_W, v2=True)
+    mism = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
+    misses = []
+    for i, r in enumerate(run.results):
+        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
+               else r["last_pixel_cycle"] + BUDGET + 1)
+        if r["result_cycle"] >= nxt:
+            misses.append(f"frame {i}: latency {r['latency']} > {BUDGET}")
+    stalls = [f["stall_cycles"] for f in run.frames]
+    _report("realtime_v2_1080p60_lanes%d" % DEFAULT_LANES, {
+        "source": f"MotorRolling {V2_RT_START}-{V2_RT_START + V2_RT_FRAMES - 1} x3", "frames": len(frames),
+        "box": list(box), "lanes": DEFAULT_LANES, "budget_clocks": BUDGET, "latency_clocks": run.latencies,
+        "worst_latency_clocks": max(run.latencies), "stall_cycles": stalls,
+        "status": [e["status"] for e in exp], "searched": [e["searched"] for e in exp],
+        "iter": [e["iter"] for e in exp], "decim_log2": [e["decim_log2"] for e in exp],
+        "cycles": run.cycles, "seconds": round(run.seconds, 2), "build_seconds": round(run.build_seconds, 1),
+        "mismatches": mism, "realtime_misses": misses})
+    assert len(run.results) == len(frames)
+    assert not mism, "DUT differs from the fixed model:\n" + "\n".join(mism)
+    assert not any(stalls) and not misses, f"stalls {stalls}; latencies {run.latencies}:\n" + "\n".join(misses)
+
+
 def _lanes_720p60() -> list:
     lanes = [int(v) for v in os.environ.get("MSTRACK_RT720_LANES", str(DEFAULT_LANES)).split(",")]
     miss = pytest.mark.xfail(

@@ -183,7 +183,10 @@ int main(int argc, char** argv) {
     top.s_init_w = static_cast<uint32_t>(num("init_w", 0));
     top.s_init_h = static_cast<uint32_t>(num("init_h", 0));
     top.s_axis_tvalid = 0;
-    top.s_axis_tdata = 0;
+    {
+        const uint32_t zeros[4] = {0, 0, 0, 0};
+        set_pixels(top.s_axis_tdata, zeros, static_cast<int>(ppc));
+    }
     top.s_axis_tlast = 0;
     top.s_axis_tuser = 0;
     top.m_axis_result_tready = 0;

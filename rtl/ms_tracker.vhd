@@ -8,7 +8,8 @@
 -- tlast = last beat of each line.  PPC = 1 is the one-pixel core (ports as before); with PPC > 1
 -- a frame whose frame_width is not a multiple of PPC is refused (error result, code 4 `size`),
 -- and PPC <= LANES is required (generic assertion; the region capture writes the PPC pixels of a
--- beat into PPC different banks).  The results do not depend on PPC (bit-exact with the model).  One result word per frame out on m_axis_result
+-- beat into PPC different banks).  The results do not depend on PPC (bit-exact with the model).
+-- One result word per frame out on m_axis_result
 -- (fields: mstrack.fixed.vhdl_pkg.result_layout, LSB first: cx, cy, rho_c, rho_e, alpha_c,
 -- iter_c, iter_e, stop_c, stop_e, flags, err_code, box_w, box_h, frame_count).
 --

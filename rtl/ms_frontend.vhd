@@ -2,7 +2,9 @@
 -- (ms_colour_bin | ms_grey) -> ms_sobel.
 --
 -- Computes: the (x, y, colour bin, edge bin) of every interior pixel
--- (1 <= x <= W-2, 1 <= y <= H-2) of each frame, in raster order, plus the
+-- (1 <= x <= W-2, 1 <= y <= H-2) of each frame, in raster order, PPC pixels
+-- per clock (PPC = 1, 2 or 4; lane k = column ip_x + k, valid where
+-- ip_mask(k) = 1; see ms_sobel: a line's first beat has lanes 0 .. 1 off), plus the
 -- frame events of ms_stream_check re-timed so that they keep their order with
 -- the pixels: every event is delayed by EVT_DELAY = 8 clocks, so that
 --   * frame_end comes 1 clock AFTER the frame's last interior pixel (ip_valid),
@@ -13,12 +15,18 @@
 --     pixel of that frame (which needs >= 2 W + 3 beats).
 -- Latency: input beat of pixel (x+1, y+1) -> ip_valid of (x, y): 8 clocks
 -- (check 1, grey 2, sobel 5 after the grey; ms_sobel reads its line buffer
--- with the position, which it gets one clock before the grey).  Throughput: 1 pixel/clock; never stalls (no
--- ready): the top must back-pressure upstream itself if it needs to.
+-- with the position, which it gets one clock before the grey); the same for every PPC.
+-- Throughput: 1 beat of PPC pixels/clock; never stalls (no ready): the top must
+-- back-pressure upstream itself if it needs to.
+-- Pixels per clock: in_data carries PPC pixels per beat (AXI4-Stream video: pixel k in bits
+-- 24k+23 .. 24k, the leftmost pixel in the low bits; in_sof on the frame's first beat, in_eol on
+-- the line's last beat); one ms_colour_bin and one ms_grey per pixel, ms_sobel PPC wide.  A
+-- frame_width that is not a multiple of PPC is refused like a size out of range (ERR_SIZE).
+-- PPC = 1 keeps every port as in the one-pixel core (ip_mask = ip_valid).
 -- Pixel layout (RGB_PACKING): 0 = R 23:16, G 15:8, B 7:0 (default); 1 = AMD UG934's RGB
 -- order (video format code 2: R 23:16, B 15:8, G 7:0), so that AMD video IP connects directly.
--- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height; ms_stream_check drops a
--- frame out of that range (frame_error, ERR_SIZE).
+-- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height, frame_width a multiple of
+-- PPC; ms_stream_check drops a frame out of that range (frame_error, ERR_SIZE).
 -- Python model: mstrack.fixed.blocks ms_colour_bin and
 -- ms_edge_bin(ms_sobel(ms_grey(frame)), 2**EDGE_BINS_LOG2, EDGE_SHIFT).
 library ieee;
@@ -33,8 +41,9 @@ entity ms_frontend is
     COLOUR_BITS    : natural range 1 to 8 := 3;  -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural range 1 to 8 := 4;  -- edge bin width
     EDGE_SHIFT     : natural range 0 to 11 := 5; -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
-    RGB_PACKING    : natural range 0 to 1 := 0   -- in_data layout: 0 R 23:16 G 15:8 B 7:0 (mstrack);
+    RGB_PACKING    : natural range 0 to 1 := 0;  -- pixel layout: 0 R 23:16 G 15:8 B 7:0 (mstrack);
                                                  -- 1 R 23:16 B 15:8 G 7:0 (AMD UG934, RGB video); wiring only
+    PPC            : positive := 1               -- pixels per clock (beat): 1, 2 or 4
   );
   port (
     clk          : in  std_logic;                                       -- clock
@@ -42,14 +51,15 @@ entity ms_frontend is
     frame_width  : in  unsigned(COORD_W - 1 downto 0);                  -- W, sampled on sof
     frame_height : in  unsigned(COORD_W - 1 downto 0);                  -- H, sampled on sof
     in_valid     : in  std_logic;                                       -- beat present (AXI tvalid; tready = 1)
-    in_data      : in  std_logic_vector(23 downto 0);                   -- RGB pixel, layout set by RGB_PACKING
+    in_data      : in  std_logic_vector(24 * PPC - 1 downto 0);         -- PPC RGB pixels, pixel k at 24k+23 .. 24k (RGB_PACKING)
     in_sof       : in  std_logic;                                       -- start of frame (AXI tuser)
     in_eol       : in  std_logic;                                       -- end of line (AXI tlast)
-    ip_valid     : out std_logic;                                       -- interior pixel out
-    ip_x         : out unsigned(COORD_W - 1 downto 0);                  -- its column (1 .. W-2)
+    ip_valid     : out std_logic;                                       -- interior pixel(s) out (ip_mask /= 0)
+    ip_mask      : out std_logic_vector(PPC - 1 downto 0);              -- lane k holds an interior pixel
+    ip_x         : out unsigned(COORD_W - 1 downto 0);                  -- column of lane 0 (1 .. W-2 when ip_mask(0))
     ip_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (1 .. H-2)
-    ip_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0);  -- its colour bin
-    ip_ebin      : out std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);   -- its edge bin
+    ip_cbin      : out std_logic_vector(PPC * 3 * COLOUR_BITS - 1 downto 0);  -- colour bin of lane k at lane k
+    ip_ebin      : out std_logic_vector(PPC * EDGE_BINS_LOG2 - 1 downto 0);   -- edge bin of lane k at lane k
     frame_start  : out std_logic;                                       -- pulse: a frame started (delayed)
     frame_end    : out std_logic;                                       -- pulse: good frame complete, after its last ip_valid
     frame_error  : out std_logic;                                       -- pulse: protocol error (delayed), no frame_end for that frame
@@ -68,17 +78,17 @@ architecture rtl of ms_frontend is
   constant EVT_DELAY : natural := 8;  -- = pixel path after ms_stream_check (grey 2 + sobel 5) + 1
   constant CB_W : natural := 3 * COLOUR_BITS;
 
-  signal rgb      : std_logic_vector(23 downto 0);  -- in_data as R 23:16, G 15:8, B 7:0
+  signal rgb      : std_logic_vector(24 * PPC - 1 downto 0);  -- in_data as R 23:16, G 15:8, B 7:0 per pixel
   signal px_valid : std_logic;
-  signal px_data  : std_logic_vector(23 downto 0);
+  signal px_data  : std_logic_vector(24 * PPC - 1 downto 0);
   signal px_x, px_y : unsigned(COORD_W - 1 downto 0);
   signal c_start, c_end, c_err : std_logic;
   signal c_code   : std_logic_vector(ERR_CODE_W - 1 downto 0);
 
-  signal cb_valid : std_logic;
-  signal cb_bin, cb_bin_d : std_logic_vector(CB_W - 1 downto 0);
-  signal g_valid  : std_logic;
-  signal g_grey   : unsigned(7 downto 0);
+  signal cb_valid : std_logic_vector(PPC - 1 downto 0);
+  signal cb_bin, cb_bin_d : std_logic_vector(PPC * CB_W - 1 downto 0);
+  signal g_valid  : std_logic_vector(PPC - 1 downto 0);
+  signal g_grey   : unsigned(8 * PPC - 1 downto 0);
   signal pv1      : std_logic := '0';              -- px_valid delayed 1 clock
   signal x1, y1   : unsigned(COORD_W - 1 downto 0);  -- px_x, px_y delayed 1 clock
 
@@ -87,24 +97,31 @@ architecture rtl of ms_frontend is
   signal ev : ev_pipe_t := (others => (others => '0'));
 begin
   -- pixel layout of the input (no logic: a permutation of wires)
-  rgb <= in_data when RGB_PACKING = 0 else in_data(23 downto 16) & in_data(7 downto 0) & in_data(15 downto 8);
+  g_rgb : for k in 0 to PPC - 1 generate
+    rgb(24 * k + 23 downto 24 * k) <= in_data(24 * k + 23 downto 24 * k) when RGB_PACKING = 0 else
+                                      in_data(24 * k + 23 downto 24 * k + 16) & in_data(24 * k + 7 downto 24 * k)
+                                      & in_data(24 * k + 15 downto 24 * k + 8);
+  end generate;
 
   u_check : entity work.ms_stream_check
-    generic map (COORD_W => COORD_W, DATA_W => 24, MIN_SIZE => 3, MAX_W => MAX_FRAME_W)
+    generic map (COORD_W => COORD_W, DATA_W => 24, MIN_SIZE => 3, MAX_W => MAX_FRAME_W, PPC => PPC)
     port map (
       clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
       in_valid => in_valid, in_data => rgb, in_sof => in_sof, in_eol => in_eol,
       px_valid => px_valid, px_data => px_data, px_x => px_x, px_y => px_y,
       frame_start => c_start, frame_end => c_end, frame_error => c_err, err_code => c_code);
 
-  u_colour : entity work.ms_colour_bin
-    generic map (COLOUR_BITS => COLOUR_BITS)
-    port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data,
-              out_valid => cb_valid, out_bin => cb_bin);
+  -- one colour bin and one grey per pixel of the beat
+  g_pix : for k in 0 to PPC - 1 generate
+    u_colour : entity work.ms_colour_bin
+      generic map (COLOUR_BITS => COLOUR_BITS)
+      port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data(24 * k + 23 downto 24 * k),
+                out_valid => cb_valid(k), out_bin => cb_bin(CB_W * (k + 1) - 1 downto CB_W * k));
 
-  u_grey : entity work.ms_grey
-    port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data,
-              out_valid => g_valid, out_grey => g_grey);
+    u_grey : entity work.ms_grey
+      port map (clk => clk, rst => rst, in_valid => px_valid, in_data => px_data(24 * k + 23 downto 24 * k),
+                out_valid => g_valid(k), out_grey => g_grey(8 * k + 7 downto 8 * k));
+  end generate;
 
   -- align the colour bin (latency 1) with the grey (latency 2); ms_sobel takes the
   -- position (valid, x, y) one clock before the grey
@@ -128,10 +145,10 @@ begin
 
   u_sobel : entity work.ms_sobel
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
-                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT)
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, PPC => PPC)
     port map (clk => clk, rst => rst, in_valid => pv1, in_x => x1, in_y => y1,
               in_grey => g_grey, in_cbin => cb_bin_d,
-              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin);
+              ip_valid => ip_valid, ip_mask => ip_mask, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin);
 
   -- event delay line
   p_events : process (clk)

@@ -13,7 +13,8 @@ package ms_stream_pkg is
   constant ERR_NO_SOF     : std_logic_vector(2 downto 0) := "010";
   -- sof in the middle of a frame: that frame is abandoned, the sof beat starts a new frame
   constant ERR_CUT        : std_logic_vector(2 downto 0) := "011";
-  -- sof with frame_width / frame_height out of range (W < MIN_SIZE, H < MIN_SIZE, W > MAX_W):
+  -- sof with frame_width / frame_height out of range (W < MIN_SIZE, H < MIN_SIZE, W > MAX_W,
+  -- or W not a multiple of the pixels per clock PPC of a PPC > 1 core):
   -- the frame is dropped (a frame in progress is abandoned too, reported by this one code)
   constant ERR_SIZE       : std_logic_vector(2 downto 0) := "100";
   -- (top only) a good frame whose size differs from the size the target was initialised for:

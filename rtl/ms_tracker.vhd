@@ -1,10 +1,15 @@
 -- ms_tracker: mean-shift colour + edge fusion tracking core (top level).
 --
 -- Computes, per video frame, the tracking result of mstrack.fixed.FixedTracker bit for bit
--- (docs/architecture.md, docs/fixed_point.md).  Video in as AXI4-Stream, 1 pixel per clock:
--- s_axis_tdata = R(23:16) G(15:8) B(7:0) (RGB_PACKING = 0) or AMD UG934's R(23:16) B(15:8) G(7:0)
--- (RGB_PACKING = 1), tuser = start of frame (first pixel),
--- tlast = last pixel of each line.  One result word per frame out on m_axis_result
+-- (docs/architecture.md, docs/fixed_point.md).  Video in as AXI4-Stream, PPC pixels per clock
+-- (generic PPC = 1, 2 or 4; AXI4-Stream video convention): pixel k of a beat in s_axis_tdata bits
+-- 24k+23 .. 24k, the leftmost pixel in the low bits, each R(23:16) G(15:8) B(7:0) (RGB_PACKING = 0)
+-- or AMD UG934's R(23:16) B(15:8) G(7:0) (RGB_PACKING = 1); tuser = start of frame (first beat),
+-- tlast = last beat of each line.  PPC = 1 is the one-pixel core (ports as before); with PPC > 1
+-- a frame whose frame_width is not a multiple of PPC is refused (error result, code 4 `size`),
+-- and PPC <= LANES is required (generic assertion; the region capture writes the PPC pixels of a
+-- beat into PPC different banks).  The results do not depend on PPC (bit-exact with the model).
+-- One result word per frame out on m_axis_result
 -- (fields: mstrack.fixed.vhdl_pkg.result_layout, LSB first: cx, cy, rho_c, rho_e, alpha_c,
 -- iter_c, iter_e, stop_c, stop_e, flags, err_code, box_w, box_h, frame_count).
 --
@@ -24,7 +29,7 @@
 -- dropped: a full result FIFO back-pressures the video input.  docs/architecture.md lists
 -- every fault and its behaviour.
 --
--- Throughput: 1 pixel per clock while a frame streams in.  After the last pixel of a
+-- Throughput: PPC pixels per clock while a frame streams in.  After the last pixel of a
 -- frame, s_axis_tready stays low until that frame's result is computed (both features'
 -- mean-shift loops in parallel, then fusion); see docs/performance.md for cycle counts.
 -- The input is back-pressured while a frame is streaming only after a protocol error (until
@@ -41,6 +46,7 @@ entity ms_tracker is
   generic (
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth); 3 .. 2**COORD_W - 1
     RGB_PACKING    : natural := 0;               -- s_axis_tdata layout: 0 R 23:16 G 15:8 B 7:0; 1 AMD UG934 (R B G)
+    PPC            : natural := 1;               -- pixels per clock (s_axis beat): 1, 2 or 4 (<= LANES)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
@@ -97,11 +103,11 @@ entity ms_tracker is
     s_init_w             : in  unsigned(COORD_W downto 0);               -- box width
     s_init_h             : in  unsigned(COORD_W downto 0);               -- box height
     -- video in
-    s_axis_tdata         : in  std_logic_vector(23 downto 0);            -- pixel: R 23:16, G 15:8, B 7:0 (RGB_PACKING 1: R, B, G)
+    s_axis_tdata         : in  std_logic_vector(24 * PPC - 1 downto 0);  -- PPC pixels, pixel k at 24k+23 .. 24k: R, G, B (RGB_PACKING 1: R, B, G)
     s_axis_tvalid        : in  std_logic;                                -- pixel valid
     s_axis_tready        : out std_logic;                                -- pixel accepted
-    s_axis_tlast         : in  std_logic;                                -- last pixel of a line
-    s_axis_tuser         : in  std_logic;                                -- first pixel of a frame
+    s_axis_tlast         : in  std_logic;                                -- last beat of a line
+    s_axis_tuser         : in  std_logic;                                -- first beat of a frame
     -- results
     m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);  -- result word
     m_axis_result_tvalid : out std_logic;                                -- result valid
@@ -166,8 +172,12 @@ architecture rtl of ms_tracker is
   -- front end
   signal ip_valid       : std_logic;
   signal ip_x, ip_y     : unsigned(COORD_W - 1 downto 0);
-  signal ip_cbin        : std_logic_vector(BIN_C_W - 1 downto 0);
-  signal ip_ebin        : std_logic_vector(BIN_E_W - 1 downto 0);
+  signal ip_cbin        : std_logic_vector(PPC * BIN_C_W - 1 downto 0);
+  signal ip_ebin        : std_logic_vector(PPC * BIN_E_W - 1 downto 0);
+  signal cap_bwe        : std_logic_vector(LANES - 1 downto 0);          -- per-bank write port (PPC > 1)
+  signal cap_bwaddr     : std_logic_vector(LANES * ADDR_W - 1 downto 0);
+  signal cap_bwc        : std_logic_vector(LANES * BIN_C_W - 1 downto 0);
+  signal cap_bwe_d      : std_logic_vector(LANES * BIN_E_W - 1 downto 0);
   signal fe_start, fe_end, fe_error : std_logic;
   signal fe_code        : std_logic_vector(ERR_CODE_W - 1 downto 0);
   signal cap_we         : std_logic;
@@ -303,6 +313,17 @@ architecture rtl of ms_tracker is
   constant X_RESULT  : natural := 2 * CENTRE_ABS_W + 2 * RHO_OUT_W + ALPHA_W + 2 * ITER_W + 4 + FLAGS_W
                                   + ERR_W + 2 * WIN_W + FCOUNT_W;
 
+  -- frame width accepted with PPC pixels per beat: a multiple of PPC (PPC a power of two)
+  function width_ppc_ok(w : unsigned) return boolean is
+  begin
+    for i in 0 to 1 loop
+      if 2 ** (i + 1) <= PPC and w(i) = '1' then
+        return false;
+      end if;
+    end loop;
+    return true;
+  end function;
+
   -- evaluated once at elaboration; returns true so that it can initialise a constant
   function checks return boolean is
   begin
@@ -313,6 +334,10 @@ architecture rtl of ms_tracker is
     assert KERNEL_EPAN <= 1 report "ms_tracker: KERNEL_EPAN = " & img(KERNEL_EPAN) & " (0 flat, 1 Epanechnikov)"
       severity failure;
     assert RGB_PACKING <= 1 report "ms_tracker: RGB_PACKING = " & img(RGB_PACKING) & " (0 mstrack, 1 UG934)"
+      severity failure;
+    assert PPC = 1 or PPC = 2 or PPC = 4 report "ms_tracker: PPC = " & img(PPC) & " (1, 2 or 4)" severity failure;
+    assert PPC <= LANES report "ms_tracker: PPC = " & img(PPC) & " > LANES = " & img(LANES)
+      & " is not supported (the region capture writes the PPC pixels of a beat into PPC different banks)"
       severity failure;
     assert MAX_HALF >= 1 report "ms_tracker: MAX_HALF must be >= 1" severity failure;
     assert MAX_FRAME_W >= 3 and MAX_FRAME_W <= 2 ** COORD_W - 1
@@ -353,7 +378,8 @@ begin
   -- closed: outside T_IDLE, after a frame's last beat until its result, while an error result is
   -- on its way to the FIFO (so that no second error can come before it: none is ever lost), and
   -- in the clock an init box is taken (the box applies to the frame after that clock)
-  size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
+  size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W
+                     and width_ppc_ok(frame_width) else '0';
   accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
                      and fe_err_now = '0' and init_take = '0' else '0';
   s_axis_tready <= accept;
@@ -403,7 +429,8 @@ begin
   ---------------------------------------------------------------------------- front end, capture, RAMs
   u_fe : entity work.ms_frontend
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
-                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, RGB_PACKING => RGB_PACKING)
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, RGB_PACKING => RGB_PACKING,
+                 PPC => PPC)
     port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
               in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
               ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
@@ -415,24 +442,53 @@ begin
 
   u_cap : entity work.ms_region_capture
     generic map (LANES => LANES, COORD_W => COORD_W, REGION_MAX => REGION_MAX, STRIDE => STRIDE,
-                 ADDR_W => ADDR_W, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2)
+                 ADDR_W => ADDR_W, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
+                 PPC => PPC)
     port map (clk => clk, rst => rst, frame_start => fe_start, frame_end => fe_end,
               frame_error => fe_error, reg_x => reg_x, reg_y => reg_y, reg_w => reg_w_c,
               reg_h => reg_h_c, ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin,
               ip_ebin => ip_ebin, we => cap_we, wbank => cap_bank, waddr => cap_addr,
-              wdata_colour => cap_c, wdata_edge => cap_e, done => cap_done);
+              wdata_colour => cap_c, wdata_edge => cap_e, done => cap_done,
+              bwe => cap_bwe, bwaddr => cap_bwaddr, bwdata_colour => cap_bwc, bwdata_edge => cap_bwe_d);
 
-  u_ram_c : entity work.ms_region_ram
-    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
-                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
-    port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
-              raddr => ram_c_addr, rdata => ram_c_data);
+  -- PPC = 1: one write per clock into the LANES-banked RAMs (shared write port)
+  g_ram1 : if PPC = 1 generate
+    u_ram_c : entity work.ms_region_ram
+      generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
+                   RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
+      port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
+                raddr => ram_c_addr, rdata => ram_c_data);
 
-  u_ram_e : entity work.ms_region_ram
-    generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W,
-                 RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
-    port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_e,
-              raddr => ram_e_addr, rdata => ram_e_data);
+    u_ram_e : entity work.ms_region_ram
+      generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W,
+                   RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
+      port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_e,
+                raddr => ram_e_addr, rdata => ram_e_data);
+  end generate;
+
+  -- PPC > 1: up to PPC writes per clock, one per bank: one single-bank ms_region_ram per bank
+  -- (the same banks, layout and latencies as the LANES-banked RAM above)
+  g_ramn : if PPC > 1 generate
+    g_bank : for bk in 0 to LANES - 1 generate
+      u_ram_c : entity work.ms_region_ram
+        generic map (LANES => 1, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
+                     RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
+        port map (clk => clk, we => cap_bwe(bk), wbank => "0",
+                  waddr => unsigned(cap_bwaddr(ADDR_W * (bk + 1) - 1 downto ADDR_W * bk)),
+                  wdata => cap_bwc(BIN_C_W * (bk + 1) - 1 downto BIN_C_W * bk),
+                  raddr => ram_c_addr(ADDR_W * (bk + 1) - 1 downto ADDR_W * bk),
+                  rdata => ram_c_data(BIN_C_W * (bk + 1) - 1 downto BIN_C_W * bk));
+
+      u_ram_e : entity work.ms_region_ram
+        generic map (LANES => 1, DEPTH => DEPTH, DATA_W => BIN_E_W, ADDR_W => ADDR_W,
+                     RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
+        port map (clk => clk, we => cap_bwe(bk), wbank => "0",
+                  waddr => unsigned(cap_bwaddr(ADDR_W * (bk + 1) - 1 downto ADDR_W * bk)),
+                  wdata => cap_bwe_d(BIN_E_W * (bk + 1) - 1 downto BIN_E_W * bk),
+                  raddr => ram_e_addr(ADDR_W * (bk + 1) - 1 downto ADDR_W * bk),
+                  rdata => ram_e_data(BIN_E_W * (bk + 1) - 1 downto BIN_E_W * bk));
+    end generate;
+  end generate;
 
   ---------------------------------------------------------------------------- init path
   u_clip : entity work.ms_box_clip
@@ -602,7 +658,7 @@ begin
         when T_CLIP =>
           if bc_out_valid = '1' then
             -- a frame size out of range when the box came: rejected too
-            if bc_rejected = '1' or in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W then
+            if bc_rejected = '1' or in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W or not width_ppc_ok(in_fw) then
               rejected_pending <= '1';
               state <= T_IDLE;
             else

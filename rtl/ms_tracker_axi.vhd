@@ -1,7 +1,8 @@
 -- ms_tracker_axi: ms_tracker with an AXI4-Lite register interface and an interrupt (system top).
 --
 -- Wraps rtl/ms_tracker.vhd (unchanged) for a camera pipeline with a CPU beside it:
---   * video AXI4-Stream in (s_axis_*: 24-bit RGB, tuser = start of frame, tlast = end of line),
+--   * video AXI4-Stream in (s_axis_*: PPC 24-bit RGB pixels per beat, pixel k at 24k+23 .. 24k
+--     (generic PPC, passed to the core), tuser = start of frame, tlast = end of line),
 --     passed to the core frame by frame: CTRL.enable is looked at on each start-of-frame beat; a
 --     frame that starts while enable = 0 is consumed (tready = 1) and dropped whole (DROP_COUNT),
 --     so the core never sees a partial frame; beats before the first start of frame are dropped;
@@ -21,7 +22,7 @@
 --     FIFO.  RESULT_STREAM = false: tvalid = 0, tready ignored, results only through registers.
 -- Latency    : the core's (docs/performance.md) + 1 clock to L; a register read answers in 2 clocks
 --              after the address (PeakRDL regblock + AXI4-Lite adapter), 2 transactions in flight.
--- Throughput : the core's: 1 pixel per clock while a frame streams in.
+-- Throughput : the core's: PPC pixels per clock while a frame streams in.
 -- Reset      : rst synchronous, active high (core and registers; every register to its reset value).
 -- Cost       : over the core, ECP5 (yosys synth_ecp5, default generics): +1,509 LUT4, +748 FF,
 --              +161 CCU2C; no RAM, no multiplier (docs/blocks/ms_tracker_axi.md, Resources).
@@ -37,6 +38,7 @@ use work.ms_tracker_regs_pkg.all;
 entity ms_tracker_axi is
   generic (
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    PPC            : natural := 1;               -- pixels per clock (s_axis beat): 1, 2 or 4 (<= LANES)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
@@ -105,7 +107,7 @@ entity ms_tracker_axi is
     s_axil_rdata         : out std_logic_vector(31 downto 0);            -- read data
     s_axil_rresp         : out std_logic_vector(1 downto 0);             -- OKAY "00" / SLVERR "10"
     -- video in
-    s_axis_tdata         : in  std_logic_vector(23 downto 0);            -- R 23:16, G 15:8, B 7:0
+    s_axis_tdata         : in  std_logic_vector(24 * PPC - 1 downto 0);  -- PPC pixels, pixel k: R 24k+23:24k+16, G, B
     s_axis_tvalid        : in  std_logic;                                -- pixel valid
     s_axis_tready        : out std_logic;                                -- pixel accepted
     s_axis_tlast         : in  std_logic;                                -- last pixel of a line
@@ -318,6 +320,7 @@ begin
   u_core : entity work.ms_tracker
     generic map (
       MAX_FRAME_W    => MAX_FRAME_W,
+      PPC            => PPC,
       LANES          => LANES,
       COLOUR_BITS    => COLOUR_BITS,
       EDGE_BINS_LOG2 => EDGE_BINS_LOG2,

@@ -1,13 +1,15 @@
 """cocotb test bench + pytest entry points for rtl/ms_frontend.vhd
 (ms_stream_check -> ms_colour_bin | ms_grey -> ms_sobel).
 
-Frames are streamed pixel by pixel (in_valid/in_data/in_sof/in_eol), at full
-speed and with random valid gaps.  Every interior pixel's (x, y, cbin, ebin) is
+Frames are streamed beat by beat (in_valid/in_data/in_sof/in_eol), PPC pixels
+per beat (generic PPC = 1, 2, 4: pixel k in bits 24k+23 .. 24k, in_sof on the
+frame's first beat, in_eol on the line's last beat), at full speed and with
+random valid gaps.  Every interior pixel's (x, y, cbin, ebin) is
 compared exactly with the fixed model (``ms_colour_bin`` and
 ``ms_edge_bin(ms_sobel(ms_grey(frame)))``); the frame events and error codes
 are checked against the expected sequence; protocol errors (short line, long
-line, missing sof, cut frame) are each followed by a good frame that must be
-processed exactly.
+line, missing sof, cut frame, frame size, and with PPC > 1 a width that is not a
+multiple of PPC) are each followed by a good frame that must be processed exactly.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_frontend.py`` (``--waves`` for waves).
 """
@@ -29,7 +31,8 @@ from mstrack.fixed.blocks import ms_colour_bin, ms_edge_bin, ms_grey, ms_sobel
 from mstrack.hw.hdl import dut_generics
 
 CLK_NS = 10
-DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5}
+DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5,
+            "PPC": 1}
 # error codes of rtl/ms_stream_pkg.vhd
 ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT, ERR_SIZE = 0, 1, 2, 3, 4
 #: input beat (last one accepted in clock c) -> frame_end high in clock c + FRAME_END_LAT
@@ -68,6 +71,28 @@ def frame_beats(frame: np.ndarray, sof: bool = True) -> list[tuple[int, int, int
             for y in range(h) for x in range(w)]
 
 
+def pack_beats(beats, ppc: int) -> list[tuple[int, int, int, int, int]]:
+    """Pixel beats (frame_beats) -> beats of ppc pixels: pixel k of a beat in bits 24k+23 .. 24k,
+    sof of the beat's first pixel, eol if one of its pixels has eol (a beat closes at ppc pixels
+    or at an eol; a short last beat is padded with zero pixels)."""
+    if ppc == 1:
+        return list(beats)
+    out, cur = [], []
+
+    def close():
+        data = sum(p[0] << (24 * k) for k, p in enumerate(cur))
+        out.append((data, cur[0][1], int(any(p[2] for p in cur)), cur[0][3], cur[0][4]))
+        cur.clear()
+
+    for b in beats:
+        cur.append(b)
+        if len(cur) == ppc or b[2]:
+            close()
+    if cur:
+        close()
+    return out
+
+
 def model_interior(frame: np.ndarray, g: dict) -> list[tuple[int, int, int, int]]:
     """(x, y, cbin, ebin) of every interior pixel in raster order, from the fixed model."""
     cb = ms_colour_bin(frame, int(g["COLOUR_BITS"]))[1:-1, 1:-1]
@@ -85,7 +110,8 @@ class TB:
         dut.rst.value = Immediate(1)
         dut.in_valid.value = Immediate(0)
         cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start(start_high=False))
-        self.ips: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin, ebin))
+        self.ppc = int(self.g.get("PPC", 1))
+        self.ips: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin, ebin)), one per pixel
         self.events: list[tuple[int, tuple]] = []    # (cycle, ("start",) | ("end",) | ("error", code))
         self.last_beat_cycle = -1
 
@@ -102,6 +128,7 @@ class TB:
     async def monitor(self):
         d = self.dut
         has_code = hasattr(d, "err_code")
+        has_ip = hasattr(d, "ip_valid") and (self.ppc == 1 or hasattr(d, "ip_mask"))
         while True:
             await RisingEdge(d.clk)
             await ReadOnly()
@@ -112,16 +139,28 @@ class TB:
                 self.events.append((c, ("start",)))
             if int(d.frame_end.value):
                 self.events.append((c, ("end",)))
-            if hasattr(d, "ip_valid") and int(d.ip_valid.value):
-                self.ips.append((c, (int(d.ip_x.value), int(d.ip_y.value), int(d.ip_cbin.value),
-                                     int(d.ip_ebin.value))))
+            if has_ip and int(d.ip_valid.value):
+                if self.ppc == 1:
+                    self.ips.append((c, (int(d.ip_x.value), int(d.ip_y.value), int(d.ip_cbin.value),
+                                         int(d.ip_ebin.value))))
+                    continue
+                # lanes: column ip_x + k where ip_mask(k) (ip_x wraps on a line's first beat)
+                mask, x0, y = int(d.ip_mask.value), int(d.ip_x.value), int(d.ip_y.value)
+                cb, eb = int(d.ip_cbin.value), int(d.ip_ebin.value)
+                cw, ew = 3 * int(self.g["COLOUR_BITS"]), int(self.g["EDGE_BINS_LOG2"])
+                xm = (1 << int(self.g["COORD_W"])) - 1
+                for k in range(self.ppc):
+                    if mask >> k & 1:
+                        self.ips.append((c, ((x0 + k) & xm, y, (cb >> (k * cw)) & ((1 << cw) - 1),
+                                             (eb >> (k * ew)) & ((1 << ew) - 1))))
 
     async def drive(self, beats, rng: random.Random, gap: float):
+        """Drive pixel beats (frame_beats), packed PPC pixels per beat."""
         d = self.dut
-        for data, sof, eol, w, h in beats:
+        for data, sof, eol, w, h in pack_beats(beats, self.ppc):
             while gap and rng.random() < gap:
                 d.in_valid.value = 0
-                d.in_data.value = rng.getrandbits(24)  # garbage while not valid
+                d.in_data.value = rng.getrandbits(24 * self.ppc)  # garbage while not valid
                 d.in_sof.value = rng.getrandbits(1)
                 d.in_eol.value = rng.getrandbits(1)
                 await RisingEdge(d.clk)
@@ -137,9 +176,19 @@ class TB:
 
 
 def scenario(g: dict, seed: int):
-    """Segments (beats, expected events, expected interior pixels, exact?) of one run."""
+    """Segments (beats, expected events, expected interior pixels, exact?) of one run.
+
+    PPC = 1: the original scenario.  PPC > 1: the frame widths are multiples of 4 (23 -> 24) and
+    every fault sits at the end of a beat (a short line ends on a full beat, a long line has
+    whole extra beats); plus a frame whose width is not a multiple of PPC (ERR_SIZE)."""
     rng = np.random.default_rng(seed)
     segs = []
+    ppc = int(g.get("PPC", 1))
+    W = 23 if ppc == 1 else 24                    # the usual frame width
+
+    def al(i):
+        """Pixel index i moved up to the last pixel of its beat (a beat boundary after it)."""
+        return i + (-(i + 1)) % ppc
 
     def good(frame):
         segs.append((frame_beats(frame), [("start",), ("end",)], model_interior(frame, g), True))
@@ -147,44 +196,59 @@ def scenario(g: dict, seed: int):
     def bad(beats, events, frame):
         segs.append((beats, events, model_interior(frame, g), False))
 
-    good(random_frame(rng, 11, 23))
+    good(random_frame(rng, 11, W))
     good(random_frame(rng, 17, 40))
-    good(grey_frame(rng, 11, 23))
+    good(grey_frame(rng, 11, W))
     good(edge_frame(9, 16))
-    # short line: row 4 ends (eol) at x = 9; the rest of the frame is dropped
-    f = random_frame(rng, 11, 23)
+    # short line: row 4 ends (eol) at x = 9 (PPC > 1: at the end of that pixel's beat); the rest
+    # of the frame is dropped
+    f = random_frame(rng, 11, W)
     b = frame_beats(f)
-    b = b[:4 * 23 + 9] + [b[4 * 23 + 9][:2] + (1,) + b[4 * 23 + 9][3:]] + b[5 * 23:]
+    k = 4 * W + al(9)
+    b = b[:k] + [b[k][:2] + (1,) + b[k][3:]] + b[5 * W:]
     bad(b, [("start",), ("error", ERR_SHORT_LINE)], f)
-    good(random_frame(rng, 11, 23))
-    # long line: row 3 has 3 extra pixels (eol on the last one)
-    f = random_frame(rng, 11, 23)
+    good(random_frame(rng, 11, W))
+    # long line: row 3 has 3 extra pixels (PPC > 1: one extra beat; eol on the last one)
+    f = random_frame(rng, 11, W)
     b = frame_beats(f)
-    row3 = [(p[0], 0, 0, 23, 11) for p in b[3 * 23:4 * 23]]
-    extra = [(0x123456, 0, 0, 23, 11), (0x654321, 0, 0, 23, 11), (0xABCDEF, 0, 1, 23, 11)]
-    b = b[:3 * 23] + row3 + extra + b[4 * 23:]
+    row3 = [(p[0], 0, 0, W, 11) for p in b[3 * W:4 * W]]
+    extra = [(0x123456, 0, 0, W, 11), (0x654321, 0, 0, W, 11), (0xABCDEF, 0, 0, W, 11)][:al(2) + 1]
+    extra += [(0x0F0F0F, 0, 0, W, 11)] * (al(2) + 1 - len(extra))
+    extra[-1] = extra[-1][:2] + (1,) + extra[-1][3:]
+    b = b[:3 * W] + row3 + extra + b[4 * W:]
     bad(b, [("start",), ("error", ERR_LONG_LINE)], f)
     good(random_frame(rng, 17, 40))
     # missing sof: a whole frame without sof (reported once), then a good frame
-    f = random_frame(rng, 5, 23)
+    f = random_frame(rng, 5, W)
     segs.append((frame_beats(f, sof=False), [("error", ERR_NO_SOF)], [], True))
-    good(random_frame(rng, 11, 23))
-    # cut: a new frame (sof) after 5 rows and 3 pixels
-    f = random_frame(rng, 11, 23)
-    bad(frame_beats(f)[:5 * 23 + 3], [("start",)], f)
-    f2 = random_frame(rng, 11, 23)
+    good(random_frame(rng, 11, W))
+    # cut: a new frame (sof) after 5 rows and 3 pixels (PPC > 1: the beat of pixel 2)
+    f = random_frame(rng, 11, W)
+    bad(frame_beats(f)[:5 * W + al(2) + 1], [("start",)], f)
+    f2 = random_frame(rng, 11, W)
     segs.append((frame_beats(f2), [("error", ERR_CUT), ("start",), ("end",)], model_interior(f2, g), True))
     good(edge_frame(9, 16))
     # frame size out of range at the sof (W > MAX_FRAME_W, W < 3, H < 3): one ERR_SIZE, no frame
     mw = int(g["MAX_FRAME_W"])
-    for h, w in [(4, mw + 1), (5, 2), (2, 23)]:
+    for h, w in [(4, mw + 1), (5, 2), (2, W)]:
         segs.append((frame_beats(random_frame(rng, h, w)), [("error", ERR_SIZE)], [], True))
-        good(random_frame(rng, 11, 23))
+        good(random_frame(rng, 11, W))
     # a frame cut by a sof of a bad size: one ERR_SIZE (no ERR_CUT), then a good frame
-    f = random_frame(rng, 11, 23)
-    bad(frame_beats(f)[:4 * 23 + 5], [("start",)], f)
+    f = random_frame(rng, 11, W)
+    bad(frame_beats(f)[:4 * W + al(5) + 1], [("start",)], f)
     segs.append((frame_beats(random_frame(rng, 6, 1)), [("error", ERR_SIZE)], [], True))
-    good(random_frame(rng, 11, 23))
+    good(random_frame(rng, 11, W))
+    if ppc > 1:
+        # a frame width that is not a multiple of PPC (rows padded to whole beats): ERR_SIZE,
+        # the frame is dropped; the next good frame is processed exactly
+        for wbad in (W - 1, W - ppc // 2, 2 * ppc + 1):
+            segs.append((frame_beats(random_frame(rng, 7, wbad)), [("error", ERR_SIZE)], [], True))
+            good(random_frame(rng, 11, W))
+        # ... also when it cuts a frame in progress (one ERR_SIZE, no ERR_CUT)
+        f = random_frame(rng, 11, W)
+        bad(frame_beats(f)[:3 * W + al(4) + 1], [("start",)], f)
+        segs.append((frame_beats(random_frame(rng, 5, W + 1)), [("error", ERR_SIZE)], [], True))
+        good(random_frame(rng, 11, 40))
     return segs
 
 
@@ -248,12 +312,12 @@ async def latency(dut):
     tb = TB(dut)
     await tb.reset()
     mon = cocotb.start_soon(tb.monitor())
-    f = random_frame(np.random.default_rng(3), 12, 30)
+    f = random_frame(np.random.default_rng(3), 12, 30 if tb.ppc == 1 else 32)
     beats = frame_beats(f)
     first = tb.cycle()
     await tb.drive(beats, random.Random(0), 0.0)
     last = tb.last_beat_cycle
-    assert last - first == len(beats) - 1, "driver not at one beat per clock"
+    assert last - first == len(beats) // tb.ppc - 1, "driver not at one beat per clock"
     await ClockCycles(dut.clk, 20)
     mon.cancel()
     end = [c for c, e in tb.events if e == ("end",)]
@@ -264,9 +328,13 @@ async def latency(dut):
                   end[0] - last)
     assert end[0] - last == FRAME_END_LAT, f"frame_end latency {end[0] - last} != {FRAME_END_LAT}"
     assert end[0] == last_ip + 1, "frame_end must come 1 clock after the last interior pixel"
-    # throughput: interior pixels come out at one per clock within a line
-    cyc = [c for c, _ in tb.ips[:f.shape[1] - 2]]
-    assert cyc == list(range(cyc[0], cyc[0] + len(cyc))), "interior pixels not at 1 per clock"
+    # throughput: interior pixels come out at PPC per clock within a line (the first beat of a
+    # line carries PPC - 2 of them, the next ones PPC each)
+    cyc = sorted({c for c, _ in tb.ips[:f.shape[1] - 2]})
+    assert cyc == list(range(cyc[0], cyc[0] + len(cyc))), "interior beats not at 1 per clock"
+    # interior column c (lane k of the beat at x = c + 1 - k) leaves with the beat (c + 1) // PPC
+    assert len(cyc) == len({(c + 1) // tb.ppc for c in range(1, f.shape[1] - 1)}), \
+        f"{len(cyc)} clocks for a line of {f.shape[1] - 2} interior pixels at PPC {tb.ppc}"
 
 
 # ---------------------------------------------------------------- pytest entry points
@@ -282,19 +350,25 @@ TOP = "ms_frontend"
 MODULE = "test_ms_frontend"
 
 
-def fe_generics(max_frame_w: int = 64, **tp_kw) -> dict:
+def fe_generics(max_frame_w: int = 64, ppc: int = 1, **tp_kw) -> dict:
     """ms_frontend generics from the model parameters (core_generics)."""
     g = core_generics(TrackerParams(**tp_kw), FixedParams(max_half=4, margin=2), lanes=2)
     out = {k: g[k] for k in ("COORD_W", "COLOUR_BITS", "EDGE_BINS_LOG2", "EDGE_SHIFT")}
     out["MAX_FRAME_W"] = max_frame_w
+    if ppc != 1:
+        out["PPC"] = ppc
     return out
 
 
 PARAMS = [
-    pytest.param(fe_generics(), id="default"),
-    pytest.param(fe_generics(max_frame_w=40), id="maxw40"),
-    pytest.param(fe_generics(colour_bits=2, edge_bins_log2=3, edge_shift=2), id="cb2_e3_s2"),
-    pytest.param(fe_generics(colour_bits=8, edge_bins_log2=8, edge_shift=0), id="cb8_e8_s0"),
+    pytest.param(fe_generics(), id="ppc1-default"),
+    pytest.param(fe_generics(max_frame_w=40), id="ppc1-maxw40"),
+    pytest.param(fe_generics(colour_bits=2, edge_bins_log2=3, edge_shift=2), id="ppc1-cb2_e3_s2"),
+    pytest.param(fe_generics(colour_bits=8, edge_bins_log2=8, edge_shift=0), id="ppc1-cb8_e8_s0"),
+    pytest.param(fe_generics(ppc=2), id="ppc2-default"),
+    pytest.param(fe_generics(ppc=4), id="ppc4-default"),
+    pytest.param(fe_generics(ppc=4, max_frame_w=40, colour_bits=2, edge_bins_log2=3, edge_shift=2),
+                 id="ppc4-maxw40_cb2_e3_s2"),
 ]
 
 

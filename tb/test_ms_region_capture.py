@@ -6,8 +6,10 @@ For each region a frame is streamed (full speed and with random valid gaps),
 then the whole region is read back through the RAM read ports (all banks in
 parallel, bank b of word j = region column j * LANES + b) and compared with
 ``ms_region_capture(frame, Region(...), tp)``.  Regions touch the interior
-borders and have odd sizes; LANES 1, 2 and 4.  A frame abandoned by a protocol
-error must not raise ``done``.
+borders and have odd sizes; LANES 1, 2 and 4; PPC 1, 2 and 4 pixels per clock
+(PPC <= LANES; with PPC > 1 the frame is 24 px wide and the capture writes the
+PPC pixels of a beat into PPC banks through its per-bank write port).  A frame
+abandoned by a protocol error must not raise ``done``.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_region_capture.py``.
 """
@@ -27,7 +29,7 @@ from mstrack.track.params import TrackerParams
 from test_ms_frontend import ERR_SHORT_LINE, TB, edge_frame, frame_beats, random_frame
 
 DEFAULTS = {"LANES": 2, "COORD_W": 12, "MAX_FRAME_W": 64, "REGION_MAX": 13, "STRIDE": 7, "ADDR_W": 7,
-            "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5}
+            "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5, "PPC": 1}
 
 
 def regions(g: dict, w: int, h: int) -> list[Region]:
@@ -135,7 +137,7 @@ async def run_test(dut, gap):
     seed = 11 + int(gap * 100)
     nrng = np.random.default_rng(seed)
     rng = random.Random(seed)
-    h, w = 17, 21
+    h, w = 17, (21 if tb.ppc == 1 else 24)
     for i, reg in enumerate(regions(tb.g, w, h)):
         frame = edge_frame(h, w) if i == 4 else random_frame(nrng, h, w)
         await tb.capture(frame, reg, rng, gap)
@@ -144,14 +146,14 @@ async def run_test(dut, gap):
     reg = regions(tb.g, w, h)[0]
     tb.set_region(reg)
     beats = frame_beats(random_frame(nrng, h, w))
-    k = 15 * w + 4
+    k = 15 * w + 4 + (-(4 + 1)) % tb.ppc        # the end of a beat
     beats = beats[:k] + [beats[k][:2] + (1,) + beats[k][3:]] + beats[k + 1:]
     await tb.drive(beats, rng, gap)
     await ClockCycles(dut.clk, 20)
     assert len(tb.dones) == n_done, "done raised for an abandoned frame"
     assert tb.events[-1][1] == ("error", ERR_SHORT_LINE), f"expected a short-line error, got {tb.events[-2:]}"
     await tb.capture(random_frame(nrng, h, w), regions(tb.g, w, h)[1], rng, gap)
-    dut._log.info("LANES %d: %d regions captured and read back, gap %.2f", tb.lanes, len(tb.dones), gap)
+    dut._log.info("LANES %d PPC %d: %d regions captured and read back, gap %.2f", tb.lanes, tb.ppc, len(tb.dones), gap)
 
 
 # ---------------------------------------------------------------- pytest entry points
@@ -167,19 +169,24 @@ MODULE = "test_ms_region_capture"
 WRAPPER = hdl.TB_DIR / "ms_capture_tb_top.vhd"
 
 
-def cap_generics(lanes: int, **tp_kw) -> dict:
+def cap_generics(lanes: int, ppc: int = 1, **tp_kw) -> dict:
     g = core_generics(TrackerParams(**tp_kw), FixedParams(max_half=4, margin=2), lanes=lanes)
     keys = ("LANES", "COORD_W", "REGION_MAX", "STRIDE", "ADDR_W", "COLOUR_BITS", "EDGE_BINS_LOG2", "EDGE_SHIFT")
     out = {k: g[k] for k in keys}
     out["MAX_FRAME_W"] = 64
+    if ppc != 1:
+        out["PPC"] = ppc
     return out
 
 
 PARAMS = [
-    pytest.param(cap_generics(2), id="lanes2"),
-    pytest.param(cap_generics(1), id="lanes1"),
-    pytest.param(cap_generics(4), id="lanes4"),
-    pytest.param(cap_generics(4, colour_bits=2, edge_bins_log2=3, edge_shift=3), id="lanes4_cb2_e3"),
+    pytest.param(cap_generics(2), id="ppc1-lanes2"),
+    pytest.param(cap_generics(1), id="ppc1-lanes1"),
+    pytest.param(cap_generics(4), id="ppc1-lanes4"),
+    pytest.param(cap_generics(4, colour_bits=2, edge_bins_log2=3, edge_shift=3), id="ppc1-lanes4_cb2_e3"),
+    pytest.param(cap_generics(2, ppc=2), id="ppc2-lanes2"),
+    pytest.param(cap_generics(4, ppc=2), id="ppc2-lanes4"),
+    pytest.param(cap_generics(4, ppc=4), id="ppc4-lanes4"),
 ]
 
 
@@ -187,3 +194,12 @@ PARAMS = [
 @pytest.mark.parametrize("generics", PARAMS)
 def test_ms_region_capture(generics, hdl_waves):
     hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP, extra=[WRAPPER]), waves=hdl_waves)
+
+
+@pytest.mark.ghdl
+def test_ms_region_capture_ppc_gt_lanes():
+    """PPC > LANES is refused at elaboration (generic assertion): two pixels of a beat, one bank."""
+    g = {**cap_generics(2), "PPC": 4}
+    with pytest.raises(hdl.HdlError, match="PPC > LANES is not supported"):
+        hdl.run_ghdl_plain(TOP, hdl.rtl_sources(TOP, extra=[WRAPPER]), g, build_name="capture_ppc4_lanes2",
+                           stop_time="1ns")

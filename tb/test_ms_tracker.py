@@ -8,7 +8,11 @@ protocol faults).  Every result word is compared field by field with
 its result are recorded in the job's report file (docs/performance.md quotes them).
 
 Framing with cocotbext-axi: one AxiStreamFrame per line (tlast on its last beat), tuser a
-per-beat list [1, 0, ...] on the first line of a frame; byte_lanes=1 so a beat is a pixel.
+per-pixel list [1, 0, ...] on the first line of a frame (the source takes a beat's tuser from
+its last pixel: the first PPC entries are 1); byte_lanes = PPC (job key "ppc", generic PPC) so a
+beat carries PPC pixels, pixel k in tdata bits 24k+23 .. 24k (AXI4-Stream video).
+Fault "width_ppc" (PPC > 1): that frame is sent with frame_width = W - 1 (not a multiple of
+PPC, its rows one pixel shorter, the last beat padded): one error result, code 4 (size).
 """
 from __future__ import annotations
 
@@ -25,7 +29,7 @@ from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 from cocotbext.axi import AxiStreamBus, AxiStreamFrame, AxiStreamSink, AxiStreamSource
 
-from mstrack.hw.cosim import CoreConfig, diff_fields, expected_results, frame_words, flags_word
+from mstrack.hw.cosim import ERR_SIZE, CoreConfig, diff_fields, expected_results, frame_words, flags_word
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, unpack_result
 from mstrack.track.params import TrackerParams
@@ -49,21 +53,25 @@ def load_frames(job: dict) -> list[np.ndarray]:
 
 def config_of(job: dict) -> CoreConfig:
     return CoreConfig(TrackerParams(**job.get("tp", {})), FixedParams(**job.get("fp", {})),
-                      lanes=job.get("lanes", DEFAULT_LANES), max_frame_w=job.get("max_frame_w", 1024))
+                      lanes=job.get("lanes", DEFAULT_LANES), max_frame_w=job.get("max_frame_w", 1024),
+                      ppc=job.get("ppc", 1))
 
 
-def lines_of(frame: np.ndarray, fault: str | None = None) -> list[AxiStreamFrame]:
-    """AXI frames (one per line) for a video frame, optionally with a protocol fault."""
+def lines_of(frame: np.ndarray, fault: str | None = None, ppc: int = 1) -> list[AxiStreamFrame]:
+    """AXI frames (one per line) for a video frame, optionally with a protocol fault; ppc pixels
+    per beat (a short / long line is short / long by whole beats)."""
     words = frame_words(frame)
     h, w = words.shape
     out = []
     for y in range(h):
         row = words[y].tolist()
         if fault == "short_line" and y == h // 2:
-            row = row[: w - 3]
+            row = row[: w - 3 * ppc]
         if fault == "long_line" and y == h // 2:
-            row = row + row[:2]
-        user = [1] + [0] * (len(row) - 1) if y == 0 else 0
+            row = row + row[:2 * ppc]
+        if fault == "width_ppc":
+            row = row[: w - 1]
+        user = [1] * ppc + [0] * (len(row) - ppc) if y == 0 else 0
         if fault == "no_sof" and y == 0:
             user = 0
         out.append(AxiStreamFrame(row, tuser=user))
@@ -97,7 +105,8 @@ class TB:
         cocotb.start_soon(Clock(d.clk, CLK_NS, unit="ns").start())
         await ClockCycles(d.clk, 3)
         # bind the AXI models once every signal has a defined value
-        self.source = AxiStreamSource(AxiStreamBus.from_prefix(d, "s_axis"), d.clk, d.rst, byte_lanes=1)
+        self.ppc = int(self.job.get("ppc", 1))
+        self.source = AxiStreamSource(AxiStreamBus.from_prefix(d, "s_axis"), d.clk, d.rst, byte_lanes=self.ppc)
         self.sink = AxiStreamSink(AxiStreamBus.from_prefix(d, "m_axis_result"), d.clk, d.rst, byte_lanes=1)
         rng = random.Random(self.job.get("seed", 1))
         if self.job.get("pause_in"):
@@ -171,7 +180,7 @@ async def run_job(dut):
         # an init box with less than 3x3 px inside the frame is rejected: the next frame's
         # result says so (and, with no earlier target, no_target); a good init then works
         await tb.init(tuple(job["bad_box"]))
-        for line in lines_of(frames[0]):
+        for line in lines_of(frames[0], ppc=tb.ppc):
             tb.source.send_nowait(line)
         got = await recv_result(tb, g, per_frame_budget)
         d = diff_fields(got, {"flags": flags_word(rejected=1, no_target=1), "frame_count": 0},
@@ -184,16 +193,32 @@ async def run_job(dut):
         offset = 1
     await tb.init(box)
     # queue every frame (a cut frame's error only shows when the next start of frame comes)
-    for i, frame in enumerate(frames):
-        for line in lines_of(frame, faults.get(i)):
-            tb.source.send_nowait(line)
+    if "width_ppc" not in faults.values():
+        for i, frame in enumerate(frames):
+            for line in lines_of(frame, faults.get(i), tb.ppc):
+                tb.source.send_nowait(line)
+    else:
+        # frame_width changes for the bad frame: send frame by frame, each once the previous
+        # one has left the source (frame_width is sampled on the start-of-frame beat)
+        async def feed():
+            for i, frame in enumerate(frames):
+                await tb.source.wait()
+                dut.frame_width.value = w - 1 if faults.get(i) == "width_ppc" else w
+                for line in lines_of(frame, faults.get(i), tb.ppc):
+                    tb.source.send_nowait(line)
+                await RisingEdge(dut.clk)
+        cocotb.start_soon(feed())
     gi = 0
     for i in range(len(frames)):
         got = await recv_result(tb, g, per_frame_budget)
         if i in faults:
             # one error result for the bad frame; nothing tracked, state unchanged
             exp = {"flags": flags_word(error=1), "frame_count": (i + offset) & 0xFFFF}
-            d = diff_fields(got, exp, fields=("flags", "frame_count"))
+            fields = ("flags", "frame_count")
+            if faults[i] == "width_ppc":
+                exp["err_code"] = ERR_SIZE
+                fields += ("err_code",)
+            d = diff_fields(got, exp, fields=fields)
         else:
             exp = dict(exp_good[gi])
             exp["frame_count"] = (i + offset) & 0xFFFF
@@ -298,3 +323,47 @@ def test_tracker_verilator_real(name, start, n):
            "report": str(out / f"{name}.json")}
     run_verilator("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
                   build_name="ms_tracker_default", extra_env=_job_env(job))
+
+
+# ----------------------------------------------------------------------------- pixels per clock
+PPCS = [pytest.param(p, id=f"ppc{p}") for p in (1, 2, 4)]
+
+
+@pytest.mark.parametrize("variant", ["plain", "throttled"])
+@pytest.mark.parametrize("ppc", [pytest.param(p, id=f"ppc{p}") for p in (2, 4)])
+def test_tracker_ppc_synthetic(ppc, variant, tmp_path):
+    """GHDL, PPC pixels per beat: the generated 64x48 scene of test_tracker_ghdl_synthetic (its
+    ppc1 case), full speed and throttled (input gaps, result back-pressure), bit-exact."""
+    from mstrack.hw.hdl import run_ghdl
+    job = {**SMALL, "ppc": ppc, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
+           "pause_in": variant == "throttled", "pause_out": variant == "throttled",
+           "report": str(tmp_path / "report.json")}
+    run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
+             build_name=f"ms_tracker_ppc{ppc}_{variant}", extra_env=_job_env(job))
+
+
+@pytest.mark.parametrize("variant", ["plain", "throttled"])
+@pytest.mark.parametrize("ppc", PPCS)
+def test_tracker_ppc_real(ppc, variant, tmp_path):
+    """Verilator (GHDL-synthesised netlist; GHDL if Verilator is missing), default generics,
+    PPC pixels per beat: 8 frames of a real sequence (Girl, 128x96), every result bit-exact;
+    throttled: input gaps and result back-pressure."""
+    from mstrack.hw.hdl import have_verilator, run_ghdl, run_verilator
+    seq = _seq("Girl")
+    job = {"seq": str(seq), "n": 8, "box": list(_gt_box(seq)), "ppc": ppc,
+           "pause_in": variant == "throttled", "pause_out": variant == "throttled",
+           "report": str(tmp_path / "r.json")}
+    runner = run_verilator if have_verilator() else run_ghdl
+    runner("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
+           build_name="ms_tracker_default" if ppc == 1 else f"ms_tracker_ppc{ppc}_real", extra_env=_job_env(job))
+
+
+@pytest.mark.parametrize("ppc", [pytest.param(p, id=f"ppc{p}") for p in (2, 4)])
+def test_tracker_ppc_width_error(ppc, tmp_path):
+    """A frame whose width is not a multiple of PPC: one error result (code 4, size), nothing
+    tracked; the next good frames track exactly as the model."""
+    from mstrack.hw.hdl import run_ghdl
+    job = {**SMALL, "ppc": ppc, "synthetic": {"n": 5, "w": 48, "h": 40, "seed": 5}, "box": [16, 12, 12, 12],
+           "faults": {"2": "width_ppc"}, "report": str(tmp_path / "r.json")}
+    run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
+             build_name=f"ms_tracker_ppc{ppc}_width", extra_env=_job_env(job))

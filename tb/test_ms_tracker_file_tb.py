@@ -165,6 +165,7 @@ def test_config_package_compiles(tmp_path):
     ("LANES", 3, "ms_tracker: LANES = 3 is not a power of two"),
     ("MAX_FRAME_W", 4096, "ms_tracker: MAX_FRAME_W = 4096 out of 3 .. 2**COORD_W - 1 = 4095"),
     ("RESULT_W", 152, "ms_tracker: RESULT_W = 152, expected the result fields rounded up to 8 bits = 144"),
+    ("PPC", 3, "ms_tracker: PPC = 3 (1, 2 or 4)"),
 ])
 def test_wrong_generic_refused(generic, value, message):
     """Elaborating the core with one wrong generic fails with the relation it breaks."""
@@ -177,6 +178,16 @@ def test_wrong_generic_refused(generic, value, message):
     # the right value elaborates
     run_ghdl_plain("ms_tracker", rtl_sources("ms_tracker"), derive(CoreChoices()).generics,
                    build_name="ms_tracker_elab", elab_only=True)
+
+
+def test_ppc_above_lanes_refused():
+    """PPC > LANES is refused at elaboration (the region capture needs PPC different banks)."""
+    from mstrack.hw.hdl import HdlError, rtl_sources, run_ghdl_plain
+    from mstrack.hw.hdl_config import CoreChoices, derive
+    g = {**derive(CoreChoices(lanes=2)).generics, "PPC": 4}
+    with pytest.raises(HdlError) as e:
+        run_ghdl_plain("ms_tracker", rtl_sources("ms_tracker"), g, build_name="ms_tracker_elab", elab_only=True)
+    assert "ms_tracker: PPC = 4 > LANES = 2 is not supported" in str(e.value)
 
 
 # ----------------------------------------------------------------------------- FuseSoC

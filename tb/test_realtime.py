@@ -21,6 +21,9 @@ with :func:`mstrack.hw.cosim.expected_results` (the fixed-point model).
   wide margin in the worst case; LANES = 4 meets it on this footage (98,562 clocks) but not in
   the worst window alignment (docs/realtime.md).  Other LANES values:
   ``MSTRACK_RT_LANES=2,4,8`` (one Verilator build each, cached).
+* ``test_realtime_ppc``: the same footage at 2160p30 with PPC 4 (core clock 74.25 MHz, 140 +
+  99,000 blank clocks: real time with LANES 4) and at 1080p60 with PPC 2 (74.25 MHz, 140 + 49,500
+  blank clocks: LANES 4 misses, expected failure; ``MSTRACK_RT_PPC_EXTRA=1`` adds LANES 8).
 * ``test_long_real_video``: all frames of Girl, Crossing and Couple at their native size,
   frames back to back (the core back-pressures while it tracks), Couple with random input
   gaps and result back-pressure.
@@ -218,6 +221,69 @@ def test_realtime_720p60(lanes):
     if any(stalls) or misses:
         raise RealtimeMiss(f"LANES={lanes} at 720p60: stalls {stalls}; latencies {run.latencies} (budget {budget}):\n"
                            + "\n".join(misses))
+
+
+# ----------------------------------------------------------------------------- pixels per clock
+#: (mode, PPC, LANES, expected to be real time): the core clock is the pixel clock / PPC and the
+#: blanking shrinks to hblank / PPC + vblank / PPC clocks (fastsim.video_mode):
+#: 2160p30 at PPC 4: 74.25 MHz, 140 + 99,000 = 99,140 blank clocks (as 1080p30 at PPC 1);
+#: 1080p60 at PPC 2: 74.25 MHz, 140 + 49,500 = 49,640 blank clocks (as 720p60: LANES 4 misses).
+#: MSTRACK_RT_PPC_EXTRA=1 adds 1080p60 at PPC 2 with LANES 8 (one more Verilator build).
+PPC_MODES = [
+    ("2160p30", 4, 4, True),
+    ("1080p60", 2, 4, False),
+]
+PPC_MODES_EXTRA = [
+    ("1080p60", 2, 8, True),
+]
+
+
+def _ppc_params() -> list:
+    out = []
+    extra = PPC_MODES_EXTRA if os.environ.get("MSTRACK_RT_PPC_EXTRA") == "1" else []
+    for mode, ppc, lanes, ok in PPC_MODES + extra:
+        marks = () if ok else pytest.mark.xfail(
+            strict=True, raises=RealtimeMiss,
+            reason=f"{mode} at PPC {ppc} leaves {fastsim.video_mode(mode, ppc)['hblank'] + fastsim.video_mode(mode, ppc)['vblank']:,} "
+                   f"blank clocks: with LANES {lanes} the 127 px window at MAX_ITER colour iterations overruns them "
+                   "(docs/performance.md, Operating points)")
+        out.append(pytest.param(mode, ppc, lanes, marks=marks, id=f"{mode}-ppc{ppc}-lanes{lanes}"))
+    return out
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("mode,ppc,lanes", _ppc_params())
+def test_realtime_ppc(mode, ppc, lanes):
+    """A video mode at PPC pixels per clock (the core at pixel clock / PPC): the footage of
+    test_realtime_1080p60 upscaled to the mode, bit-exact; real time only if no input stall and
+    every result before the next frame."""
+    m = fastsim.video_mode(mode, ppc)
+    hb, vb = int(m["hblank"]), int(m["vblank"])
+    frames, box, src = _hd_clip(HD_FRAMES, int(m["w"]), int(m["h"]))
+    tp, fp = TrackerParams(), FixedParams()
+    run = fastsim.simulate(frames, box, tp, fp, lanes=lanes, hblank=hb, vblank=vb, lead=vb, ppc=ppc,
+                           max_frame_w=max(2048, int(m["w"])))
+    mism = fastsim.compare(run.results, expected_results(frames, box, tp, fp))
+    budget = hb + vb
+    misses = []
+    for i, r in enumerate(run.results):
+        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
+               else r["last_pixel_cycle"] + budget + 1)
+        if r["result_cycle"] >= nxt:
+            misses.append(f"frame {i}: latency {r['latency']} > {budget}")
+    stalls = [f["stall_cycles"] for f in run.frames]
+    _report(f"realtime_{mode}_ppc{ppc}_lanes{lanes}", {
+        "source": src, "mode": mode, "ppc": ppc, "core_mhz": m["mhz"], "frames": len(frames), "box": list(box),
+        "lanes": lanes, "budget_clocks": budget, "latency_clocks": run.latencies,
+        "worst_latency_clocks": max(run.latencies), "stall_cycles": stalls,
+        "iter_c": [r["iter_c"] for r in run.results], "cycles": run.cycles,
+        "seconds": round(run.seconds, 2), "cpu_seconds": round(run.cpu_seconds, 2),
+        "build_seconds": round(run.build_seconds, 1), "mismatches": mism, "realtime_misses": misses})
+    assert len(run.results) == len(frames)
+    assert not mism, "DUT differs from the fixed model:\n" + "\n".join(mism)
+    if any(stalls) or misses:
+        raise RealtimeMiss(f"{mode} at PPC {ppc}, LANES {lanes}: stalls {stalls}; latencies {run.latencies} "
+                           f"(budget {budget}):\n" + "\n".join(misses))
 
 
 LONG_RUNS = [

@@ -19,7 +19,15 @@ from mstrack.track.params import TrackerParams
 
 def test_default_choices_give_the_default_generics():
     cfg = derive(CoreChoices())
-    assert cfg.generics == {"MAX_FRAME_W": 2048, "RGB_PACKING": 0, **core_generics()}
+    assert cfg.generics == {"MAX_FRAME_W": 2048, "RGB_PACKING": 0, "PPC": 1, **core_generics()}
+
+
+def test_ppc_choice():
+    """PPC 1, 2, 4 (<= LANES) reaches the generic; other values and PPC > LANES are refused."""
+    assert derive(CoreChoices(ppc=4)).generics["PPC"] == 4
+    for bad in (dict(ppc=3), dict(ppc=8, lanes=8), dict(ppc=4, lanes=2)):
+        with pytest.raises(ConfigError, match="PPC"):
+            derive(CoreChoices(**bad))
 
 
 def test_every_entity_generic_is_configured():

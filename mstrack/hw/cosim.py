@@ -70,16 +70,23 @@ def diff_fields(got: dict[str, int], exp: dict[str, int],
 
 @dataclass
 class CoreConfig:
-    """Model parameters + lanes -> the generics of ms_tracker."""
+    """Model parameters + lanes (+ pixels per clock) -> the generics of ms_tracker.
+
+    ppc: pixels per clock of the video input (generic PPC, 1, 2 or 4, <= lanes); the results do
+    not depend on it.  PPC = 1 is not passed (the core's default), so the generic sets (and build
+    names) of the one-pixel core stay as they were."""
 
     tp: TrackerParams
     fp: FixedParams
     lanes: int = DEFAULT_LANES
     max_frame_w: int = 2048
+    ppc: int = 1
 
     def generics(self) -> dict[str, int]:
         g = core_generics(self.tp, self.fp, self.lanes)
         g["MAX_FRAME_W"] = self.max_frame_w
+        if self.ppc != 1:
+            g["PPC"] = self.ppc
         return g
 
     def layout(self) -> list[tuple[str, int, int]]:
@@ -121,8 +128,8 @@ class CoreModel:
     COMPARED_FIELDS) in order; ``epochs[i]`` the reset epoch of result i.
     """
 
-    def __init__(self, tp: TrackerParams, fp: FixedParams, max_frame_w: int) -> None:
-        self.tp, self.fp, self.max_frame_w = tp, fp, max_frame_w
+    def __init__(self, tp: TrackerParams, fp: FixedParams, max_frame_w: int, ppc: int = 1) -> None:
+        self.tp, self.fp, self.max_frame_w, self.ppc = tp, fp, max_frame_w, ppc
         self.results: list[dict[str, int]] = []
         self.kinds: list[str] = []          # "init", "track", "no_target", "error:<code name>"
         self.epochs: list[int] = []
@@ -153,7 +160,8 @@ class CoreModel:
         self.epoch += 1
 
     def size_ok(self, fw: int, fh: int) -> bool:
-        return fw >= MIN_FRAME and fh >= MIN_FRAME and fw <= self.max_frame_w
+        """The frame size check (ERR_SIZE): also a width that is not a multiple of PPC."""
+        return fw >= MIN_FRAME and fh >= MIN_FRAME and fw <= self.max_frame_w and fw % self.ppc == 0
 
     # -- results -----------------------------------------------------------------------------
     def _push(self, kind: str, flags: dict[str, int] | None = None, **fields: int) -> None:

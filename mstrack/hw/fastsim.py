@@ -62,6 +62,19 @@ VIDEO_MODES: dict[str, dict[str, int | float]] = {
     "2160p60": {"w": 3840, "h": 2160, "mhz": 594.0, "hblank": 560, "vblank": 90 * 4400},
 }
 
+
+
+def video_mode(name: str, ppc: int = 1) -> dict[str, int | float]:
+    """A :data:`VIDEO_MODES` entry for a core taking *ppc* pixels per clock: the core clock is the
+    pixel clock / ppc and the blanking (in pixels in the video timing) becomes hblank / ppc and
+    vblank / ppc clocks (every CEA-861 total here is a multiple of 4).  Adds ``ppc``."""
+    m = dict(VIDEO_MODES[name])
+    if m["w"] % ppc or m["hblank"] % ppc or m["vblank"] % ppc:
+        raise ValueError(f"{name}: sizes not a multiple of ppc {ppc}")
+    m.update(mhz=m["mhz"] / ppc, hblank=int(m["hblank"]) // ppc, vblank=int(m["vblank"]) // ppc, ppc=ppc)
+    return m
+
+
 #: C++ optimisation of the model and the harness (-CFLAGS: comes after Verilator's own
 #: OPT_FAST = -Os, so it wins, and also reaches the harness, which is otherwise built without -O).
 #: Measured on Crossing (40 frames, default generics): -O3 0.80M clocks per CPU second, -O2 0.67-0.77M.
@@ -255,7 +268,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
              fp: FixedParams | None = None, lanes: int = 2, hblank: int = 0, vblank: int = 0, *,
              max_frame_w: int = 2048, lead: int = 0, in_pause_pct: int = 0, out_pause_pct: int = 0,
              seed: int = 1, watchdog: int | None = None, max_cycles: int | None = None, tail: int = 200,
-             init: bool = True, workdir: Path | str | None = None, check: bool = True,
+             init: bool = True, workdir: Path | str | None = None, check: bool = True, ppc: int = 1,
              v2: bool = False) -> FastsimRun:
     """Stream *frames* through the verilated core with the init box *box* on the first frame.
 
@@ -265,8 +278,10 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         All the same size (H, W >= 3; W <= max_frame_w).
     box : (x, y, w, h) int
         Init box given on s_init before the first frame (the core clips it).
-    tp, fp, lanes, max_frame_w
+    tp, fp, lanes, max_frame_w, ppc
         Core configuration (:class:`mstrack.hw.cosim.CoreConfig`); one build per generic set.
+        ppc: pixels per clock (generic PPC, 1, 2, 4 <= lanes; the frame width a multiple of it):
+        the harness packs ppc pixels per beat; hblank, vblank stay in clocks.
     hblank, vblank : int
         tvalid-low clocks after every line / additionally after every frame
         (:data:`HD1080P60` for 1080p60 timing).  0, 0: frames back to back (the core then
@@ -294,12 +309,14 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
     cfg: CoreConfig | CoreConfigV2
     if v2:
         from ..fixed.vhdl_pkg import unpack_result_v2
+        if ppc != 1:
+            raise ValueError("core v2 (ms_tracker_v2) takes one pixel per clock: ppc must be 1")
         tp = tp or TrackerParams(preset="v2")
         cfg = CoreConfigV2(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
         unpack = unpack_result_v2
     else:
         tp = tp or TrackerParams()
-        cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
+        cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w, ppc=ppc)
     g = cfg.generics()
     exe, build_s = build(cfg, top="ms_tracker_v2" if v2 else TOP)
     tmp = None
@@ -314,7 +331,9 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         if w > max_frame_w:
             raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
         cw = g["COORD_W"]
-        job = {"width": w, "height": h, "frames": n, "pixels": str(wd / "pixels.bin"), "init": int(init),
+        if w % ppc:
+            raise ValueError(f"frame width {w} is not a multiple of ppc {ppc}")
+        job = {"width": w, "height": h, "ppc": ppc, "frames": n, "pixels": str(wd / "pixels.bin"), "init": int(init),
                "init_x": _mask(box[0], cw + 2), "init_y": _mask(box[1], cw + 2),
                "init_w": _mask(box[2], cw + 1), "init_h": _mask(box[3], cw + 1),
                "hblank": hblank, "vblank": vblank, "lead": lead, "in_pause_pct": in_pause_pct,
@@ -333,7 +352,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
     run = FastsimRun(results=results, frames=fl, cycles=cycles, seconds=secs, cpu_seconds=cpu, status=status,
                      detail=detail,
                      build_seconds=build_s, workdir=None if tmp is not None else wd,
-                     config={**job, "lanes": lanes, "max_frame_w": max_frame_w})
+                     config={**job, "lanes": lanes, "max_frame_w": max_frame_w, "ppc": ppc})
     if check and status != "done":
         raise FastsimError(f"harness stopped: {status} {detail} (after {cycles} clocks, "
                            f"{len(results)} results of {n})")

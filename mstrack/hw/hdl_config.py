@@ -73,6 +73,8 @@ class CoreChoices:
         COORD_W: frame coordinate bits; frames up to 2**coord_bits - 1 px wide and high.
     rgb_packing : {"mstrack", "ug934"}
         Layout of s_axis_tdata (:data:`RGB_PACKINGS`).
+    ppc : {1, 2, 4}
+        PPC: pixels per clock of the video input (s_axis_tdata of 24 PPC bits); at most LANES.
     """
 
     max_frame_width: int = 2048
@@ -84,6 +86,7 @@ class CoreChoices:
     margin: int = FixedParams.margin
     coord_bits: int = FixedParams.coord_bits
     rgb_packing: str = "mstrack"
+    ppc: int = 1
 
 
 @dataclass(frozen=True)
@@ -128,6 +131,11 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         raise ConfigError(f"margin {c.margin} px out of 0..255")
     if c.lanes < 1 or c.lanes & (c.lanes - 1):
         raise ConfigError(f"LANES {c.lanes} is not a power of two (1, 2, 4, 8, ...)")
+    if c.ppc not in (1, 2, 4):
+        raise ConfigError(f"PPC {c.ppc} pixels per clock: 1, 2 or 4")
+    if c.ppc > c.lanes:
+        raise ConfigError(f"PPC {c.ppc} > LANES {c.lanes}: the region capture writes the pixels of a beat into "
+                          f"PPC different banks; use --lanes {c.ppc} or more")
     region_max = 2 * max_half + 1 + 2 * c.margin
     if c.lanes > region_max:
         raise ConfigError(f"LANES {c.lanes} > the region width {region_max} px (REGION_MAX): "
@@ -137,7 +145,7 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         fp = FixedParams(max_half=max_half, margin=c.margin, coord_bits=c.coord_bits)
     except ValueError as exc:  # the model's own checks (one line each)
         raise ConfigError(str(exc)) from None
-    g = {"MAX_FRAME_W": c.max_frame_width, "RGB_PACKING": RGB_PACKINGS[c.rgb_packing][0],
+    g = {"MAX_FRAME_W": c.max_frame_width, "RGB_PACKING": RGB_PACKINGS[c.rgb_packing][0], "PPC": c.ppc,
          **core_generics(tp, fp, c.lanes)}
     return CoreConfiguration(c, tp, fp, g)
 
@@ -166,7 +174,7 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
              f"  frames up to {c.max_frame_width} px wide, {(1 << c.coord_bits) - 1} px high (COORD_W {c.coord_bits});",
              f"  targets up to {2 * g['MAX_HALF'] + 1} px (MAX_HALF {g['MAX_HALF']}), search margin {c.margin} px;",
              f"  LANES {c.lanes}, features {c.features}, kernel {c.kernel}, preset {c.preset};",
-             f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]};",
+             f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]}, {c.ppc} pixel(s) per clock (PPC);",
              f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout)."]
     return [f"{comment} {ln}".rstrip() for ln in lines]
 
@@ -211,6 +219,8 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"COORD_W: frames up to 2**N - 1 px (default {d.coord_bits})")
     p.add_argument("--rgb-packing", choices=tuple(RGB_PACKINGS), default=d.rgb_packing,
                    help="s_axis_tdata layout: mstrack (R, G, B from the MSB) or ug934 (R, B, G)")
+    p.add_argument("--ppc", type=int, choices=(1, 2, 4), default=d.ppc,
+                   help="pixels per clock of the video input (PPC, <= LANES; default 1)")
     p.add_argument("--format", choices=FORMATS, default="package", help="output (default: VHDL package)")
     p.add_argument("--name", default="ms_tracker_config_pkg", help="package name (--format package)")
     p.add_argument("--out", help="output file (default: standard output)")
@@ -219,7 +229,7 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
 def run_config(args: argparse.Namespace) -> int:
     choices = CoreChoices(max_frame_width=args.max_frame_width, max_target=args.max_target, lanes=args.lanes,
                           features=args.features, kernel=args.kernel, preset=args.preset, margin=args.margin,
-                          coord_bits=args.coord_bits, rgb_packing=args.rgb_packing)
+                          coord_bits=args.coord_bits, rgb_packing=args.rgb_packing, ppc=args.ppc)
     cfg = derive(choices)
     command = getattr(args, "command_line", None) or "mstrack hdl config"
     text = render(cfg, args.format, args.name, command)

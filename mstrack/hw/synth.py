@@ -64,7 +64,7 @@ VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
 # ----------------------------------------------------------------------------- configurations
 @dataclass(frozen=True)
 class Config:
-    """One generic set of the core: model parameters + LANES (+ MAX_FRAME_W)."""
+    """One generic set of the core: model parameters + LANES (+ MAX_FRAME_W, PPC)."""
 
     name: str
     note: str
@@ -72,6 +72,7 @@ class Config:
     fp: dict = field(default_factory=dict)
     lanes: int = DEFAULT_LANES
     max_frame_w: int = 2048
+    ppc: int = 1
 
     def params(self) -> tuple[TrackerParams, FixedParams]:
         return TrackerParams(**self.tp), FixedParams(**self.fp)
@@ -80,6 +81,8 @@ class Config:
         tp, fp = self.params()
         g = core_generics(tp, fp, self.lanes)
         g["MAX_FRAME_W"] = self.max_frame_w
+        if self.ppc != 1:
+            g["PPC"] = self.ppc
         return g
 
 
@@ -89,6 +92,8 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
     Config("lanes2", "default with LANES 2", lanes=2),
     Config("small", "default with MAX_HALF 31, MARGIN 16", fp={"max_half": 31, "margin": 16}),
     Config("epan", "default with the Epanechnikov kernel", tp={"kernel": "epanechnikov"}),
+    Config("ppc4", "default with PPC 4 (4 pixels per clock, MAX_FRAME_W 3840: 2160p30 at 74.25 MHz)",
+           max_frame_w=3840, ppc=4),
 )}
 
 

@@ -23,6 +23,7 @@ entity ms_tracker_pins is
   generic (
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
     RGB_PACKING    : natural := 0;               -- s_axis_tdata layout (ms_tracker)
+    PPC            : natural := 1;               -- pixels per clock (ms_tracker)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
@@ -73,7 +74,7 @@ entity ms_tracker_pins is
     cfg_din       : in  std_logic;                      -- configuration bit in
     s_init_tvalid : in  std_logic;                      -- init box (from the chain) valid
     s_init_tready : out std_logic;                      -- init box accepted
-    s_axis_tdata  : in  std_logic_vector(23 downto 0);  -- video in (as ms_tracker)
+    s_axis_tdata  : in  std_logic_vector(24 * PPC - 1 downto 0);  -- video in (as ms_tracker)
     s_axis_tvalid : in  std_logic;
     s_axis_tready : out std_logic;
     s_axis_tlast  : in  std_logic;
@@ -111,6 +112,7 @@ begin
     generic map (
       MAX_FRAME_W  => MAX_FRAME_W,
       RGB_PACKING  => RGB_PACKING,
+      PPC          => PPC,
       LANES        => LANES,
       COLOUR_BITS  => COLOUR_BITS,
       EDGE_BINS_LOG2=> EDGE_BINS_LOG2,

@@ -3,8 +3,9 @@
 // Built and driven by mstrack.hw.fastsim (docs/performance.md, "Real-time check (1080p60)"): the
 // GHDL netlist of ms_tracker (generics baked in) is verilated with --prefix Vms_tracker and
 // linked with this file.  It resets the core, gives the init box on s_init_*, streams the
-// frames on s_axis_* (1 pixel per clock, tuser on each frame's first pixel, tlast on each
-// line's last pixel) with programmable blanking (tvalid low) after every line and after
+// frames on s_axis_* (PPC pixels per clock, pixel k in tdata bits 24k+23 .. 24k, tuser on each
+// frame's first beat, tlast on each line's last beat) with programmable blanking (tvalid low)
+// after every line and after
 // every frame, takes the result words on m_axis_result_* (optionally with random
 // back-pressure), and writes, per frame and per result, the cycles at which things happened.
 //
@@ -12,6 +13,7 @@
 //
 // job.txt: one "key value" per line ('#' starts a comment line):
 //   width, height     frame size (px); frame_width/frame_height ports
+//   ppc               pixels per beat, the core's PPC generic (default 1); width a multiple of it
 //   frames            number of frames in the pixel file
 //   pixels            path of the pixel file: frames x height x width little-endian uint32,
 //                     R << 16 | G << 8 | B (mstrack.hw.cosim.frame_words)
@@ -71,6 +73,30 @@ std::string hex_of(const VlWide<N>& w) {
     return s;
 }
 
+// Drive a tdata port with ppc 24-bit pixels, pixel k at bits 24k+23 .. 24k: a scalar port
+// (PPC 1, 2: up to 48 bits) or a VlWide (PPC 4: 96 bits in 32-bit words, LSB first).
+template <std::size_t N>
+void set_pixels(VlWide<N>& port, const uint32_t* p, int ppc) {
+    uint32_t w[N] = {};
+    for (int k = 0; k < ppc; ++k) {
+        const uint64_t v = p[k] & 0xFFFFFFu;
+        const int bit = 24 * k;
+        const std::size_t i = static_cast<std::size_t>(bit / 32);
+        const int sh = bit % 32;
+        const uint64_t wide = v << sh;
+        if (i < N) w[i] |= static_cast<uint32_t>(wide);
+        if (i + 1 < N) w[i + 1] |= static_cast<uint32_t>(wide >> 32);
+    }
+    for (std::size_t i = 0; i < N; ++i) port[i] = w[i];
+}
+
+template <typename T>
+void set_pixels(T& port, const uint32_t* p, int ppc) {
+    uint64_t v = 0;
+    for (int k = 0; k < ppc; ++k) v |= static_cast<uint64_t>(p[k] & 0xFFFFFFu) << (24 * k);
+    port = static_cast<T>(v);
+}
+
 std::string hex_of(uint64_t v) {
     char buf[17];
     std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
@@ -117,8 +143,10 @@ int main(int argc, char** argv) {
         return it == job.end() ? d : std::stoll(it->second, nullptr, 0);
     };
     const long long W = num("width", 0), H = num("height", 0), n_frames = num("frames", 0);
-    if (W < 3 || H < 3 || n_frames < 0 || !job.count("pixels")) {
-        std::fprintf(stderr, "job needs width, height (>= 3), frames and pixels\n");
+    const long long ppc = num("ppc", 1);
+    if (W < 3 || H < 3 || n_frames < 0 || !job.count("pixels") || !(ppc == 1 || ppc == 2 || ppc == 4) ||
+        W % ppc != 0) {
+        std::fprintf(stderr, "job needs width, height (>= 3), frames and pixels; ppc 1, 2, 4 dividing width\n");
         return 2;
     }
     const long long hblank = num("hblank", 0), vblank = num("vblank", 0), lead = num("lead", 0);
@@ -155,7 +183,10 @@ int main(int argc, char** argv) {
     top.s_init_w = static_cast<uint32_t>(num("init_w", 0));
     top.s_init_h = static_cast<uint32_t>(num("init_h", 0));
     top.s_axis_tvalid = 0;
-    top.s_axis_tdata = 0;
+    {
+        const uint32_t zeros[4] = {0, 0, 0, 0};
+        set_pixels(top.s_axis_tdata, zeros, static_cast<int>(ppc));
+    }
     top.s_axis_tlast = 0;
     top.s_axis_tuser = 0;
     top.m_axis_result_tready = 0;
@@ -208,9 +239,9 @@ int main(int argc, char** argv) {
             // a beat once offered stays until taken (AXI4-Stream); pauses only between beats
             s_valid = holding || !(in_pause && pct(rng) < in_pause);
             if (s_valid) {
-                top.s_axis_tdata = pix[static_cast<std::size_t>(y * W + x)];
+                set_pixels(top.s_axis_tdata, &pix[static_cast<std::size_t>(y * W + x)], static_cast<int>(ppc));
                 top.s_axis_tuser = (x == 0 && y == 0);
-                top.s_axis_tlast = (x == W - 1);
+                top.s_axis_tlast = (x == W - ppc);
             }
         }
         top.s_axis_tvalid = s_valid;
@@ -256,7 +287,7 @@ int main(int argc, char** argv) {
         if (s_fire) {
             holding = false;
             if (x == 0 && y == 0) frames[f].first = cycle;
-            if (x == W - 1) {
+            if (x == W - ppc) {
                 blank = hblank;
                 x = 0;
                 if (++y == H) {
@@ -267,7 +298,7 @@ int main(int argc, char** argv) {
                     frame_loaded = false;
                 }
             } else {
-                ++x;
+                x += ppc;
             }
         }
         // result watchdog: the oldest frame without a result

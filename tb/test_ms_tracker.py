@@ -326,14 +326,13 @@ def test_tracker_verilator_real(name, start, n):
 
 
 # ----------------------------------------------------------------------------- pixels per clock
-PPCS = [pytest.param(p, id=f"ppc{p}") for p in (1, 2, 4)]
 
 
-@pytest.mark.parametrize("variant", ["plain", "throttled"])
+@pytest.mark.parametrize("variant", ["throttled"])   # full speed: test_tracker_ppc_width_error's good frames
 @pytest.mark.parametrize("ppc", [pytest.param(p, id=f"ppc{p}") for p in (2, 4)])
 def test_tracker_ppc_synthetic(ppc, variant, tmp_path):
     """GHDL, PPC pixels per beat: the generated 64x48 scene of test_tracker_ghdl_synthetic (its
-    ppc1 case), full speed and throttled (input gaps, result back-pressure), bit-exact."""
+    ppc1 case), throttled (input gaps, result back-pressure), bit-exact."""
     from mstrack.hw.hdl import run_ghdl
     job = {**SMALL, "ppc": ppc, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
@@ -342,8 +341,9 @@ def test_tracker_ppc_synthetic(ppc, variant, tmp_path):
              build_name=f"ms_tracker_ppc{ppc}_{variant}", extra_env=_job_env(job))
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("variant", ["plain", "throttled"])
-@pytest.mark.parametrize("ppc", PPCS)
+@pytest.mark.parametrize("ppc", [pytest.param(p, id=f"ppc{p}") for p in (2, 4)])   # ppc1: the tests above
 def test_tracker_ppc_real(ppc, variant, tmp_path):
     """Verilator (GHDL-synthesised netlist; GHDL if Verilator is missing), default generics,
     PPC pixels per beat: 8 frames of a real sequence (Girl, 128x96), every result bit-exact;

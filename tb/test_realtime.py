@@ -228,12 +228,13 @@ def test_realtime_720p60(lanes):
 #: blanking shrinks to hblank / PPC + vblank / PPC clocks (fastsim.video_mode):
 #: 2160p30 at PPC 4: 74.25 MHz, 140 + 99,000 = 99,140 blank clocks (as 1080p30 at PPC 1);
 #: 1080p60 at PPC 2: 74.25 MHz, 140 + 49,500 = 49,640 blank clocks (as 720p60: LANES 4 misses).
-#: MSTRACK_RT_PPC_EXTRA=1 adds 1080p60 at PPC 2 with LANES 8 (one more Verilator build).
+#: MSTRACK_RT_PPC_EXTRA=1 adds 1080p60 at PPC 2 with LANES 4 (a strict expected failure) and 8 (two
+#: more Verilator builds).
 PPC_MODES = [
     ("2160p30", 4, 4, True),
-    ("1080p60", 2, 4, False),
 ]
 PPC_MODES_EXTRA = [
+    ("1080p60", 2, 4, False),     # measured: misses (80,647 > 49,640 blank clocks), docs/performance.md
     ("1080p60", 2, 8, True),
 ]
 
@@ -251,6 +252,7 @@ def _ppc_params() -> list:
     return out
 
 
+@pytest.mark.long
 @pytest.mark.verilator
 @pytest.mark.parametrize("mode,ppc,lanes", _ppc_params())
 def test_realtime_ppc(mode, ppc, lanes):

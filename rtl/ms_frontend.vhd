@@ -70,7 +70,7 @@ entity ms_frontend is
     av_valid     : out std_logic;                                       -- a pixel of the frame
     av_x         : out unsigned(COORD_W - 1 downto 0);                  -- its column (0 .. W-1)
     av_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (0 .. H-1)
-    av_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0)   -- its colour bin
+    av_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0)   -- its colour bin (all-pixel stream: PPC = 1 only)
   );
 end entity;
 
@@ -141,7 +141,7 @@ begin
   av_valid <= pv1;
   av_x     <= x1;
   av_y     <= y1;
-  av_cbin  <= cb_bin;
+  av_cbin  <= cb_bin(CB_W - 1 downto 0);   -- PPC > 1: the beat's first pixel (core v2 runs at PPC = 1)
 
   u_sobel : entity work.ms_sobel
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,

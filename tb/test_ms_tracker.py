@@ -341,7 +341,7 @@ def test_tracker_ppc_synthetic(ppc, variant, tmp_path):
              build_name=f"ms_tracker_ppc{ppc}_{variant}", extra_env=_job_env(job))
 
 
-@pytest.mark.long
+@pytest.mark.extra
 @pytest.mark.parametrize("variant", ["plain", "throttled"])
 @pytest.mark.parametrize("ppc", [pytest.param(p, id=f"ppc{p}") for p in (2, 4)])   # ppc1: the tests above
 def test_tracker_ppc_real(ppc, variant, tmp_path):

@@ -141,6 +141,7 @@ def test_realtime_1080p60(lanes):
 V2_RT_START, V2_RT_FRAMES = 30, 10
 
 
+@pytest.mark.long
 @pytest.mark.verilator
 def test_realtime_v2_1080p60():
     """Core v2 (ms_tracker_v2, LANES 4) at 1080p60 timing on real footage with a loss, a wide search and
@@ -252,7 +253,7 @@ def _ppc_params() -> list:
     return out
 
 
-@pytest.mark.long
+@pytest.mark.extra
 @pytest.mark.verilator
 @pytest.mark.parametrize("mode,ppc,lanes", _ppc_params())
 def test_realtime_ppc(mode, ppc, lanes):

@@ -71,6 +71,19 @@ def _report(name: str, data: dict) -> None:
     print(f"\n[{name}] " + json.dumps({k: v for k, v in data.items() if k != "frames"}))
 
 
+def _misses(run: "fastsim.FastsimRun", budget: int) -> list[str]:
+    """Frames whose result came at or after the next frame's first pixel (for the last frame: more
+    than *budget* blank clocks after its last pixel), one line each."""
+    out = []
+    for i, r in enumerate(run.results):
+        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
+               else r["last_pixel_cycle"] + budget + 1)      # where the next frame would start
+        if r["result_cycle"] >= nxt:
+            out.append(f"frame {i}: result at clock {r['result_cycle']}, next frame starts at {nxt} "
+                       f"(latency {r['latency']} > {budget})")
+    return out
+
+
 def _hd_clip(n: int, out_w: int = HD_W, out_h: int = HD_H) -> tuple[list[np.ndarray], tuple[int, int, int, int], str]:
     """n frames of out_w x out_h (default 1920x1080) and the init box: MotorRolling (640x360) or the
     generated scene upscaled (x3 for 1080p, x2 for 720p)."""
@@ -111,13 +124,7 @@ def test_realtime_1080p60(lanes):
     exp = expected_results(frames, box, tp, fp)
     mism = fastsim.compare(run.results, exp)
 
-    misses = []
-    for i, r in enumerate(run.results):
-        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
-               else r["last_pixel_cycle"] + BUDGET + 1)      # where the next frame would start
-        if r["result_cycle"] >= nxt:
-            misses.append(f"frame {i}: result at clock {r['result_cycle']}, next frame starts at {nxt} "
-                          f"(latency {r['latency']} > {BUDGET})")
+    misses = _misses(run, BUDGET)
     stalls = [f["stall_cycles"] for f in run.frames]
     lat = run.latencies
     _report(f"realtime_1080p60_lanes{lanes}", {
@@ -164,12 +171,7 @@ def test_realtime_v2_1080p60():
     run = fastsim.simulate(frames, box, tp, fp, lanes=DEFAULT_LANES, hblank=HBLANK, vblank=VBLANK, lead=VBLANK,
                            max_frame_w=HD_W, v2=True)
     mism = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
-    misses = []
-    for i, r in enumerate(run.results):
-        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
-               else r["last_pixel_cycle"] + BUDGET + 1)
-        if r["result_cycle"] >= nxt:
-            misses.append(f"frame {i}: latency {r['latency']} > {BUDGET}")
+    misses = _misses(run, BUDGET)
     stalls = [f["stall_cycles"] for f in run.frames]
     _report("realtime_v2_1080p60_lanes%d" % DEFAULT_LANES, {
         "source": f"MotorRolling {V2_RT_START}-{V2_RT_START + V2_RT_FRAMES - 1} x3", "frames": len(frames),
@@ -205,12 +207,7 @@ def test_realtime_720p60(lanes):
     run = fastsim.simulate(frames, box, tp, fp, lanes=lanes, hblank=hb, vblank=vb, lead=vb)
     mism = fastsim.compare(run.results, expected_results(frames, box, tp, fp))
     budget = hb + vb
-    misses = []
-    for i, r in enumerate(run.results):
-        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
-               else r["last_pixel_cycle"] + budget + 1)
-        if r["result_cycle"] >= nxt:
-            misses.append(f"frame {i}: latency {r['latency']} > {budget}")
+    misses = _misses(run, budget)
     stalls = [f["stall_cycles"] for f in run.frames]
     _report(f"realtime_720p60_lanes{lanes}", {
         "source": src, "frames": len(frames), "box": list(box), "lanes": lanes, "budget_clocks": budget,
@@ -268,12 +265,7 @@ def test_realtime_ppc(mode, ppc, lanes):
                            max_frame_w=max(2048, int(m["w"])))
     mism = fastsim.compare(run.results, expected_results(frames, box, tp, fp))
     budget = hb + vb
-    misses = []
-    for i, r in enumerate(run.results):
-        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
-               else r["last_pixel_cycle"] + budget + 1)
-        if r["result_cycle"] >= nxt:
-            misses.append(f"frame {i}: latency {r['latency']} > {budget}")
+    misses = _misses(run, budget)
     stalls = [f["stall_cycles"] for f in run.frames]
     _report(f"realtime_{mode}_ppc{ppc}_lanes{lanes}", {
         "source": src, "mode": mode, "ppc": ppc, "core_mhz": m["mhz"], "frames": len(frames), "box": list(box),

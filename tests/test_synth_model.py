@@ -149,3 +149,36 @@ def test_nexus_table_row():
     row = t[2]
     assert "| 5,178 | 12,241 | 3,381 | 44 | 0 | 6 | 168 | 70.1 / 71.5 | 71.5 | 70.8 |" in row
     assert row.endswith("yes: 28 % / 38 % / 52 % / 0 % |")
+
+
+# ----------------------------------------------------------------------------- core v2 (issue 11 item 5)
+def test_v2_config_has_v2_generics_and_wrapper():
+    """Configuration "v2": ms_tracker_v2 with CoreConfigV2's generics, placed through ms_tracker_v2_pins,
+    whose generics are exactly ms_tracker_v2's (every one passed through); the paper configurations unchanged."""
+    import re
+
+    from mstrack.fixed import FixedParams
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import TrackerParams
+    c = synth.CONFIGS["v2"]
+    assert c.v2 and c.core == "ms_tracker_v2" and c.pins_top == "ms_tracker_v2_pins"
+    g = c.generics()
+    assert g == CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).generics()
+    assert g["RESULT_W"] == 160 and g["REGION_MAX"] == 445 and g["FEATURES"] == 1
+    d = synth.CONFIGS["default"]
+    assert (d.core, d.pins_top) == ("ms_tracker", "ms_tracker_pins") and "RESULT_W" in d.generics()
+    assert d.generics()["RESULT_W"] != 160
+    srcs = synth.pins_sources(c.pins_top)
+    assert srcs[-1] == synth.PINS_VHD_V2 and any(p.name == "ms_tracker_v2.vhd" for p in srcs)
+    assert synth.pins_sources()[-1] == synth.PINS_VHD
+
+    def generic_names(path, entity):
+        t = path.read_text()
+        t = t[t.index(f"entity {entity} is"):]
+        t = t[t.index("generic ("):t.index("  port (")]
+        return re.findall(r"^\s+(\w+)\s*:", t, re.M)
+    core = generic_names(synth.REPO_ROOT / "rtl" / "ms_tracker_v2.vhd", "ms_tracker_v2")
+    assert generic_names(synth.PINS_VHD_V2, "ms_tracker_v2_pins") == core
+    body = synth.PINS_VHD_V2.read_text()
+    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n in core)
+    assert set(g) <= set(core)                 # every generic the flow sets exists on the wrapper

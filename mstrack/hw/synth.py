@@ -15,7 +15,10 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * Fmax: the core has ~260 ports, more than the 205 user I/Os of the LFE5U-85F CABGA381, so
   nextpnr-ecp5 places ``rtl/wrappers/ms_tracker_pins.vhd`` (the core + a serial configuration
   chain + a result serialiser, ~40 pins), one run per seed, ``--freq`` 150 MHz; the report
-  gives max and median Fmax over the seeds and the critical path of the worst seed.
+  gives max and median Fmax over the seeds and the critical path of the worst seed;
+* core v2 (configuration ``v2``): the same flow on ``ms_tracker_v2`` (generics from
+  :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_v2_pins.vhd``
+  (160-bit result word v2); the cycle table is the paper core's only.
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
@@ -45,6 +48,10 @@ PERF_MD = REPO_ROOT / "docs" / "performance.md"
 SYNTH_DIR = REPO_ROOT / "build" / "synth"
 PINS_TOP = "ms_tracker_pins"
 PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_pins.vhd"
+#: core v2 (issue 11): its top and its pin wrapper (a sibling of ms_tracker_pins for the 160-bit result word v2)
+TOP_V2 = "ms_tracker_v2"
+PINS_TOP_V2 = "ms_tracker_v2_pins"
+PINS_VHD_V2 = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_v2_pins.vhd"
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
@@ -64,7 +71,11 @@ VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
 # ----------------------------------------------------------------------------- configurations
 @dataclass(frozen=True)
 class Config:
-    """One generic set of the core: model parameters + LANES (+ MAX_FRAME_W, PPC)."""
+    """One generic set of the core: model parameters + LANES (+ MAX_FRAME_W, PPC).
+
+    ``core``: the top synthesised, ``ms_tracker`` (the paper core) or ``ms_tracker_v2`` (core v2:
+    tracker preset "v2", generics from :class:`mstrack.hw.cosim.CoreConfigV2`, placed through
+    rtl/wrappers/ms_tracker_v2_pins.vhd)."""
 
     name: str
     note: str
@@ -73,12 +84,27 @@ class Config:
     lanes: int = DEFAULT_LANES
     max_frame_w: int = 2048
     ppc: int = 1
+    core: str = "ms_tracker"
+
+    @property
+    def v2(self) -> bool:
+        return self.core == TOP_V2
+
+    @property
+    def pins_top(self) -> str:
+        """The pin wrapper nextpnr places for this core."""
+        return PINS_TOP_V2 if self.v2 else PINS_TOP
 
     def params(self) -> tuple[TrackerParams, FixedParams]:
-        return TrackerParams(**self.tp), FixedParams(**self.fp)
+        tp = TrackerParams(preset="v2", **self.tp) if self.v2 else TrackerParams(**self.tp)
+        return tp, FixedParams(**self.fp)
 
     def generics(self) -> dict[str, int]:
         tp, fp = self.params()
+        if self.v2:
+            from .cosim import CoreConfigV2
+            assert self.ppc == 1, "core v2 takes one pixel per clock"
+            return CoreConfigV2(tp, fp, self.lanes, self.max_frame_w).generics()
         g = core_generics(tp, fp, self.lanes)
         g["MAX_FRAME_W"] = self.max_frame_w
         if self.ppc != 1:
@@ -94,6 +120,8 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
     Config("epan", "default with the Epanechnikov kernel", tp={"kernel": "epanechnikov"}),
     Config("ppc4", "default with PPC 4 (4 pixels per clock, MAX_FRAME_W 3840: 2160p30 at 74.25 MHz)",
            max_frame_w=3840, ppc=4),
+    Config("v2", "core v2 (ms_tracker_v2, tracker preset v2, CoreConfigV2 generics: colour only, REGION_MAX 445, "
+                 "result word v2 of 160 bits)", core=TOP_V2),
 )}
 
 
@@ -154,9 +182,10 @@ def sources(top: str, extra: Sequence[Path] = ()) -> list[Path]:
         hdl.RTL_DIR, hdl.SOURCES_TXT = old
 
 
-def pins_sources() -> list[Path]:
-    """The core + rtl/wrappers/ms_tracker_pins.vhd (always from the working tree)."""
-    return sources(PINS_TOP, extra=[PINS_VHD])
+def pins_sources(top: str = PINS_TOP) -> list[Path]:
+    """The core + its pin wrapper: rtl/wrappers/ms_tracker_pins.vhd, or ms_tracker_v2_pins.vhd for
+    ``top`` = :data:`PINS_TOP_V2` (the wrapper always from the working tree)."""
+    return sources(top, extra=[PINS_VHD_V2 if top == PINS_TOP_V2 else PINS_VHD])
 
 
 # ----------------------------------------------------------------------------- nextpnr
@@ -310,7 +339,7 @@ def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds:
     """The ECP5 part of :func:`synth_config`: yosys counts of the core, nextpnr-ecp5 of the pins wrapper."""
     secs = out["seconds"]
     t0 = time.monotonic()
-    r = yosys_cached("ecp5", "ms_tracker", g, None, f"ecp5_{cfg.name}")
+    r = yosys_cached("ecp5", cfg.core, g, None, f"ecp5_{cfg.name}")
     secs["ecp5_core"] = round(time.monotonic() - t0, 1)
     out["ecp5"] = {k: r[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D", "TRELLIS_DPR16X4")}
     out["ecp5"]["dir"] = r["dir"]
@@ -318,7 +347,7 @@ def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds:
 
     if pnr:
         t0 = time.monotonic()
-        rp = yosys_cached("ecp5", PINS_TOP, g, pins_sources(), f"ecp5pnr_{cfg.name}")
+        rp = yosys_cached("ecp5", cfg.pins_top, g, pins_sources(cfg.pins_top), f"ecp5pnr_{cfg.name}")
         secs["ecp5_pins_yosys"] = round(time.monotonic() - t0, 1)
         out["ecp5_pins"] = {k: rp[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D",
                                                 "TRELLIS_DPR16X4")}
@@ -350,7 +379,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
     from . import hdl
     cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
     g = cfg.generics()
-    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "generics": g, "seconds": {},
+    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "core": cfg.core, "generics": g, "seconds": {},
                            "rtl": _RTL_DESC}
     secs = out["seconds"]
 
@@ -358,13 +387,13 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         _synth_ecp5_part(cfg, g, out, seeds, freq_mhz, pnr, log)
     if nexus:
         t0 = time.monotonic()
-        n = yosys_cached("nexus", "ms_tracker", g, None, f"nexus_{cfg.name}")
+        n = yosys_cached("nexus", cfg.core, g, None, f"nexus_{cfg.name}")
         secs["nexus_core"] = round(time.monotonic() - t0, 1)
         out["nexus"] = {k: n[k] for k in NEXUS_KEYS}
         log(f"[{cfg.name}] nexus core: {out['nexus']} ({secs['nexus_core']} s)")
         if pnr:
             t0 = time.monotonic()
-            npins = yosys_cached("nexus", PINS_TOP, g, pins_sources(), f"nexuspnr_{cfg.name}")
+            npins = yosys_cached("nexus", cfg.pins_top, g, pins_sources(cfg.pins_top), f"nexuspnr_{cfg.name}")
             secs["nexus_pins_yosys"] = round(time.monotonic() - t0, 1)
             nruns = []
             for sd in seeds:
@@ -382,7 +411,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
 
     if xilinx:
         t0 = time.monotonic()
-        x = yosys_cached("xc7", "ms_tracker", g, None, f"xc7_{cfg.name}")
+        x = yosys_cached("xc7", cfg.core, g, None, f"xc7_{cfg.name}")
         secs["xc7"] = round(time.monotonic() - t0, 1)
         out["xc7"] = {k: x[k] for k in ("LUT", "FF", "BRAM36", "RAMB36E1", "RAMB18E1", "DSP48E1", "CARRY4",
                                         "LUTRAM", "SRL")}
@@ -938,8 +967,9 @@ def run(args: argparse.Namespace) -> int:
         + ([f"--rtl-commit {args.rtl_commit}"] if args.rtl_commit else [])
         + (["--write"] if args.write else [])).strip()
     print(f"RTL: {use_rtl_commit(args.rtl_commit)}", file=sys.stderr)
-    figs = [cycle_figures(c) for c in args.config]
-    for c in args.config:                         # and the largest window of each configuration
+    paper = [c for c in args.config if not CONFIGS[c].v2]   # the cycle model is the paper core's
+    figs = [cycle_figures(c) for c in paper]
+    for c in paper:                               # and the largest window of each configuration
         m = 2 * CONFIGS[c].generics()["MAX_HALF"] + 1
         if m != 63:
             figs.append(cycle_figures(c, m, m))

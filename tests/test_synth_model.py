@@ -182,3 +182,25 @@ def test_v2_config_has_v2_generics_and_wrapper():
     body = synth.PINS_VHD_V2.read_text()
     assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n in core)
     assert set(g) <= set(core)                 # every generic the flow sets exists on the wrapper
+
+
+def test_write_section_keeps_rows_of_other_configs(tmp_path):
+    """--write of one configuration keeps the other configurations' rows (and says where they came from);
+    a row of the same configuration is replaced; without keep_rows the table is replaced whole."""
+    p = tmp_path / "perf.md"
+    synth.write_section("RTL: r1.\n\n| config | n |\n|---|---|\n| default | 1 |\n| v2 | 0 |", "x",
+                        "mstrack synth --config default v2", p, tools="Tools: t1.")
+    synth.write_section("RTL: r2.\n\n| config | n |\n|---|---|\n| v2 | 2 |", "x", "mstrack synth --config v2", p,
+                        tools="Tools: t2.", keep_rows=True)
+    text = p.read_text()
+    assert "| default | 1 |\n| v2 | 2 |" in text and "| v2 | 0 |" not in text
+    assert ("Rows kept from an earlier run (default): Command: `mstrack synth --config default v2` "
+            "Tools: t1. RTL: r1.") in text
+    assert "Command: `mstrack synth --config v2`" in text and text.index("RTL: r2.") < text.index("| config |")
+    synth.write_section("RTL: r3.\n\n| config | n |\n|---|---|\n| v2 | 3 |", "x", "mstrack synth --config v2", p,
+                        tools="Tools: t3.", keep_rows=True)
+    text = p.read_text()
+    assert "| default | 1 |\n| v2 | 3 |" in text and text.count("Rows kept from an earlier run (default)") == 1
+    assert "RTL: r1." in text and "RTL: r2." not in text
+    synth.write_section("RTL: r4.\n\n| config | n |\n|---|---|\n| v2 | 4 |", "x", "mstrack synth --config v2", p)
+    assert "| default |" not in p.read_text()

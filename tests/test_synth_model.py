@@ -204,3 +204,10 @@ def test_write_section_keeps_rows_of_other_configs(tmp_path):
     assert "RTL: r1." in text and "RTL: r2." not in text
     synth.write_section("RTL: r4.\n\n| config | n |\n|---|---|\n| v2 | 4 |", "x", "mstrack synth --config v2", p)
     assert "| default |" not in p.read_text()
+
+
+def test_cycle_table_skips_core_v2(capsys):
+    """The analytic cycle model is the paper core's: `mstrack synth --cycles` lists no v2 row."""
+    assert synth.main(["--cycles", "--config", "default", "v2"]) == 0
+    out = capsys.readouterr().out
+    assert "| default | 64x64" in out and "| v2 |" not in out

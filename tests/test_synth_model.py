@@ -211,3 +211,11 @@ def test_cycle_table_skips_core_v2(capsys):
     assert synth.main(["--cycles", "--config", "default", "v2"]) == 0
     out = capsys.readouterr().out
     assert "| default | 64x64" in out and "| v2 |" not in out
+
+
+def test_write_section_replaces_kept_table_rows_in_place(tmp_path):
+    p = tmp_path / "perf.md"
+    synth.write_section("RTL: r1.\n\n| design | n |\n|---|---|\n| ref | 0 |\n| a | 1 |", "x", "c1", p, tools="T1.")
+    synth.write_section("RTL: r2.\n\n| design | n |\n|---|---|\n| ref | 0 |\n| b | 2 |", "x", "c2", p, tools="T2.",
+                        keep_rows=True)
+    assert "| ref | 0 |\n| a | 1 |\n| b | 2 |\n\n<!-- perf-x:end -->" in p.read_text()

@@ -911,8 +911,8 @@ def _row_key(line: str) -> str:
 
 def _merge_rows(old_block: str, md: str) -> str:
     """*md* with the rows of *old_block*'s table that *md* has no row for, and a note (just above the
-    table) of where they came from: rows are keyed by their first cell; kept rows stay in their order
-    before the new ones, rows of the same key are replaced.  The note repeats the old section's
+    table) of where they came from: rows are keyed by their first cell; the old rows keep their order,
+    a row of the same key is replaced in place, rows of new keys follow.  The note repeats the old section's
     command / tools / RTL lines (and older such notes while their rows stay)."""
     lines = md.split("\n")
     i = next((k for k, ln in enumerate(lines) if ln.startswith("|---")), None)
@@ -920,7 +920,8 @@ def _merge_rows(old_block: str, md: str) -> str:
     j = next((k for k, ln in enumerate(old) if ln.startswith("|---")), None)
     if i is None or j is None:
         return md
-    new_keys = {_row_key(ln) for ln in lines[i + 1:] if ln.startswith("|")}
+    new_rows = {_row_key(ln): ln for ln in lines[i + 1:] if ln.startswith("|")}
+    new_keys = set(new_rows)
     old_rows = [ln for ln in old[j + 1:] if ln.startswith("|")]
     kept = [ln for ln in old_rows if _row_key(ln) not in new_keys]
     if not kept:
@@ -941,7 +942,11 @@ def _merge_rows(old_block: str, md: str) -> str:
     mine = [_row_key(ln) for ln in kept if _row_key(ln) not in covered]   # rows of the old section's own run
     if mine:
         notes.insert(0, f"Rows kept from an earlier run ({', '.join(mine)}): " + " ".join(prov))
-    out = lines[:i - 1] + ["\n\n".join(notes), ""] + lines[i - 1:i + 1] + kept + lines[i + 1:]
+    old_keys = [_row_key(ln) for ln in old_rows]
+    rows = [new_rows.get(k, ln) for k, ln in zip(old_keys, old_rows)]
+    rows += [ln for k, ln in new_rows.items() if k not in old_keys]
+    tail = [ln for ln in lines[i + 1:] if not ln.startswith("|")]
+    out = lines[:i - 1] + ["\n\n".join(notes), ""] + lines[i - 1:i + 1] + rows + tail
     return "\n".join(out)
 
 
@@ -1025,8 +1030,9 @@ def run(args: argparse.Namespace) -> int:
     ct = (f"RTL: {_RTL_DESC}; pixel pass scan: "
           + ("bounding box" if scan_kind() == "box" else "row extents of the kernel ellipse")
           + f".  Worst window alignment, 20 iterations for both features.\n\n" + cycles_table(figs))
-    print(ct)
-    if args.write and args.cycles:
+    if figs:
+        print(ct)
+    if args.write and args.cycles and figs:
         write_section(ct, f"cycles{_tag()}", "mstrack synth --cycles"
                       + (f" --rtl-commit {args.rtl_commit}" if args.rtl_commit else "") + " --write",
                       tools="Tools: none (analytic cycle model in Python, read from the RTL sources).")

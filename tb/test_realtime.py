@@ -114,6 +114,7 @@ def _lanes_params() -> list:
     return [pytest.param(n, marks=miss) if n == 2 else n for n in lanes]
 
 
+@pytest.mark.long
 @pytest.mark.verilator
 @pytest.mark.parametrize("lanes", _lanes_params())
 def test_realtime_1080p60(lanes):
@@ -195,6 +196,7 @@ def _lanes_720p60() -> list:
     return [pytest.param(n, marks=miss) if n <= 4 else n for n in lanes]
 
 
+@pytest.mark.long
 @pytest.mark.verilator
 @pytest.mark.parametrize("lanes", _lanes_720p60())
 def test_realtime_720p60(lanes):
@@ -288,6 +290,7 @@ LONG_RUNS = [
 ]
 
 
+@pytest.mark.long
 @pytest.mark.verilator
 @pytest.mark.parametrize("name,stream", LONG_RUNS, ids=[n for n, _ in LONG_RUNS])
 def test_long_real_video(name, stream):

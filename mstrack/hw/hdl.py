@@ -308,8 +308,9 @@ def _run_cocotb(runner, *, toplevel: str, test_module: str, build_dir: Path, tes
 
 def _ghdl_runner(skip_build: bool):
     """cocotb's GHDL runner; with *skip_build* its build step runs no command (``ghdl -i`` and
-    ``ghdl -m`` re-analyse and re-link every unit on each call: ~2 s for a block, ~15 s for the
-    core, paid by every test before this cache)."""
+    ``ghdl -m`` on an unchanged library still cost about 1-2 s per test, and before this cache
+    every generic set had its own build dir, so a new generic set paid a full analysis and
+    elaboration)."""
     from cocotb_tools.runner import Ghdl
 
     class _CachedGhdl(Ghdl):

@@ -205,7 +205,7 @@ def test_tracker_v2_preset_generic(tmp_path):
     every result word v2 bit-exact with FixedTrackerV2, frame by frame."""
     job = {"synthetic": {"n": 3, "w": 48, "h": 40, "seed": 5}, "box": [16, 12, 12, 12],
            "report": str(tmp_path / "r.json")}
-    _run(job, "ms_tracker_default", top="ms_tracker")   # the paper tests' build: same sources
+    _run(job, "ms_tracker_ghdl", top="ms_tracker")   # the paper core's GHDL build (same sources, generics at run time)
     rep = json.loads((tmp_path / "r.json").read_text())
     assert rep["frames"] == 3 and not rep["mismatches"]
 

@@ -330,8 +330,9 @@ BLOCK_BASE_EPAN: dict[str, tuple[int, int]] = {"ms_pixel_pass": (2282, 2180), "m
 #: LANES 2 and 4 measurements (docs/blocks/ms_pixel_pass.md: 906 and 1,524 FF -> 288 + 309 per lane;
 #: LUT4 720 and 1,499 -> about 0 + 390 per lane).
 BLOCK_FIXED: dict[str, tuple[int, int]] = {"ms_pixel_pass": (0, 288)}
-#: Tracker v2 blocks measured alone (docs/blocks/<block>.md; LANES 4): added for preset v2.  Core v2
-#: is not built: this is the paper core + these blocks (ms_target_stats scales with LANES).
+#: Tracker v2 blocks measured alone (docs/blocks/<block>.md; LANES 4): added for preset v2.  The v2
+#: estimate is the paper core + these blocks (ms_target_stats scales with LANES), not core v2 as built
+#: (ms_tracker with PRESET 1, docs/performance.md "Core v2").
 V2_BLOCKS: dict[str, tuple[int, int]] = {
     "ms_target_stats": (253, 472), "ms_share": (77, 54), "ms_spread": (95, 70), "ms_scale": (408, 459),
     "ms_resize": (123, 115), "ms_bg_model": (1866, 2654), "ms_model_scale": (241, 192),

@@ -4,11 +4,15 @@ The frames of VIDEO (a video file, an image folder or an OTB/VOT sequence folder
 :class:`mstrack.io.data.VideoSource` as ``mstrack track`` reads them) are streamed through the
 verilated netlist of ``ms_tracker`` (:func:`mstrack.hw.fastsim.simulate`: GHDL ``--synth`` to
 Verilog, Verilator, the C++ harness tools/hdl/cosim_main.cpp; the build is cached in
-``build/fastsim/``), with the init box given before the first frame.  Every result word is
-decoded and compared, field by field, with what the fixed-point model says the core must output
-(:func:`mstrack.hw.cosim.expected_results`).  Written to ``--out``:
+``build/fastsim/``), with the init box given before the first frame.  ``--preset paper`` (default)
+is the paper core (generic PRESET 0, :class:`mstrack.hw.cosim.CoreConfig`); ``--preset v2`` core v2
+(PRESET 1, :meth:`mstrack.hw.cosim.CoreConfigV2.tracker_generics`, result word v2).  Every result
+word is decoded and compared, field by field, with what the fixed-point model says the core must
+output (:func:`mstrack.hw.cosim.expected_results`, v2: :func:`mstrack.hw.cosim.expected_results_v2`).
+Written to ``--out``:
 
-* ``results.csv``: one row per frame, the decoded result word (:data:`SIM_CSV_FIELDS`);
+* ``results.csv``: one row per frame, the decoded result word (:data:`SIM_CSV_FIELDS`; v2:
+  :data:`SIM_CSV_FIELDS_V2`);
 * ``overlay.mp4`` (``.avi`` when mp4 cannot be written): the core's box on the frames, drawn by
   :func:`mstrack.cli.draw_overlay` (the ``mstrack track`` overlay: status colour, banner, legend);
 * ``bitexact.json``: the comparison (:func:`bitexact_report`), also printed as one line.
@@ -35,11 +39,11 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
-from .hw.cosim import COMPARED_FIELDS, ERR_NAMES, MIN_FRAME, CoreConfig
+from .hw.cosim import COMPARED_FIELDS, COMPARED_FIELDS_V2, ERR_NAMES, MIN_FRAME, CoreConfig, CoreConfigV2
 from .io.data import DataError, VideoSource
 from .fixed import FixedParams
 from .fixed.blocks import STOP_CODES, ms_box_clip, round_box
-from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, pack_result
+from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, STATUS_V2, pack_result, pack_result_v2
 from .track.params import TrackerParams
 from .track.types import Box, Status, box_from_centre_index
 
@@ -52,12 +56,18 @@ from .track.types import Box, Status, box_from_centre_index
 #: pixel to the result); word: the raw result word, hexadecimal (every field, exactly).
 SIM_CSV_FIELDS = ("frame", "x", "y", "w", "h", "cx", "cy", "rho_c", "rho_e", "alpha_c", "iter_c", "iter_e",
                   "stop_c", "stop_e", "status", "flags", "err_code", "frame_count", "latency", "word")
+#: Columns of results.csv for core v2 (``--preset v2``, result word v2): frame, the box x, y, w, h
+#: (from the centre and w8, h8, exact), cx, cy (Q.CF, exact), rho and confidence (Q1.16 as decimals),
+#: status (:data:`mstrack.fixed.vhdl_pkg.STATUS_V2` name), iter, stop (name), decim_log2, searched,
+#: flags, err_code, frame_count, latency, word (hexadecimal).
+SIM_CSV_FIELDS_V2 = ("frame", "x", "y", "w", "h", "cx", "cy", "rho", "confidence", "status", "iter", "stop",
+                     "decim_log2", "searched", "flags", "err_code", "frame_count", "latency", "word")
 #: Decimals of rho_c, rho_e, alpha_c in results.csv: 2**-16 = 1.5e-5 apart, so 6 decimals keep
 #: every value apart (the raw integers are in ``word``).
 RHO_DECIMALS = 6
 STOP_NAMES = {v: k for k, v in STOP_CODES.items()}
-#: Presets the RTL core implements (preset v2 has no core yet: issue 11).
-CORE_PRESETS = ("paper",)
+#: Presets the RTL core implements (generic PRESET of ms_tracker: paper 0, v2 1).
+CORE_PRESETS = ("paper", "v2")
 #: Mismatches listed in bitexact.json (the count is always complete).
 MAX_LISTED = 200
 EXIT_OK, EXIT_MISMATCH, EXIT_BAD_INPUT = 0, 1, 2
@@ -108,6 +118,27 @@ def decode_row(fields: dict[str, int], g: dict[str, int], frame: int, latency: i
             "word": f"{pack_result({k: fields[k] for k in COMPARED_FIELDS}, g):0{g['RESULT_W'] // 4}x}"}
 
 
+def decode_row_v2(fields: dict[str, int], g: dict[str, int], frame: int, latency: int | None = None
+                  ) -> dict[str, Any]:
+    """One results.csv row of core v2 (:data:`SIM_CSV_FIELDS_V2`) from the fields of a result word v2
+    (``g``: the core's generics; CF scales the centre, w8 and h8 are Q.8, rho and confidence Q1.16)."""
+    cf = float(1 << g["CF"])
+    cx, cy = fields["cx"] / cf, fields["cy"] / cf
+    b = box_from_centre_index(cx, cy, fields["w8"] / 256.0, fields["h8"] / 256.0)
+    q16 = lambda v: round(v / 65536.0, RHO_DECIMALS)  # noqa: E731
+    flags = "|".join(n for i, n in enumerate(RESULT_FLAGS) if (fields["flags"] >> i) & 1)
+    err = fields["err_code"]
+    err_name = ERR_NAMES[err] if err < len(ERR_NAMES) else str(err)
+    st = fields["status"]
+    return {"frame": frame, "x": b.x, "y": b.y, "w": b.w, "h": b.h, "cx": cx, "cy": cy,
+            "rho": q16(fields["rho"]), "confidence": q16(fields["confidence"]),
+            "status": STATUS_V2[st] if st < len(STATUS_V2) else str(st), "iter": fields["iter"],
+            "stop": STOP_NAMES[fields["stop"]], "decim_log2": fields["decim_log2"], "searched": fields["searched"],
+            "flags": flags, "err_code": err_name if fields["flags"] >> RESULT_FLAGS.index("error") & 1 else "",
+            "frame_count": fields["frame_count"], "latency": "" if latency is None else latency,
+            "word": f"{pack_result_v2({k: fields[k] for k in COMPARED_FIELDS_V2}, g):0{g['RESULT_W'] // 4}x}"}
+
+
 # ----------------------------------------------------------------------------- comparison
 def field_mismatches(results: Sequence[dict], expected: Sequence[dict], frames: Sequence[int],
                      fields: Sequence[str] = COMPARED_FIELDS) -> list[dict[str, Any]]:
@@ -129,13 +160,14 @@ def field_mismatches(results: Sequence[dict], expected: Sequence[dict], frames: 
 
 
 def bitexact_report(results: Sequence[dict], expected: Sequence[dict], frames: Sequence[int],
-                    fields: Sequence[str] = COMPARED_FIELDS) -> dict[str, Any]:
+                    fields: Sequence[str] = COMPARED_FIELDS,
+                    reference: str = "mstrack.hw.cosim.expected_results") -> dict[str, Any]:
     """The bit-exactness report: ``bit_exact``, ``frames`` compared, ``fields``, ``mismatched_frames``,
     ``mismatches`` (count), ``first_mismatch`` (or None) and the first :data:`MAX_LISTED` in
     ``listed`` (:func:`field_mismatches`)."""
     mm = field_mismatches(results, expected, frames, fields)
     return {"bit_exact": not mm, "frames": len(expected), "results": len(results), "fields": list(fields),
-            "reference": "fixed-point model, mstrack.hw.cosim.expected_results",
+            "reference": f"fixed-point model, {reference}",
             "mismatched_frames": len({m["result"] for m in mm}), "mismatches": len(mm),
             "first_mismatch": mm[0] if mm else None, "listed": mm[:MAX_LISTED]}
 
@@ -173,7 +205,7 @@ class SimJob:
     count: int
     box: tuple[int, int, int, int]
     given: Box
-    cfg: CoreConfig
+    cfg: CoreConfig | CoreConfigV2
     size: tuple[int, int]                     # (W, H)
     gt: np.ndarray | None = None              # ground truth of the streamed frames (sequence folder)
     notes: list[str] = field(default_factory=list)
@@ -203,7 +235,7 @@ def check_frame_size(w: int, h: int, g: dict[str, int]) -> None:
 
 
 def prepare(video: str | Path, box: Box | None, frame_range: tuple[int, int] | None, max_frames: int | None,
-            cfg: CoreConfig) -> SimJob:
+            cfg: CoreConfig | CoreConfigV2) -> SimJob:
     """Open ``video``, pick the frames and the init box and check them against the core.
 
     Raises :class:`SimInputError` / :class:`mstrack.io.data.DataError` (both exit 2)."""
@@ -249,7 +281,9 @@ def prepare(video: str | Path, box: Box | None, frame_range: tuple[int, int] | N
     if not (-(1 << (cw + 1)) <= ib[0] < 1 << (cw + 1) and -(1 << (cw + 1)) <= ib[1] < 1 << (cw + 1)
             and ib[2] < 1 << (cw + 1) and ib[3] < 1 << (cw + 1)):
         raise SimInputError(f"--box {ib}: does not fit the core's init port (COORD_W = {cw})")
-    clipped, _ = ms_box_clip(*ib, size[0], size[1], cfg.fp.max_half)
+    # core v2 clips the box to the frame without shrinking it (large targets are decimated), as
+    # FixedTrackerV2.init
+    clipped, _ = ms_box_clip(*ib, size[0], size[1], 4095 if isinstance(cfg, CoreConfigV2) else cfg.fp.max_half)
     if clipped is None:
         raise SimInputError(f"--box {ib} leaves less than 3x3 px inside the {size[0]}x{size[1]} frame "
                             "(the core rejects it; 1-px border excluded)")
@@ -274,29 +308,35 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
     Returns the report (bitexact.json's content)."""
     from .hw import fastsim
     from .cli import draw_overlay
-    from .hw.cosim import expected_results
+    from .hw.cosim import expected_results, expected_results_v2
     from .io.data import open_video_writer
 
-    model = model or expected_results
-    g = job.cfg.generics()
+    v2 = isinstance(job.cfg, CoreConfigV2)
+    model = model or (expected_results_v2 if v2 else expected_results)
+    g = job.cfg.tracker_generics() if isinstance(job.cfg, CoreConfigV2) else job.cfg.generics()
     say = (lambda m: print(f"mstrack sim: {m}", file=sys.stderr, flush=True)) if progress else (lambda m: None)
     t0 = time.monotonic()
     say(f"co-simulating {job.count} frames {job.size[0]}x{job.size[1]} (LANES {job.cfg.lanes}; the first "
         "run of a generic set builds the Verilator model, 1-2 min)...")
+    # ms_tracker, the entity integrators instantiate (v2: generic PRESET 1)
     run = fastsim.simulate(job.frames(), job.box, job.cfg.tp, job.cfg.fp, lanes=job.cfg.lanes,
-                           max_frame_w=job.cfg.max_frame_w, check=False)
+                           max_frame_w=job.cfg.max_frame_w, check=False, v2=v2, top=fastsim.TOP)
     t_sim = time.monotonic() - t0
     say(f"simulated {run.cycles} clocks in {run.seconds:.1f} s ({run.status}); running the fixed-point model...")
     t1 = time.monotonic()
     expected = model(job.frames(), job.box, job.cfg.tp, job.cfg.fp)
     t_model = time.monotonic() - t1
     idx = job.frame_indices
-    rep = bitexact_report(run.results, expected, idx)
-    rows = [decode_row(r, g, idx[i] if i < len(idx) else idx[-1] + i - len(idx) + 1, r.get("latency"))
+    if v2:
+        rep = bitexact_report(run.results, expected, idx, COMPARED_FIELDS_V2, "mstrack.hw.cosim.expected_results_v2")
+    else:
+        rep = bitexact_report(run.results, expected, idx)
+    decode = decode_row_v2 if v2 else decode_row
+    rows = [decode(r, g, idx[i] if i < len(idx) else idx[-1] + i - len(idx) + 1, r.get("latency"))
             for i, r in enumerate(run.results)]
     out.mkdir(parents=True, exist_ok=True)
     with open(out / "results.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=SIM_CSV_FIELDS)
+        w = csv.DictWriter(fh, fieldnames=SIM_CSV_FIELDS_V2 if v2 else SIM_CSV_FIELDS)
         w.writeheader()
         w.writerows(rows)
     video = None
@@ -307,7 +347,9 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
                 if i >= len(rows):
                     break
                 gt = None if job.gt is None or i >= len(job.gt) else job.gt[i]
-                img = draw_overlay(frame, rows[i], gt)
+                # core v2: one feature (colour), its rho as rho_c and the confidence in the banner
+                row = {**rows[i], "rho_c": rows[i]["rho"], "alpha_c": 1.0} if v2 else rows[i]
+                img = draw_overlay(frame, row, gt)
                 if writer is None:
                     writer, video = open_video_writer(out / "overlay.mp4", job.source.fps, (img.shape[1], img.shape[0]))
                 writer.write(img)
@@ -343,13 +385,17 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         return EXIT_BAD_INPUT
 
     if args.preset not in CORE_PRESETS:
-        return bad(f"--preset {args.preset}: the RTL core implements the paper preset only "
-                   "(core v2, issue 11, is not built); use --preset paper")
+        return bad(f"--preset {args.preset}: the RTL core implements the presets {', '.join(CORE_PRESETS)}")
     if args.lanes & (args.lanes - 1):
         return bad(f"--lanes {args.lanes}: LANES must be a power of two (1, 2, 4, 8, ...)")
     try:
-        cfg = CoreConfig(TrackerParams(preset="paper"), FixedParams(), lanes=args.lanes,
-                         max_frame_w=args.max_frame_width)
+        cfg: CoreConfig | CoreConfigV2
+        if args.preset == "v2":
+            cfg = CoreConfigV2(TrackerParams(preset="v2"), FixedParams(), lanes=args.lanes,
+                               max_frame_w=args.max_frame_width)
+        else:
+            cfg = CoreConfig(TrackerParams(preset="paper"), FixedParams(), lanes=args.lanes,
+                             max_frame_w=args.max_frame_width)
         cfg.generics()
         out = Path(args.out) if args.out else Path("out/sim") / Path(args.video).resolve().name
         job = prepare(args.video, args.box, args.frames, args.max_frames, cfg)
@@ -393,7 +439,8 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
                         "one Verilator build per value, cached)")
     p.add_argument("--max-frame-width", type=_positive, default=2048, help="MAX_FRAME_W generic (default 2048)")
     p.add_argument("--preset", default="paper",
-                   help="tracker preset of the core: paper (the only one the RTL core implements)")
+                   help="tracker preset of the core: paper (default; generic PRESET 0) or v2 (core v2, PRESET 1: "
+                        "result word v2, results.csv with confidence and status)")
     p.add_argument("--out", help="output folder (default out/sim/<VIDEO name>)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=_cmd_sim)
@@ -409,5 +456,6 @@ def _positive(s: str) -> int:
     return _positive_int(s)
 
 
-__all__ = ["SIM_CSV_FIELDS", "SimInputError", "SimJob", "bitexact_report", "decode_row", "field_mismatches",
+__all__ = ["SIM_CSV_FIELDS", "SIM_CSV_FIELDS_V2", "SimInputError", "SimJob", "bitexact_report", "decode_row",
+           "decode_row_v2", "field_mismatches",
            "parse_frame_range", "prepare", "register_cli", "report_line", "result_status", "run_sim"]

@@ -1,6 +1,17 @@
--- ms_tracker: mean-shift colour + edge fusion tracking core (top level).
+-- ms_tracker: mean-shift tracking core (top level): the paper core or core v2 (generic PRESET).
 --
--- Computes, per video frame, the tracking result of mstrack.fixed.FixedTracker bit for bit
+-- PRESET selects the tracker (TrackerParams.preset); ports and handshakes are the same for both, only
+-- the result word differs:
+--   0 (default) the paper core: colour + edge fusion, mstrack.fixed.FixedTracker bit for bit, result
+--     word of RESULT_W = 144 bits with the default generics; described below.
+--   1 core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2) bit for bit, colour only, result word
+--     v2 of RESULT_W = 160 bits (mstrack.fixed.vhdl_pkg.result_layout_v2); the engine ms_tracker_v2
+--     (rtl/ms_tracker_v2.vhd: its header gives the latency) with every port and generic passed through;
+--     one pixel per clock (PPC = 1); the generics after RESULT_W are core v2's own.
+-- Each preset ignores the other's own generics.  `mstrack hdl config --preset paper|v2` writes every
+-- generic; RESULT_W and the derived widths are checked against the preset at elaboration.
+--
+-- PRESET 0 computes, per video frame, the tracking result of mstrack.fixed.FixedTracker bit for bit
 -- (docs/architecture.md, docs/fixed_point.md).  Video in as AXI4-Stream, PPC pixels per clock
 -- (generic PPC = 1, 2 or 4; AXI4-Stream video convention): pixel k of a beat in s_axis_tdata bits
 -- 24k+23 .. 24k, the leftmost pixel in the low bits, each R(23:16) G(15:8) B(7:0) (RGB_PACKING = 0)
@@ -44,6 +55,7 @@ use work.ms_stream_pkg.all;
 
 entity ms_tracker is
   generic (
+    PRESET         : natural := 0;               -- 0 the paper core (below), 1 core v2 (ms_tracker_v2)
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth); 3 .. 2**COORD_W - 1
     RGB_PACKING    : natural := 0;               -- s_axis_tdata layout: 0 R 23:16 G 15:8 B 7:0; 1 AMD UG934 (R B G)
     PPC            : natural := 1;               -- pixels per clock (s_axis beat): 1, 2 or 4 (<= LANES)
@@ -88,7 +100,36 @@ entity ms_tracker is
     RHO_OUT_W      : natural := D_RHO_OUT_W;
     ALPHA_W        : natural := D_ALPHA_W;
     WIN_W          : natural := D_WIN_W;
-    RESULT_W       : natural := D_RESULT_W
+    RESULT_W       : natural := D_RESULT_W;       -- PRESET 0: 144 (result word), 1: 160 (result word v2)
+    -- core v2 only (PRESET 1; ms_tracker_v2's defaults; mstrack.hw.cosim.CoreConfigV2.generics)
+    PAD16          : natural := 4;               -- pad in 1/16
+    RING16         : natural := 10;              -- bg_ring in 1/16
+    MAX_WINDOW     : natural := 127;             -- largest window diameter (decimated px)
+    KT_W           : natural := 9;               -- KA/KB width (KERNEL_BITS + 1)
+    ST2_W          : natural := 23;
+    SHARE_W        : natural := 17;
+    SPREAD_W       : natural := 25;
+    SIZE_W         : natural := 20;              -- w8, h8 bits (COORD_W + 8)
+    SCALE_W        : natural := 17;
+    SCALE_GAIN     : natural := 19661;
+    SCALE_REG      : natural := 6554;
+    SCALE_STEP     : natural := 6554;
+    SCALE_RATIO_Q_W: natural := 17;
+    WR_Q_W         : natural := 27;
+    CON_W          : natural := 18;
+    LOSS_K         : natural := 1;
+    REF_K          : natural := 6;
+    LOSS_RHO       : natural := 57672;
+    LOSS_CONTRAST  : integer := 12452;
+    CONF_LOST      : natural := 26214;           -- round(conf_lost 2**16)
+    CONF_UNCERTAIN : natural := 32768;
+    CONF_REACQUIRE : natural := 32768;
+    SPREAD_DEFAULT : natural := 2581110;         -- spread_ref when the init spread is 0
+    BG_Q_W         : natural := 14;
+    BG_O_W         : natural := 17;
+    SEARCH_ITER    : natural := 5;               -- iterations per start point while lost
+    STEP16         : natural := 16;              -- search_step in 1/16
+    MARGIN_MAX     : natural := 255              -- largest region margin (MARGIN + the search offset)
   );
   port (
     clk                  : in  std_logic;                                -- core and pixel clock
@@ -312,6 +353,10 @@ architecture rtl of ms_tracker is
   constant X_SQRT_IN : natural := bits_of(shift_left(mul(X_HISTMAX, X_HISTMAX), 2 * RF));
   constant X_RESULT  : natural := 2 * CENTRE_ABS_W + 2 * RHO_OUT_W + ALPHA_W + 2 * ITER_W + 4 + FLAGS_W
                                   + ERR_W + 2 * WIN_W + FCOUNT_W;
+  -- result word v2 (PRESET 1, mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence (17),
+  -- status (3), iter, stop (2), decim_log2 (3), searched (4), flags, err_code, frame_count
+  constant X_RESULT_V2 : natural := 2 * CENTRE_ABS_W + 2 * (COORD_W + 8) + RHO_OUT_W + 17 + 3 + ITER_W + 2 + 3 + 4
+                                    + FLAGS_W + ERR_W + FCOUNT_W;
 
   -- frame width accepted with PPC pixels per beat: a multiple of PPC (PPC a power of two)
   function width_ppc_ok(w : unsigned) return boolean is
@@ -327,6 +372,18 @@ architecture rtl of ms_tracker is
   -- evaluated once at elaboration; returns true so that it can initialise a constant
   function checks return boolean is
   begin
+    assert PRESET <= 1 report "ms_tracker: PRESET = " & img(PRESET) & " (0 the paper core, 1 core v2)"
+      severity failure;
+    if PRESET = 1 then
+      -- core v2: ms_tracker_v2 checks its own generics
+      assert RESULT_W = 8 * ((X_RESULT_V2 + 7) / 8)
+        report "ms_tracker: RESULT_W = " & img(RESULT_W) & " but PRESET 1 (core v2) has a result word v2 of "
+               & img(8 * ((X_RESULT_V2 + 7) / 8)) & " bits (mstrack hdl config --preset v2 sets every generic)"
+        severity failure;
+      assert PPC = 1 report "ms_tracker: PPC = " & img(PPC) & ": PRESET 1 (core v2) takes one pixel per clock"
+        severity failure;
+      return true;
+    end if;
     assert LANES = 1 or (LANES >= 1 and 2 ** clog2(LANES) = LANES)
       report "ms_tracker: LANES = " & img(LANES) & " is not a power of two" severity failure;
     assert FEATURES <= 2 report "ms_tracker: FEATURES = " & img(FEATURES) & " (0 fused, 1 colour, 2 edge)"
@@ -368,11 +425,50 @@ architecture rtl of ms_tracker is
     check("ITER_W", ITER_W, bits_of(big(MAX_ITER)), "bits_for(MAX_ITER)");
     check("RHO_OUT_W", RHO_OUT_W, RHO_OUT_FRAC + 1, "RHO_OUT_FRAC + 1");
     check("ALPHA_W", ALPHA_W, AF + 1, "AF + 1");
-    check("RESULT_W", RESULT_W, 8 * ((X_RESULT + 7) / 8), "the result fields rounded up to 8 bits");
+    check("RESULT_W", RESULT_W, 8 * ((X_RESULT + 7) / 8),
+          "PRESET 0 (the paper core): the result fields rounded up to 8 bits");
     return true;
   end function;
   constant GENERICS_OK : boolean := checks;
 begin
+
+  ---------------------------------------------------------------------------- PRESET 1: core v2
+  -- the v2 engine with every port and generic passed through (PPC = 1: s_axis_tdata is one pixel)
+  g_v2 : if PRESET = 1 generate
+    u_v2 : entity work.ms_tracker_v2
+      generic map (
+        MAX_FRAME_W => MAX_FRAME_W, RGB_PACKING => RGB_PACKING, LANES => LANES, COLOUR_BITS => COLOUR_BITS,
+        EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, FEATURES => FEATURES,
+        KERNEL_EPAN => KERNEL_EPAN, KERNEL_BITS => KERNEL_BITS, MAX_HALF => MAX_HALF, MARGIN => MARGIN,
+        COORD_W => COORD_W, CF => CF, WI => WI, WF => WF, RF => RF, AF => AF, RHO_OUT_FRAC => RHO_OUT_FRAC,
+        MAX_ITER => MAX_ITER, EPS2 => EPS2, HALF_W => HALF_W, REGION_MAX => REGION_MAX, REGION_W => REGION_W,
+        STRIDE => STRIDE, ADDR_W => ADDR_W, KVAL_W => KVAL_W, HIST_W => HIST_W, COUNT_W => COUNT_W,
+        POSSUM_W => POSSUM_W, KD_W => KD_W, SQRT_IN_W => SQRT_IN_W, RHO_SUM_W => RHO_SUM_W,
+        RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W,
+        CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, ITER_W => ITER_W, RHO_OUT_W => RHO_OUT_W,
+        ALPHA_W => ALPHA_W, WIN_W => WIN_W, RESULT_W => RESULT_W,
+        PAD16 => PAD16, RING16 => RING16, MAX_WINDOW => MAX_WINDOW, KT_W => KT_W, ST2_W => ST2_W,
+        SHARE_W => SHARE_W, SPREAD_W => SPREAD_W, SIZE_W => SIZE_W, SCALE_W => SCALE_W,
+        SCALE_GAIN => SCALE_GAIN, SCALE_REG => SCALE_REG, SCALE_STEP => SCALE_STEP,
+        SCALE_RATIO_Q_W => SCALE_RATIO_Q_W, WR_Q_W => WR_Q_W, CON_W => CON_W, LOSS_K => LOSS_K, REF_K => REF_K,
+        LOSS_RHO => LOSS_RHO, LOSS_CONTRAST => LOSS_CONTRAST, CONF_LOST => CONF_LOST,
+        CONF_UNCERTAIN => CONF_UNCERTAIN, CONF_REACQUIRE => CONF_REACQUIRE, SPREAD_DEFAULT => SPREAD_DEFAULT,
+        BG_Q_W => BG_Q_W, BG_O_W => BG_O_W, SEARCH_ITER => SEARCH_ITER, STEP16 => STEP16,
+        MARGIN_MAX => MARGIN_MAX)
+      port map (
+        clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
+        s_init_tvalid => s_init_tvalid, s_init_tready => s_init_tready, s_init_x => s_init_x,
+        s_init_y => s_init_y, s_init_w => s_init_w, s_init_h => s_init_h,
+        s_axis_tdata => s_axis_tdata(23 downto 0), s_axis_tvalid => s_axis_tvalid,
+        s_axis_tready => s_axis_tready, s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+        m_axis_result_tdata => m_axis_result_tdata, m_axis_result_tvalid => m_axis_result_tvalid,
+        m_axis_result_tready => m_axis_result_tready, m_axis_result_tlast => m_axis_result_tlast,
+        busy => busy);
+  end generate g_v2;
+
+  ---------------------------------------------------------------------------- PRESET 0: the paper core
+  -- (the statements of this generate are not indented one level more, to keep the paper core's history)
+  g_paper : if PRESET = 0 generate
 
   ---------------------------------------------------------------------------- video input gate
   -- closed: outside T_IDLE, after a frame's last beat until its result, while an error result is
@@ -767,4 +863,5 @@ begin
                          and gate_closed = '0' and err_hold = '0' and fe_err_now = '0' else '0';
   init_take <= s_init_tvalid and init_ready;
   s_init_tready <= init_ready;
+  end generate g_paper;
 end architecture;

@@ -50,7 +50,7 @@
 #define MSTRACK_FLAG_OVERFLOW (1u << 6)
 #define MSTRACK_FLAG_RESERVED (1u << 7)
 
-// result word v2 (result_layout_v2, core v2: not built yet; docs/architecture.md)
+// result word v2 (result_layout_v2: core v2, ms_tracker with PRESET 1; result stream only, the AXI-Lite registers decode word v1; docs/integration.md)
 #define MSTRACK_RESULT_V2_W 160
 #define MSTRACK_RES2_CX_OFF 0
 #define MSTRACK_RES2_CX_W 20

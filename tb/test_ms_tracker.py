@@ -261,6 +261,10 @@ def _gt_box(seq: Path) -> tuple[int, int, int, int]:
 
 
 SMALL = {"fp": {"max_half": 15, "margin": 8}}
+#: one GHDL build of ms_tracker for every GHDL run of it (generics are given at run time, so one analysis
+#: and elaboration serves every configuration and PPC; tb/test_ms_tracker_v2.py's PRESET 1 run shares
+#: it too): each cold build of the core's 45 files costs about 15 s of CPU
+GHDL_BUILD = "ms_tracker_ghdl"
 
 
 @pytest.mark.parametrize("variant", ["plain", "throttled"])
@@ -271,7 +275,7 @@ def test_tracker_ghdl_synthetic(variant, tmp_path):
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
     g = config_of(job).generics()
-    run_ghdl("ms_tracker", "test_ms_tracker", generics=g, build_name=f"ms_tracker_synth_{variant}",
+    run_ghdl("ms_tracker", "test_ms_tracker", generics=g, build_name=GHDL_BUILD,
              extra_env=_job_env(job))
 
 
@@ -281,7 +285,7 @@ def test_tracker_ghdl_real_frame(tmp_path):
     seq = _seq("Girl")
     job = {"seq": str(seq), "n": 3, "box": list(_gt_box(seq)), "report": str(tmp_path / "r.json")}
     run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
-             build_name="ms_tracker_real", extra_env=_job_env(job))
+             build_name=GHDL_BUILD, extra_env=_job_env(job))
 
 
 @pytest.mark.parametrize("fault", ["short_line", "long_line", "no_sof", "cut"])
@@ -303,7 +307,7 @@ def test_tracker_rejected_box(bad_box, tmp_path):
     job = {**SMALL, "synthetic": {"n": 4, "w": 64, "h": 48, "seed": 3}, "box": [22, 14, 14, 12],
            "bad_box": bad_box, "report": str(tmp_path / "r.json")}
     run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
-             build_name="ms_tracker_rejected", extra_env=_job_env(job))
+             build_name=GHDL_BUILD, extra_env=_job_env(job))
 
 
 REAL_RUNS = [("Girl", 0, 40), ("Crossing", 0, 10), ("Couple", 0, 10)]
@@ -338,7 +342,7 @@ def test_tracker_ppc_synthetic(ppc, variant, tmp_path):
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
     run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
-             build_name=f"ms_tracker_ppc{ppc}_{variant}", extra_env=_job_env(job))
+             build_name=GHDL_BUILD, extra_env=_job_env(job))
 
 
 @pytest.mark.extra
@@ -366,4 +370,4 @@ def test_tracker_ppc_width_error(ppc, tmp_path):
     job = {**SMALL, "ppc": ppc, "synthetic": {"n": 5, "w": 48, "h": 40, "seed": 5}, "box": [16, 12, 12, 12],
            "faults": {"2": "width_ppc"}, "report": str(tmp_path / "r.json")}
     run_ghdl("ms_tracker", "test_ms_tracker", generics=config_of(job).generics(),
-             build_name=f"ms_tracker_ppc{ppc}_width", extra_env=_job_env(job))
+             build_name=GHDL_BUILD, extra_env=_job_env(job))

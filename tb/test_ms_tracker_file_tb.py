@@ -107,6 +107,7 @@ CONFIG_CASES = {
     "small_l2_epan": dict(max_target=31, margin=8, lanes=2, kernel="epanechnikov"),
     "big_window": dict(max_target=511, max_frame_width=8000, coord_bits=13, kernel="epanechnikov"),
     "l1_edge_ug934": dict(lanes=1, features="edge", max_target=15, margin=0, rgb_packing="ug934"),
+    "v2": dict(preset="v2", max_frame_width=1920),        # PRESET 1: core v2 (ms_tracker_v2 elaborated too)
 }
 
 
@@ -158,13 +159,29 @@ def test_config_package_compiles(tmp_path):
     run_ghdl_plain("cfg_top", rtl_sources("ms_tracker") + extra, build_name="cfg_top", elab_only=True)
 
 
+def test_config_package_v2_analyses(tmp_path):
+    """The VHDL package of `mstrack hdl config --preset v2` (PRESET 1, LOSS_CONTRAST an integer) analyses."""
+    from mstrack.hw.hdl import HdlError, have_ghdl
+    from mstrack.hw.hdl_config import CoreChoices, derive, render
+    if not have_ghdl():
+        pytest.skip("ghdl not installed (tools/setup.sh)")
+    pkg = tmp_path / "ms_tracker_config_pkg.vhd"
+    pkg.write_text(render(derive(CoreChoices(preset="v2")), "package"))
+    r = subprocess.run(["ghdl", "-a", "--std=08", f"--workdir={tmp_path}", str(pkg)], capture_output=True, text=True)
+    if r.returncode:
+        raise HdlError(r.stderr)
+
+
 @pytest.mark.parametrize("generic,value,message", [
     ("REGION_W", 7, "ms_tracker: REGION_W = 7, expected bits_for(REGION_MAX) = 8"),
     ("STRIDE", 47, "ms_tracker: STRIDE = 47, expected ceil(REGION_MAX / LANES) = 48"),
     ("HIST_W", 13, "ms_tracker: HIST_W = 13, expected bits_for(window pixels x kernel maximum) = 14"),
     ("LANES", 3, "ms_tracker: LANES = 3 is not a power of two"),
     ("MAX_FRAME_W", 4096, "ms_tracker: MAX_FRAME_W = 4096 out of 3 .. 2**COORD_W - 1 = 4095"),
-    ("RESULT_W", 152, "ms_tracker: RESULT_W = 152, expected the result fields rounded up to 8 bits = 144"),
+    ("RESULT_W", 152, "ms_tracker: RESULT_W = 152, expected PRESET 0 (the paper core): the result fields "
+                      "rounded up to 8 bits = 144"),
+    ("PRESET", 2, "ms_tracker: PRESET = 2 (0 the paper core, 1 core v2)"),
+    ("PRESET", 1, "ms_tracker: RESULT_W = 144 but PRESET 1 (core v2) has a result word v2 of 160 bits"),
     ("PPC", 3, "ms_tracker: PPC = 3 (1, 2 or 4)"),
 ])
 def test_wrong_generic_refused(generic, value, message):

@@ -1,5 +1,9 @@
 """System test of rtl/ms_tracker_v2.vhd (core v2) against FixedTrackerV2, frame by frame, bit for bit.
 
+Core v2 runs as the engine ms_tracker_v2 alone (the GHDL scenes, protocol errors) and as integrators
+instantiate it, ms_tracker with generic PRESET = 1 (test_tracker_v2_preset_generic under GHDL; the
+Verilator runs, long set included, through :func:`mstrack.hw.fastsim.simulate`'s default top).
+
 cocotb module and pytest entry points in one file, in the style of tb/test_ms_tracker.py: a *job*
 (JSON in MSTRACK_JOB) names the frames (real sequence images or a generated scene), the init box,
 the stream conditions (random tvalid gaps, result back-pressure, protocol faults).  Every field of
@@ -177,9 +181,11 @@ def _gt_box(seq: Path, start: int = 0) -> tuple[int, int, int, int]:
     return round_box(*[float(v) for v in s.gt[start]])
 
 
-def _run(job: dict, build_name: str) -> None:
+def _run(job: dict, build_name: str, top: str = "ms_tracker_v2") -> None:
+    """GHDL run of the job on ``top``: the engine ms_tracker_v2, or ms_tracker with PRESET 1 (the entity
+    integrators instantiate; CoreConfigV2.tracker_generics)."""
     from mstrack.hw.hdl import run_ghdl
-    run_ghdl("ms_tracker_v2", "test_ms_tracker_v2", generics=config_of(job).generics(),
+    run_ghdl(top, "test_ms_tracker_v2", generics=config_of(job).generics_for(top),
              build_name=build_name, extra_env=_job_env(job))
 
 
@@ -191,6 +197,17 @@ def test_tracker_v2_synthetic(variant, tmp_path):
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
     _run(job, f"ms_tracker_v2_synth_{variant}")
+
+
+def test_tracker_v2_preset_generic(tmp_path):
+    """GHDL: core v2 as integrators instantiate it, ``ms_tracker`` with generic PRESET = 1 (every port and
+    generic passed to ms_tracker_v2): init + 2 tracking frames of a generated 48x40 scene, every field of
+    every result word v2 bit-exact with FixedTrackerV2, frame by frame."""
+    job = {"synthetic": {"n": 3, "w": 48, "h": 40, "seed": 5}, "box": [16, 12, 12, 12],
+           "report": str(tmp_path / "r.json")}
+    _run(job, "ms_tracker_ghdl", top="ms_tracker")   # the paper core's GHDL build (same sources, generics at run time)
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["frames"] == 3 and not rep["mismatches"]
 
 
 def test_tracker_v2_real_frames(tmp_path):
@@ -211,8 +228,10 @@ def test_tracker_v2_protocol_errors(tmp_path):
 
 
 def _fastsim_real(name: str, start: int, n: int, pin: int, pout: int) -> None:
-    """Verilator: real frames through ms_tracker_v2, every field of every result word v2 bit-exact.
-    MAX_FRAME_W 1920: the same build as tb/test_realtime.py::test_realtime_v2_1080p60."""
+    """Verilator: real frames through core v2 as integrators instantiate it (ms_tracker, PRESET 1; the
+    netlist of its engine ms_tracker_v2 is the same as ms_tracker_v2's alone), every field of every result
+    word v2 bit-exact.  MAX_FRAME_W 1920: the same build as tb/test_realtime.py::test_realtime_v2_1080p60
+    and tb/test_sim_cli.py::test_sim_preset_v2_real."""
     from mstrack.hw import fastsim
     from mstrack.hw.hdl import have_verilator
     from mstrack.io.data import load_sequence
@@ -242,7 +261,7 @@ LONG_RUNS = [("Girl", 500, 0, 0), ("Couple", 140, 20, 30), ("Crossing", 120, 0, 
 @pytest.mark.verilator
 @pytest.mark.parametrize("name,n,pin,pout", LONG_RUNS, ids=[r[0] for r in LONG_RUNS])
 def test_tracker_v2_fastsim_long(name, n, pin, pout):
-    """Verilator: whole real sequences through ms_tracker_v2 (1,545 frames), bit-exact, frames back to
+    """Verilator: whole real sequences through core v2 (ms_tracker, PRESET 1; 1,545 frames), bit-exact, frames back to
     back (the core back-pressures while it tracks).  Marker ``long``: `make test` runs it on the
     second core after the netlist build (`make test-synth-only`)."""
     _fastsim_real(name, 0, n, pin, pout)

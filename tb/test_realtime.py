@@ -152,7 +152,7 @@ V2_RT_START, V2_RT_FRAMES = 30, 10
 @pytest.mark.long
 @pytest.mark.verilator
 def test_realtime_v2_1080p60():
-    """Core v2 (ms_tracker_v2, LANES 4) at 1080p60 timing on real footage with a loss, a wide search and
+    """Core v2 (ms_tracker with PRESET 1, LANES 4) at 1080p60 timing on real footage with a loss, a wide search and
     a re-acquisition: bit-exact (every field of result word v2), no input stall, every result before
     the next frame's first pixel.  The analytic worst case (largest window, max_iter, the search) is
     the v2 cycle budget of docs/fixed_point.md ("Hardware cost of v2")."""

@@ -16,7 +16,13 @@ every test here; then each simulation takes about a second.
 * ``test_sim_detects_mismatch``: the model side is corrupted in one field of one frame: exit 1,
   and both the printed line and bitexact.json name that frame and field.
 * ``test_sim_bad_input``: missing file, box outside the frame, frame too wide for MAX_FRAME_W,
-  preset v2, frames beyond the end, no box: one-line error, exit 2 (no HDL tools needed).
+  an unknown preset, frames beyond the end, no box: one-line error, exit 2 (no HDL tools needed).
+* ``test_sim_preset_v2_decoding``: ``--preset v2`` without a simulator (fastsim.simulate replaced by
+  the model's words): core v2 is asked for as ms_tracker with PRESET 1, results.csv has the v2
+  columns decoded from result word v2, bitexact.json compares the v2 fields.
+* ``test_sim_preset_v2_real``: ``--preset v2`` on 12 Girl frames through the verilated ms_tracker
+  with PRESET 1 (marker ``long``: the Verilator build of core v2 at MAX_FRAME_W 1920 is the one the
+  long core v2 runs use, so it is built once, on the second core of `make test`).
 """
 from __future__ import annotations
 
@@ -38,7 +44,7 @@ from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import round_box
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, pack_result
 from mstrack.track.params import TrackerParams
-from mstrack.simcli import SIM_CSV_FIELDS, bitexact_report, decode_row, report_line
+from mstrack.simcli import SIM_CSV_FIELDS, SIM_CSV_FIELDS_V2, bitexact_report, decode_row, decode_row_v2, report_line
 from mstrack.io.synthetic import make_scene, write_video
 
 REPO = Path(__file__).resolve().parents[1]
@@ -200,7 +206,7 @@ def test_report_missing_and_extra_results():
     (["{video}", "--box", "500,400,30,30"], "less than 3x3 px"),
     (["{video}", "--box=-100,10,20,20"], "less than 3x3 px"),
     (["{video}", "--box", "10,10,30,30", "--max-frame-width", "100"], "MAX_FRAME_W"),
-    (["{video}", "--box", "10,10,30,30", "--preset", "v2"], "paper preset only"),
+    (["{video}", "--box", "10,10,30,30", "--preset", "v3"], "implements the presets paper, v2"),
     (["{video}", "--box", "10,10,30,30", "--frames", f"{N_FRAMES - 2},{N_FRAMES + 5}"], "the source ends"),
     (["{video}", "--box", "10,10,30,30", "--frames", f"{N_FRAMES + 3},{N_FRAMES + 5}"], f"no frame {N_FRAMES + 3}"),
     (["{video}", "--box", "10,10,30,30", "--lanes", "3"], "power of two"),
@@ -215,3 +221,85 @@ def test_sim_bad_input(video, tmp_path, capsys, argv, says):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("mstrack sim: error: ") and says in lines[0], err
     assert not (out / "results.csv").exists()
+
+
+def _v2_model_rows(frames: list[np.ndarray], box: tuple[int, int, int, int], first: int = 0) -> list[dict[str, str]]:
+    """Core v2's expected results, decoded as results.csv writes them (strings)."""
+    from mstrack.hw.cosim import CoreConfigV2, expected_results_v2
+    g = CoreConfigV2(TrackerParams(preset="v2"), FixedParams(), lanes=DEFAULT_LANES).tracker_generics()
+    exp = expected_results_v2(frames, box)
+    return [{k: str(v) for k, v in decode_row_v2(r, g, first + i).items()} for i, r in enumerate(exp)]
+
+
+def test_sim_preset_v2_decoding(scene, tmp_path, monkeypatch, capsys):
+    """--preset v2 without a simulator: fastsim.simulate is replaced by the model's result words v2
+    (unpacked as the harness output is); the CLI must ask for core v2 through ms_tracker (PRESET 1) and
+    write the v2 columns, every one equal to the model's decoded row."""
+    from mstrack.fixed.vhdl_pkg import pack_result_v2, unpack_result_v2
+    from mstrack.hw import fastsim
+    from mstrack.hw.cosim import COMPARED_FIELDS_V2, expected_results_v2
+
+    frames, gt = scene
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    n = 5
+    for i, f in enumerate(frames[:n]):
+        cv2.imwrite(str(folder / f"{i:03d}.png"), f)
+    box = round_box(*gt[0])
+    calls = []
+
+    def fake_simulate(frames_it, box_, tp, fp, lanes, **kw):
+        calls.append({"tp": tp, "lanes": lanes, **kw})
+        fr = list(frames_it)
+        res = []
+        for i, e in enumerate(expected_results_v2(fr, box_, tp, fp)):
+            word = pack_result_v2(e)
+            r = unpack_result_v2(word)
+            r.update(word=word, latency=1000 + i)
+            res.append(r)
+        return fastsim.FastsimRun(results=res, frames=[], cycles=1, seconds=0.0, cpu_seconds=0.0, status="done",
+                                  detail="", build_seconds=0.0, workdir=None, config={})
+
+    monkeypatch.setattr(fastsim, "simulate", fake_simulate)
+    out = tmp_path / "out"
+    rc = cli.main(["sim", str(folder), "--preset", "v2", "--box", ",".join(map(str, box)), "--out", str(out),
+                   "--quiet"])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.out + cap.err
+    (call,) = calls
+    assert call["v2"] is True and call["top"] == "ms_tracker" and call["tp"].preset == "v2"
+    with open(out / "results.csv", newline="") as fh:
+        assert tuple(csv.DictReader(fh).fieldnames or ()) == SIM_CSV_FIELDS_V2
+    rows = _rows(out)
+    want = _v2_model_rows(list(frames[:n]), box)
+    for got, exp in zip(rows, want, strict=True):
+        diff = {k: (got[k], exp[k]) for k in SIM_CSV_FIELDS_V2 if k != "latency" and got[k] != exp[k]}
+        assert not diff, f"frame {got['frame']}: {diff}"
+    assert rows[0]["status"] == "init" and float(rows[1]["confidence"]) > 0
+    rep = json.loads((out / "bitexact.json").read_text())
+    assert rep["bit_exact"] and rep["preset"] == "v2" and rep["fields"] == list(COMPARED_FIELDS_V2)
+    assert rep["generics"]["PRESET"] == 1 and rep["generics"]["RESULT_W"] == 160
+    assert "expected_results_v2" in rep["reference"]
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_sim_preset_v2_real(tmp_path, capsys):
+    """`mstrack sim --preset v2` on 12 Girl frames: the verilated ms_tracker with PRESET 1, every field of
+    every result word v2 equal to FixedTrackerV2's (the CSV rows too)."""
+    seq = SEQ_ROOT / "Girl"
+    if not seq.is_dir():
+        pytest.skip(f"real sequence {seq} not found (../shared/data/sequences absent)")
+    out = tmp_path / "girl_v2"
+    rc = cli.main(["sim", str(seq), "--preset", "v2", "--max-frame-width", "1920", "--max-frames", "12",
+                   "--out", str(out), "--quiet"])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.out + cap.err
+    assert "bit-exact: 12 frames x 14 fields" in cap.out
+    box = round_box(*VideoSource(seq).sequence.gt[0])          # type: ignore[union-attr]
+    rows = _rows(out)
+    want = _v2_model_rows(_frames_of(seq, 0, 12), box)
+    for got, exp in zip(rows, want, strict=True):
+        diff = {k: (got[k], exp[k]) for k in SIM_CSV_FIELDS_V2 if k != "latency" and got[k] != exp[k]}
+        assert not diff, f"frame {got['frame']}: {diff}"
+        assert int(got["latency"]) > 0

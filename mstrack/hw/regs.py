@@ -70,7 +70,8 @@ def result_header_text() -> str:
     lines.append("// flags field bits (RESULT_FLAGS)")
     for i, f in enumerate(RESULT_FLAGS):
         lines.append(f"#define MSTRACK_FLAG_{f.upper()} (1u << {i})")
-    lines += ["", "// result word v2 (result_layout_v2, core v2: not built yet; docs/architecture.md)",
+    lines += ["", "// result word v2 (result_layout_v2: core v2, ms_tracker with PRESET 1; result stream only, the"
+              " AXI-Lite registers decode word v1; docs/integration.md)",
               f"#define MSTRACK_RESULT_V2_W {result_width_v2()}"]
     for name, off, w in result_layout_v2():
         lines.append(f"#define MSTRACK_RES2_{name.upper()}_OFF {off}")

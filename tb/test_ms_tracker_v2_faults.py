@@ -263,7 +263,7 @@ async def reinit_and_reset_pending(dut):
         assert [k for k, e in zip(kinds_of(b), b.model.epochs) if e == 0] == \
             ["init", "track", "error:short_line", "init", "track", "init", "track"], kinds_of(b)
         assert b.model.results[2]["flags"] & (1 << 4), "rejected flag expected"
-        assert [k for k, e in zip(kinds_of(b), b.model.epochs) if e == 3] == ["error:cut", "init", "track"]
+        assert [k for k, e in zip(kinds_of(b), b.model.epochs) if e == 2] == ["error:cut", "init", "track"]
     await run_directed(dut, body)
 
 

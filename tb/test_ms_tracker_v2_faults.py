@@ -282,7 +282,7 @@ async def fuzz(dut):
     for seed in range(first, first + count):
         dut._log.info(f"v2 fuzz seed {seed}")
         b = await fuzz_seed(dut, seed, done == 0, cover, bench=BenchV2,
-                            replay="MSTRACK_FUZZ={seed}:1 pytest tb/test_ms_tracker_v2_faults.py -k fuzz")
+                            replay="make test-fuzz-v2 SEEDS={seed} N=1")
         done += 1
         results += b.stats.results
         beats += b.stats.beats
@@ -304,14 +304,17 @@ def _run(testcase, env: dict[str, str]) -> None:
            build_name="ms_tracker_v2_faults", testcase=testcase, extra_env=env)
 
 
-@pytest.mark.ghdl
+@pytest.mark.long
+@pytest.mark.verilator
 def test_tracker_v2_faults():
     """The directed stream-fault cases of core v2 in one simulation, every field of every result
-    compared with CoreModelV2."""
+    compared with CoreModelV2.  Marker ``long``: `make test` runs it on the second core after the
+    netlist build (CI time: the Verilator build of core v2 is the larger part)."""
     _run(DIRECTED, {})
 
 
-@pytest.mark.ghdl
+@pytest.mark.long
+@pytest.mark.verilator
 def test_tracker_v2_fuzz(tmp_path):
     """Seeds of the constrained-random protocol test on core v2 (MSTRACK_FUZZ=first:count, default 1:3)."""
     seeds = os.environ.get("MSTRACK_FUZZ", "1:3")

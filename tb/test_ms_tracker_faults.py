@@ -866,7 +866,7 @@ async def fuzz_seed(dut, seed: int, first: bool, cover: dict[str, int], bench: t
     steps = rng.randint(8, 14)
     for _ in range(steps):
         cur = f"{'gap' if b.gap else 'nogap'}/{'bp' if b.ready_mode < 1 else 'ready'}/" + \
-              ("track" if b.model.trk else "pending" if b.model.pending else "none")
+              ("track" if b.model.has_target() else "pending" if b.model.pending else "none")
         op = rng.choices(["good", "fault", "size", "badsize", "init", "reset", "flow"],
                          [30, 28, 7, 6, 12, 5, 12])[0]
         words = nxt()[:h, :w]

@@ -6,7 +6,7 @@ field by field, frame by frame, with :func:`expected_results`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from typing import TYPE_CHECKING, Iterable, Sequence
 
 import numpy as np
 
@@ -15,6 +15,9 @@ from ..fixed.blocks import init_centre, ms_box_clip
 from ..fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, core_generics, result_layout
 from ..track.params import TrackerParams
 from ..track.types import Status
+
+if TYPE_CHECKING:
+    from ..fixed.tracker_v2 import FixedTrackerV2
 
 COMPARED_FIELDS = ("cx", "cy", "rho_c", "rho_e", "alpha_c", "iter_c", "iter_e", "stop_c", "stop_e",
                    "flags", "err_code", "box_w", "box_h", "frame_count")
@@ -158,6 +161,10 @@ class CoreModel:
     def reset(self) -> None:
         self._reset_state()
         self.epoch += 1
+
+    def has_target(self) -> bool:
+        """A target is valid (its init frame was learnt)."""
+        return self.trk is not None
 
     def size_ok(self, fw: int, fh: int) -> bool:
         """The frame size check (ERR_SIZE): also a width that is not a multiple of PPC."""
@@ -368,6 +375,10 @@ class CoreModelV2(CoreModel):
     def _reset_state(self) -> None:
         super()._reset_state()
         self.box_wh = (0, 0)                      # w8, h8 of the state
+        self.v2: FixedTrackerV2 | None = None     # the target (CoreModel.trk stays None)
+
+    def has_target(self) -> bool:
+        return self.v2 is not None
 
     def _push(self, kind: str, flags: dict[str, int] | int | None = None, **fields: int) -> None:
         """flags: named flags, or the flags field of result_fields_v2; ``rejected`` is added."""
@@ -386,7 +397,7 @@ class CoreModelV2(CoreModel):
     def _error(self, code: int) -> None:
         from ..fixed.vhdl_pkg import STATUS_V2
         self._push(f"error:{ERR_NAMES[code]}", err_code=code, status=STATUS_V2.index("error"),
-                   flags={"error": 1, "no_target": int(self.trk is None)})
+                   flags={"error": 1, "no_target": int(self.v2 is None)})
 
     def init(self, box: tuple[int, int, int, int], fw: int, fh: int) -> None:
         """An init box taken while frame_width, frame_height = fw, fh (clipped without shrink, as
@@ -396,7 +407,7 @@ class CoreModelV2(CoreModel):
             self.rejected = 1
             return
         self.pending = (tuple(box), clipped)
-        self.trk = None
+        self.v2 = None
         self.c8 = init_centre(ib, self.fp.centre_frac)
         self.box_wh = (ib.w << 8, ib.h << 8)
         self.tgt = (fw, fh)
@@ -405,23 +416,24 @@ class CoreModelV2(CoreModel):
         from ..fixed.tracker_v2 import FixedTrackerV2
         from ..fixed.vhdl_pkg import result_fields_v2
         h, w = words.shape
-        if (self.pending or self.trk) and (w, h) != self.tgt:
+        if (self.pending or self.v2) and (w, h) != self.tgt:
             self._error(ERR_SIZE_CHANGED)
             return
         if self.pending:
             box, _ = self.pending
             trk = FixedTrackerV2(self.tp, self.fp)
             r = trk.init(words_frame(words), box)
-            self.trk, self.pending = trk, None
+            self.v2, self.pending = trk, None
             kind = "init"
-        elif self.trk:
-            r = self.trk.update(words_frame(words))
+        elif self.v2:
+            trk = self.v2
+            r = trk.update(words_frame(words))
             kind = "track"
         else:
             self._push("no_target", flags={"no_target": 1})
             return
-        self.c8 = self.trk.c8
-        self.box_wh = (self.trk.w8, self.trk.h8)
+        self.c8 = trk.c8
+        self.box_wh = (trk.w8, trk.h8)
         f = result_fields_v2(r.extra, self.count)
         del f["frame_count"]
         self._push(kind, **f)

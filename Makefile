@@ -4,7 +4,7 @@ PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 ARGS    ?=
 
-.PHONY: regs setup demo typecheck test test-fuzz test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -41,8 +41,8 @@ test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS); b=$$?; \
 	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
 
-# the long co-simulations alone (core v2 on 1,545 real frames, the paper core on 760, the real-time checks;
-# Verilator; part of `make test`)
+# the long co-simulations alone (core v2 on 1,545 real frames, the paper core on 760, the real-time checks,
+# core v2's stream faults; Verilator; part of `make test`)
 test-long: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m long -p no:cacheprovider $(ARGS)
 
@@ -62,6 +62,14 @@ test-fuzz: setup
 	mkdir -p build
 	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_FUZZ_REPORT=$(abspath $(FUZZ_REPORT)) MSTRACK_REQUIRE_TOOLS=1 \
 	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_faults.py -k test_tracker_fuzz $(ARGS)
+
+# The same constrained-random stream-fault test on core v2 (tb/test_ms_tracker_v2_faults.py::fuzz,
+# Verilator; CI runs seeds 1..3); replay a failing seed with `make test-fuzz-v2 SEEDS=<seed> N=1`.
+FUZZ_V2_REPORT ?= build/fuzz_v2_report.json
+test-fuzz-v2: setup
+	mkdir -p build
+	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_FUZZ_REPORT=$(abspath $(FUZZ_V2_REPORT)) MSTRACK_REQUIRE_TOOLS=1 \
+	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_v2_faults.py -k test_tracker_v2_fuzz $(ARGS)
 
 # The tests against the newest PyPI versions (not in CI): a separate venv, installed without the
 # lock, so drift in numpy/OpenCV/cocotb/... is seen before it reaches the lock.

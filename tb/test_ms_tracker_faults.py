@@ -112,13 +112,17 @@ class Stats:
 class Bench:
     """Driver, consumer, init port and model of one run (one cocotb test or one fuzz seed)."""
 
+    #: the result fields compared (core v2's bench, tb/test_ms_tracker_v2_faults.py, overrides these
+    #: three and make_config / make_model)
+    fields: tuple[str, ...] = COMPARED_FIELDS
+
     def __init__(self, dut, seed: int = 0, label: str = "") -> None:
         self.dut = dut
-        self.cfg = core_config()
+        self.cfg = self.make_config()
         self.g = self.cfg.generics()
         self.rng = random.Random(seed)
         self.label = label or f"seed {seed}"
-        self.model = CoreModel(self.cfg.tp, self.cfg.fp, MAX_FRAME_W)
+        self.model = self.make_model()
         self.fw = self.fh = 0
         self.gap = 0.0                      # probability of an idle clock before a beat
         self.ready_mode: float = 1.0        # P(result tready) per clock; 0 = sustained back-pressure
@@ -130,6 +134,15 @@ class Bench:
         self.errors: list[str] = []
         self.mode_evt = Event()
         self.stopped = False
+
+    def make_config(self):
+        return core_config()
+
+    def make_model(self) -> CoreModel:
+        return CoreModel(self.cfg.tp, self.cfg.fp, MAX_FRAME_W)
+
+    def unpack(self, word: int) -> dict[str, int]:
+        return unpack_result(word, self.g)
 
     # -- set-up ------------------------------------------------------------------------------
     async def start(self, fw: int, fh: int, clock: bool = True) -> None:
@@ -338,7 +351,7 @@ class Bench:
             if len(got) > len(exp) or (ep == self.epoch and len(got) != len(exp)):
                 out.append(f"epoch {ep}: {len(got)} results, model predicts {len(exp)}")
             for i, (w, e) in enumerate(zip(got, exp)):
-                d = diff_fields(unpack_result(w, self.g), e, COMPARED_FIELDS)
+                d = diff_fields(self.unpack(w), e, self.fields)
                 if d:
                     out.append(f"epoch {ep} result {i} ({kinds[idx[i]]}): " + "; ".join(d))
         return out
@@ -803,14 +816,16 @@ FAULTS = ["short_line", "long_line", "no_sof", "no_tlast", "cut", "extra_lines",
 BAD_SIZES = [(0, None), (1, None), (2, None), (MAX_FRAME_W + 1, None), (None, 0), (None, 2), (4095, 4095)]
 
 
-async def fuzz_seed(dut, seed: int, first: bool, cover: dict[str, int]) -> Bench:
+async def fuzz_seed(dut, seed: int, first: bool, cover: dict[str, int], bench: type[Bench] = Bench,
+                    replay: str = "make test-fuzz SEEDS={seed} N=1") -> Bench:
     """One random run: a seeded mix of good frames, every fault class, size changes, bad sizes,
     inits (good / clipped / rejected, between frames / mid-frame), resets (mid-frame, during the
-    mean shift, with results queued), input gaps and result back-pressure."""
+    mean shift, with results queued), input gaps and result back-pressure.  bench: the Bench class
+    (core v2: tb/test_ms_tracker_v2_faults.py); replay: the command printed for a failing seed."""
     rng = random.Random(seed)
     w = rng.choice([32, 40, 48, 64])
     h = rng.choice([24, 32, 40])
-    b = Bench(dut, seed, label=f"fuzz seed {seed}")
+    b = bench(dut, seed, label=f"fuzz seed {seed}")
     b.rng = random.Random(seed * 7919 + 1)
     fr, gt = scene(16, 64, 48, seed)
     await b.start(w, h, clock=first)
@@ -851,7 +866,7 @@ async def fuzz_seed(dut, seed: int, first: bool, cover: dict[str, int]) -> Bench
     steps = rng.randint(8, 14)
     for _ in range(steps):
         cur = f"{'gap' if b.gap else 'nogap'}/{'bp' if b.ready_mode < 1 else 'ready'}/" + \
-              ("track" if b.model.trk else "pending" if b.model.pending else "none")
+              ("track" if b.model.has_target() else "pending" if b.model.pending else "none")
         op = rng.choices(["good", "fault", "size", "badsize", "init", "reset", "flow"],
                          [30, 28, 7, 6, 12, 5, 12])[0]
         words = nxt()[:h, :w]
@@ -931,7 +946,7 @@ async def fuzz_seed(dut, seed: int, first: bool, cover: dict[str, int]) -> Bench
     for k in b.model.kinds:
         hit("result:" + k)
     if errs:
-        raise AssertionError(f"FUZZ SEED {seed} FAILED (replay: make test-fuzz SEEDS={seed} N=1)\n"
+        raise AssertionError(f"FUZZ SEED {seed} FAILED (replay: {replay.format(seed=seed)})\n"
                              + "\n".join(errs[:20]))
     return b
 

@@ -6,7 +6,7 @@ field by field, frame by frame, with :func:`expected_results`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Iterable, Sequence
+from typing import TYPE_CHECKING, Iterable, Sequence
 
 import numpy as np
 
@@ -15,6 +15,9 @@ from ..fixed.blocks import init_centre, ms_box_clip
 from ..fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, core_generics, result_layout
 from ..track.params import TrackerParams
 from ..track.types import Status
+
+if TYPE_CHECKING:
+    from ..fixed.tracker_v2 import FixedTrackerV2
 
 COMPARED_FIELDS = ("cx", "cy", "rho_c", "rho_e", "alpha_c", "iter_c", "iter_e", "stop_c", "stop_e",
                    "flags", "err_code", "box_w", "box_h", "frame_count")
@@ -158,6 +161,10 @@ class CoreModel:
     def reset(self) -> None:
         self._reset_state()
         self.epoch += 1
+
+    def has_target(self) -> bool:
+        """A target is valid (its init frame was learnt)."""
+        return self.trk is not None
 
     def size_ok(self, fw: int, fh: int) -> bool:
         """The frame size check (ERR_SIZE): also a width that is not a multiple of PPC."""
@@ -351,3 +358,96 @@ class CoreConfigV2:
         if top == "ms_tracker_v2":
             return self.generics()
         raise ValueError(f"core v2 is built as ms_tracker (PRESET 1) or ms_tracker_v2, not {top!r}")
+
+
+class CoreModelV2(CoreModel):
+    """What ms_tracker_v2 outputs for an arbitrary input stream (docs/architecture.md, "Core v2:
+    stream faults"): :class:`CoreModel`'s stream checker, frame gate, init boxes, size checks and
+    reset, around :class:`mstrack.fixed.tracker_v2.FixedTrackerV2`, with result word v2.
+
+    Every field of every result is predicted (COMPARED_FIELDS_V2):
+
+    * tracked / init frames: :func:`mstrack.fixed.vhdl_pkg.result_fields_v2` of the model's frame,
+      plus the flag ``rejected`` when an init box was rejected since the last result;
+    * error results (protocol errors, frame size out of range, a frame of another size than the
+      target's): status 6 (error), flags ``error`` (+ ``no_target`` while there is no target: before
+      any init or while an init is pending, + ``rejected``), ``err_code``; cx, cy, w8, h8 of the
+      current target (the pending init box's centre and size while an init is pending: centre
+      (2x + w - 1) << (CF - 1), size w << 8 of the clipped box; 0 after a reset); rho, confidence,
+      iter, stop, decim_log2 and searched 0.  The target state (centre, size, model Qn and T,
+      references, loss filters, search state lost / not lost) is unchanged: a lost target stays
+      lost (the next good frame is searched at D x 2 with the 8 start points);
+    * results without a target (``no_target``: no init since reset): status 0, cx, cy, w8, h8 of the
+      state (0), the rest 0.
+    A bad init frame leaves the init pending: the next good frame of the box's size is the init
+    frame (the background model learns it from its first pixel; ms_tracker_v2 re-arms ms_bg_model).
+    """
+
+    def __init__(self, tp: TrackerParams, fp: FixedParams, max_frame_w: int) -> None:
+        super().__init__(tp, fp, max_frame_w, ppc=1)
+
+    def _reset_state(self) -> None:
+        super()._reset_state()
+        self.box_wh = (0, 0)                      # w8, h8 of the state
+        self.v2: FixedTrackerV2 | None = None     # the target (CoreModel.trk stays None)
+
+    def has_target(self) -> bool:
+        return self.v2 is not None
+
+    def _push(self, kind: str, flags: dict[str, int] | int | None = None, **fields: int) -> None:
+        """flags: named flags, or the flags field of result_fields_v2; ``rejected`` is added."""
+        r = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.box_wh[0], "h8": self.box_wh[1], "rho": 0,
+             "confidence": 0, "status": 0, "iter": 0, "stop": 0, "decim_log2": 0, "searched": 0,
+             "err_code": 0, "frame_count": self.count & 0xFFFF}
+        r.update(fields)
+        fl = flags if isinstance(flags, int) else flags_word(**(flags or {}))
+        r["flags"] = fl | flags_word(rejected=self.rejected)
+        self.rejected = 0
+        self.count += 1
+        self.results.append(r)
+        self.kinds.append(kind)
+        self.epochs.append(self.epoch)
+
+    def _error(self, code: int) -> None:
+        from ..fixed.vhdl_pkg import STATUS_V2
+        self._push(f"error:{ERR_NAMES[code]}", err_code=code, status=STATUS_V2.index("error"),
+                   flags={"error": 1, "no_target": int(self.v2 is None)})
+
+    def init(self, box: tuple[int, int, int, int], fw: int, fh: int) -> None:
+        """An init box taken while frame_width, frame_height = fw, fh (clipped without shrink, as
+        FixedTrackerV2.init: large targets are decimated)."""
+        ib, clipped = ms_box_clip(*box, fw, fh, (1 << (self.fp.coord_bits - 1)) - 1)
+        if ib is None or not self.size_ok(fw, fh):
+            self.rejected = 1
+            return
+        self.pending = (tuple(box), clipped)
+        self.v2 = None
+        self.c8 = init_centre(ib, self.fp.centre_frac)
+        self.box_wh = (ib.w << 8, ib.h << 8)
+        self.tgt = (fw, fh)
+
+    def _frame(self, words: np.ndarray) -> None:
+        from ..fixed.tracker_v2 import FixedTrackerV2
+        from ..fixed.vhdl_pkg import result_fields_v2
+        h, w = words.shape
+        if (self.pending or self.v2) and (w, h) != self.tgt:
+            self._error(ERR_SIZE_CHANGED)
+            return
+        if self.pending:
+            box, _ = self.pending
+            trk = FixedTrackerV2(self.tp, self.fp)
+            r = trk.init(words_frame(words), box)
+            self.v2, self.pending = trk, None
+            kind = "init"
+        elif self.v2:
+            trk = self.v2
+            r = trk.update(words_frame(words))
+            kind = "track"
+        else:
+            self._push("no_target", flags={"no_target": 1})
+            return
+        self.c8 = trk.c8
+        self.box_wh = (trk.w8, trk.h8)
+        f = result_fields_v2(r.extra, self.count)
+        del f["frame_count"]
+        self._push(kind, **f)

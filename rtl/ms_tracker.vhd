@@ -124,7 +124,7 @@ entity ms_tracker is
     CONF_LOST      : natural := 26214;           -- round(conf_lost 2**16)
     CONF_UNCERTAIN : natural := 32768;
     CONF_REACQUIRE : natural := 32768;
-    SPREAD_DEFAULT : natural := 2581110;         -- spread_ref when the init spread is 0
+    SPREAD_DEFAULT : natural := 5368709;         -- spread_ref when the init spread is 0
     BG_Q_W         : natural := 14;
     BG_O_W         : natural := 17;
     SEARCH_ITER    : natural := 5;               -- iterations per start point while lost

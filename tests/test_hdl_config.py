@@ -150,3 +150,30 @@ def test_cli_preset_v2_package(tmp_path):
     assert consts["PRESET"] == "1" and consts["RESULT_W"] == "160" and consts["MAX_FRAME_W"] == "1920"
     assert re.search(r"constant C_LOSS_CONTRAST +: integer := 12452;", text)
     assert "preset v2 (PRESET 1)" in text and "result_layout_v2" in text
+
+
+def _vhdl_defaults(path, entity):
+    """Literal integer defaults of *entity*'s generics (names with a non-literal default are left out)."""
+    text = re.sub(r"--[^\n]*", "", path.read_text())
+    m = re.search(rf"entity\s+{entity}\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
+    assert m, f"no generic clause in {path}"
+    return {k: int(v) for k, v in re.findall(r"(\w+)\s*:\s*(?:natural|integer)\s*:=\s*(-?\d+)\b", m.group(1), re.I)}
+
+
+def test_core_v2_vhdl_defaults_are_the_models():
+    """The VHDL defaults of core v2's own generics (in ms_tracker) and of every generic of the engine
+    ms_tracker_v2 are the values CoreConfigV2 derives from the default v2 parameters, so an
+    instantiation that leaves them out still runs the specification (SPREAD_DEFAULT and the region
+    sizes were stale once)."""
+    from mstrack.hw.hdl_config import TRACKER_VHD
+    want = CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).generics()
+    top = _vhdl_defaults(TRACKER_VHD, "ms_tracker")
+    own = [k for k in V2_GENERICS if k in want]          # BG_Q_W, BG_O_W: engine constants, not derived
+    assert len(own) >= len(V2_GENERICS) - 2
+    assert {k: top[k] for k in own} == {k: want[k] for k in own}
+    keys = [k for k in want if k != "MAX_FRAME_W"]        # the frame width is the integrator's choice
+    for path, entity in ((TRACKER_VHD.with_name("ms_tracker_v2.vhd"), "ms_tracker_v2"),
+                         (TRACKER_VHD.parent / "wrappers" / "ms_tracker_v2_pins.vhd", "ms_tracker_v2_pins")):
+        eng = _vhdl_defaults(path, entity)
+        assert set(keys) <= set(eng), entity
+        assert {k: eng[k] for k in keys} == {k: want[k] for k in keys}, entity

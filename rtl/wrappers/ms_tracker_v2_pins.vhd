@@ -41,10 +41,10 @@ entity ms_tracker_v2_pins is
     MAX_ITER       : natural := 20;
     EPS2           : natural := 65536;
     HALF_W         : natural := 6;
-    REGION_MAX     : natural := 191;
-    REGION_W       : natural := 8;
-    STRIDE         : natural := 48;
-    ADDR_W         : natural := 14;
+    REGION_MAX     : natural := 445;
+    REGION_W       : natural := 9;
+    STRIDE         : natural := 112;
+    ADDR_W         : natural := 16;
     KVAL_W         : natural := 1;
     HIST_W         : natural := 14;
     COUNT_W        : natural := 14;
@@ -57,7 +57,7 @@ entity ms_tracker_v2_pins is
     SW_W           : natural := 22;
     SWX_W          : natural := 29;
     SHIFT_Q_W      : natural := 14;
-    CENTRE_W       : natural := 16;
+    CENTRE_W       : natural := 17;
     CENTRE_ABS_W   : natural := 20;
     ITER_W         : natural := 5;
     RHO_OUT_W      : natural := 17;
@@ -86,7 +86,7 @@ entity ms_tracker_v2_pins is
     CONF_LOST      : natural := 26214;    -- round(conf_lost 2**16)
     CONF_UNCERTAIN : natural := 32768;
     CONF_REACQUIRE : natural := 32768;
-    SPREAD_DEFAULT : natural := 2581110;  -- spread_ref when the init spread is 0: (128 << (KB + 16)) / (16 + PAD16)**2
+    SPREAD_DEFAULT : natural := 5368709;  -- spread_ref when the init spread is 0: (128 << (KB + 16)) / (16 + PAD16)**2
     BG_Q_W         : natural := 14;
     BG_O_W         : natural := 17;
     SEARCH_ITER    : natural := 5;        -- iterations per start point while lost

@@ -9,8 +9,9 @@
 -- Read pipeline (edge s samples raddr): s: DP16KD address register (CEB = raddr < DEPTH, so the
 -- read latch holds on reads >= DEPTH, as in `inferred`); s + 1: DP16KD output register
 -- (REGMODE_B = "OUTREG": clock-to-out ~1 ns instead of ~5.8 ns).  One row (NROW = 1): that is
--- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (row index and in-range flag of raddr
--- delayed two clocks) -> output register, loaded only for reads < DEPTH; RD_LAT >= 3.  RD_LAT - 3
+-- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (the row of raddr one-hot at s + 1, an
+-- AND-OR of the output registers; the in-range flag delayed two clocks) -> output register, loaded
+-- only for reads < DEPTH; RD_LAT >= 3.  RD_LAT - 3
 -- (- 2 with one row) more plain registers.
 -- RD_LAT = 1, or 2 with several rows: the inferred RAM of rtl/ms_ram_sdp.vhd (yosys maps it,
 -- without the output register).

@@ -126,8 +126,21 @@ architecture rtl of ms_meanshift is
   signal first            : std_logic;
   signal it               : unsigned(ITER_W - 1 downto 0);
   signal dxs, dys         : sc_t := (others => '0');
-  signal sqx, sqy         : unsigned(2 * SCW - 1 downto 0) := (others => '0');
-  signal shift2           : unsigned(2 * SCW - 1 downto 0);
+  -- stop test on |dxs|, |dys| saturated to SQ_W bits (p_shift): the smallest width whose largest
+  -- value squared is >= EPS2, at most CENTRE_W (|dxs| < 2**CENTRE_W: no saturation then) and 16
+  -- (65535**2 > any natural EPS2), so each square is one unsigned <= 16 x 16 product
+  function sq_width(eps2, max_w : natural) return natural is
+    variable w : natural := 1;
+  begin
+    while w < max_w and 2 ** w - 1 < 46341 and (2 ** w - 1) * (2 ** w - 1) < eps2 loop
+      w := w + 1;
+    end loop;
+    return w;
+  end function;
+  constant SQ_W : natural := sq_width(EPS2, CENTRE_W);
+  signal dxa, dya         : unsigned(SQ_W - 1 downto 0) := (others => '0');
+  signal sqx, sqy         : unsigned(2 * SQ_W - 1 downto 0) := (others => '0');
+  signal shift2           : unsigned(2 * SQ_W downto 0);
   signal shift_small      : std_logic;
   signal rho_fell         : std_logic;
 
@@ -191,15 +204,41 @@ begin
 
   busy <= '0' when state = S_IDLE else '1';
 
-  -- shift2 = dxs^2 + dys^2 < EPS2, free running in three register stages (square | sum |
-  -- compare): dxs / dys are written in S_CENTRE_WAIT and read back in S_DECIDE after a whole
-  -- pixel pass and bin pass (>= N_BINS clocks), so shift_small has long settled by then.
+  -- shift2 = dxs^2 + dys^2 < EPS2, free running in four register stages (|d| saturated |
+  -- square | sum | compare): dxs / dys are written in S_CENTRE_WAIT and read back in S_DECIDE
+  -- after a whole pixel pass and bin pass (>= N_BINS clocks), so shift_small has long settled
+  -- by then.  Saturation keeps the result: let M = 2**SQ_W - 1, a = min(|dxs|, M),
+  -- b = min(|dys|, M).  If |dxs| <= M and |dys| <= M, a^2 + b^2 = dxs^2 + dys^2.  Otherwise
+  -- one of them, say |dxs| > M, so dxs^2 > M^2 and a^2 = M^2; with M^2 >= EPS2 (sq_width) both
+  -- dxs^2 + dys^2 and a^2 + b^2 are >= EPS2: "not small" either way.  (When SQ_W = CENTRE_W,
+  -- M >= |d| always and nothing saturates.)
   p_shift : process(clk)
+    variable ad : unsigned(SCW - 1 downto 0);
   begin
     if rising_edge(clk) then
-      sqx <= unsigned(dxs * dxs);
-      sqy <= unsigned(dys * dys);
-      shift2 <= sqx + sqy;
+      if dxs < 0 then                           -- |dxs| < 2**CENTRE_W: no overflow
+        ad := unsigned(-dxs);                   -- (not abs: GHDL 2.0 writes it as VHDL into the Verilog)
+      else
+        ad := unsigned(dxs);
+      end if;
+      if shift_right(ad, SQ_W) /= 0 then
+        dxa <= (others => '1');
+      else
+        dxa <= ad(SQ_W - 1 downto 0);
+      end if;
+      if dys < 0 then
+        ad := unsigned(-dys);
+      else
+        ad := unsigned(dys);
+      end if;
+      if shift_right(ad, SQ_W) /= 0 then
+        dya <= (others => '1');
+      else
+        dya <= ad(SQ_W - 1 downto 0);
+      end if;
+      sqx <= dxa * dxa;
+      sqy <= dya * dya;
+      shift2 <= resize(sqx, 2 * SQ_W + 1) + sqy;
       if shift2 < EPS2 then
         shift_small <= '1';
       else

@@ -326,6 +326,10 @@ architecture rtl of ms_tracker_v2 is
   signal ql_cnt       : unsigned(BIN_C_W downto 0) := (others => '0');
   signal ql_issue, ql_v1 : std_logic := '0';
   signal ql_bin1      : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
+  -- Qn registered once more before ms_model_scale (timing: model RAM read -> the multiplier's 3 Qn chain)
+  signal ql_v2        : std_logic := '0';
+  signal ql_bin2      : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
+  signal m_qn_r       : unsigned(16 downto 0) := (others => '0');
   signal ms_out_valid : std_logic;
   signal ms_out_qw    : unsigned(HIST_W - 1 downto 0);
   signal ms_out_tag   : std_logic_vector(BIN_C_W - 1 downto 0);
@@ -600,10 +604,20 @@ begin
               kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr);
 
   ---------------------------------------------------------------------------- Qw = ms_model_scale(Qn, K)
-  ms_in_tag <= std_logic_vector(ql_bin1);
+  -- one register stage between the model RAM's read data and the multiplier: T_QLOAD counts the
+  -- results (ql_seen = N_BINS), so it takes one clock more per frame, nothing else changes
+  p_qn_r : process (clk)
+  begin
+    if rising_edge(clk) then
+      m_qn_r <= m_qn;
+      ql_bin2 <= ql_bin1;
+      ql_v2 <= ql_v1 and not rst;
+    end if;
+  end process;
+  ms_in_tag <= std_logic_vector(ql_bin2);
   u_mscale : entity work.ms_model_scale
     generic map (HIST_W => HIST_W, QN_FRAC => 16, TAG_W => BIN_C_W)
-    port map (clk => clk, rst => rst, in_valid => ql_v1, in_qn => m_qn, in_k => k_acc, in_tag => ms_in_tag,
+    port map (clk => clk, rst => rst, in_valid => ql_v2, in_qn => m_qn_r, in_k => k_acc, in_tag => ms_in_tag,
               out_valid => ms_out_valid, out_qw => ms_out_qw, out_tag => ms_out_tag);
 
   ---------------------------------------------------------------------------- engine + statistics

@@ -9,8 +9,9 @@
 -- Read pipeline (edge s samples raddr): s: DP16KD address register (CEB = raddr < DEPTH, so the
 -- read latch holds on reads >= DEPTH, as in `inferred`); s + 1: DP16KD output register
 -- (REGMODE_B = "OUTREG": clock-to-out ~1 ns instead of ~5.8 ns).  One row (NROW = 1): that is
--- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (row index and in-range flag of raddr
--- delayed two clocks) -> output register, loaded only for reads < DEPTH; RD_LAT >= 3.  RD_LAT - 3
+-- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (the row of raddr one-hot at s + 1, an
+-- AND-OR of the output registers; the in-range flag delayed two clocks) -> output register, loaded
+-- only for reads < DEPTH; RD_LAT >= 3.  RD_LAT - 3
 -- (- 2 with one row) more plain registers.
 -- RD_LAT = 1, or 2 with several rows: the inferred RAM of rtl/ms_ram_sdp.vhd (yosys maps it,
 -- without the output register).
@@ -250,16 +251,31 @@ begin
       signal sel  : sel_t := (others => 0);
       signal inr  : std_logic_vector(1 to 2) := (others => '0');
       signal mux_q : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
+      signal hot   : std_logic_vector(0 to NROW - 1) := (others => '0');  -- the row, one-hot
     begin
+      -- (timing: the row is decoded one-hot a clock ahead, so the multiplexer is an AND-OR of
+      -- the output registers, no row compare in it: core v2's 25 rows per bank were its
+      -- critical path, the decode of a binary row index spread over the bank's DP16KD)
       p_mux : process (clk)
+        variable acc : std_logic_vector(DATA_W - 1 downto 0);
       begin
         if rising_edge(clk) then
           sel(1) <= row_of(raddr);     -- edge s: the read's row ...
-          sel(2) <= sel(1);            -- ... edge s + 1, beside the DP16KD output register
+          for r in 0 to NROW - 1 loop  -- ... edge s + 1, one-hot, beside the DP16KD output register
+            if sel(1) = r then
+              hot(r) <= '1';
+            else
+              hot(r) <= '0';
+            end if;
+          end loop;
           inr(1) <= rd_ok;
           inr(2) <= inr(1);
           if inr(2) = '1' then         -- edge s + 2: the output registers hold the read of edge s
-            mux_q <= dout(sel(2))(DATA_W - 1 downto 0);
+            acc := (others => '0');
+            for r in 0 to NROW - 1 loop
+              acc := acc or (dout(r)(DATA_W - 1 downto 0) and (DATA_W - 1 downto 0 => hot(r)));
+            end loop;
+            mux_q <= acc;
           end if;
         end if;
       end process;

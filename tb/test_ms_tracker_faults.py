@@ -366,6 +366,34 @@ class Bench:
         return self.compare()
 
 
+async def play_plan(b: Bench, frames: list[np.ndarray], plan: list, stall_every: int,
+                    stall_cycles: int, bad_width: int, ready: float = 0.3) -> None:
+    """Stream ``frames`` (all of the bench's size) through ``b`` following ``plan``, one entry per
+    frame: None a good frame, ``(fault, arg)`` a frame with that fault (:func:`beats_of`), "size" the
+    frame announced ``bad_width`` wide (an out-of-range size), "resize" a frame 8 px narrower with
+    the size set to match (then set back).  Every ``stall_every``-th frame the result consumer
+    stops for ``stall_cycles`` clocks, then resumes at ready probability ``ready``."""
+    w, h = b.fw, b.fh
+
+    async def stall(cycles: int) -> None:
+        b.ready(0)
+        await b.idle(cycles)
+        b.ready(ready)
+    for i, p in enumerate(plan):
+        if i % stall_every == stall_every - 1:
+            cocotb.start_soon(stall(stall_cycles))
+        if p == "size":
+            b.set_size(bad_width, h)
+            await b.frame(frames[i])
+            b.set_size(w, h)
+        elif p == "resize":
+            b.set_size(w - 8, h)
+            await b.frame(frames[i][:, : w - 8])
+            b.set_size(w, h)
+        else:
+            await b.frame(frames[i], *(p or (None, 0)))
+
+
 async def run_directed(dut, body, seed: int = 1, size: tuple[int, int] = (48, 40)) -> Bench:
     b = Bench(dut, seed, label=body.__qualname__.split(".")[0])
     await b.start(*size)
@@ -746,23 +774,7 @@ async def faults_with_gaps_and_backpressure(dut):
                 None, ("no_tlast", 9), None, ("extra_lines", 2), None, ("tuser_stuck", 6), None,
                 ("sof_eol", 0), None, "size", None, "resize", None, ("cut", 50), ("short_line", 0),
                 None, None]
-        async def stall(cycles: int) -> None:
-            b.ready(0)
-            await b.idle(cycles)
-            b.ready(0.3)
-        for i, p in enumerate(plan):
-            if i % 6 == 5:
-                cocotb.start_soon(stall(15_000))
-            if p == "size":
-                b.set_size(1, H0)
-                await b.frame(fr[i])
-                b.set_size(W0, H0)
-            elif p == "resize":
-                b.set_size(W0 - 8, H0)
-                await b.frame(fr[i][:, : W0 - 8])
-                b.set_size(W0, H0)
-            else:
-                await b.frame(fr[i], *(p or (None, 0)))
+        await play_plan(b, fr, plan, stall_every=6, stall_cycles=15_000, bad_width=1)
         names = {k.split(":")[-1] for k in kinds_of(b)}
         assert {"short_line", "long_line", "no_sof", "cut", "size", "size_changed", "track"} <= names, names
     await run_directed(dut, body)

@@ -30,7 +30,7 @@ from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import unpack_result_v2
 from mstrack.hw.cosim import COMPARED_FIELDS_V2, CoreConfigV2, CoreModelV2, frame_words
 from mstrack.track.params import TrackerParams
-from test_ms_tracker_faults import MAX_FRAME_W, Bench, beats_of, fuzz_seed, scene
+from test_ms_tracker_faults import MAX_FRAME_W, Bench, beats_of, fuzz_seed, play_plan, scene
 
 W0, H0 = 48, 40
 ERROR = 6                       # status error (STATUS_V2)
@@ -166,23 +166,7 @@ async def faults_while_tracking(dut):
                 None, ("no_tlast", 9), ("extra_lines", 2), None, ("tuser_stuck", 4), None, ("sof_eol", 0),
                 "size", None, "resize", ("cut", 50), ("short_line", 0), None]
 
-        async def stall(cycles: int) -> None:
-            b.ready(0)
-            await b.idle(cycles)
-            b.ready(0.3)
-        for i, p in enumerate(plan):
-            if i % 7 == 6:
-                cocotb.start_soon(stall(8_000))
-            if p == "size":
-                b.set_size(2, H0)
-                await b.frame(fr[i])
-                b.set_size(W0, H0)
-            elif p == "resize":
-                b.set_size(W0 - 8, H0)
-                await b.frame(fr[i][:, : W0 - 8])
-                b.set_size(W0, H0)
-            else:
-                await b.frame(fr[i], *(p or (None, 0)))
+        await play_plan(b, fr, plan, stall_every=7, stall_cycles=8_000, bad_width=2)
         names = {k.split(":")[-1] for k in kinds_of(b)}
         assert {"short_line", "long_line", "no_sof", "cut", "size", "size_changed", "track"} <= names, names
     await run_directed(dut, body)

@@ -471,3 +471,16 @@ def test_axi_v2_synthetic():
     word, STATUS.tracking, INT_STATUS (lost / reacquired from the v2 status), counters and irq."""
     job = {"preset": 1, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 4}
     _run(job, "ms_tracker_axi_v2")
+
+
+def test_axi_v2_real():
+    """GHDL, core v2 (PRESET 1, default v2 generics): init + 2 tracked frames of a real sequence (Girl,
+    128x96), results in registers only (RESULT_STREAM false)."""
+    seq = SEQ_ROOT / "Girl"
+    if not seq.is_dir():
+        pytest.skip(f"{seq} not found: the real-video test needs ../shared/data/sequences")
+    from mstrack.io.data import load_sequence
+    from mstrack.fixed.blocks import round_box
+    box = round_box(*[float(v) for v in load_sequence(seq).gt[0]])
+    job = {"preset": 1, "scene": "real", "seq": str(seq), "n": 3, "box": list(box), "result_stream": False}
+    _run(job, "ms_tracker_axi_v2_real")

@@ -484,3 +484,11 @@ def test_axi_v2_real():
     box = round_box(*[float(v) for v in load_sequence(seq).gt[0]])
     job = {"preset": 1, "scene": "real", "seq": str(seq), "n": 3, "box": list(box), "result_stream": False}
     _run(job, "ms_tracker_axi_v2_real")
+
+
+@pytest.mark.verilator
+def test_axi_v2_verilator():
+    """PRESET 1 as the GHDL-synthesised netlist (register block and core v2 included) under Verilator,
+    throttled: the pattern scene of test_axi_v2_synthetic (GHDL's Verilog writer on the v2 wrapper logic)."""
+    job = {"preset": 1, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 5}
+    _run(job, "ms_tracker_axi_v2_verilator", verilator=True)

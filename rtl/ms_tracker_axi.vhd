@@ -1,6 +1,10 @@
 -- ms_tracker_axi: ms_tracker with an AXI4-Lite register interface and an interrupt (system top).
 --
--- Wraps rtl/ms_tracker.vhd (unchanged) for a camera pipeline with a CPU beside it:
+-- Wraps rtl/ms_tracker.vhd (unchanged) for a camera pipeline with a CPU beside it, either core:
+-- generic PRESET 0 (default) the paper core, result word v1 (mstrack.fixed.vhdl_pkg.result_layout);
+-- PRESET 1 core v2, result word v2 (result_layout_v2, 160 bits; PPC 1).  Every generic of ms_tracker
+-- is passed through under the same name (`mstrack hdl config` writes them; RESULT_STREAM is this
+-- entity's own); VERSION.result_version (1 or 2) and CONFIG.preset tell software which word it reads.
 --   * video AXI4-Stream in (s_axis_*: PPC 24-bit RGB pixels per beat, pixel k at 24k+23 .. 24k
 --     (generic PPC, passed to the core), tuser = start of frame, tlast = end of line),
 --     passed to the core frame by frame: CTRL.enable is looked at on each start-of-frame beat; a
@@ -16,7 +20,13 @@
 --   * the last result: latched whole in one clock when the core produces it (L); reading RES_HEAD
 --     returns L's head and copies all of L into the snapshot S that RES_CX .. RES_RAW4 show, in the
 --     same clock, so one frame's fields are read one by one without tearing (docs/integration.md);
---   * irq: high while an INT_STATUS bit (result / lost / error; W1C) is set and enabled;
+--     the fields of the preset's word are decoded (v1: RES_CX .. RES_BOX; v2: RES_CX, RES_CY, rho in
+--     RES_RHO_C, RES_W8, RES_H8, RES_CONF, RES_STATE), the other preset's registers read 0;
+--   * STATUS.tracking and the lost / reacquired events: v1 from the flags (tracking: none of
+--     no_target, lost, error); v2 from the status field (tracking: status ok, reacquired, init or
+--     clipped, and neither no_target nor error, i.e. the box is trusted; lost: status lost, which is
+--     exactly when the core sets flag lost; reacquired: status reacquired, v2 only);
+--   * irq: high while an INT_STATUS bit (result / lost / error / reacquired; W1C) is set and enabled;
 --   * m_axis_result_* (RESULT_STREAM = true): the core's result words as an AXI4-Stream (one beat
 --     per frame, tlast = 1); its back-pressure reaches the video input through the core's result
 --     FIFO.  RESULT_STREAM = false: tvalid = 0, tready ignored, results only through registers.
@@ -24,10 +34,12 @@
 --              after the address (PeakRDL regblock + AXI4-Lite adapter), 2 transactions in flight.
 -- Throughput : the core's: PPC pixels per clock while a frame streams in.
 -- Reset      : rst synchronous, active high (core and registers; every register to its reset value).
--- Cost       : over the core, ECP5 (yosys synth_ecp5, default generics): +1,509 LUT4, +748 FF,
---              +161 CCU2C; no RAM, no multiplier (docs/blocks/ms_tracker_axi.md, Resources).
+-- Cost       : over the core, ECP5 (yosys synth_ecp5, default generics, RESULT_STREAM false): PRESET 0
+--              +1,466 LUT4, +750 FF, +165 CCU2C (+1,509 / +748 / +161 on older RTL); PRESET 1 +1,811
+--              LUT4, +787 FF, +111 CCU2C; no RAM, no multiplier (docs/blocks/ms_tracker_axi.md, Resources).
 -- Generics: those of ms_tracker (passed through; the derived widths come from
--- mstrack.fixed.vhdl_pkg.core_generics) and RESULT_STREAM.
+-- mstrack.fixed.vhdl_pkg.core_generics, core v2's from mstrack.hw.cosim.CoreConfigV2.tracker_generics)
+-- and RESULT_STREAM.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -37,7 +49,9 @@ use work.ms_tracker_regs_pkg.all;
 
 entity ms_tracker_axi is
   generic (
+    PRESET         : natural := 0;               -- 0 the paper core (result word v1), 1 core v2 (result word v2)
     MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
+    RGB_PACKING    : natural := 0;               -- s_axis_tdata layout (ms_tracker): 0 R G B, 1 AMD UG934 (R B G)
     PPC            : natural := 1;               -- pixels per clock (s_axis beat): 1, 2 or 4 (<= LANES)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
@@ -80,7 +94,36 @@ entity ms_tracker_axi is
     RHO_OUT_W      : natural := D_RHO_OUT_W;
     ALPHA_W        : natural := D_ALPHA_W;
     WIN_W          : natural := D_WIN_W;
-    RESULT_W       : natural := D_RESULT_W;
+    RESULT_W       : natural := D_RESULT_W;       -- PRESET 0: 144 (result word), 1: 160 (result word v2)
+    -- core v2 only (PRESET 1; ms_tracker_v2's defaults; mstrack.hw.cosim.CoreConfigV2.generics)
+    PAD16          : natural := 4;               -- pad in 1/16
+    RING16         : natural := 10;              -- bg_ring in 1/16
+    MAX_WINDOW     : natural := 127;             -- largest window diameter (decimated px)
+    KT_W           : natural := 9;               -- KA/KB width (KERNEL_BITS + 1)
+    ST2_W          : natural := 23;
+    SHARE_W        : natural := 17;
+    SPREAD_W       : natural := 25;
+    SIZE_W         : natural := 20;              -- w8, h8 bits (COORD_W + 8)
+    SCALE_W        : natural := 17;
+    SCALE_GAIN     : natural := 19661;
+    SCALE_REG      : natural := 6554;
+    SCALE_STEP     : natural := 6554;
+    SCALE_RATIO_Q_W: natural := 17;
+    WR_Q_W         : natural := 27;
+    CON_W          : natural := 18;
+    LOSS_K         : natural := 1;
+    REF_K          : natural := 6;
+    LOSS_RHO       : natural := 57672;
+    LOSS_CONTRAST  : integer := 12452;
+    CONF_LOST      : natural := 26214;           -- round(conf_lost 2**16)
+    CONF_UNCERTAIN : natural := 32768;
+    CONF_REACQUIRE : natural := 32768;
+    SPREAD_DEFAULT : natural := 5368709;         -- spread_ref when the init spread is 0
+    BG_Q_W         : natural := 14;
+    BG_O_W         : natural := 17;
+    SEARCH_ITER    : natural := 5;               -- iterations per start point while lost
+    STEP16         : natural := 16;              -- search_step in 1/16
+    MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
     RESULT_STREAM  : boolean := true              -- true: m_axis_result_* carries each result word
   );
   port (
@@ -113,7 +156,7 @@ entity ms_tracker_axi is
     s_axis_tlast         : in  std_logic;                                -- last pixel of a line
     s_axis_tuser         : in  std_logic;                                -- first pixel of a frame
     -- result stream (RESULT_STREAM = true)
-    m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);  -- result word (result_layout)
+    m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);  -- result word (result_layout / _v2)
     m_axis_result_tvalid : out std_logic;                                -- result valid
     m_axis_result_tready : in  std_logic;                                -- result taken
     m_axis_result_tlast  : out std_logic;                                -- always 1
@@ -144,6 +187,29 @@ architecture rtl of ms_tracker_axi is
   constant F_REJ  : natural := 4;
   constant F_NOT  : natural := 5;
   constant W_MAX  : natural := 2 ** COORD_W - 1;
+  -- result word v2 fields (mstrack.fixed.vhdl_pkg.result_layout_v2), LSB first (PRESET 1)
+  constant CONF_W : natural := 17;                     -- Q1.16 (vhdl_pkg.CONF_W)
+  constant V_CX   : natural := 0;
+  constant V_CY   : natural := V_CX + CENTRE_ABS_W;
+  constant V_W8   : natural := V_CY + CENTRE_ABS_W;
+  constant V_H8   : natural := V_W8 + SIZE_W;
+  constant V_RHO  : natural := V_H8 + SIZE_W;
+  constant V_CONF : natural := V_RHO + RHO_OUT_W;
+  constant V_ST   : natural := V_CONF + CONF_W;
+  constant V_IT   : natural := V_ST + 3;
+  constant V_SP   : natural := V_IT + ITER_W;
+  constant V_DL   : natural := V_SP + 2;
+  constant V_SR   : natural := V_DL + 3;
+  constant V_FL   : natural := V_SR + 4;
+  constant V_EC   : natural := V_FL + 8;
+  constant V_FC   : natural := V_EC + 3;
+  -- status codes of result word v2 (vhdl_pkg.STATUS_V2)
+  constant ST_OK    : natural := 0;
+  constant ST_UNC   : natural := 1;
+  constant ST_LOST  : natural := 2;
+  constant ST_REACQ : natural := 3;
+  constant ST_INIT  : natural := 4;
+  constant ST_CLIP  : natural := 5;
 
   signal hw_in    : ms_tracker_regs_in_t;
   signal hw_out   : ms_tracker_regs_out_t;
@@ -162,10 +228,12 @@ architecture rtl of ms_tracker_axi is
   -- results
   signal r_data   : std_logic_vector(RESULT_W - 1 downto 0);
   signal r_valid, r_ready, r_take : std_logic;
+  signal r_word   : std_logic_vector(RAW_W - 1 downto 0);                      -- r_data, zero-extended
+  signal c_lost, c_err, c_rej, c_reacq : std_logic;                           -- events of r_word
   signal lat      : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- L
   signal snap     : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- S
   signal lat_ok   : std_logic := '0';
-  signal ev_res, ev_lost, ev_err, ev_rej : std_logic := '0';
+  signal ev_res, ev_lost, ev_err, ev_rej, ev_reacq : std_logic := '0';
   signal busy     : std_logic;
   signal fw, fh   : unsigned(COORD_W - 1 downto 0);
 
@@ -196,7 +264,9 @@ begin
   assert RESULT_W <= RAW_W report "ms_tracker_axi: RESULT_W > 160 does not fit RES_RAW0..4" severity failure;
   assert CENTRE_ABS_W <= 32 and RHO_OUT_W <= 32 and ALPHA_W <= 32 and ITER_W <= 8 and WIN_W <= 16
     report "ms_tracker_axi: a result field is wider than its register field" severity failure;
-  assert O_FC + 16 <= RESULT_W report "ms_tracker_axi: result layout and RESULT_W disagree" severity failure;
+  assert PRESET /= 0 or O_FC + 16 <= RESULT_W report "ms_tracker_axi: result layout and RESULT_W disagree" severity failure;
+  assert PRESET = 0 or (V_FC + 16 <= RESULT_W and SIZE_W <= 32)
+    report "ms_tracker_axi: result layout v2 and RESULT_W disagree" severity failure;
   assert COORD_W + 2 <= 16 report "ms_tracker_axi: init box registers are 16 bits" severity failure;
 
   ---------------------------------------------------------------------------- registers
@@ -212,11 +282,12 @@ begin
       s_axil_rresp => s_axil_rresp, hwif_in => hw_in, hwif_out => hw_out);
 
   -- identification and build-time configuration
-  hw_in.VERSION.result_version.next_q <= x"1";
+  hw_in.VERSION.result_version.next_q <= x"1" when PRESET = 0 else x"2";
   hw_in.VERSION.result_width.next_q   <= std_logic_vector(to_unsigned(RESULT_W, 8));
   hw_in.CONFIG.features.next_q        <= std_logic_vector(to_unsigned(FEATURES, 2));
   hw_in.CONFIG.kernel_epan.next_q     <= '1' when KERNEL_EPAN /= 0 else '0';
   hw_in.CONFIG.result_stream.next_q   <= '1' when RESULT_STREAM else '0';
+  hw_in.CONFIG.preset.next_q          <= std_logic_vector(to_unsigned(PRESET, 2));
   hw_in.CONFIG.lanes.next_q           <= std_logic_vector(to_unsigned(LANES, 8));
   hw_in.CONFIG.max_half.next_q        <= std_logic_vector(to_unsigned(MAX_HALF, 16));
   hw_in.FORMAT.max_frame_w.next_q     <= std_logic_vector(to_unsigned(MAX_FRAME_W, 16));
@@ -228,13 +299,13 @@ begin
   hw_in.STATUS.init_pending.next_q <= init_v;
   hw_in.STATUS.busy.next_q         <= busy;
   hw_in.STATUS.gate_open.next_q    <= pass_r;
-  hw_in.STATUS.tracking.next_q     <= lat_ok and not (lat(O_FL + F_NOT) or lat(O_FL + F_LOST) or lat(O_FL + F_ERR));
   hw_in.STATUS.result_valid.next_q <= lat_ok;
 
   -- interrupts (level inputs of sticky intr fields: a one-clock pulse sets the bit) and counters
   hw_in.INT_STATUS.result.next_q <= ev_res;
   hw_in.INT_STATUS.lost.next_q   <= ev_lost;
   hw_in.INT_STATUS.error.next_q  <= ev_err or ev_rej;
+  hw_in.INT_STATUS.reacquired.next_q <= ev_reacq;
   irq <= hw_out.INT_STATUS.intr;
   hw_in.RESULT_COUNT.count.incr <= ev_res;
   hw_in.LOST_COUNT.count.incr   <= ev_lost;
@@ -242,22 +313,79 @@ begin
   hw_in.REJECT_COUNT.count.incr <= ev_rej;
   hw_in.DROP_COUNT.count.incr   <= drop_sof;
 
-  -- last result: head from L, the rest from the snapshot S
-  hw_in.RES_HEAD.frame_count.next_q <= fld(lat, O_FC, 16, 16);
-  hw_in.RES_HEAD.flags.next_q       <= fld(lat, O_FL, 8, 8);
-  hw_in.RES_HEAD.err_code.next_q    <= fld(lat, O_EC, 3, 3);
+  -- last result: head from L, the rest from the snapshot S; the fields of the preset's word
+  g_v1 : if PRESET = 0 generate
+    -- tracking: the last result has none of the flags no_target, lost, error
+    hw_in.STATUS.tracking.next_q      <= lat_ok and not (lat(O_FL + F_NOT) or lat(O_FL + F_LOST) or lat(O_FL + F_ERR));
+    c_lost  <= r_word(O_FL + F_LOST);
+    c_err   <= r_word(O_FL + F_ERR);
+    c_rej   <= r_word(O_FL + F_REJ);
+    c_reacq <= '0';
+    hw_in.RES_HEAD.frame_count.next_q <= fld(lat, O_FC, 16, 16);
+    hw_in.RES_HEAD.flags.next_q       <= fld(lat, O_FL, 8, 8);
+    hw_in.RES_HEAD.err_code.next_q    <= fld(lat, O_EC, 3, 3);
+    hw_in.RES_CX.value.next_q         <= fld(snap, O_CX, CENTRE_ABS_W, 32);
+    hw_in.RES_CY.value.next_q         <= fld(snap, O_CY, CENTRE_ABS_W, 32);
+    hw_in.RES_RHO_C.value.next_q      <= fld(snap, O_RC, RHO_OUT_W, 32);
+    hw_in.RES_RHO_E.value.next_q      <= fld(snap, O_RE, RHO_OUT_W, 32);
+    hw_in.RES_ALPHA.value.next_q      <= fld(snap, O_AL, ALPHA_W, 32);
+    hw_in.RES_ITER.iter_c.next_q      <= fld(snap, O_IC, ITER_W, 8);
+    hw_in.RES_ITER.iter_e.next_q      <= fld(snap, O_IE, ITER_W, 8);
+    hw_in.RES_ITER.stop_c.next_q      <= fld(snap, O_SC, 2, 2);
+    hw_in.RES_ITER.stop_e.next_q      <= fld(snap, O_SE, 2, 2);
+    hw_in.RES_BOX.box_w.next_q        <= fld(snap, O_BW, WIN_W, 16);
+    hw_in.RES_BOX.box_h.next_q        <= fld(snap, O_BH, WIN_W, 16);
+    hw_in.RES_W8.value.next_q         <= (others => '0');
+    hw_in.RES_H8.value.next_q         <= (others => '0');
+    hw_in.RES_CONF.value.next_q       <= (others => '0');
+    hw_in.RES_STATE.status.next_q     <= (others => '0');
+    hw_in.RES_STATE.iter.next_q       <= (others => '0');
+    hw_in.RES_STATE.stop.next_q       <= (others => '0');
+    hw_in.RES_STATE.decim_log2.next_q <= (others => '0');
+    hw_in.RES_STATE.searched.next_q   <= (others => '0');
+  end generate;
+
+  g_v2 : if PRESET /= 0 generate
+    signal st_lat, st_new : natural range 0 to 7;
+  begin
+    -- result word v2: the status says what the frame is (STATUS_V2); the core sets flag lost exactly
+    -- for status lost, flag error with status error, no_target (status 0) before any init.
+    -- tracking: the box of the last result is trusted (TrackResult.ok): status ok, reacquired, init or
+    -- clipped, and neither no_target nor error; uncertain (the loss flag is up, search state not lost)
+    -- and lost are not tracking
+    st_lat <= to_integer(unsigned(lat(V_ST + 2 downto V_ST)));
+    st_new <= to_integer(unsigned(r_word(V_ST + 2 downto V_ST)));
+    hw_in.STATUS.tracking.next_q <= lat_ok and not (lat(V_FL + F_NOT) or lat(V_FL + F_ERR))
+                                    when st_lat = ST_OK or st_lat = ST_REACQ or st_lat = ST_INIT or st_lat = ST_CLIP
+                                    else '0';
+    c_lost  <= '1' when st_new = ST_LOST else '0';
+    c_reacq <= '1' when st_new = ST_REACQ else '0';
+    c_err   <= r_word(V_FL + F_ERR);
+    c_rej   <= r_word(V_FL + F_REJ);
+    hw_in.RES_HEAD.frame_count.next_q <= fld(lat, V_FC, 16, 16);
+    hw_in.RES_HEAD.flags.next_q       <= fld(lat, V_FL, 8, 8);
+    hw_in.RES_HEAD.err_code.next_q    <= fld(lat, V_EC, 3, 3);
+    hw_in.RES_CX.value.next_q         <= fld(snap, V_CX, CENTRE_ABS_W, 32);
+    hw_in.RES_CY.value.next_q         <= fld(snap, V_CY, CENTRE_ABS_W, 32);
+    hw_in.RES_RHO_C.value.next_q      <= fld(snap, V_RHO, RHO_OUT_W, 32);
+    hw_in.RES_RHO_E.value.next_q      <= (others => '0');
+    hw_in.RES_ALPHA.value.next_q      <= (others => '0');
+    hw_in.RES_ITER.iter_c.next_q      <= (others => '0');
+    hw_in.RES_ITER.iter_e.next_q      <= (others => '0');
+    hw_in.RES_ITER.stop_c.next_q      <= (others => '0');
+    hw_in.RES_ITER.stop_e.next_q      <= (others => '0');
+    hw_in.RES_BOX.box_w.next_q        <= (others => '0');
+    hw_in.RES_BOX.box_h.next_q        <= (others => '0');
+    hw_in.RES_W8.value.next_q         <= fld(snap, V_W8, SIZE_W, 32);
+    hw_in.RES_H8.value.next_q         <= fld(snap, V_H8, SIZE_W, 32);
+    hw_in.RES_CONF.value.next_q       <= fld(snap, V_CONF, CONF_W, 32);
+    hw_in.RES_STATE.status.next_q     <= fld(snap, V_ST, 3, 3);
+    hw_in.RES_STATE.iter.next_q       <= fld(snap, V_IT, ITER_W, 8);
+    hw_in.RES_STATE.stop.next_q       <= fld(snap, V_SP, 2, 2);
+    hw_in.RES_STATE.decim_log2.next_q <= fld(snap, V_DL, 3, 3);
+    hw_in.RES_STATE.searched.next_q   <= fld(snap, V_SR, 4, 4);
+  end generate;
   hw_in.RES_HEAD.valid.next_q       <= lat_ok;
-  hw_in.RES_CX.value.next_q         <= fld(snap, O_CX, CENTRE_ABS_W, 32);
-  hw_in.RES_CY.value.next_q         <= fld(snap, O_CY, CENTRE_ABS_W, 32);
-  hw_in.RES_RHO_C.value.next_q      <= fld(snap, O_RC, RHO_OUT_W, 32);
-  hw_in.RES_RHO_E.value.next_q      <= fld(snap, O_RE, RHO_OUT_W, 32);
-  hw_in.RES_ALPHA.value.next_q      <= fld(snap, O_AL, ALPHA_W, 32);
-  hw_in.RES_ITER.iter_c.next_q      <= fld(snap, O_IC, ITER_W, 8);
-  hw_in.RES_ITER.iter_e.next_q      <= fld(snap, O_IE, ITER_W, 8);
-  hw_in.RES_ITER.stop_c.next_q      <= fld(snap, O_SC, 2, 2);
-  hw_in.RES_ITER.stop_e.next_q      <= fld(snap, O_SE, 2, 2);
-  hw_in.RES_BOX.box_w.next_q        <= fld(snap, O_BW, WIN_W, 16);
-  hw_in.RES_BOX.box_h.next_q        <= fld(snap, O_BH, WIN_W, 16);
   hw_in.RES_RAW0.value.next_q       <= snap(31 downto 0);
   hw_in.RES_RAW1.value.next_q       <= snap(63 downto 32);
   hw_in.RES_RAW2.value.next_q       <= snap(95 downto 64);
@@ -319,7 +447,9 @@ begin
   ---------------------------------------------------------------------------- core
   u_core : entity work.ms_tracker
     generic map (
+      PRESET         => PRESET,
       MAX_FRAME_W    => MAX_FRAME_W,
+      RGB_PACKING    => RGB_PACKING,
       PPC            => PPC,
       LANES          => LANES,
       COLOUR_BITS    => COLOUR_BITS,
@@ -362,7 +492,35 @@ begin
       RHO_OUT_W      => RHO_OUT_W,
       ALPHA_W        => ALPHA_W,
       WIN_W          => WIN_W,
-      RESULT_W       => RESULT_W
+      RESULT_W       => RESULT_W,
+      PAD16          => PAD16,
+      RING16         => RING16,
+      MAX_WINDOW     => MAX_WINDOW,
+      KT_W           => KT_W,
+      ST2_W          => ST2_W,
+      SHARE_W        => SHARE_W,
+      SPREAD_W       => SPREAD_W,
+      SIZE_W         => SIZE_W,
+      SCALE_W        => SCALE_W,
+      SCALE_GAIN     => SCALE_GAIN,
+      SCALE_REG      => SCALE_REG,
+      SCALE_STEP     => SCALE_STEP,
+      SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
+      WR_Q_W         => WR_Q_W,
+      CON_W          => CON_W,
+      LOSS_K         => LOSS_K,
+      REF_K          => REF_K,
+      LOSS_RHO       => LOSS_RHO,
+      LOSS_CONTRAST  => LOSS_CONTRAST,
+      CONF_LOST      => CONF_LOST,
+      CONF_UNCERTAIN => CONF_UNCERTAIN,
+      CONF_REACQUIRE => CONF_REACQUIRE,
+      SPREAD_DEFAULT => SPREAD_DEFAULT,
+      BG_Q_W         => BG_Q_W,
+      BG_O_W         => BG_O_W,
+      SEARCH_ITER    => SEARCH_ITER,
+      STEP16         => STEP16,
+      MARGIN_MAX     => MARGIN_MAX
     )
     port map (
       clk => clk, rst => rst, frame_width => fw, frame_height => fh,
@@ -380,16 +538,18 @@ begin
   m_axis_result_tdata  <= r_data;
   m_axis_result_tvalid <= r_valid when RESULT_STREAM else '0';
   m_axis_result_tlast  <= '1';
+  r_word <= std_logic_vector(resize(unsigned(r_data), RAW_W));
 
   p_result : process(clk)
   begin
     if rising_edge(clk) then
       ev_res  <= r_take;
-      ev_lost <= r_take and r_data(O_FL + F_LOST);
-      ev_err  <= r_take and r_data(O_FL + F_ERR);
-      ev_rej  <= r_take and r_data(O_FL + F_REJ);
+      ev_lost <= r_take and c_lost;
+      ev_err  <= r_take and c_err;
+      ev_rej  <= r_take and c_rej;
+      ev_reacq <= r_take and c_reacq;
       if r_take = '1' then                           -- L: the whole word in one clock
-        lat    <= std_logic_vector(resize(unsigned(r_data), RAW_W));
+        lat    <= r_word;
         lat_ok <= '1';
       end if;
       if hw_out.RES_HEAD.frame_count.swacc = '1' then  -- read of RES_HEAD: S <= L, same clock
@@ -403,6 +563,7 @@ begin
         ev_lost <= '0';
         ev_err <= '0';
         ev_rej <= '0';
+        ev_reacq <= '0';
       end if;
     end if;
   end process;

@@ -110,6 +110,10 @@ architecture rtl of ms_tracker_regs is
         RES_ALPHA : std_logic;
         RES_ITER : std_logic;
         RES_BOX : std_logic;
+        RES_W8 : std_logic;
+        RES_H8 : std_logic;
+        RES_CONF : std_logic;
+        RES_STATE : std_logic;
         RES_RAW0 : std_logic;
         RES_RAW1 : std_logic;
         RES_RAW2 : std_logic;
@@ -212,10 +216,16 @@ architecture rtl of ms_tracker_regs is
         load_next : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_STATUS.reacquired_combo_t\ is record
+        next_q : std_logic;
+        load_next : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_STATUS_combo_t\ is record
         result : \ms_tracker_regs.INT_STATUS.result_combo_t\;
         lost : \ms_tracker_regs.INT_STATUS.lost_combo_t\;
         error : \ms_tracker_regs.INT_STATUS.error_combo_t\;
+        reacquired : \ms_tracker_regs.INT_STATUS.reacquired_combo_t\;
     end record;
 
     type \ms_tracker_regs.INT_ENABLE.result_combo_t\ is record
@@ -233,10 +243,16 @@ architecture rtl of ms_tracker_regs is
         load_next : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_ENABLE.reacquired_combo_t\ is record
+        next_q : std_logic;
+        load_next : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_ENABLE_combo_t\ is record
         result : \ms_tracker_regs.INT_ENABLE.result_combo_t\;
         lost : \ms_tracker_regs.INT_ENABLE.lost_combo_t\;
         error : \ms_tracker_regs.INT_ENABLE.error_combo_t\;
+        reacquired : \ms_tracker_regs.INT_ENABLE.reacquired_combo_t\;
     end record;
 
     type \ms_tracker_regs.RESULT_COUNT.count_combo_t\ is record
@@ -383,10 +399,15 @@ architecture rtl of ms_tracker_regs is
         value : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_STATUS.reacquired_storage_t\ is record
+        value : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_STATUS_storage_t\ is record
         result : \ms_tracker_regs.INT_STATUS.result_storage_t\;
         lost : \ms_tracker_regs.INT_STATUS.lost_storage_t\;
         error : \ms_tracker_regs.INT_STATUS.error_storage_t\;
+        reacquired : \ms_tracker_regs.INT_STATUS.reacquired_storage_t\;
     end record;
 
     type \ms_tracker_regs.INT_ENABLE.result_storage_t\ is record
@@ -401,10 +422,15 @@ architecture rtl of ms_tracker_regs is
         value : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_ENABLE.reacquired_storage_t\ is record
+        value : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_ENABLE_storage_t\ is record
         result : \ms_tracker_regs.INT_ENABLE.result_storage_t\;
         lost : \ms_tracker_regs.INT_ENABLE.lost_storage_t\;
         error : \ms_tracker_regs.INT_ENABLE.error_storage_t\;
+        reacquired : \ms_tracker_regs.INT_ENABLE.reacquired_storage_t\;
     end record;
 
     type \ms_tracker_regs.RESULT_COUNT.count_storage_t\ is record
@@ -751,6 +777,18 @@ begin
         decoded_reg_strb.RES_BOX <= cpuif_req_masked and (cpuif_addr = 16#6C#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#6C#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#6C#) and not cpuif_req_is_wr);
+        decoded_reg_strb.RES_W8 <= cpuif_req_masked and (cpuif_addr = 16#70#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#70#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#70#) and not cpuif_req_is_wr);
+        decoded_reg_strb.RES_H8 <= cpuif_req_masked and (cpuif_addr = 16#74#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#74#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#74#) and not cpuif_req_is_wr);
+        decoded_reg_strb.RES_CONF <= cpuif_req_masked and (cpuif_addr = 16#78#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#78#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#78#) and not cpuif_req_is_wr);
+        decoded_reg_strb.RES_STATE <= cpuif_req_masked and (cpuif_addr = 16#7C#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#7C#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#7C#) and not cpuif_req_is_wr);
         decoded_reg_strb.RES_RAW0 <= cpuif_req_masked and (cpuif_addr = 16#80#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#80#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#80#) and not cpuif_req_is_wr);
@@ -1141,10 +1179,42 @@ begin
             end if;
         end if;
     end process;
+
+    -- Field: ms_tracker_regs.INT_STATUS.reacquired
+    process(all)
+        variable next_c: std_logic;
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.INT_STATUS.reacquired.value;
+        load_next_c := '0';
+        if decoded_reg_strb.INT_STATUS and decoded_req_is_wr then -- SW write 1 clear
+            next_c := field_storage.INT_STATUS.reacquired.value and not (decoded_wr_data(3) and decoded_wr_biten(3));
+            load_next_c := '1';
+        elsif hwif_in.INT_STATUS.reacquired.next_q then -- stickybit
+            next_c := '1';
+            load_next_c := '1';
+        end if;
+        field_combo.INT_STATUS.reacquired.next_q <= next_c;
+        field_combo.INT_STATUS.reacquired.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.INT_STATUS.reacquired.value <= '0';
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.INT_STATUS.reacquired.value <= '0';
+            else
+                if field_combo.INT_STATUS.reacquired.load_next then
+                    field_storage.INT_STATUS.reacquired.value <= field_combo.INT_STATUS.reacquired.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
     hwif_out.INT_STATUS.intr <=
         (field_storage.INT_STATUS.result.value and field_storage.INT_ENABLE.result.value)
         or (field_storage.INT_STATUS.lost.value and field_storage.INT_ENABLE.lost.value)
-        or (field_storage.INT_STATUS.error.value and field_storage.INT_ENABLE.error.value);
+        or (field_storage.INT_STATUS.error.value and field_storage.INT_ENABLE.error.value)
+        or (field_storage.INT_STATUS.reacquired.value and field_storage.INT_ENABLE.reacquired.value);
 
     -- Field: ms_tracker_regs.INT_ENABLE.result
     process(all)
@@ -1225,6 +1295,34 @@ begin
             else
                 if field_combo.INT_ENABLE.error.load_next then
                     field_storage.INT_ENABLE.error.value <= field_combo.INT_ENABLE.error.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
+
+    -- Field: ms_tracker_regs.INT_ENABLE.reacquired
+    process(all)
+        variable next_c: std_logic;
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.INT_ENABLE.reacquired.value;
+        load_next_c := '0';
+        if decoded_reg_strb.INT_ENABLE and decoded_req_is_wr then -- SW write
+            next_c := (field_storage.INT_ENABLE.reacquired.value and not decoded_wr_biten(3)) or (decoded_wr_data(3) and decoded_wr_biten(3));
+            load_next_c := '1';
+        end if;
+        field_combo.INT_ENABLE.reacquired.next_q <= next_c;
+        field_combo.INT_ENABLE.reacquired.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.INT_ENABLE.reacquired.value <= '0';
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.INT_ENABLE.reacquired.value <= '0';
+            else
+                if field_combo.INT_ENABLE.reacquired.load_next then
+                    field_storage.INT_ENABLE.reacquired.value <= field_combo.INT_ENABLE.reacquired.next_q;
                 end if;
             end if;
         end if;
@@ -1440,7 +1538,7 @@ begin
             readback_data_var(31 downto 0) := 32x"4D53544B";
         end if;
         if rd_mux_addr = 16#4# then
-            readback_data_var(7 downto 0) := 8x"0";
+            readback_data_var(7 downto 0) := 8x"1";
             readback_data_var(15 downto 8) := 8x"1";
             readback_data_var(19 downto 16) := hwif_in.VERSION.result_version.next_q;
             readback_data_var(31 downto 24) := hwif_in.VERSION.result_width.next_q;
@@ -1449,6 +1547,7 @@ begin
             readback_data_var(1 downto 0) := hwif_in.CONFIG.features.next_q;
             readback_data_var(2) := hwif_in.CONFIG.kernel_epan.next_q;
             readback_data_var(3) := hwif_in.CONFIG.result_stream.next_q;
+            readback_data_var(5 downto 4) := hwif_in.CONFIG.preset.next_q;
             readback_data_var(15 downto 8) := hwif_in.CONFIG.lanes.next_q;
             readback_data_var(31 downto 16) := hwif_in.CONFIG.max_half.next_q;
         end if;
@@ -1484,11 +1583,13 @@ begin
             readback_data_var(0) := field_storage.INT_STATUS.result.value;
             readback_data_var(1) := field_storage.INT_STATUS.lost.value;
             readback_data_var(2) := field_storage.INT_STATUS.error.value;
+            readback_data_var(3) := field_storage.INT_STATUS.reacquired.value;
         end if;
         if rd_mux_addr = 16#2C# then
             readback_data_var(0) := field_storage.INT_ENABLE.result.value;
             readback_data_var(1) := field_storage.INT_ENABLE.lost.value;
             readback_data_var(2) := field_storage.INT_ENABLE.error.value;
+            readback_data_var(3) := field_storage.INT_ENABLE.reacquired.value;
         end if;
         if rd_mux_addr = 16#30# then
             readback_data_var(31 downto 0) := field_storage.RESULT_COUNT.count.value;
@@ -1535,6 +1636,22 @@ begin
         if rd_mux_addr = 16#6C# then
             readback_data_var(15 downto 0) := hwif_in.RES_BOX.box_w.next_q;
             readback_data_var(31 downto 16) := hwif_in.RES_BOX.box_h.next_q;
+        end if;
+        if rd_mux_addr = 16#70# then
+            readback_data_var(31 downto 0) := hwif_in.RES_W8.value.next_q;
+        end if;
+        if rd_mux_addr = 16#74# then
+            readback_data_var(31 downto 0) := hwif_in.RES_H8.value.next_q;
+        end if;
+        if rd_mux_addr = 16#78# then
+            readback_data_var(31 downto 0) := hwif_in.RES_CONF.value.next_q;
+        end if;
+        if rd_mux_addr = 16#7C# then
+            readback_data_var(2 downto 0) := hwif_in.RES_STATE.status.next_q;
+            readback_data_var(15 downto 8) := hwif_in.RES_STATE.iter.next_q;
+            readback_data_var(17 downto 16) := hwif_in.RES_STATE.stop.next_q;
+            readback_data_var(22 downto 20) := hwif_in.RES_STATE.decim_log2.next_q;
+            readback_data_var(27 downto 24) := hwif_in.RES_STATE.searched.next_q;
         end if;
         if rd_mux_addr = 16#80# then
             readback_data_var(31 downto 0) := hwif_in.RES_RAW0.value.next_q;

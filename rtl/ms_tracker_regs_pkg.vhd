@@ -37,6 +37,10 @@ package ms_tracker_regs_pkg is
         next_q : std_logic;
     end record;
 
+    type \ms_tracker_regs.CONFIG.preset_in_t\ is record
+        next_q : std_logic_vector(1 downto 0);
+    end record;
+
     type \ms_tracker_regs.CONFIG.lanes_in_t\ is record
         next_q : std_logic_vector(7 downto 0);
     end record;
@@ -49,6 +53,7 @@ package ms_tracker_regs_pkg is
         features : \ms_tracker_regs.CONFIG.features_in_t\;
         kernel_epan : \ms_tracker_regs.CONFIG.kernel_epan_in_t\;
         result_stream : \ms_tracker_regs.CONFIG.result_stream_in_t\;
+        preset : \ms_tracker_regs.CONFIG.preset_in_t\;
         lanes : \ms_tracker_regs.CONFIG.lanes_in_t\;
         max_half : \ms_tracker_regs.CONFIG.max_half_in_t\;
     end record;
@@ -116,10 +121,15 @@ package ms_tracker_regs_pkg is
         next_q : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_STATUS.reacquired_in_t\ is record
+        next_q : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_STATUS_in_t\ is record
         result : \ms_tracker_regs.INT_STATUS.result_in_t\;
         lost : \ms_tracker_regs.INT_STATUS.lost_in_t\;
         error : \ms_tracker_regs.INT_STATUS.error_in_t\;
+        reacquired : \ms_tracker_regs.INT_STATUS.reacquired_in_t\;
     end record;
 
     type \ms_tracker_regs.RESULT_COUNT.count_in_t\ is record
@@ -261,6 +271,58 @@ package ms_tracker_regs_pkg is
         box_h : \ms_tracker_regs.RES_BOX.box_h_in_t\;
     end record;
 
+    type \ms_tracker_regs.RES_W8.value_in_t\ is record
+        next_q : std_logic_vector(31 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_W8_in_t\ is record
+        value : \ms_tracker_regs.RES_W8.value_in_t\;
+    end record;
+
+    type \ms_tracker_regs.RES_H8.value_in_t\ is record
+        next_q : std_logic_vector(31 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_H8_in_t\ is record
+        value : \ms_tracker_regs.RES_H8.value_in_t\;
+    end record;
+
+    type \ms_tracker_regs.RES_CONF.value_in_t\ is record
+        next_q : std_logic_vector(31 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_CONF_in_t\ is record
+        value : \ms_tracker_regs.RES_CONF.value_in_t\;
+    end record;
+
+    type \ms_tracker_regs.RES_STATE.status_in_t\ is record
+        next_q : std_logic_vector(2 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_STATE.iter_in_t\ is record
+        next_q : std_logic_vector(7 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_STATE.stop_in_t\ is record
+        next_q : std_logic_vector(1 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_STATE.decim_log2_in_t\ is record
+        next_q : std_logic_vector(2 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_STATE.searched_in_t\ is record
+        next_q : std_logic_vector(3 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_STATE_in_t\ is record
+        status : \ms_tracker_regs.RES_STATE.status_in_t\;
+        iter : \ms_tracker_regs.RES_STATE.iter_in_t\;
+        stop : \ms_tracker_regs.RES_STATE.stop_in_t\;
+        decim_log2 : \ms_tracker_regs.RES_STATE.decim_log2_in_t\;
+        searched : \ms_tracker_regs.RES_STATE.searched_in_t\;
+    end record;
+
     type \ms_tracker_regs.RES_RAW0.value_in_t\ is record
         next_q : std_logic_vector(31 downto 0);
     end record;
@@ -320,6 +382,10 @@ package ms_tracker_regs_pkg is
         RES_ALPHA : \ms_tracker_regs.RES_ALPHA_in_t\;
         RES_ITER : \ms_tracker_regs.RES_ITER_in_t\;
         RES_BOX : \ms_tracker_regs.RES_BOX_in_t\;
+        RES_W8 : \ms_tracker_regs.RES_W8_in_t\;
+        RES_H8 : \ms_tracker_regs.RES_H8_in_t\;
+        RES_CONF : \ms_tracker_regs.RES_CONF_in_t\;
+        RES_STATE : \ms_tracker_regs.RES_STATE_in_t\;
         RES_RAW0 : \ms_tracker_regs.RES_RAW0_in_t\;
         RES_RAW1 : \ms_tracker_regs.RES_RAW1_in_t\;
         RES_RAW2 : \ms_tracker_regs.RES_RAW2_in_t\;

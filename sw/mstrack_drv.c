@@ -26,20 +26,24 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
     dev->base = base;
     dev->irq_mask = 0;
     dev->irq_count = 0;
+    dev->result_version = 0;
     dev->last.valid = 0;
+    dev->last_v2.valid = 0;
     if (REG(dev, ID) != MSTRACK_MAGIC) {
         return MSTRACK_ERR_ID;
     }
     v = REG(dev, VERSION);
-    if (FIELD(v, VERSION, MAP_MAJOR) != MSTRACK_MAP_MAJOR || FIELD(v, VERSION, RESULT_VERSION) != 1u) {
+    if (FIELD(v, VERSION, MAP_MAJOR) != MSTRACK_MAP_MAJOR || FIELD(v, VERSION, RESULT_VERSION) < 1u ||
+        FIELD(v, VERSION, RESULT_VERSION) > 2u) {
         return MSTRACK_ERR_VERSION;
     }
+    dev->result_version = FIELD(v, VERSION, RESULT_VERSION);
     if (width < 3u || height < 3u || width > FIELD(REG(dev, FORMAT), FORMAT, MAX_FRAME_W) || height > 0xFFFFu) {
         return MSTRACK_ERR_ARG;
     }
     REG(dev, CTRL) = 0;                                    /* frames dropped from the next start */
     REG(dev, INT_ENABLE) = 0;
-    REG(dev, INT_STATUS) = MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR;  /* W1C */
+    REG(dev, INT_STATUS) = MSTRACK_IRQ_ALL;                /* W1C */
     REG(dev, CMD) = PUT(CMD, CLEAR_COUNTERS, 1u);
     REG(dev, FRAME_SIZE) = PUT(FRAME_SIZE, WIDTH, width) | PUT(FRAME_SIZE, HEIGHT, height);
     return MSTRACK_OK;
@@ -53,7 +57,7 @@ int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t
     REG(dev, INIT_POS) = PUT(INIT_POS, X, (uint32_t)x & 0xFFFFu) | PUT(INIT_POS, Y, (uint32_t)y & 0xFFFFu);
     REG(dev, INIT_SIZE) = PUT(INIT_SIZE, WIDTH, w) | PUT(INIT_SIZE, HEIGHT, h);
     REG(dev, CMD) = PUT(CMD, INIT, 1u);                    /* box copied now, taken between frames */
-    dev->irq_mask = irq_mask & (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR);
+    dev->irq_mask = irq_mask & MSTRACK_IRQ_ALL;
     REG(dev, INT_ENABLE) = dev->irq_mask;
     REG(dev, CTRL) = PUT(CTRL, ENABLE, 1u);
     return MSTRACK_OK;
@@ -86,6 +90,28 @@ int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r)
     v = REG(dev, RES_BOX);
     r->box_w = FIELD(v, RES_BOX, BOX_W);
     r->box_h = FIELD(v, RES_BOX, BOX_H);
+    return r->valid ? MSTRACK_OK : MSTRACK_NO_RESULT;
+}
+
+int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r)
+{
+    uint32_t v = REG(dev, RES_HEAD);                       /* first: snapshot of one whole result */
+    r->valid = FIELD(v, RES_HEAD, VALID);
+    r->frame_count = FIELD(v, RES_HEAD, FRAME_COUNT);
+    r->flags = FIELD(v, RES_HEAD, FLAGS);
+    r->err_code = FIELD(v, RES_HEAD, ERR_CODE);
+    r->cx = REG(dev, RES_CX);
+    r->cy = REG(dev, RES_CY);
+    r->rho = REG(dev, RES_RHO_C);
+    r->w8 = REG(dev, RES_W8);
+    r->h8 = REG(dev, RES_H8);
+    r->confidence = REG(dev, RES_CONF);
+    v = REG(dev, RES_STATE);
+    r->status = FIELD(v, RES_STATE, STATUS);
+    r->iter = FIELD(v, RES_STATE, ITER);
+    r->stop = FIELD(v, RES_STATE, STOP);
+    r->decim_log2 = FIELD(v, RES_STATE, DECIM_LOG2);
+    r->searched = FIELD(v, RES_STATE, SEARCHED);
     return r->valid ? MSTRACK_OK : MSTRACK_NO_RESULT;
 }
 
@@ -133,17 +159,38 @@ void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r)
     r->flags = bits(words, MSTRACK_RES2_FLAGS_OFF, MSTRACK_RES2_FLAGS_W);
     r->err_code = bits(words, MSTRACK_RES2_ERR_CODE_OFF, MSTRACK_RES2_ERR_CODE_W);
     r->frame_count = bits(words, MSTRACK_RES2_FRAME_COUNT_OFF, MSTRACK_RES2_FRAME_COUNT_W);
+    r->valid = 1u;
 }
 
 uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
 {
-    uint32_t st = REG(dev, INT_STATUS) & (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR);
+    uint32_t st = REG(dev, INT_STATUS) & MSTRACK_IRQ_ALL;
     if (st == 0u) {
         return 0u;
     }
     dev->irq_count++;
     if (st & MSTRACK_IRQ_RESULT) {
-        (void)mstrack_read_result(dev, &dev->last);
+        if (dev->result_version == 2u) {
+            const mstrack_result_v2_t *v2 = &dev->last_v2;
+            (void)mstrack_read_result_v2(dev, &dev->last_v2);
+            dev->last.valid = v2->valid;
+            dev->last.frame_count = v2->frame_count;
+            dev->last.flags = v2->flags;
+            dev->last.err_code = v2->err_code;
+            dev->last.cx = v2->cx;
+            dev->last.cy = v2->cy;
+            dev->last.rho_c = v2->rho;
+            dev->last.rho_e = 0u;
+            dev->last.alpha_c = 0u;
+            dev->last.iter_c = 0u;
+            dev->last.iter_e = 0u;
+            dev->last.stop_c = 0u;
+            dev->last.stop_e = 0u;
+            dev->last.box_w = 0u;
+            dev->last.box_h = 0u;
+        } else {
+            (void)mstrack_read_result(dev, &dev->last);
+        }
         if (r != NULL) {
             *r = dev->last;
         }

@@ -2,7 +2,10 @@
  *
  * Register offsets and fields come from the generated header ms_tracker_regs.h (PeakRDL, from
  * regs/ms_tracker_regs.rdl); the result word layout from the generated ms_tracker_result.h
- * (mstrack.fixed.vhdl_pkg.result_layout, default generics).  C99, no allocation, no libc beyond
+ * (mstrack.fixed.vhdl_pkg.result_layout / result_layout_v2, default generics).  Both cores: the paper
+ * core (PRESET 0, result word v1: mstrack_read_result) and core v2 (PRESET 1, result word v2:
+ * mstrack_read_result_v2); mstrack_init records which (VERSION.result_version, dev->result_version).
+ * C99, no allocation, no libc beyond
  * <stdint.h> / <stddef.h>.  Every register access is one aligned 32-bit volatile load or store
  * (never through the generated packed struct, which a compiler may split into byte accesses:
  * RES_HEAD has a read side effect).
@@ -40,6 +43,10 @@ extern "C" {
 #define MSTRACK_IRQ_RESULT MS_TRACKER_REGS__INT_STATUS__RESULT_bm
 #define MSTRACK_IRQ_LOST MS_TRACKER_REGS__INT_STATUS__LOST_bm
 #define MSTRACK_IRQ_ERROR MS_TRACKER_REGS__INT_STATUS__ERROR_bm
+#define MSTRACK_IRQ_REACQUIRED MS_TRACKER_REGS__INT_STATUS__REACQUIRED_bm   /* core v2 only */
+#define MSTRACK_IRQ_ALL (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR | MSTRACK_IRQ_REACQUIRED)
+
+/* status of result word v2 (RES_STATE.status): MSTRACK_STATUS_* in the generated ms_tracker_result.h */
 
 /* One result, every field of result word v1, as integers (fixed-point formats in comments;
  * FORMAT register / MSTRACK_CF, MSTRACK_RHO_OUT_FRAC, MSTRACK_AF give the fraction bits). */
@@ -56,20 +63,27 @@ typedef struct {
     uint32_t box_w, box_h; /* target box size (px) */
 } mstrack_result_t;
 
-/* Result word v2 (core v2, result_layout_v2): decode only, for software written ahead of it. */
+/* One result of core v2, every field of result word v2 (result_layout_v2): cx, cy Q.CF px; w8, h8
+ * box size Q.8 px; rho, confidence Q1.16; status MSTRACK_STATUS_*; iter, stop of the winning mean
+ * shift; decim_log2 log2 of the decimation; searched start points besides the centre; flags,
+ * err_code, frame_count as v1; valid as v1 (1 for a decoded word). */
 typedef struct {
     uint32_t cx, cy, w8, h8, rho, confidence, status, iter, stop, decim_log2, searched;
     uint32_t flags, err_code, frame_count;
+    uint32_t valid;
 } mstrack_result_v2_t;
 
 typedef struct {
     uintptr_t base;        /* byte address of the register block */
     uint32_t irq_mask;     /* interrupts enabled by mstrack_start */
     uint32_t irq_count;    /* handler calls that found a status bit set */
-    mstrack_result_t last; /* filled by mstrack_irq_handler on a result interrupt */
+    uint32_t result_version; /* 1 paper core (result word v1), 2 core v2 (mstrack_init sets it) */
+    mstrack_result_t last; /* filled by mstrack_irq_handler on a result interrupt (v2: the common fields) */
+    mstrack_result_v2_t last_v2; /* v2: filled by mstrack_irq_handler on a result interrupt */
 } mstrack_dev_t;
 
-/* Check ID and versions, disable the core, clear interrupts and counters, set the frame size.
+/* Check ID and versions (map major 1, result word 1 or 2: dev->result_version), disable the core,
+ * clear interrupts and counters, set the frame size.
  * Returns MSTRACK_OK, MSTRACK_ERR_ID, MSTRACK_ERR_VERSION or MSTRACK_ERR_ARG (size < 3 or
  * width > FORMAT.max_frame_w). */
 int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t height);
@@ -82,8 +96,13 @@ int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t
 void mstrack_stop(mstrack_dev_t *dev);
 
 /* Read the last result: RES_HEAD first (it snapshots the result), then every field.
- * Returns MSTRACK_OK or MSTRACK_NO_RESULT (r->valid = 0). */
+ * Returns MSTRACK_OK or MSTRACK_NO_RESULT (r->valid = 0).  On core v2 the registers of v1-only
+ * fields read 0 (rho_e, alpha_c, iter_*, stop_*, box_*) and rho_c holds rho: use mstrack_read_result_v2. */
 int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r);
+
+/* Core v2: read the last result, RES_HEAD first, then every field of result word v2.
+ * Returns MSTRACK_OK or MSTRACK_NO_RESULT (r->valid = 0). */
+int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r);
 
 /* Read the raw result word of the snapshot taken by the last RES_HEAD read (5 x 32 bits, LSB first). */
 void mstrack_read_raw(const mstrack_dev_t *dev, uint32_t words[5]);
@@ -92,11 +111,13 @@ void mstrack_read_raw(const mstrack_dev_t *dev, uint32_t words[5]);
  * ms_tracker_result.h; sets r->valid = 1. */
 void mstrack_decode_word(const uint32_t *words, mstrack_result_t *r);
 
-/* Decode a result word v2 (5 words LSB first). */
+/* Decode a result word v2 (5 words LSB first); sets r->valid = 1. */
 void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r);
 
 /* Interrupt handler: reads INT_STATUS, on a result reads it into dev->last (and *r if not NULL),
- * clears the bits it saw (W1C) and returns them (0: not ours). */
+ * clears the bits it saw (W1C) and returns them (0: not ours).  Core v2 (dev->result_version 2):
+ * the result is read with mstrack_read_result_v2 into dev->last_v2, and dev->last (*r) gets the
+ * fields common to both words (valid, frame_count, flags, err_code, cx, cy; rho_c = rho; the rest 0). */
 uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r);
 
 /* Counters (RESULT_COUNT .. DROP_COUNT) and their clear. */

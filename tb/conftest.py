@@ -57,6 +57,10 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",
+    "tb/test_ms_tracker_axi.py::test_axi_v2_verilator": "test_axi_v2_synthetic (the RTL under GHDL) and "
+        "test_axi_verilator (the PRESET 0 netlist of the same wrapper)",
+    "tb/test_ms_tracker_axi.py::test_axi_v2_real": "test_axi_v2_synthetic (PRESET 1) and tb/test_ms_tracker_v2.py's real "
+        "frames (the 1,545-frame Verilator run, marker long)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_real_frames":
         "the 1,545-frame Verilator run (marker long) and the throttled GHDL scene",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_protocol_errors":

@@ -1,5 +1,9 @@
 """System test of rtl/ms_tracker_axi.vhd: the core behind its AXI4-Lite registers, as a CPU sees it.
 
+Both presets: the paper core (generic PRESET 0, result word v1, model :class:`mstrack.hw.cosim.CoreModel`)
+and core v2 (PRESET 1, result word v2, :class:`mstrack.hw.cosim.CoreModelV2`; the v2 registers RES_W8 ..
+RES_STATE, STATUS.tracking and INT_STATUS.lost / reacquired from the v2 status).
+
 cocotb module and pytest entry points in one file.  cocotbext-axi's AxiLiteMaster drives the
 registers (offsets and fields read from regs/ms_tracker_regs.rdl by :func:`mstrack.hw.regs.register_map`,
 the same description the register block and the C header are generated from), an AxiStreamSource
@@ -9,10 +13,13 @@ exactly the frames the wrapper passes to the core; each is read back field by fi
 RES_* registers, from the raw window RES_RAW0..4 and (RESULT_STREAM) from the stream, and compared.
 
 Covered: identification / configuration registers against the generics; bad accesses (unmapped
-address, reserved v2 space, write to read-only, read of write-only: SLVERR, nothing changes);
+address, write to read-only, read of write-only: SLVERR, nothing changes); the other preset's
+registers read 0; STATUS.tracking after every result;
 a frame while disabled (dropped whole, DROP_COUNT, no result); init by CMD.init (init_pending);
 interrupts (status set while disabled and irq low, irq high once enabled, W1C clear); result,
-lost, protocol error (short line) and rejected init box, with their interrupt bits and counters;
+lost, protocol error (short line) and rejected init box (v2 also reacquired: the pattern scene's
+grey frame is lost, the next frame is found again by the wide search at D = 2), with their interrupt
+bits and counters;
 the snapshot (a result landing between the read of RES_HEAD and the other fields does not tear
 them); clear_counters.
 """
@@ -33,9 +40,10 @@ from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
 from cocotbext.axi import (AxiLiteBus, AxiLiteMaster, AxiResp, AxiStreamBus, AxiStreamSink,
                            AxiStreamSource)
 
-from mstrack.hw.cosim import COMPARED_FIELDS, CoreConfig, CoreModel, diff_fields, frame_words
+from mstrack.hw.cosim import (COMPARED_FIELDS, COMPARED_FIELDS_V2, CoreConfig, CoreConfigV2, CoreModel, CoreModelV2,
+                              diff_fields, frame_words)
 from mstrack.fixed import FixedParams
-from mstrack.fixed.vhdl_pkg import RESULT_FLAGS, unpack_result
+from mstrack.fixed.vhdl_pkg import RESULT_FLAGS, STATUS_V2, unpack_result, unpack_result_v2
 from mstrack.track.params import TrackerParams
 from mstrack.hw.regs import register_map
 
@@ -44,6 +52,10 @@ from test_ms_tracker import SEQ_ROOT, lines_of
 CLK_NS = 10
 REGS = register_map()
 FLAG = {f: 1 << i for i, f in enumerate(RESULT_FLAGS)}
+ST = {name: i for i, name in enumerate(STATUS_V2)}
+#: registers of the fields only one word has (they read 0 under the other preset)
+V1_ONLY = ("RES_RHO_E", "RES_ALPHA", "RES_ITER", "RES_BOX")
+V2_ONLY = ("RES_W8", "RES_H8", "RES_CONF", "RES_STATE")
 
 
 # ----------------------------------------------------------------------------- scenes
@@ -78,9 +90,34 @@ def load_job_frames(job: dict) -> tuple[list[np.ndarray], list[str | None], tupl
     return [cv2.imread(str(f), cv2.IMREAD_COLOR) for f in files], [None] * job["n"], tuple(job["box"])
 
 
-def config_of(job: dict) -> CoreConfig:
+def config_of(job: dict) -> CoreConfig | CoreConfigV2:
+    if job.get("preset", 0):
+        return CoreConfigV2(TrackerParams(**{"preset": "v2", **job.get("tp", {})}), FixedParams(**job.get("fp", {})),
+                            max_frame_w=job.get("max_frame_w", 1024))
     return CoreConfig(TrackerParams(**job.get("tp", {})), FixedParams(**job.get("fp", {})),
                       max_frame_w=job.get("max_frame_w", 1024))
+
+
+def top_generics(job: dict) -> dict[str, object]:
+    """Generics of ms_tracker_axi for the job: those of ms_tracker (PRESET 1: tracker_generics) + RESULT_STREAM."""
+    cfg = config_of(job)
+    g: dict[str, object] = dict(cfg.tracker_generics() if isinstance(cfg, CoreConfigV2) else cfg.generics())
+    g["RESULT_STREAM"] = bool(job["result_stream"])
+    return g
+
+
+def is_lost(r: dict[str, int], v2: bool) -> bool:
+    """v1: flag lost; v2: status lost (the core sets flag lost exactly then; checked too)."""
+    return r["status"] == ST["lost"] if v2 else bool(r["flags"] & FLAG["lost"])
+
+
+def is_tracking(r: dict[str, int], v2: bool) -> int:
+    """STATUS.tracking after result r (docs/blocks/ms_tracker_axi.md)."""
+    if r["flags"] & (FLAG["no_target"] | FLAG["error"]):
+        return 0
+    if v2:
+        return int(r["status"] in (ST["ok"], ST["reacquired"], ST["init"], ST["clipped"]))
+    return int(not r["flags"] & FLAG["lost"])
 
 
 # ----------------------------------------------------------------------------- cocotb side
@@ -90,6 +127,8 @@ class TB:
         self.job = job
         self.cfg = config_of(job)
         self.g = self.cfg.generics()
+        self.v2 = bool(job.get("preset", 0))
+        self.fields = COMPARED_FIELDS_V2 if self.v2 else COMPARED_FIELDS
 
     async def reset(self) -> None:
         d = self.dut
@@ -148,8 +187,22 @@ class TB:
         return await self.read_fields(head), await self.read_raw()
 
     async def read_fields(self, head: dict[str, int]) -> dict[str, int]:
+        """Every field of the preset's word from its registers; ``_other``: the raw values of the
+        other preset's registers (must be 0)."""
         r = {"frame_count": head["frame_count"], "flags": head["flags"], "err_code": head["err_code"],
              "valid": head["valid"]}
+        if self.v2:
+            r["cx"] = (await self.rd("RES_CX"))["value"]
+            r["cy"] = (await self.rd("RES_CY"))["value"]
+            r["rho"] = (await self.rd("RES_RHO_C"))["value"]
+            r["w8"] = (await self.rd("RES_W8"))["value"]
+            r["h8"] = (await self.rd("RES_H8"))["value"]
+            r["confidence"] = (await self.rd("RES_CONF"))["value"]
+            st = await self.rd("RES_STATE")
+            r.update({k: st[k] for k in ("status", "iter", "stop", "decim_log2", "searched")})
+            r["_other"] = {n: (await self.rd(n))["_raw"] for n in V1_ONLY}
+            return r
+        r["_other"] = {n: (await self.rd(n))["_raw"] for n in V2_ONLY}
         r["cx"] = (await self.rd("RES_CX"))["value"]
         r["cy"] = (await self.rd("RES_CY"))["value"]
         r["rho_c"] = (await self.rd("RES_RHO_C"))["value"]
@@ -190,9 +243,12 @@ async def run_axi(dut):
     job = json.loads(os.environ["MSTRACK_JOB"])
     tb = TB(dut, job)
     g = tb.g
+    v2 = tb.v2
+    fields = tb.fields
+    unpack = unpack_result_v2 if v2 else unpack_result
     frames, faults, box = load_job_frames(job)
     fh, fw = frames[0].shape[:2]
-    model = CoreModel(tb.cfg.tp, tb.cfg.fp, tb.cfg.max_frame_w)
+    model = (CoreModelV2 if v2 else CoreModel)(tb.cfg.tp, tb.cfg.fp, tb.cfg.max_frame_w)
     budget = 40 * fw * fh + 400_000
     await tb.reset()
     errors: list[str] = []
@@ -204,19 +260,20 @@ async def run_axi(dut):
 
     # -- identification, configuration, reset values
     check("ID", await tb.rd("ID"), {"magic": 0x4D53544B})
-    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "result_version": 1, "result_width": g["RESULT_W"]})
-    check("CONFIG", await tb.rd("CONFIG"), {"features": g["FEATURES"], "kernel_epan": g["KERNEL_EPAN"],
+    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 1, "result_version": 2 if v2 else 1,
+                                              "result_width": g["RESULT_W"]})
+    check("CONFIG", await tb.rd("CONFIG"), {"preset": int(v2), "features": g["FEATURES"], "kernel_epan": g["KERNEL_EPAN"],
                                             "result_stream": int(job["result_stream"]), "lanes": g["LANES"],
                                             "max_half": g["MAX_HALF"]})
     check("FORMAT", await tb.rd("FORMAT"), {"max_frame_w": tb.cfg.max_frame_w, "centre_frac": g["CF"],
                                             "rho_frac": g["RHO_OUT_FRAC"], "alpha_frac": g["AF"]})
-    for name in ("CTRL", "INT_STATUS", "INT_ENABLE", "RESULT_COUNT", "DROP_COUNT", "RES_HEAD", "RES_CX"):
+    for name in ("CTRL", "INT_STATUS", "INT_ENABLE", "RESULT_COUNT", "DROP_COUNT", "RES_HEAD", "RES_CX", *V2_ONLY):
         v = await tb.rd(name)
         if v["_raw"]:
             errors.append(f"{name} after reset: 0x{v['_raw']:08x}")
 
     # -- bad accesses: SLVERR, data 0, no effect
-    for addr in (0x044, 0x070, 0x07C, 0x094, 0xFFC):
+    for addr in (0x044, 0x04C, 0x094, 0x0FC, 0xFFC):
         v, resp = await tb.read_at(addr)
         if resp != AxiResp.SLVERR or v:
             errors.append(f"read of unmapped 0x{addr:03x}: {resp} 0x{v:08x}")
@@ -260,8 +317,11 @@ async def run_axi(dut):
     async def expect_result(k: int, what: str) -> None:
         exp = model.results[k]
         got, raw = await tb.read_result()
-        check(f"{what} registers", got, {**exp, "valid": 1}, list(COMPARED_FIELDS) + ["valid"])
-        check(f"{what} raw", unpack_result(raw, g), exp, COMPARED_FIELDS)
+        check(f"{what} registers", got, {**exp, "valid": 1}, list(fields) + ["valid"])
+        if any(got["_other"].values()):
+            errors.append(f"{what}: registers of the other preset not 0: {got['_other']}")
+        check(f"{what} raw", unpack(raw, g), exp, fields)
+        check(f"{what} STATUS", await tb.rd("STATUS"), {"tracking": is_tracking(exp, v2), "result_valid": 1})
         if raw >> g["RESULT_W"]:
             errors.append(f"{what}: raw bits above RESULT_W set: 0x{raw:x}")
         if tb.sink is not None:
@@ -270,8 +330,11 @@ async def run_axi(dut):
                 errors.append(f"{what}: stream word 0x{int(fr.tdata[0]):x} != registers 0x{raw:x}")
 
     def int_bits(exp: dict) -> dict[str, int]:
-        return {"result": 1, "lost": int(bool(exp["flags"] & FLAG["lost"])),
-                "error": int(bool(exp["flags"] & (FLAG["error"] | FLAG["rejected"])))}
+        if v2 and is_lost(exp, True) != bool(exp["flags"] & FLAG["lost"]):
+            errors.append(f"model: status {exp['status']} and flags 0x{exp['flags']:x} disagree on lost")
+        return {"result": 1, "lost": int(is_lost(exp, v2)),
+                "error": int(bool(exp["flags"] & (FLAG["error"] | FLAG["rejected"]))),
+                "reacquired": int(v2 and exp["status"] == ST["reacquired"])}
 
     # -- frame 0 (init frame) with interrupts disabled: status set, irq low; enabling raises irq
     lines = await tb.send(frames[0], faults[0])
@@ -281,12 +344,12 @@ async def run_axi(dut):
     if int(dut.irq.value):
         errors.append("irq high with INT_ENABLE = 0")
     check("INT_STATUS (disabled)", await tb.rd("INT_STATUS"), int_bits(model.results[0]))
-    await tb.wr("INT_ENABLE", result=1, lost=1, error=1)
+    await tb.wr("INT_ENABLE", result=1, lost=1, error=1, reacquired=1)
     await ClockCycles(dut.clk, 2)
     if not int(dut.irq.value):
         errors.append("irq low with INT_STATUS.result and INT_ENABLE.result set")
     await expect_result(0, "frame 0")
-    await tb.wr("INT_STATUS", result=1, lost=1, error=1)
+    await tb.wr("INT_STATUS", result=1, lost=1, error=1, reacquired=1)
     await ClockCycles(dut.clk, 2)
     if int(dut.irq.value) or (await tb.rd("INT_STATUS"))["_raw"]:
         errors.append("W1C did not clear INT_STATUS / irq")
@@ -307,7 +370,7 @@ async def run_axi(dut):
         exp = model.results[k]
         check(f"frame {i} INT_STATUS", await tb.rd("INT_STATUS"), int_bits(exp))
         await expect_result(k, f"frame {i} ({faults[i] or model.kinds[k]})")
-        await tb.wr("INT_STATUS", result=1, lost=1, error=1)
+        await tb.wr("INT_STATUS", result=1, lost=1, error=1, reacquired=1)
         k += 1
         if len(errors) > 8:
             break
@@ -322,27 +385,29 @@ async def run_axi(dut):
         feed_model(model, lines, fw, fh)
         await tb.wait_result(k + 2, budget)           # result k + 1 is latched now
         got = await tb.read_fields(head)
-        check("snapshot (fields after a newer result)", got, model.results[k], COMPARED_FIELDS)
-        check("snapshot raw", unpack_result(await tb.read_raw(), g), model.results[k], COMPARED_FIELDS)
+        check("snapshot (fields after a newer result)", got, model.results[k], fields)
+        check("snapshot raw", unpack(await tb.read_raw(), g), model.results[k], fields)
         if tb.sink is None:
             await expect_result(k + 1, "after the snapshot")
         else:
             for j in (k, k + 1):                      # the stream carried both
                 fr = await with_timeout(tb.sink.recv(), budget * CLK_NS, "ns")
-                check(f"stream {j}", unpack_result(int(fr.tdata[0]), g), model.results[j], COMPARED_FIELDS)
+                check(f"stream {j}", unpack(int(fr.tdata[0]), g), model.results[j], fields)
             got, raw = await tb.read_result()
-            check("after the snapshot", got, model.results[k + 1], COMPARED_FIELDS)
+            check("after the snapshot", got, model.results[k + 1], fields)
         k += 2
 
     # -- counters, clear, disable
-    n_lost = sum(bool(r["flags"] & FLAG["lost"]) for r in model.results)
+    n_lost = sum(is_lost(r, v2) for r in model.results)
+    n_reacq = sum(v2 and r["status"] == ST["reacquired"] for r in model.results)
     n_err = sum(bool(r["flags"] & FLAG["error"]) for r in model.results)
     n_rej = sum(bool(r["flags"] & FLAG["rejected"]) for r in model.results)
     check("counters", {"results": (await tb.rd("RESULT_COUNT"))["count"], "lost": (await tb.rd("LOST_COUNT"))["count"],
                        "error": (await tb.rd("ERROR_COUNT"))["count"], "reject": (await tb.rd("REJECT_COUNT"))["count"]},
           {"results": len(model.results), "lost": n_lost, "error": n_err, "reject": n_rej})
-    if job["scene"] == "pattern" and not (n_lost and n_err):
-        errors.append(f"the scene should give lost and error results (lost {n_lost}, error {n_err})")
+    if job["scene"] == "pattern" and not (n_lost and n_err and (n_reacq or not v2)):
+        errors.append(f"the scene should give lost, error (v2: reacquired) results (lost {n_lost}, error {n_err}, "
+                      f"reacquired {n_reacq})")
     await tb.wr("CMD", clear_counters=1)
     for name in ("RESULT_COUNT", "LOST_COUNT", "ERROR_COUNT", "REJECT_COUNT", "DROP_COUNT"):
         if (await tb.rd(name))["count"]:
@@ -352,8 +417,10 @@ async def run_axi(dut):
     await ClockCycles(dut.clk, 200)
     check("disabled again", {"drop": (await tb.rd("DROP_COUNT"))["count"], "results": (await tb.rd("RESULT_COUNT"))["count"]},
           {"drop": 1, "results": 0})
-    dut._log.warning("compared %d results (%s), lost %d, error %d, rejected %d; %d mismatches",
-                     len(model.results), ",".join(model.kinds), n_lost, n_err, n_rej, len(errors))
+    dut._log.warning("PRESET %d: compared %d results (%s), status %s, lost %d, reacquired %d, error %d, rejected %d; "
+                     "%d mismatches", int(v2), len(model.results), ",".join(model.kinds),
+                     [r.get("status") for r in model.results] if v2 else "-", n_lost, n_reacq, n_err, n_rej,
+                     len(errors))
     assert not errors, "\n".join(errors)
 
 
@@ -363,8 +430,7 @@ SMALL = {"fp": {"max_half": 15, "margin": 8}}
 
 def _run(job: dict, build_name: str, verilator: bool = False) -> None:
     from mstrack.hw.hdl import run_ghdl, run_verilator
-    g = config_of(job).generics()
-    g["RESULT_STREAM"] = bool(job["result_stream"])
+    g = top_generics(job)
     runner = run_verilator if verilator else run_ghdl
     runner("ms_tracker_axi", "test_ms_tracker_axi", generics=g, build_name=build_name,
            extra_env={"MSTRACK_JOB": json.dumps(job)})
@@ -395,3 +461,34 @@ def test_axi_real():
     box = round_box(*[float(v) for v in load_sequence(seq).gt[0]])
     job = {"scene": "real", "seq": str(seq), "n": 3, "box": list(box), "result_stream": False}
     _run(job, "ms_tracker_axi_real")
+
+
+# ----------------------------------------------------------------------------- core v2 (PRESET 1)
+def test_axi_v2_synthetic():
+    """GHDL, core v2 (PRESET 1, default v2 generics, MAX_FRAME_W 1024), throttled, result stream: the
+    pattern scene gives init, ok, lost (grey frame), reacquired (wide search at D = 2), ok, a protocol
+    error and a rejected init box; every register field of every result, the raw window, the stream
+    word, STATUS.tracking, INT_STATUS (lost / reacquired from the v2 status), counters and irq."""
+    job = {"preset": 1, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 4}
+    _run(job, "ms_tracker_axi_v2")
+
+
+def test_axi_v2_real():
+    """GHDL, core v2 (PRESET 1, default v2 generics): init + 2 tracked frames of a real sequence (Girl,
+    128x96), results in registers only (RESULT_STREAM false)."""
+    seq = SEQ_ROOT / "Girl"
+    if not seq.is_dir():
+        pytest.skip(f"{seq} not found: the real-video test needs ../shared/data/sequences")
+    from mstrack.io.data import load_sequence
+    from mstrack.fixed.blocks import round_box
+    box = round_box(*[float(v) for v in load_sequence(seq).gt[0]])
+    job = {"preset": 1, "scene": "real", "seq": str(seq), "n": 3, "box": list(box), "result_stream": False}
+    _run(job, "ms_tracker_axi_v2_real")
+
+
+@pytest.mark.verilator
+def test_axi_v2_verilator():
+    """PRESET 1 as the GHDL-synthesised netlist (register block and core v2 included) under Verilator,
+    throttled: the pattern scene of test_axi_v2_synthetic (GHDL's Verilog writer on the v2 wrapper logic)."""
+    job = {"preset": 1, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 5}
+    _run(job, "ms_tracker_axi_v2_verilator", verilator=True)

@@ -24,14 +24,15 @@ def test_generated_files_marked():
 
 
 def test_register_map():
-    """The map the wrapper and the driver rely on: 32-bit aligned, no overlaps, v2 space free."""
+    """The map the wrapper and the driver rely on: 32-bit aligned, no overlaps, v2 fields at 0x070..0x07C."""
     m = regs.register_map()
     offs = sorted(r.offset for r in m.values())
     assert all(o % 4 == 0 for o in offs) and len(set(offs)) == len(offs)
     assert m["ID"].offset == 0 and m["ID"].fields["magic"].reset == 0x4D53544B
     assert m["RES_HEAD"].offset < m["RES_CX"].offset
-    reserved_v2 = range(0x70, 0x80)
-    assert not [r.name for r in m.values() if r.offset in reserved_v2]
+    v2_space = range(0x70, 0x80)
+    assert [r.name for r in m.values() if r.offset in v2_space] == ["RES_W8", "RES_H8", "RES_CONF", "RES_STATE"]
+    assert m["VERSION"].fields["map_minor"].reset == 1 and m["VERSION"].fields["map_major"].reset == 1
     raw = [m[f"RES_RAW{i}"].offset for i in range(5)]
     assert raw == list(range(raw[0], raw[0] + 20, 4))
     assert 5 * 32 >= max(result_width(), result_width_v2())
@@ -43,7 +44,7 @@ def test_register_map():
             bits |= mask
         assert bits < 1 << 32
     # the interrupt bits the wrapper sets and the flags they follow
-    assert set(m["INT_STATUS"].fields) == set(m["INT_ENABLE"].fields) == {"result", "lost", "error"}
+    assert set(m["INT_STATUS"].fields) == set(m["INT_ENABLE"].fields) == {"result", "lost", "error", "reacquired"}
 
 
 def test_register_fields_hold_result_fields():
@@ -59,6 +60,34 @@ def test_register_fields_hold_result_fields():
     for name, off, w in result_layout():
         reg, fld = where[name]
         assert m[reg].fields[fld].width >= w, name
+
+
+def test_register_fields_hold_result_fields_v2():
+    """Every field of result word v2 fits its register field (ms_tracker_axi, PRESET 1)."""
+    m = regs.register_map()
+    where = {"cx": ("RES_CX", "value"), "cy": ("RES_CY", "value"), "w8": ("RES_W8", "value"),
+             "h8": ("RES_H8", "value"), "rho": ("RES_RHO_C", "value"), "confidence": ("RES_CONF", "value"),
+             "status": ("RES_STATE", "status"), "iter": ("RES_STATE", "iter"), "stop": ("RES_STATE", "stop"),
+             "decim_log2": ("RES_STATE", "decim_log2"), "searched": ("RES_STATE", "searched"),
+             "flags": ("RES_HEAD", "flags"), "err_code": ("RES_HEAD", "err_code"),
+             "frame_count": ("RES_HEAD", "frame_count")}
+    for name, off, w in result_layout_v2():
+        reg, fld = where[name]
+        assert m[reg].fields[fld].width >= w, name
+
+
+def test_wrapper_takes_every_core_generic():
+    """ms_tracker_axi has every generic of ms_tracker (so `mstrack hdl config`'s generic map fits it too)
+    and passes each to the core under the same name."""
+    from mstrack.hw.hdl_config import entity_generics
+    text = re.sub(r"--[^\n]*", "", (regs.REPO / "rtl" / "ms_tracker_axi.vhd").read_text())
+    decl = re.search(r"entity\s+ms_tracker_axi\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
+    assert decl
+    names = re.findall(r"(\w+)\s*:\s*(?:natural|integer|boolean)\b", decl.group(1), re.I)
+    core = entity_generics()
+    assert [n for n in names if n != "RESULT_STREAM"] == core
+    for n in core:
+        assert re.search(rf"\b{n}\s*=>\s*{n}\b", text), f"{n} not passed to ms_tracker"
 
 
 def test_wrapper_uses_generated_names():

@@ -167,10 +167,68 @@ def test_init_and_start(drv):
     c = got[3]
     assert c["rc"] == 0 and c["FRAME_SIZE"] == m["FRAME_SIZE"].encode(width=640, height=480)
     assert c["CTRL"] == 0 and c["CMD"] == m["CMD"].encode(clear_counters=1)
-    assert c["INT_STATUS"] == m["INT_STATUS"].encode(result=1, lost=1, error=1)
+    assert c["INT_STATUS"] == m["INT_STATUS"].encode(result=1, lost=1, error=1, reacquired=1)
+    assert c["RV"] == 1
     assert got[4]["rc"] == -3                                         # wider than max_frame_w
     s = got[7]
     assert s["rc"] == 0 and s["INIT_POS"] == m["INIT_POS"].encode(x=(-5) & 0xFFFF, y=10)
     assert s["INIT_SIZE"] == m["INIT_SIZE"].encode(width=20, height=30)
     assert s["CMD"] == m["CMD"].encode(init=1) and s["INT_ENABLE"] == 3 and s["CTRL"] == 1
     assert got[8]["rc"] == -3
+
+
+# ----------------------------------------------------------------------------- core v2 (PRESET 1)
+def model_words_v2() -> list[int]:
+    """Result words v2 of the fixed-point model on a synthetic scene (init + tracking frames)."""
+    from mstrack.fixed import pack_result_v2
+    from mstrack.hw.cosim import expected_results_v2
+    from mstrack.io.synthetic import make_scene
+    frames, _ = make_scene(5, 96, 72, seed=3)
+    return [pack_result_v2(r) for r in expected_results_v2(frames, (17, 34, 24, 24), first_count=65533)]
+
+
+def _regs_of_v2(f: dict[str, int], m) -> dict[int, int]:
+    """Register values ms_tracker_axi (PRESET 1) shows for one result word v2 (encoded with the RDL's
+    fields); the v1-only registers read 0."""
+    return {
+        m["RES_HEAD"].offset: m["RES_HEAD"].encode(frame_count=f["frame_count"], flags=f["flags"],
+                                                   err_code=f["err_code"], valid=1),
+        m["RES_CX"].offset: f["cx"], m["RES_CY"].offset: f["cy"], m["RES_RHO_C"].offset: f["rho"],
+        m["RES_RHO_E"].offset: 0, m["RES_ALPHA"].offset: 0, m["RES_ITER"].offset: 0, m["RES_BOX"].offset: 0,
+        m["RES_W8"].offset: f["w8"], m["RES_H8"].offset: f["h8"], m["RES_CONF"].offset: f["confidence"],
+        m["RES_STATE"].offset: m["RES_STATE"].encode(**{k: f[k] for k in ("status", "iter", "stop", "decim_log2",
+                                                                         "searched")}),
+    }
+
+
+def test_read_result_v2_and_irq(drv):
+    """Core v2: mstrack_init accepts result word 2, mstrack_read_result_v2 and mstrack_irq_handler read
+    every field of model and random words v2 from a fake register file laid out as ms_tracker_axi's."""
+    m = register_map()
+    names = [n for n, _, _ in result_layout_v2()]
+    words = model_words_v2() + random_words(20, sum(w for _, _, w in result_layout_v2()), 10)
+    ident = {m["ID"].offset: 0x4D53544B, m["VERSION"].offset: m["VERSION"].encode(map_major=1, map_minor=1,
+                                                                                  result_version=2),
+             m["FORMAT"].offset: m["FORMAT"].encode(max_frame_w=1024)}
+    setup = "regs " + " ".join(f"{o:x}={v:x}" for o, v in ident.items())
+    lines, exp = [setup, "init 320 240"], []
+    for w in words:
+        f = unpack_result_v2(w)
+        lines.append("regs " + " ".join(f"{o:x}={v:x}" for o, v in _regs_of_v2(f, m).items()))
+        lines.append("read2")
+        exp.append(f)
+    st = m["INT_STATUS"]
+    bits = st.encode(result=1, lost=1, reacquired=1)
+    lines += [f"regs {st.offset:x}={bits:x}", "irq2"]
+    got = _run(drv, lines)
+    assert got[1]["rc"] == 0 and got[1]["RV"] == 2
+    for f, c in zip(exp, got[3:-2:2]):
+        assert c["rc"] == 0 and c["valid"] == 1
+        assert {k: c[k] for k in names} == {k: f[k] for k in names}
+    last = got[-1]                                   # the handler on the last word's registers
+    assert last["st"] == last["written"] == bits
+    assert {k: last[k] for k in names} == {k: exp[-1][k] for k in names} and last["valid"] == 1
+    assert last["rho_c"] == exp[-1]["rho"] and last["box_w"] == 0
+    # result word 3 is refused
+    bad = m["VERSION"].encode(map_major=1, result_version=3)
+    assert _run(drv, [setup, f"regs {m['VERSION'].offset:x}={bad:x}", "init 320 240"])[2]["rc"] == -2

@@ -5,8 +5,10 @@
  *   word2 H0 H1 H2 H3 H4     decode a result word v2
  *   regs OFF=VAL ...         set registers of a fake register file (hex byte offset = hex value)
  *   read                     mstrack_read_result on the fake register file
+ *   read2                    mstrack_read_result_v2 on the fake register file
  *   irq                      mstrack_irq_handler; prints the returned bits, INT_STATUS written, the result
- *   init W H                 mstrack_init; prints the return code, FRAME_SIZE, CTRL, CMD, INT_STATUS
+ *   irq2                     the same, then dev.last_v2 (core v2)
+ *   init W H                 mstrack_init; prints the return code, result_version, FRAME_SIZE, CTRL, CMD, INT_STATUS
  *   start X Y W H MASK       mstrack_start; prints the return code, INIT_POS, INIT_SIZE, CMD, INT_ENABLE, CTRL
  * Results print as name=value (decimal) in the field order of the structs.
  */
@@ -32,12 +34,12 @@ static void print_result(const mstrack_result_t *r)
 static void print_v2(const mstrack_result_v2_t *r)
 {
     printf("cx=%lu cy=%lu w8=%lu h8=%lu rho=%lu confidence=%lu status=%lu iter=%lu stop=%lu "
-           "decim_log2=%lu searched=%lu flags=%lu err_code=%lu frame_count=%lu\n",
+           "decim_log2=%lu searched=%lu flags=%lu err_code=%lu frame_count=%lu valid=%lu\n",
            (unsigned long)r->cx, (unsigned long)r->cy, (unsigned long)r->w8, (unsigned long)r->h8,
            (unsigned long)r->rho, (unsigned long)r->confidence, (unsigned long)r->status,
            (unsigned long)r->iter, (unsigned long)r->stop, (unsigned long)r->decim_log2,
            (unsigned long)r->searched, (unsigned long)r->flags, (unsigned long)r->err_code,
-           (unsigned long)r->frame_count);
+           (unsigned long)r->frame_count, (unsigned long)r->valid);
 }
 
 #define AT(NAME) mem[offsetof(ms_tracker_regs_t, NAME) / 4u]
@@ -49,6 +51,7 @@ int main(void)
     dev.base = (uintptr_t)mem;
     dev.irq_mask = 0;
     dev.irq_count = 0;
+    dev.result_version = 1;
     while (fgets(line, sizeof line, stdin) != NULL) {
         char *tok = strtok(line, " \t\r\n");
         if (tok == NULL) {
@@ -86,6 +89,20 @@ int main(void)
             int rc = mstrack_read_result(&dev, &r);
             printf("rc=%d ", rc);
             print_result(&r);
+        } else if (strcmp(tok, "read2") == 0) {
+            mstrack_result_v2_t r;
+            int rc = mstrack_read_result_v2(&dev, &r);
+            printf("rc=%d ", rc);
+            print_v2(&r);
+        } else if (strcmp(tok, "irq2") == 0) {
+            mstrack_result_t r;
+            uint32_t st;
+            memset(&r, 0, sizeof r);
+            memset(&dev.last_v2, 0, sizeof dev.last_v2);
+            st = mstrack_irq_handler(&dev, &r);
+            printf("st=%lu written=%lu rho_c=%lu box_w=%lu ", (unsigned long)st, (unsigned long)AT(INT_STATUS),
+                   (unsigned long)r.rho_c, (unsigned long)r.box_w);
+            print_v2(&dev.last_v2);
         } else if (strcmp(tok, "irq") == 0) {
             mstrack_result_t r;
             uint32_t st;
@@ -98,7 +115,8 @@ int main(void)
             char *b = strtok(NULL, " \t\r\n");
             int rc = mstrack_init(&dev, (uintptr_t)mem, a ? (uint32_t)strtoul(a, NULL, 10) : 0u,
                                   b ? (uint32_t)strtoul(b, NULL, 10) : 0u);
-            printf("rc=%d FRAME_SIZE=%lu CTRL=%lu CMD=%lu INT_STATUS=%lu\n", rc, (unsigned long)AT(FRAME_SIZE),
+            printf("rc=%d RV=%lu FRAME_SIZE=%lu CTRL=%lu CMD=%lu INT_STATUS=%lu\n", rc,
+                   (unsigned long)dev.result_version, (unsigned long)AT(FRAME_SIZE),
                    (unsigned long)AT(CTRL), (unsigned long)AT(CMD), (unsigned long)AT(INT_STATUS));
         } else if (strcmp(tok, "start") == 0) {
             long v[5] = {0, 0, 0, 0, 0};

@@ -213,29 +213,25 @@ begin
   -- dxs^2 + dys^2 and a^2 + b^2 are >= EPS2: "not small" either way.  (When SQ_W = CENTRE_W,
   -- M >= |d| always and nothing saturates.)
   p_shift : process(clk)
-    variable ad : unsigned(SCW - 1 downto 0);
+    -- |d| saturated to SQ_W bits (|d| < 2**CENTRE_W: the negation does not overflow; not abs:
+    -- GHDL 2.0 writes it as VHDL into the Verilog)
+    function sat_mag(d : sc_t) return unsigned is
+      variable ad : unsigned(SCW - 1 downto 0);
+    begin
+      if d < 0 then
+        ad := unsigned(-d);
+      else
+        ad := unsigned(d);
+      end if;
+      if shift_right(ad, SQ_W) /= 0 then
+        return to_unsigned(2 ** SQ_W - 1, SQ_W);
+      end if;
+      return ad(SQ_W - 1 downto 0);
+    end function;
   begin
     if rising_edge(clk) then
-      if dxs < 0 then                           -- |dxs| < 2**CENTRE_W: no overflow
-        ad := unsigned(-dxs);                   -- (not abs: GHDL 2.0 writes it as VHDL into the Verilog)
-      else
-        ad := unsigned(dxs);
-      end if;
-      if shift_right(ad, SQ_W) /= 0 then
-        dxa <= (others => '1');
-      else
-        dxa <= ad(SQ_W - 1 downto 0);
-      end if;
-      if dys < 0 then
-        ad := unsigned(-dys);
-      else
-        ad := unsigned(dys);
-      end if;
-      if shift_right(ad, SQ_W) /= 0 then
-        dya <= (others => '1');
-      else
-        dya <= ad(SQ_W - 1 downto 0);
-      end if;
+      dxa <= sat_mag(dxs);
+      dya <= sat_mag(dys);
       sqx <= dxa * dxa;
       sqy <= dya * dya;
       shift2 <= resize(sqx, 2 * SQ_W + 1) + sqy;

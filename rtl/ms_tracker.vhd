@@ -43,6 +43,11 @@
 -- Throughput: PPC pixels per clock while a frame streams in.  After the last pixel of a
 -- frame, s_axis_tready stays low until that frame's result is computed (both features'
 -- mean-shift loops in parallel, then fusion); see docs/performance.md for cycle counts.
+-- Result path: the 144-bit result word is loaded in the clock after the branch that decides it,
+-- from held registers (centre in c8x / c8y, the fusion's and engines' outputs, the branch's flags
+-- and error code registered with it), so its load enable is one flip-flop; a tracked or learnt
+-- result still leaves T_PUSH in the next clock (the frame's latency is unchanged), an error result
+-- goes to the FIFO one clock after its word (the input stays closed until then).
 -- The input is back-pressured while a frame is streaming only after a protocol error (until
 -- the error result is written), when the result FIFO is full, and for one clock when an init
 -- box is taken.
@@ -203,6 +208,7 @@ architecture rtl of ms_tracker is
   signal line_cnt       : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal drain_cnt      : natural range 0 to DRAIN := 0;
   signal fr_w, fr_h     : unsigned(COORD_W - 1 downto 0) := (others => '0');  -- size of the frame in progress
+  signal size_mis       : std_logic := '0';  -- registered (fr_w, fr_h) /= (tgt_w, tgt_h): both settle long before cap_done
   signal size_ok        : std_logic;                      -- frame_width / frame_height in range
   signal err_hold       : std_logic := '0';               -- an error is on its way to the FIFO: input closed
   signal init_take      : std_logic;                      -- the init box is taken this clock
@@ -263,6 +269,14 @@ architecture rtl of ms_tracker is
   signal fu_rho_c, fu_rho_e : unsigned(RHO_OUT_W - 1 downto 0);
   -- results
   signal res_word       : std_logic_vector(RESULT_W - 1 downto 0);
+  -- the result word is loaded one clock after the branch that decides it (res_ld), from held
+  -- registers selected by registered flags (rs_learn / rs_fuse): no deep load enable on its
+  -- 144 flip-flops; the branch keeps its flags and error code in res_flags / res_err
+  signal res_ld, rs_learn, rs_fuse : std_logic := '0';
+  signal res_flags      : std_logic_vector(FLAGS_W - 1 downto 0) := (others => '0');
+  signal res_err        : std_logic_vector(ERR_W - 1 downto 0) := (others => '0');
+  signal err_push       : std_logic := '0';           -- an error result goes to the FIFO next clock
+  signal push_now       : std_logic;                  -- T_PUSH writes its word this clock
   signal fifo_valid, fifo_ready : std_logic;
   signal fifo_data      : std_logic_vector(RESULT_W - 1 downto 0);
   signal frame_count    : unsigned(FCOUNT_W - 1 downto 0) := (others => '0');
@@ -476,8 +490,9 @@ begin
   -- in the clock an init box is taken (the box applies to the frame after that clock)
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W
                      and width_ppc_ok(frame_width) else '0';
+  -- (err_push: the error word is loaded, the FIFO takes it at the end of the next clock)
   accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
-                     and fe_err_now = '0' and init_take = '0' else '0';
+                     and err_push = '0' and fe_err_now = '0' and init_take = '0' else '0';
   s_axis_tready <= accept;
   beat <= s_axis_tvalid and accept;
 
@@ -500,6 +515,9 @@ begin
           in_frame <= '0';
         end if;
       end if;
+      -- fr_w / fr_h change at a start of frame, tgt_w / tgt_h in T_TABLES: both at least a
+      -- frame's beats and the front end's delay before the cap_done that reads size_mis
+      size_mis <= '1' when fr_w /= tgt_w or fr_h /= tgt_h else '0';
       if gate_closed = '1' and state = T_IDLE then
         -- a frame that ended badly has no frame_end: reopen once the front end has drained
         if drain_cnt = DRAIN then
@@ -511,7 +529,7 @@ begin
       else
         drain_cnt <= 0;
       end if;
-      if state = T_PUSH and fifo_ready = '1' then
+      if push_now = '1' then
         gate_closed <= '0';
       end if;
       if rst = '1' then
@@ -676,7 +694,38 @@ begin
       fu_start <= '0';
       rg_valid_in <= '0';
       fifo_valid <= '0';
+      res_ld <= '0';
       zero_s2 := "00";
+
+      -- the result word of the branch decided a clock ago (below): c8x / c8y already hold its
+      -- centre (the learn and fuse branches load them in the same clock)
+      if res_ld = '1' then
+        if FEATURES = 1 then a_init := to_unsigned(A_ONE, ALPHA_W);
+        elsif FEATURES = 2 then a_init := (others => '0');
+        else a_init := to_unsigned(A_ONE / 2, ALPHA_W);
+        end if;
+        ic := c_iter; sc := c_stop; ie := e_iter; se := e_stop;
+        if FEATURES = 2 then ic := (others => '0'); sc := "00"; end if;
+        if FEATURES = 1 then ie := (others => '0'); se := "00"; end if;
+        if rs_fuse = '1' then
+          res_word <= pack(c8x, c8y, fu_rho_c, fu_rho_e, fu_alpha, ic, ie, sc, se, res_flags, res_err,
+                           box_w, box_h, frame_count);
+        elsif rs_learn = '1' then
+          res_word <= pack(c8x, c8y, to_unsigned(RHO_ONE, RHO_OUT_W), to_unsigned(RHO_ONE, RHO_OUT_W),
+                           a_init, to_unsigned(0, ITER_W), to_unsigned(0, ITER_W), zero_s2, zero_s2,
+                           res_flags, res_err, box_w, box_h, frame_count);
+        else
+          res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
+                           to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
+                           zero_s2, zero_s2, res_flags, res_err, box_w, box_h, frame_count);
+        end if;
+      end if;
+      -- an error result: its word is loaded in this clock, the FIFO takes it in the next
+      err_push <= '0';
+      if err_push = '1' then
+        fifo_valid <= '1';
+        frame_count <= frame_count + 1;
+      end if;
 
       -- protocol errors: one error result each (pushed when the FIFO has room)
       if fe_err_now = '1' then
@@ -706,13 +755,11 @@ begin
 
         when T_IDLE =>
           if cap_done = '1' then                     -- a good frame is in the region RAMs
-            if (init_pending = '1' or target_valid = '1') and (fr_w /= tgt_w or fr_h /= tgt_h) then
+            if (init_pending = '1' or target_valid = '1') and size_mis = '1' then
               -- not the size the target was initialised for: not tracked, state unchanged
-              res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
-                               to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
-                               zero_s2, zero_s2,
-                               flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
-                               ERR_SIZE_CHANGED, box_w, box_h, frame_count);
+              res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '0';
+              res_flags <= flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow);
+              res_err <= ERR_SIZE_CHANGED;
               state <= T_PUSH;
             elsif init_pending = '1' or target_valid = '1' then
               learn_run <= init_pending;
@@ -721,21 +768,17 @@ begin
               e_got <= '0';
               state <= T_RUN;
             else
-              res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
-                               to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
-                               zero_s2, zero_s2,
-                               flags_of('0', '0', '0', '0', rejected_pending, '1', overflow),
-                               "000", box_w, box_h, frame_count);
+              res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '0';
+              res_flags <= flags_of('0', '0', '0', '0', rejected_pending, '1', overflow);
+              res_err <= "000";
               state <= T_PUSH;
             end if;
-          elsif err_pending = '1' and fifo_ready = '1' then
-            res_word <= pack(c8x, c8y, to_unsigned(0, RHO_OUT_W), to_unsigned(0, RHO_OUT_W),
-                             to_unsigned(0, ALPHA_W), to_unsigned(0, ITER_W), to_unsigned(0, ITER_W),
-                             zero_s2, zero_s2,
-                             flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
-                             err_code_r, box_w, box_h, frame_count);
-            fifo_valid <= '1';
-            frame_count <= frame_count + 1;
+          elsif err_pending = '1' and fifo_ready = '1' and err_push = '0' and fifo_valid = '0' then
+            -- (no write on its way: fifo_ready counts every word already written)
+            res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '0';
+            res_flags <= flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow);
+            res_err <= err_code_r;
+            err_push <= '1';
             overflow <= '0';
             rejected_pending <= '0';
             if fe_error = '0' then
@@ -786,19 +829,14 @@ begin
           if e_done = '1' then e_got <= '1'; end if;
           if (c_got = '1' or c_done = '1') and (e_got = '1' or e_done = '1') then
             if learn_run = '1' then
-              if FEATURES = 1 then a_init := to_unsigned(A_ONE, ALPHA_W);
-              elsif FEATURES = 2 then a_init := (others => '0');
-              else a_init := to_unsigned(A_ONE / 2, ALPHA_W);
-              end if;
               k_r <= c_k;
               c8x <= c_cx;
               c8y <= c_cy;
               target_valid <= '1';
               init_pending <= '0';
-              res_word <= pack(c_cx, c_cy, to_unsigned(RHO_ONE, RHO_OUT_W), to_unsigned(RHO_ONE, RHO_OUT_W),
-                               a_init, to_unsigned(0, ITER_W), to_unsigned(0, ITER_W), zero_s2, zero_s2,
-                               flags_of('1', init_clipped, '0', '0', rejected_pending, '0', overflow),
-                               "000", box_w, box_h, frame_count);
+              res_ld <= '1'; rs_learn <= '1'; rs_fuse <= '0';
+              res_flags <= flags_of('1', init_clipped, '0', '0', rejected_pending, '0', overflow);
+              res_err <= "000";
               state <= T_PUSH;
             else
               fu_start <= '1';
@@ -817,18 +855,16 @@ begin
             end if;
             c8x <= fu_cx;
             c8y <= fu_cy;
-            -- an unused feature reports 0 iterations and stop code 0 (as the model)
-            ic := c_iter; sc := c_stop; ie := e_iter; se := e_stop;
-            if FEATURES = 2 then ic := (others => '0'); sc := "00"; end if;
-            if FEATURES = 1 then ie := (others => '0'); se := "00"; end if;
-            res_word <= pack(fu_cx, fu_cy, fu_rho_c, fu_rho_e, fu_alpha, ic, ie, sc, se,
-                             flags_of('0', '0', lost, '0', rejected_pending, '0', overflow),
-                             "000", box_w, box_h, frame_count);
+            -- the word a clock later (above); an unused feature reports 0 iterations and stop
+            -- code 0 (as the model)
+            res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '1';
+            res_flags <= flags_of('0', '0', lost, '0', rejected_pending, '0', overflow);
+            res_err <= "000";
             state <= T_PUSH;
           end if;
 
-        when T_PUSH =>
-          if fifo_ready = '1' then
+        when T_PUSH =>              -- its word was loaded in the clock after the branch
+          if push_now = '1' then
             fifo_valid <= '1';
             frame_count <= frame_count + 1;
             overflow <= '0';
@@ -845,6 +881,8 @@ begin
         rejected_pending <= '0';
         err_pending <= '0';
         err_hold <= '0';
+        err_push <= '0';
+        res_ld <= '0';
         overflow <= '0';
         frame_count <= (others => '0');
         box_w <= (others => '0');
@@ -859,8 +897,12 @@ begin
     end if;
   end process;
 
+  -- T_PUSH writes when the FIFO has room and no error word is on its way (fifo_valid: written
+  -- at the next edge, not yet counted by fifo_ready)
+  push_now <= '1' when state = T_PUSH and fifo_ready = '1' and fifo_valid = '0' else '0';
+
   init_ready <= '1' when state = T_IDLE and cap_done = '0' and err_pending = '0' and in_frame = '0'
-                         and gate_closed = '0' and err_hold = '0' and fe_err_now = '0' else '0';
+                         and gate_closed = '0' and err_hold = '0' and err_push = '0' and fe_err_now = '0' else '0';
   init_take <= s_init_tvalid and init_ready;
   s_init_tready <= init_ready;
   end generate g_paper;

@@ -28,7 +28,8 @@
 -- be stable during a pass.
 -- Scan tap (px_*): the scan's beat (valid, lane mask, lane-0 dx, dy, last) in the cycle its
 -- ram_addr is out, for ms_target_stats (v2), which reads the same beat's bins from ram_data one
--- clock later (so with RAM_LAT = 1 only); wires from the scan's registers, the pass itself is unchanged.
+-- clock later (so with RAM_LAT = 1 only; ms_tracker_v2 delays the tap RAM_LAT - 1 clocks); wires from the
+-- scan's registers, the pass itself is unchanged.
 -- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
 library ieee;
 use ieee.std_logic_1164.all;

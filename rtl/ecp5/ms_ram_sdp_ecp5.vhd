@@ -7,7 +7,8 @@
 -- a block holds BW = 16384 / WM words (1024 for x18); NCOL = ceil(DATA_W / WM) blocks side by side,
 -- NROW = ceil(DEPTH / BW) rows.  Port A writes, port B reads (WEB = 0).
 -- Read pipeline (edge s samples raddr): s: DP16KD address register (CEB = raddr < DEPTH, so the
--- read latch holds on reads >= DEPTH, as in `inferred`); s + 1: DP16KD output register
+-- read latch holds on reads >= DEPTH, as in `inferred`; CEB = 1 with two multiplexer levels, whose
+-- output register alone holds); s + 1: DP16KD output register
 -- (REGMODE_B = "OUTREG": clock-to-out ~1 ns instead of ~5.8 ns).  One row (NROW = 1): that is
 -- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (the row of raddr one-hot at s + 1, an
 -- AND-OR of the output registers; the in-range flag delayed two clocks) -> output register, loaded
@@ -186,6 +187,7 @@ begin
     signal wdata_w  : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
     signal row_we_w : row_we_t := (others => '0');
     signal rd_ok    : std_logic;
+    signal ceb      : std_logic;                               -- DP16KD read clock enable
     signal dout     : rows_t;
     signal head     : std_logic_vector(DATA_W - 1 downto 0);  -- the read data after MUX_LAT clocks
   begin
@@ -210,6 +212,10 @@ begin
       end process;
     end generate;
     rd_ok <= '1' when in_range(raddr) else '0';
+    -- two levels: the output register alone holds on reads >= DEPTH (loaded only for reads < DEPTH),
+    -- so the DP16KD read every clock (timing: the compare raddr < DEPTH fed the CEB of a whole bank,
+    -- core v2's path after the two levels)
+    ceb <= '1' when TWO_LEVEL else rd_ok;
 
     g_row : for r in 0 to NROW - 1 generate
       g_col : for c in 0 to NCOL - 1 generate
@@ -235,7 +241,7 @@ begin
             CSDECODE_B => "0b000", WRITEMODE_A => "NORMAL", WRITEMODE_B => "NORMAL", GSR => "DISABLED")
           port map (
             CEA => '1', OCEA => '1', CLKA => clk, WEA => wea, RSTA => '0', CSA2 => '0', CSA1 => '0', CSA0 => '0',
-            CEB => rd_ok, OCEB => '1', CLKB => clk, WEB => '0', RSTB => '0', CSB2 => '0', CSB1 => '0', CSB0 => '0',
+            CEB => ceb, OCEB => '1', CLKB => clk, WEB => '0', RSTB => '0', CSB2 => '0', CSB1 => '0', CSB0 => '0',
           DIA0 => dia(0), DIA1 => dia(1), DIA2 => dia(2), DIA3 => dia(3), DIA4 => dia(4), DIA5 =>
           dia(5), DIA6 => dia(6), DIA7 => dia(7), DIA8 => dia(8), DIA9 => dia(9), DIA10 => dia(10),
           DIA11 => dia(11), DIA12 => dia(12), DIA13 => dia(13), DIA14 => dia(14), DIA15 => dia(15),

@@ -54,7 +54,7 @@ entity ms_meanshift is
     MAX_ITER     : natural := 20;     -- iteration limit
     ITER_W       : natural := 5;      -- iteration counter bits
     EPS2         : natural := 65536;  -- shift stop threshold, Q.2CF px^2
-    RAM_LAT      : positive := 1;     -- region RAM read latency (ms_pixel_pass, 1 .. 3; cycles do not change)
+    RAM_LAT      : positive := 1;     -- region RAM read latency (ms_pixel_pass, 1 .. 4; cycles do not change)
     ITER_BINS    : natural := 0       -- ms_bin_pass ITERATIVE: 1 = iterative arithmetic (few bins; slower pass)
   );
   port (

@@ -18,7 +18,7 @@
 -- Cycle count: if rising edge s samples start = '1', done = '1' is sampled by
 -- edge s + C (done is high during the cycle before that edge), with
 --   C = sum over dy = -ey .. ey of G(dy) + PASS_LAT, PASS_LAT = 10
---   (scan row pipeline 2, kernel 4 (the RAM read, RAM_LAT <= 3 clocks, overlaps it), histogram 4:
+--   (scan row pipeline 2, kernel 4 (the RAM read, RAM_LAT <= 4 clocks, overlaps it), histogram 4:
 --   see docs/blocks/ms_pixel_pass.md; PASS_LAT does not depend on RAM_LAT),
 --   G(dy) = floor((win_x + XR[|dy|]) / LANES) - floor((win_x - XR[|dy|]) / LANES) + 1.
 -- Throughput: LANES pixels per clock, no stall.  Handshake: `start` is a pulse,
@@ -28,7 +28,8 @@
 -- be stable during a pass.
 -- Scan tap (px_*): the scan's beat (valid, lane mask, lane-0 dx, dy, last) in the cycle its
 -- ram_addr is out, for ms_target_stats (v2), which reads the same beat's bins from ram_data one
--- clock later (so with RAM_LAT = 1 only); wires from the scan's registers, the pass itself is unchanged.
+-- clock later (so with RAM_LAT = 1 only; ms_tracker_v2 delays the tap RAM_LAT - 1 clocks); wires from the
+-- scan's registers, the pass itself is unchanged.
 -- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -49,7 +50,7 @@ entity ms_pixel_pass is
     HIST_W      : natural := 14;  -- width of H
     COUNT_W     : natural := 14;  -- width of N
     POSSUM_W    : natural := 21;  -- width of the signed SX, SY
-    RAM_LAT     : positive := 1   -- region RAM read latency, 1 .. 3 (3: ms_ram_sdp on ECP5): no clock more, 2 bin delay stages fewer
+    RAM_LAT     : positive := 1   -- region RAM read latency, 1 .. 4 (3 / 4: ms_ram_sdp on ECP5): no clock more, RAM_LAT - 1 bin delay stages fewer
   );
   port (
     clk          : in  std_logic;                                    -- clock
@@ -103,10 +104,9 @@ architecture rtl of ms_pixel_pass is
 
   -- delays to the histogram input (cycle t + KERNEL_LAT); index i = value of cycle t + i
   type d_arr_t is array (1 to KERNEL_LAT) of signed(D_W - 1 downto 0);
-  type bin_arr_t is array (RAM_LAT + 1 to KERNEL_LAT) of std_logic_vector(LANES * BIN_W - 1 downto 0);
+  signal hist_bin          : std_logic_vector(LANES * BIN_W - 1 downto 0);  -- the bins at cycle t + KERNEL_LAT
   signal last_d            : std_logic_vector(1 to KERNEL_LAT) := (others => '0');
   signal dx_d, dy_d        : d_arr_t := (others => (others => '0'));
-  signal bin_d             : bin_arr_t := (others => (others => '0'));
 
   -- kernel outputs (cycle t + KERNEL_LAT)
   signal k_valid, k_inside : std_logic_vector(LANES - 1 downto 0);
@@ -114,7 +114,7 @@ architecture rtl of ms_pixel_pass is
   signal h_valid           : std_logic_vector(LANES - 1 downto 0);
   signal h_dx              : std_logic_vector(LANES * D_W - 1 downto 0);
 begin
-  assert RAM_LAT < KERNEL_LAT report "ms_pixel_pass: RAM_LAT must be below the kernel latency (4)" severity failure;
+  assert RAM_LAT <= KERNEL_LAT report "ms_pixel_pass: RAM_LAT must not exceed the kernel latency (4)" severity failure;
 
   u_scan : entity work.ms_window_scan
     generic map (LANES => LANES, HALF_W => HALF_W, REGION_W => REGION_W, STRIDE => STRIDE, ADDR_W => ADDR_W)
@@ -163,22 +163,38 @@ begin
         dy_d(i)   <= dy_d(i - 1);
         last_d(i) <= last_d(i - 1);
       end loop;
-      bin_d(RAM_LAT + 1) <= ram_data;
-      for i in RAM_LAT + 2 to KERNEL_LAT loop
-        bin_d(i) <= bin_d(i - 1);
-      end loop;
       if rst = '1' then
         last_d <= (others => '0');
       end if;
     end if;
   end process;
 
+  -- the bins: RAM_LAT = KERNEL_LAT: the RAM's (registered) read data itself; else delayed to t + KERNEL_LAT
+  g_bin0 : if RAM_LAT = KERNEL_LAT generate
+    hist_bin <= ram_data;
+  end generate;
+  g_bin : if RAM_LAT < KERNEL_LAT generate
+    type bin_arr_t is array (RAM_LAT + 1 to KERNEL_LAT) of std_logic_vector(LANES * BIN_W - 1 downto 0);
+    signal bin_d : bin_arr_t := (others => (others => '0'));
+  begin
+    p_bin : process (clk)
+    begin
+      if rising_edge(clk) then
+        bin_d(RAM_LAT + 1) <= ram_data;
+        for i in RAM_LAT + 2 to KERNEL_LAT loop
+          bin_d(i) <= bin_d(i - 1);
+        end loop;
+      end if;
+    end process;
+    hist_bin <= bin_d(KERNEL_LAT);
+  end generate;
+
   u_hist : entity work.ms_histogram
     generic map (LANES => LANES, BIN_W => BIN_W, D_W => D_W, KERNEL_EPAN => KERNEL_EPAN, KVAL_W => KVAL_W,
                  HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, BIN_RD_LAT => 3)
     port map (
       clk => clk, rst => rst, ready => ready,
-      in_valid => h_valid, in_bin => bin_d(KERNEL_LAT), in_k => k_val, in_dx => h_dx, in_dy => dy_d(KERNEL_LAT),
+      in_valid => h_valid, in_bin => hist_bin, in_k => k_val, in_dx => h_dx, in_dy => dy_d(KERNEL_LAT),
       in_last => last_d(KERNEL_LAT), last_done => done,
       bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
       bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);

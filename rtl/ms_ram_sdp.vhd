@@ -13,7 +13,7 @@
 --     registers.  Used by simulation (GHDL, GHDL -> Verilog -> Verilator) and for other vendors.
 --   * `ecp5` (rtl/ecp5/ms_ram_sdp_ecp5.vhd): DP16KD instantiated with the output register
 --     (REGMODE_B = "OUTREG", which yosys 0.70 never infers), tiled in depth and width, the depth
---     multiplexer behind a register: RD_LAT >= 3.  mstrack.synth analyses it after this file for
+--     multiplexer behind a register: RD_LAT >= 3 (>= 4 and more than 4 rows: two registered levels).  mstrack.synth analyses it after this file for
 --     ECP5 runs, so it becomes the entity's default (most recently analysed) architecture.
 -- Each extra clock of RD_LAT costs DATA_W flip-flops; RD_LAT = 3 lets ECP5 run a block-RAM read at
 -- the fabric's speed (DP16KD clock-to-out without the output register: ~5.8 ns).

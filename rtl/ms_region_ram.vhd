@@ -6,7 +6,7 @@
 -- Read port per bank: raddr(b) -> rdata(b), exactly RD_LAT clocks of latency
 -- (1: the RAM's read register only; 3: what ms_ram_sdp's ecp5 architecture
 -- needs to use the DP16KD output register and register its depth multiplexer;
--- ms_tracker uses 3).  A read of an address >= DEPTH keeps the previous data.
+-- ms_tracker uses 3; 4: that multiplexer in two registered levels, ms_tracker_v2 uses 4).  A read of an address >= DEPTH keeps the previous data.
 -- WR_LAT = 1 registers the write port (on ECP5 after the bank / row decode: the
 -- DP16KD write enables, addresses and data come from flip-flops); ms_tracker uses
 -- 1.  Reads of a word in the clock it is written are undefined on ECP5 (the

@@ -25,7 +25,8 @@
 -- Latency    : STATS_LAT = 6 + log2(LANES) clocks: if edge s samples px_valid = px_last = 1, edge
 --              s + STATS_LAT samples done = 1 (tb/test_ms_target_stats.py asserts it).  Attached to
 --              ms_pixel_pass (PASS_LAT = 10), done comes log2(LANES) - 2 clocks after the pass's done
---              (LANES = 4: in the same clock), long before the bin pass that follows has ended.
+--              (LANES = 4: in the same clock), long before the bin pass that follows has ended; in
+--              ms_tracker_v2 (region RAM latency 4) the tap is delayed 3 clocks, done 3 clocks later.
 -- Throughput : LANES pixels per clock (one beat per clock, no stall, no back-pressure).
 -- Handshake  : none on the input (the tap is a stream); done is a one-clock pulse, nt/st2/n_in/nt_in
 --              are registered and held until the next pass's done.  Tables must not be written

@@ -156,7 +156,7 @@ architecture rtl of ms_tracker_v2 is
   constant BIN_C_W   : natural := 3 * COLOUR_BITS;
   constant N_BINS    : natural := 2 ** BIN_C_W;
   constant DEPTH     : natural := REGION_MAX * STRIDE;
-  constant REGION_RD_LAT : positive := 3;
+  constant REGION_RD_LAT : positive := 4;  -- ms_ram_sdp ecp5: 25 rows per bank, the row multiplexer in two registered levels
   constant REGION_WR_LAT : natural := 1;
   constant DRAIN     : natural := 63;
   constant FLAGS_W   : natural := 8;

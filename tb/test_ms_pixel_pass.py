@@ -313,9 +313,10 @@ def test_ms_pixel_pass_small(kernel, lanes, hdl_waves):
 
 
 @pytest.mark.ghdl
-@pytest.mark.parametrize("kernel,lanes,ram_lat", [("flat", 4, 3), ("epanechnikov", 2, 3), ("flat", 1, 2)])
+@pytest.mark.parametrize("kernel,lanes,ram_lat", [("flat", 4, 3), ("epanechnikov", 2, 3), ("flat", 1, 2),
+                                                       ("flat", 4, 4)])
 def test_ms_pixel_pass_ram_lat(kernel, lanes, ram_lat, hdl_waves):
-    """Region RAM read latency RAM_LAT > 1 (ms_tracker uses 3, ms_ram_sdp's ecp5 architecture):
+    """Region RAM read latency RAM_LAT > 1 (ms_tracker uses 3, ms_tracker_v2 4: ms_ram_sdp's ecp5 architecture):
     same sums and the same PASS_LAT (the read hides in the kernel pipeline)."""
     gen, cfg = pass_generics(TrackerParams(colour_bits=2, kernel=kernel), SMALL_FP, lanes)
     gen["RAM_LAT"] = cfg["RAM_LAT"] = ram_lat

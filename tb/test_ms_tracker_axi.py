@@ -429,11 +429,12 @@ SMALL = {"fp": {"max_half": 15, "margin": 8}}
 
 
 def _run(job: dict, build_name: str, verilator: bool = False) -> None:
-    from mstrack.hw.hdl import run_ghdl, run_verilator
+    from mstrack.hw.hdl import VERILATOR_CXX_O1, run_ghdl, run_verilator
     g = top_generics(job)
+    kw = {"cxx_opt": VERILATOR_CXX_O1} if verilator else {}   # a cheaper C++ build of the large netlist
     runner = run_verilator if verilator else run_ghdl
     runner("ms_tracker_axi", "test_ms_tracker_axi", generics=g, build_name=build_name,
-           extra_env={"MSTRACK_JOB": json.dumps(job)})
+           extra_env={"MSTRACK_JOB": json.dumps(job)}, **kw)
 
 
 @pytest.mark.parametrize("variant", ["stream", "throttled", "no_stream"])
@@ -464,6 +465,7 @@ def test_axi_real():
 
 
 # ----------------------------------------------------------------------------- core v2 (PRESET 1)
+@pytest.mark.long   # 2 min of GHDL: on make test's second core (CI time balance), not in the simulation half
 def test_axi_v2_synthetic():
     """GHDL, core v2 (PRESET 1, default v2 generics, MAX_FRAME_W 1024), throttled, result stream: the
     pattern scene gives init, ok, lost (grey frame), reacquired (wide search at D = 2), ok, a protocol

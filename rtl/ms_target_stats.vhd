@@ -190,10 +190,11 @@ begin
 
     -- T: ms_ram_sdp, read latency 2 (on ECP5 one DP16KD with its output register: the table's
     -- ~5.8 ns clock-to-out no longer reaches the fabric; the inferred architecture: a read
-    -- register and one more), address = the registered bin (edge s + 2), data after edge s + 3
+    -- register and one more), address = the registered bin (edge s + 2), data after edge s + 3;
+    -- the write port registered (WR_LAT 1: written at init only, one clock later is harmless)
     t_wd(0) <= t_data;
     u_t : entity work.ms_ram_sdp
-      generic map (DEPTH => 2 ** BIN_W, DATA_W => 1, ADDR_W => BIN_W, RD_LAT => 2, WR_LAT => 0)
+      generic map (DEPTH => 2 ** BIN_W, DATA_W => 1, ADDR_W => BIN_W, RD_LAT => 2, WR_LAT => 1)
       port map (clk => clk, we => t_we, waddr => t_addr, wdata => t_wd,
                 raddr => unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W)), rdata => t_rd);
     t4(l) <= t_rd(0);

@@ -18,7 +18,7 @@
 -- pixel pass ignores KA/KB).  Entries used: |dx| <= ex, |dy| <= ey (exact there, < 2**KERNEL_BITS).
 --
 -- Pipeline (edge s samples the beat): s: |dx + l|, |dy|, mask -> s+1: bins registered, KA/KB read
--- -> s+2: T read, d2q = KA + KB -> s+3: T read data registered again (no logic after the block RAM)
+-- -> s+2: T read (ms_ram_sdp, RD_LAT 2), d2q = KA + KB -> s+3: T read data out of the RAM's output register
 -- -> s+4: per-lane terms (t, t d2q, in, t in) -> s+5 .. s+4+log2(LANES): adder tree over the lanes
 -- (one level per clock) -> s+5+log2(LANES): accumulators; on the last beat the sums go to the
 -- outputs and the accumulators restart from 0 (the next pass needs no clear).
@@ -90,7 +90,6 @@ architecture rtl of ms_target_stats is
   constant TC_W    : natural := TL + 1;                          -- tree: counts (<= LANES)
 
   type ka_ram_t is array (0 to 2 ** HALF_W - 1) of unsigned(KT_W - 1 downto 0);
-  type t_ram_t is array (0 to 2 ** BIN_W - 1) of std_logic;
   type a_arr_t is array (0 to LANES - 1) of unsigned(HALF_W - 1 downto 0);
   type k_arr_t is array (0 to LANES - 1) of unsigned(KT_W - 1 downto 0);
   type q_arr_t is array (0 to LANES - 1) of unsigned(D2Q_W - 1 downto 0);
@@ -111,9 +110,9 @@ architecture rtl of ms_target_stats is
   signal bin2      : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
   signal ka2       : k_arr_t := (others => (others => '0'));
   signal kb2       : unsigned(KT_W - 1 downto 0) := (others => '0');
-  -- stage 3 (edge s + 2): T read, d2q; stage 4 (edge s + 3): T read data registered again
+  -- stage 3 (edge s + 2): T read (u_t), d2q; stage 4 (edge s + 3): T read data out of u_t
   signal last3, last4 : std_logic := '0';
-  signal m3, t3    : std_logic_vector(LANES - 1 downto 0) := (others => '0');
+  signal m3        : std_logic_vector(LANES - 1 downto 0) := (others => '0');
   signal m4, t4    : std_logic_vector(LANES - 1 downto 0) := (others => '0');
   signal d3, d4    : q_arr_t := (others => (others => '0'));
   -- stage 5 and the tree (edges s + 4 .. s + 4 + TL)
@@ -176,7 +175,8 @@ begin
   -- per lane: KA table (stage 2 read) and T table (stage 3 read, address = the registered bin)
   g_lane : for l in 0 to LANES - 1 generate
     signal ka_ram : ka_ram_t := (others => (others => '0'));
-    signal t_ram  : t_ram_t := (others => '0');
+    signal t_wd   : std_logic_vector(0 downto 0);
+    signal t_rd   : std_logic_vector(0 downto 0);
   begin
     p_ka : process (clk)
     begin
@@ -188,23 +188,21 @@ begin
       end if;
     end process;
 
-    p_t : process (clk)
-    begin
-      if rising_edge(clk) then
-        if t_we = '1' then
-          t_ram(to_integer(t_addr)) <= t_data;
-        end if;
-        t3(l) <= t_ram(to_integer(unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W))));
-      end if;
-    end process;
+    -- T: ms_ram_sdp, read latency 2 (on ECP5 one DP16KD with its output register: the table's
+    -- ~5.8 ns clock-to-out no longer reaches the fabric; the inferred architecture: a read
+    -- register and one more), address = the registered bin (edge s + 2), data after edge s + 3;
+    -- the write port registered (WR_LAT 1: written at init only, one clock later is harmless)
+    t_wd(0) <= t_data;
+    u_t : entity work.ms_ram_sdp
+      generic map (DEPTH => 2 ** BIN_W, DATA_W => 1, ADDR_W => BIN_W, RD_LAT => 2, WR_LAT => 1)
+      port map (clk => clk, we => t_we, waddr => t_addr, wdata => t_wd,
+                raddr => unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W)), rdata => t_rd);
+    t4(l) <= t_rd(0);
 
     p_d2q : process (clk)
     begin
       if rising_edge(clk) then
         d3(l) <= resize(ka2(l), D2Q_W) + resize(kb2, D2Q_W);
-        -- T read data registered once more with no logic between (yosys maps T to a DP16KD
-        -- without output register: its 5.8 ns clock-to-out must reach a flip-flop directly)
-        t4(l) <= t3(l);
         d4(l) <= d3(l);
       end if;
     end process;

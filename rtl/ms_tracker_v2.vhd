@@ -209,6 +209,7 @@ architecture rtl of ms_tracker_v2 is
   signal best_cx, best_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
   signal best_s       : unsigned(RHO_SUM_W - 1 downto 0);
   signal best_conf    : unsigned(16 downto 0);
+  signal best_take    : std_logic := '0';            -- T_C2 found a better start point (copy next clock)
   signal region_ok    : std_logic := '0';
   signal reg_x, reg_y : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
@@ -777,6 +778,11 @@ begin
       cf_start <= '0'; lf_start <= '0'; fl_start <= '0'; ru_start <= '0';
       sc_start <= '0'; rz_start <= '0';
       ql_v1 <= '0';
+      -- the best start point so far (wide search): taken the clock after T_C2 decided it
+      best_take <= '0';
+      if best_take = '1' then
+        best_cx <= r_cx; best_cy <= r_cy; best_s <= r_s; best_st <= st_fin; best_conf <= conf;
+      end if;
 
       if fe_err_now = '1' then
         err_hold <= '1';
@@ -1106,8 +1112,11 @@ begin
 
         when T_C2 =>
           if cf_done = '1' then
+            -- the decision only is registered here; the copy into best_* follows a clock later
+            -- (in T_CNEXT, from r_*, st_fin and conf, which hold there), so the 17-bit compare
+            -- drives one flip-flop and not the enables of the whole best_* record
             if cand = 0 or conf > best_conf then
-              best_cx <= r_cx; best_cy <= r_cy; best_s <= r_s; best_st <= st_fin; best_conf <= conf;
+              best_take <= '1';
             end if;
             state <= T_CNEXT;
           end if;
@@ -1135,7 +1144,9 @@ begin
             eng_start <= '1';
             state <= T_RUN;
           else
-            r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s; st_fin <= best_st;
+            if best_take = '0' then            -- else this start point is the best: r_*, st_fin hold it
+              r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s; st_fin <= best_st;
+            end if;
             state <= T_STATS0;
           end if;
 

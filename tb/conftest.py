@@ -54,14 +54,19 @@ CI_EXTRA: dict[str, str] = {
         "cocotb + Verilator, 60 frames; the C++ harness runs 760 real frames of the same netlist "
         "(tb/test_realtime.py::test_long_real_video) and GHDL a real frame",
     "tb/test_ms_tracker_cycles.py::test_worst_case_cycles_ghdl":
-        "the same worst case under Verilator at LANES 4/8 (test_worst_case_cycles; LANES 2 in make test-extra)",
+        "the same worst case under Verilator at the default LANES 4 (test_worst_case_cycles[4]; 2 and 8 "
+        "in make test-extra)",
     "tb/test_ms_tracker_file_tb.py::test_fusesoc_synth_target":
         "fusesoc's core file and generator by test_fusesoc_target[lint] / [sim] (the same ghdl_verilog "
         "generator, fix-ups and file lists) and GHDL -> yosys synth_ecp5 of the same core by "
         "tb/test_synth.py (207 s of the netlist half, Debian's yosys)",
     "tb/test_ms_tracker_cycles.py::test_worst_case_cycles[2]":
-        "test_worst_case_cycles[8] (a lane count other than the default) and [4] (the default): the same "
-        "latency model and netlist at another LANES (its own GHDL synthesis and Verilator build, 43 s)",
+        "test_worst_case_cycles[4] (the default): the same latency model and netlist at another LANES "
+        "(its own GHDL synthesis and Verilator build, 43 s); LANES 2 in the blocks' tests "
+        "(tb/test_ms_pixel_pass.py epan_L2, default_config[epanechnikov-2])",
+    "tb/test_ms_tracker_cycles.py::test_worst_case_cycles[8]":
+        "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
+        "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",

@@ -429,12 +429,11 @@ SMALL = {"fp": {"max_half": 15, "margin": 8}}
 
 
 def _run(job: dict, build_name: str, verilator: bool = False) -> None:
-    from mstrack.hw.hdl import VERILATOR_CXX_O1, run_ghdl, run_verilator
+    from mstrack.hw.hdl import run_ghdl, run_verilator
     g = top_generics(job)
-    kw = {"cxx_opt": VERILATOR_CXX_O1} if verilator else {}   # a cheaper C++ build of the large netlist
     runner = run_verilator if verilator else run_ghdl
     runner("ms_tracker_axi", "test_ms_tracker_axi", generics=g, build_name=build_name,
-           extra_env={"MSTRACK_JOB": json.dumps(job)}, **kw)
+           extra_env={"MSTRACK_JOB": json.dumps(job)})
 
 
 @pytest.mark.parametrize("variant", ["stream", "throttled", "no_stream"])

@@ -809,12 +809,11 @@ DIRECTED = ["result_backpressure", "init_mid_frame", "reinit_while_tracking", "f
 def _run(testcase, env: dict[str, str], build_name: str = "ms_tracker_faults") -> None:
     """Verilator on the GHDL netlist when installed (about 50x faster here), else GHDL;
     MSTRACK_FAULTS_SIM=ghdl forces GHDL on the VHDL."""
-    from mstrack.hw.hdl import VERILATOR_CXX_O1, have_verilator, run_ghdl, run_verilator
+    from mstrack.hw.hdl import have_verilator, run_ghdl, run_verilator
     verilator = os.environ.get("MSTRACK_FAULTS_SIM", "verilator") == "verilator" and have_verilator()
-    kw = {"cxx_opt": VERILATOR_CXX_O1} if verilator else {}   # a cheaper C++ build (hdl.VERILATOR_CXX_O1)
     runner = run_verilator if verilator else run_ghdl
     runner("ms_tracker", "test_ms_tracker_faults", generics=core_config().generics(),
-           build_name=build_name, testcase=testcase, extra_env=env, **kw)
+           build_name=build_name, testcase=testcase, extra_env=env)
 
 
 @pytest.mark.ghdl

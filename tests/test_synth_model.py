@@ -219,3 +219,37 @@ def test_write_section_replaces_kept_table_rows_in_place(tmp_path):
     synth.write_section("RTL: r2.\n\n| design | n |\n|---|---|\n| ref | 0 |\n| b | 2 |", "x", "c2", p, tools="T2.",
                         keep_rows=True)
     assert "| ref | 0 |\n| a | 1 |\n| b | 2 |\n\n<!-- perf-x:end -->" in p.read_text()
+
+
+def test_speed_grade_selection(tmp_path, monkeypatch):
+    """ECP5 speed grade: nextpnr gets --speed only off the default grade 6 (the grade-6 command and
+    its cached runs stay as they were), the files and summaries of another grade carry _g<speed>,
+    a grade nextpnr-ecp5 does not model is refused before any tool runs, and the CLI takes --speed."""
+    assert synth.SPEED == 6 and synth.CI_SPEED in synth.SPEEDS == (6, 7, 8)
+    with pytest.raises(ValueError, match="speed grade 9"):
+        synth.run_nextpnr(tmp_path, seed=1, speed=9)
+    assert synth._gtag(6) == "" and synth._gtag(8) == "_g8"
+    calls = []
+
+    def fake_run(cmd, log, cwd, name):
+        calls.append(cmd)
+        rep = cmd[cmd.index("--report") + 1]
+        (tmp_path / rep).write_text(json.dumps({"fmax": {"clk": {"achieved": 150.0}}, "utilization": {},
+                                                "critical_paths": []}))
+        return 1.0
+
+    from mstrack.hw import hdl
+    monkeypatch.setattr(hdl, "_run", fake_run)
+    monkeypatch.setattr(hdl, "_tool", lambda name: name)
+    (tmp_path / "yosys.stamp").write_text("x")
+    r8 = synth.run_nextpnr(tmp_path, seed=1, speed=8)
+    r6 = synth.run_nextpnr(tmp_path, seed=1)
+    assert calls[0][calls[0].index("--speed") + 1] == "8" and "--speed" not in calls[1]
+    assert (tmp_path / "report_s1_g8.json").is_file() and (tmp_path / "report_s1.json").is_file()
+    assert (r8["speed"], r6["speed"], r8["fmax_mhz"]) == (8, 6, 150.0)
+    import argparse
+    ap = argparse.ArgumentParser()
+    synth.add_arguments(ap)
+    assert ap.parse_args(["--speed", "8"]).speed == 8 and ap.parse_args([]).speed == 6
+    with pytest.raises(SystemExit):
+        ap.parse_args(["--speed", "5"])

@@ -6,6 +6,7 @@ Synthesis (every number in docs/performance.md names the command that produced i
     mstrack synth --config default --seeds 1   # one configuration, one nextpnr seed
     mstrack synth --write                      # ... and rewrite the tables of docs/performance.md
     mstrack synth --cycles                     # analytic cycle figures only (no tools)
+    mstrack synth --config default --speed 8   # nextpnr-ecp5 at speed grade 8 (LFE5U-85F-8)
 
 Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generics`):
 
@@ -15,7 +16,8 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * Fmax: the core has ~260 ports, more than the 205 user I/Os of the LFE5U-85F CABGA381, so
   nextpnr-ecp5 places ``rtl/wrappers/ms_tracker_pins.vhd`` (the core + a serial configuration
   chain + a result serialiser, ~40 pins), one run per seed, ``--freq`` 150 MHz; the report
-  gives max and median Fmax over the seeds and the critical path of the worst seed;
+  gives max and median Fmax over the seeds and the critical path of the worst seed; speed
+  grade 6 (the slowest of the LFE5U-85F, nextpnr's default) unless ``--speed`` says 7 or 8;
 * core v2 (configuration ``v2``): the same flow on ``ms_tracker_v2`` (generics from
   :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_v2_pins.vhd``
   (160-bit result word v2); the cycle table is the paper core's only.
@@ -24,7 +26,8 @@ Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`):
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
 cycle for cycle against simulation by ``tb/test_ms_tracker_cycles.py``.
 
-Outputs go to ``build/synth/`` (one folder per tool run, ``summary_<config>[_<sha>].json``, ``_<sha>`` with --rtl-commit).
+Outputs go to ``build/synth/`` (one folder per tool run, ``summary_<config>[_g<speed>][_<sha>].json``,
+``_g<speed>`` for a speed grade other than 6, ``_<sha>`` with --rtl-commit).
 """
 from __future__ import annotations
 
@@ -55,6 +58,12 @@ PINS_VHD_V2 = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_v2_pins.vhd"
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
+#: ECP5 speed grades nextpnr-ecp5 models (LFE5U-85F-6 / -7 / -8, -8 the fastest); SPEED: the grade of
+#: `mstrack synth` unless --speed (nextpnr's default, the grade of every ECP5 figure before session 11);
+#: CI_SPEED: the grade of the CI netlist build (tb/test_synth.py), the part that takes 1080p60 (issue 13)
+SPEEDS = (6, 7, 8)
+SPEED = 6
+CI_SPEED = 8
 FREQ_MHZ = 150.0
 TARGET_FMAX_MHZ = 148.5            # 1080p60 pixel clock
 VBLANK_1080P60 = 45 * 2200         # vertical blanking of 1080p60 (CEA-861): 99,000 clocks
@@ -265,19 +274,26 @@ def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, 
             "sink_module": names.module_of(last) if names else None, "steps": steps}
 
 
-def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5") -> dict[str, Any]:
-    """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381) or nextpnr-nexus (family "nexus", :data:`NEXUS_DEVICE`)
-    on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus`` netlist) with one seed.
+def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5",
+                speed: int = SPEED) -> dict[str, Any]:
+    """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381, speed grade *speed*) or nextpnr-nexus (family
+    "nexus", :data:`NEXUS_DEVICE`) on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus``
+    netlist) with one seed.
 
-    Writes ``nextpnr_s<seed>.log`` / ``report_s<seed>.json`` there.  Returns ``{"seed",
-    "fmax_mhz", "utilization": {bel: (used, available)}, "critical_path", "seconds"}``; raises
-    :class:`mstrack.hw.hdl.HdlError` when the design does not fit (nextpnr fails)."""
+    Writes ``nextpnr_s<seed>[_g<speed>].log`` / ``report_s<seed>[_g<speed>].json`` there (``_g<speed>``
+    for an ECP5 grade other than 6).  Returns ``{"seed", "speed", "fmax_mhz", "utilization": {bel: (used,
+    available)}, "critical_path", "seconds"}``; raises :class:`mstrack.hw.hdl.HdlError` when the design
+    does not fit (nextpnr fails)."""
     from . import hdl
+    if family == "ecp5" and speed not in SPEEDS:
+        raise ValueError(f"ECP5 speed grade {speed}: nextpnr-ecp5 models {SPEEDS}")
     d = Path(synth_dir)
-    log, rep = f"nextpnr_s{seed}.log", f"report_s{seed}.json"
+    g = f"_g{speed}" if family == "ecp5" and speed != SPEED else ""
+    log, rep = f"nextpnr_s{seed}{g}.log", f"report_s{seed}{g}.json"
     netlist = "out.json"
     if family == "ecp5":
-        dev = [f"--{DEVICE}", "--package", PACKAGE]
+        # --speed only off the default: the grade-6 command (and its cached runs) stays as it was
+        dev = [f"--{DEVICE}", "--package", PACKAGE] + (["--speed", str(speed)] if speed != SPEED else [])
     else:                   # the pins wrapper's I/O sites; the carry-in workaround of hdl.nexus_fix_carry_in
         # router1: router2 (the default) fails on the clock pad -> DCC arc of this design (nextpnr 0.11)
         dev = ["--device", NEXUS_DEVICE, "--pdc", str(NEXUS_PDC), "--router", "router1"]
@@ -289,11 +305,11 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
            "--timing-allow-fail"]
     # cached: same yosys netlist (stamp written by yosys_cached) and the same command
     key = ((d / "yosys.stamp").read_text().strip() if (d / "yosys.stamp").is_file() else "") + " ".join(cmd[1:])
-    stamp = d / f"nextpnr_s{seed}.stamp"
+    stamp = d / f"nextpnr_s{seed}{g}.stamp"
     if stamp.is_file() and (d / rep).is_file() and stamp.read_text().split("\n")[0] == key:
         secs = float(stamp.read_text().split("\n")[1])
     else:
-        secs = hdl._run(cmd, d / f"nextpnr_s{seed}.stdout.log", d, f"nextpnr-{family}")
+        secs = hdl._run(cmd, d / f"nextpnr_s{seed}{g}.stdout.log", d, f"nextpnr-{family}")
         if key.strip():
             stamp.write_text(f"{key}\n{secs:.1f}\n")
     report = json.loads((d / rep).read_text())
@@ -302,7 +318,8 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
             if int(v.get("used", 0))}
     vfiles = sorted(d.glob("*.v"))
     names = NetlistNames(vfiles[0], vfiles[0].stem) if vfiles else None
-    return {"seed": seed, "fmax_mhz": round(min(fmax.values()), 2) if fmax else None,
+    return {"seed": seed, "speed": speed if family == "ecp5" else None,
+            "fmax_mhz": round(min(fmax.values()), 2) if fmax else None,
             "utilization": util, "critical_path": critical_path(report, names), "seconds": round(secs, 1)}
 
 
@@ -335,7 +352,7 @@ def yosys_cached(kind: str, top: str, g: dict, sources_: Sequence[Path] | None, 
 
 
 def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds: Sequence[int], freq_mhz: float,
-                     pnr: bool, log: Callable[[str], None]) -> None:
+                     pnr: bool, log: Callable[[str], None], speed: int = SPEED) -> None:
     """The ECP5 part of :func:`synth_config`: yosys counts of the core, nextpnr-ecp5 of the pins wrapper."""
     secs = out["seconds"]
     t0 = time.monotonic()
@@ -354,11 +371,11 @@ def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds:
         log(f"[{cfg.name}] ecp5 pins wrapper: {out['ecp5_pins']} ({secs['ecp5_pins_yosys']} s)")
         runs = []
         for s in seeds:
-            pr = run_nextpnr(rp["dir"], s, freq_mhz)
+            pr = run_nextpnr(rp["dir"], s, freq_mhz, speed=speed)
             runs.append(pr)
             secs[f"nextpnr_s{s}"] = pr["seconds"]
             cp = pr["critical_path"]
-            log(f"[{cfg.name}] nextpnr seed {s}: {pr['fmax_mhz']} MHz ({pr['seconds']} s), "
+            log(f"[{cfg.name}] nextpnr seed {s} (speed grade {speed}): {pr['fmax_mhz']} MHz ({pr['seconds']} s), "
                 f"critical path {cp.get('source')} -> {cp.get('sink')} {cp.get('total_ns')} ns")
         out["pnr"] = runs
         out["pnr_dir"] = rp["dir"]
@@ -366,14 +383,17 @@ def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds:
         out["fmax_max_mhz"] = max(f) if f else None
         out["fmax_median_mhz"] = round(statistics.median(f), 2) if f else None
         out["freq_mhz"] = freq_mhz
+        out["speed"] = speed
 
 
 
 # ----------------------------------------------------------------------------- one configuration
 def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: float = FREQ_MHZ,
                  pnr: bool = True, xilinx: bool = True, nexus: bool = False, ecp5: bool = True,
-                 log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict[str, Any]:
-    """Synthesise one configuration; returns (and saves as build/synth/summary_<name>.json)
+                 log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True),
+                 speed: int = SPEED) -> dict[str, Any]:
+    """Synthesise one configuration (ECP5 place and route at speed grade *speed*); returns (and saves
+    as build/synth/summary_<name>[_g<speed>].json)
     ``{"config", "generics", "ecp5": {...yosys counts}, "pnr": [per seed], "fmax_max_mhz",
     "fmax_median_mhz", "xc7": {...}, "seconds": {step: s}}``."""
     from . import hdl
@@ -384,7 +404,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
     secs = out["seconds"]
 
     if ecp5:
-        _synth_ecp5_part(cfg, g, out, seeds, freq_mhz, pnr, log)
+        _synth_ecp5_part(cfg, g, out, seeds, freq_mhz, pnr, log, speed)
     if nexus:
         t0 = time.monotonic()
         n = yosys_cached("nexus", cfg.core, g, None, f"nexus_{cfg.name}")
@@ -421,7 +441,8 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
     out["tools"] = {k: tool_versions()[k] for k in SYNTH_TOOLS + (("nextpnr-nexus",) if nexus else ())}
     SYNTH_DIR.mkdir(parents=True, exist_ok=True)
     # a Nexus-only run (ecp5=False) keeps its own summary beside the ECP5 one
-    (SYNTH_DIR / f"summary_{cfg.name}{'' if ecp5 else '_nexus'}{_tag()}.json").write_text(json.dumps(out, indent=1))
+    (SYNTH_DIR / f"summary_{cfg.name}{'' if ecp5 else '_nexus'}{_gtag(speed)}{_tag()}.json").write_text(
+        json.dumps(out, indent=1))
     return out
 
 
@@ -549,8 +570,13 @@ def blocks_table(rows: Iterable[dict]) -> str:
     return "\n".join(out)
 
 
-def load_summary(name: str) -> dict[str, Any] | None:
-    p = SYNTH_DIR / f"summary_{name}{_tag()}.json"
+def _gtag(speed: int) -> str:
+    """Suffix of the summary files and table sections of an ECP5 speed grade other than 6."""
+    return "" if speed == SPEED else f"_g{speed}"
+
+
+def load_summary(name: str, speed: int = SPEED) -> dict[str, Any] | None:
+    p = SYNTH_DIR / f"summary_{name}{_gtag(speed)}{_tag()}.json"
     return json.loads(p.read_text()) if p.is_file() else None
 
 
@@ -980,6 +1006,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="configurations (default: all)")
     ap.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS), help="nextpnr seeds")
     ap.add_argument("--freq", type=float, default=FREQ_MHZ, help="nextpnr target MHz")
+    ap.add_argument("--speed", type=int, default=SPEED, choices=SPEEDS,
+                    help=f"ECP5 speed grade of the place and route (default {SPEED}; 8 is the fastest LFE5U-85F)")
     ap.add_argument("--no-pnr", action="store_true", help="no nextpnr (resources only)")
     ap.add_argument("--no-xilinx", action="store_true", help="no synth_xilinx")
     ap.add_argument("--no-ecp5", action="store_true", help="no ECP5 (with --nexus: the Nexus runs alone)")
@@ -1015,6 +1043,7 @@ def run(args: argparse.Namespace) -> int:
         ([f"--config {' '.join(args.config)}"] if args.config != list(CONFIGS) else [])
         + ([f"--seeds {' '.join(map(str, args.seeds))}"] if list(args.seeds) != list(SEEDS) else [])
         + ([f"--freq {args.freq:g}"] if args.freq != FREQ_MHZ else [])
+        + ([f"--speed {args.speed}"] if args.speed != SPEED else [])
         + (["--no-pnr"] if args.no_pnr else []) + (["--no-xilinx"] if args.no_xilinx else [])
         + (["--no-ecp5"] if args.no_ecp5 else []) + (["--nexus"] if args.nexus else [])
         + (["--cycles"] if args.cycles else []) + (["--blocks"] if args.blocks else [])
@@ -1057,9 +1086,9 @@ def run(args: argparse.Namespace) -> int:
         return 0
     rows = []
     for name in args.config:
-        s = load_summary(name) if args.from_summaries else synth_config(
+        s = load_summary(name, args.speed) if args.from_summaries else synth_config(
             name, args.seeds, args.freq, pnr=not args.no_pnr, xilinx=not args.no_xilinx, nexus=args.nexus,
-            ecp5=not args.no_ecp5)
+            ecp5=not args.no_ecp5, speed=args.speed)
         if s is None:
             print(f"mstrack synth: no summary for {name} in {SYNTH_DIR}", file=sys.stderr)
             return 1
@@ -1086,10 +1115,12 @@ def run(args: argparse.Namespace) -> int:
         if sec == "nexus":                 # the Nexus table names nextpnr-nexus, not nextpnr-ecp5
             rec = rows[0].get("tools") or {}
             sec_tools = tools_line(("GHDL", "yosys", "nextpnr-nexus"), rec if "nextpnr-nexus" in rec else None)
-        md = f"RTL: {_RTL_DESC}.\n\n" + md
+        dev = f"  Device: LFE5U-85F-{args.speed}BG381C (speed grade {args.speed})." if sec == "ecp5" else ""
+        md = f"RTL: {_RTL_DESC}.{dev}\n\n" + md
         print(f"\n{sec_tools}\n{md}")
         if args.write:
-            write_section(md, f"{sec}{_tag()}", cmd, tools=sec_tools, keep_rows=True)
+            name = f"{sec}{_gtag(args.speed)}" if sec == "ecp5" else sec
+            write_section(md, f"{name}{_tag()}", cmd, tools=sec_tools, keep_rows=True)
     print("\nseconds: " + "; ".join(f"{s['config']}: " + ", ".join(f"{k} {v}" for k, v in s["seconds"].items())
                                    for s in rows))
     return 0

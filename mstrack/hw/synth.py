@@ -1116,7 +1116,9 @@ def run(args: argparse.Namespace) -> int:
             rec = rows[0].get("tools") or {}
             sec_tools = tools_line(("GHDL", "yosys", "nextpnr-nexus"), rec if "nextpnr-nexus" in rec else None)
         dev = f"  Device: LFE5U-85F-{args.speed}BG381C (speed grade {args.speed})." if sec == "ecp5" else ""
-        md = f"RTL: {_RTL_DESC}.{dev}\n\n" + md
+        # the RTL the summaries were made from (--from-summaries: not necessarily today's working tree)
+        rtl = "; ".join(dict.fromkeys(s.get("rtl") or _RTL_DESC for s in rows))
+        md = f"RTL: {rtl}.{dev}\n\n" + md
         print(f"\n{sec_tools}\n{md}")
         if args.write:
             name = f"{sec}{_gtag(args.speed)}" if sec == "ecp5" else sec

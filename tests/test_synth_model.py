@@ -245,6 +245,7 @@ def test_speed_grade_selection(tmp_path, monkeypatch):
     r8 = synth.run_nextpnr(tmp_path, seed=1, speed=8)
     r6 = synth.run_nextpnr(tmp_path, seed=1)
     assert calls[0][calls[0].index("--speed") + 1] == "8" and "--speed" not in calls[1]
+    assert all(" ".join(synth.NEXTPNR_ECP5_OPTS) in " ".join(c) for c in calls)
     assert (tmp_path / "report_s1_g8.json").is_file() and (tmp_path / "report_s1.json").is_file()
     assert (r8["speed"], r6["speed"], r8["fmax_mhz"]) == (8, 6, 150.0)
     import argparse

@@ -61,7 +61,8 @@ V2_ONLY = ("RES_W8", "RES_H8", "RES_CONF", "RES_STATE")
 
 
 # ----------------------------------------------------------------------------- scenes
-def pattern_scene(n_track: int = 3, n_red: int = 0) -> tuple[list[np.ndarray], list[str | None], tuple[int, int, int, int]]:
+def pattern_scene(n_track: int = 3, n_red: int = 0
+                  ) -> tuple[list[np.ndarray], list[str | None], tuple[int, int, int, int]]:
     """48x40 frames: a red/blue 2-px checker target on grey moving 1-2 px a frame, *n_red* all-red
     frames (core v2: the box matches half the model and the ring as much as the box, so the loss
     flag rises while the search state is uncertain: status uncertain), one all-grey frame (the
@@ -80,8 +81,7 @@ def pattern_scene(n_track: int = 3, n_red: int = 0) -> tuple[list[np.ndarray], l
         return f
 
     pos = [(18, 14), (19, 15), (21, 15), (22, 16), (23, 17), (24, 17)][: n_track + 1]
-    red = np.zeros((h, w, 3), np.uint8)
-    red[...] = (255, 0, 0)
+    red = np.full((h, w, 3), (255, 0, 0), np.uint8)
     frames = ([at(*p) for p in pos[:2]] + [red] * n_red + [np.full((h, w, 3), 128, np.uint8)]
               + [at(*p) for p in pos[2:]])
     frames.append(at(*pos[-1]))
@@ -476,8 +476,9 @@ def test_axi_real():
 def test_axi_v2_synthetic():
     """GHDL, core v2 (PRESET 1, default v2 generics, MAX_FRAME_W 1024), throttled, result stream: the
     pattern scene with two all-red frames gives init, ok, ok, uncertain (the second red frame), lost
-    (grey frame), reacquired (wide search at D = 2), ok, a protocol error and a rejected init box; every register field of every result, the raw window, the stream
-    word, STATUS.tracking, INT_STATUS (lost / reacquired from the v2 status), counters and irq."""
+    (grey frame), reacquired (wide search at D = 2), ok, a protocol error and a rejected init box;
+    every register field of every result, the raw window, the stream word, STATUS.tracking,
+    INT_STATUS (lost / reacquired from the v2 status), counters and irq."""
     job = {"preset": 1, "scene": "pattern", "result_stream": True, "throttle": True, "reject_at": 4, "seed": 4}
     _run(job, "ms_tracker_axi_v2")
 

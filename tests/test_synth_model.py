@@ -222,8 +222,8 @@ def test_write_section_replaces_kept_table_rows_in_place(tmp_path):
 
 
 def test_speed_grade_selection(tmp_path, monkeypatch):
-    """ECP5 speed grade: nextpnr gets --speed only off the default grade 6 (the grade-6 command and
-    its cached runs stay as they were), the files and summaries of another grade carry _g<speed>,
+    """ECP5 speed grade: nextpnr gets --speed only off its default grade 6, every ECP5 run gets the
+    flow's NEXTPNR_ECP5_OPTS, the files and summaries of another grade carry _g<speed>,
     a grade nextpnr-ecp5 does not model is refused before any tool runs, and the CLI takes --speed."""
     assert synth.SPEED == 6 and synth.CI_SPEED in synth.SPEEDS == (6, 7, 8)
     with pytest.raises(ValueError, match="speed grade 9"):

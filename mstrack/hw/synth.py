@@ -292,7 +292,7 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
     if family == "ecp5" and speed not in SPEEDS:
         raise ValueError(f"ECP5 speed grade {speed}: nextpnr-ecp5 models {SPEEDS}")
     d = Path(synth_dir)
-    g = f"_g{speed}" if family == "ecp5" and speed != SPEED else ""
+    g = _gtag(speed) if family == "ecp5" else ""
     log, rep = f"nextpnr_s{seed}{g}.log", f"report_s{seed}{g}.json"
     netlist = "out.json"
     if family == "ecp5":

@@ -70,6 +70,10 @@ def variants() -> dict[str, tuple]:
     v["float v2 default (for --loss-grid)"] = ("v2", {})
     v["fixed v2 orient_T 64 + scale_test 0.05 gate"] = ("v2fixed", {**g, "orient_T": 64})
     v["v2 orient_T 64 + scale_test 0.05 gate, colour_bits 2"] = ("v2", {**g, "orient_T": 64, "colour_bits": 2})
+    for T in (32, 48):
+        v[f"v2 orient_T {T} + scale_test 0.05 gate, colour_bits 2"] = ("v2", {**g, "orient_T": T, "colour_bits": 2})
+    for T in (48, 64):
+        v[f"fixed v2 orient_T {T} + scale_test 0.05 gate, colour_bits 2"] = ("v2fixed", {**g, "orient_T": T, "colour_bits": 2})
     v["kernel epanechnikov"] = ("v2", {"kernel": "epanechnikov"})
     v["eps2 0.25"] = ("v2", {"eps2": 0.25})
     v["colour_bits 4"] = ("v2", {"colour_bits": 4})

@@ -75,10 +75,10 @@ entity ms_tracker_v2 is
     MAX_ITER       : natural := 20;
     EPS2           : natural := 65536;
     HALF_W         : natural := 6;
-    REGION_MAX     : natural := 445;
+    REGION_MAX     : natural := 256;
     REGION_W       : natural := 9;
-    STRIDE         : natural := 112;
-    ADDR_W         : natural := 16;
+    STRIDE         : natural := 64;
+    ADDR_W         : natural := 14;
     KVAL_W         : natural := 1;
     HIST_W         : natural := 14;
     COUNT_W        : natural := 14;
@@ -440,6 +440,11 @@ begin
     report "ms_tracker_v2: tracker v2 is colour only with the flat kernel (FEATURES 1, KERNEL_EPAN 0)"
     severity failure;
   assert RESULT_W = 160 report "ms_tracker_v2: RESULT_W must be 160 (result word v2)" severity failure;
+  -- the tracking region must fit the region RAM (the lost-state bound, 255 at the defaults, is
+  -- mstrack.hw.cosim.region_max_v2: it follows from the decimation rule, not from the generics alone)
+  assert (REGION_MAX >= MAX_WINDOW + 2 * MARGIN or REGION_MAX >= MAX_FRAME_W - 2) and MARGIN_MAX >= MARGIN
+    report "ms_tracker_v2: REGION_MAX must be >= min(MAX_WINDOW + 2 MARGIN, MAX_FRAME_W - 2), MARGIN_MAX >= MARGIN"
+    severity failure;
 
   ---------------------------------------------------------------------------- video input gate
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';

@@ -343,6 +343,59 @@ def test_fixed_v2_large_target_is_decimated_not_shrunk():
     assert abs(r.box.w - 300) < 10 and abs(r.box.x - 100) < 3
 
 
+def test_lost_window_at_doubled_decimation_is_half():
+    """The bound behind core v2's region RAM (mstrack.hw.cosim.region_max_v2): unless D is already the
+    largest (8), the window at 2D (the lost state) is at most round(max_window / 2) px; every target
+    size 3 .. 4095 px and a random Q.8 fraction of each, pads 0, 4, 8 / 16.  At D = 8 it is not."""
+    rng = np.random.default_rng(12)
+    over = 0
+    for pad16 in (0, 4, 8):
+        for s in range(3, 4096):
+            for s8 in (s << 8, (s << 8) + int(rng.integers(0, 256))):
+                d = ms_decimation(s8, 3 << 8, pad16, 127)
+                wd = ms_window_size(s8, pad16, 2 * d, 127)
+                if d < 8:
+                    assert wd <= 64, (pad16, s8, d, wd)
+                over += wd > 64
+    assert over > 0
+
+
+@pytest.mark.parametrize("scene", ["lost_at_d4", "lost_at_d16", "tall_lost_at_d16"])
+def test_region_max_v2_bounds_the_fixed_model_regions(scene, monkeypatch):
+    """Every region the fixed model captures, while tracking and while lost, fits core v2's region RAM
+    (REGION_MAX = region_max_v2 rounded up to LANES: 256 at the defaults, 445 before session 12); the
+    lost region at D = 4 reaches past the tracking region's 191, so the lost-state bound is exercised."""
+    from mstrack.fixed import FixedParams
+    from mstrack.fixed import tracker_v2 as tv2
+    from mstrack.hw.cosim import CoreConfigV2, region_max_v2
+    g = CoreConfigV2(V2, FixedParams()).generics()
+    assert g["REGION_MAX"] == 256 and region_max_v2(V2, FixedParams(), 4095) == 255
+    sizes = []
+    real = tv2.ms_region
+
+    def spy(*a, **k):
+        reg = real(*a, **k)
+        sizes.append((reg.w, reg.h))
+        return reg
+    monkeypatch.setattr(tv2, "ms_region", spy)
+    rng = np.random.default_rng(7)
+    shape, box = {"lost_at_d4": ((1400, 1400), (500, 500, 203, 203)),    # D 2, lost D 4: window 63
+                  "lost_at_d16": ((1300, 2048), (100, 100, 1800, 1100)),  # D 8, lost D 16: frame-bound
+                  "tall_lost_at_d16": ((4095, 300), (10, 100, 280, 3900))}[scene]
+    f = rng.integers(0, 256, (*shape, 3)).astype(np.uint8)
+    x, y, w, h = box
+    f[y:y + h, x:x + w] = (40, 200, 60)
+    trk = Tracker(model="fixed", preset="v2")
+    trk.init(f, box)
+    for _ in range(3):
+        r = trk.update(rng.integers(0, 256, f.shape).astype(np.uint8))
+    assert r.status.value == "lost"
+    big = max(max(s) for s in sizes)
+    assert big <= g["REGION_MAX"], sizes
+    if scene == "lost_at_d4":
+        assert big > 191 and r.extra["decimation"] == 4, (sizes, r.extra["decimation"])
+
+
 @pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (../shared absent)")
 def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
     """Issue target: the fixed model (= hardware) within 0.01 AUC of float v2, whole dev set."""

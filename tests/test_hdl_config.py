@@ -32,7 +32,7 @@ def test_preset_v2_gives_core_v2_generics():
     assert cfg.tp.preset == "v2" and cfg.tp.features == "colour"
     assert {k: cfg.generics[k] for k in want} == want
     assert cfg.generics["PRESET"] == 1 and cfg.generics["RESULT_W"] == 160 and cfg.generics["PPC"] == 1
-    assert cfg.generics["FEATURES"] == 1 and cfg.generics["REGION_MAX"] == 445
+    assert cfg.generics["FEATURES"] == 1 and cfg.generics["REGION_MAX"] == 256
     g = derive(CoreChoices(preset="v2", max_frame_width=1920, lanes=2, rgb_packing="ug934")).generics
     assert {k: g[k] for k in want} == CoreConfigV2(TrackerParams(preset="v2"), FixedParams(), 2, 1920).tracker_generics()
     assert g["RGB_PACKING"] == 1

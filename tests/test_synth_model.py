@@ -164,7 +164,7 @@ def test_v2_config_has_v2_generics_and_wrapper():
     assert c.v2 and c.core == "ms_tracker_v2" and c.pins_top == "ms_tracker_v2_pins"
     g = c.generics()
     assert g == CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).generics()
-    assert g["RESULT_W"] == 160 and g["REGION_MAX"] == 445 and g["FEATURES"] == 1
+    assert g["RESULT_W"] == 160 and g["REGION_MAX"] == 256 and g["STRIDE"] == 64 and g["FEATURES"] == 1
     d = synth.CONFIGS["default"]
     assert (d.core, d.pins_top) == ("ms_tracker", "ms_tracker_pins") and "RESULT_W" in d.generics()
     assert d.generics()["RESULT_W"] != 160

@@ -300,6 +300,34 @@ def expected_results_v2(frames: Iterable[np.ndarray], box: tuple[int, int, int, 
     return out
 
 
+def region_max_v2(tp: TrackerParams, fp: FixedParams, max_frame_size: int) -> int:
+    """The widest search region (decimated px, either axis) of tracker v2's fixed model in frames up
+    to ``max_frame_size`` px on either side, the rows and columns core v2's region RAM needs
+    (docs/fixed_point.md "Search region").
+
+    ms_region gives n = min(2e + 2m + 1, S - 2) with S the decimated frame size ((W - 1) >> log2 D) + 1.
+    Three cases: tracking (e <= max_half, m = MARGIN); lost at D' = 2D <= MAX_DECIMATION: D was not the
+    largest, (1 + pad) s <= max_window D exactly (ms_decimation), so the window at 2D is at most
+    round_half_up(max_window / 2) px and the margin MARGIN + its search offset (at most 255); lost at
+    D' = 2 MAX_DECIMATION: any window up to max_window, but S is that of the frame at D'.
+    (The exhaustive check: tests/test_fixed_v2.py::test_lost_window_at_doubled_decimation_is_half.)
+    """
+    from ..fixed.blocks_v2 import MAX_DECIMATION, sixteenths
+    step16 = sixteenths(tp.search_step, "search_step")
+
+    def n(wd: int, lost: bool, d: int) -> int:
+        e = (wd - 1) >> 1
+        m = min(fp.margin + ((step16 * wd) >> 4), 255) if lost else fp.margin
+        return min(2 * e + 2 * m + 1, ((max_frame_size - 1) // d + 1) - 2)
+
+    win = 2 * fp.max_half + 1
+    half = (tp.max_window + 1) // 2
+    cases = [n(win, False, d) for d in (1, 2, 4, MAX_DECIMATION)]
+    cases += [n(min(half, win), True, d) for d in (2, 4, MAX_DECIMATION)]
+    cases.append(n(win, True, 2 * MAX_DECIMATION))
+    return max(cases)
+
+
 @dataclass
 class CoreConfigV2:
     """Tracker v2 parameters + lanes -> the generics of ms_tracker_v2 (:meth:`generics`), or of
@@ -329,14 +357,14 @@ class CoreConfigV2:
         g["RESULT_W"] = result_width_v2(core_generics(tp, fp, self.lanes))
         # the lost state: start points +- search_step windows, the region margin grows by that offset
         # (at most 255, as the model); the region RAM and the engine's region widths hold the widest
-        # such region (or the widest frame's interior)
+        # region the model can ask for (region_max_v2), rounded up to a multiple of LANES
         step16 = sixteenths(tp.search_step, "search_step")
         g["SEARCH_ITER"] = tp.search_iter
         g["STEP16"] = step16
         g["MARGIN_MAX"] = 255
-        win = 2 * fp.max_half + 1
-        rmax = min(win + 2 * min(fp.margin + ((step16 * win) >> 4), 255), self.max_frame_w - 2)
-        rmax = max(rmax, g["REGION_MAX"])
+        # (frame_width <= MAX_FRAME_W, frame_height < 2**COORD_W)
+        rmax = region_max_v2(tp, fp, max(self.max_frame_w, 2 ** g["COORD_W"] - 1))
+        rmax = max(-(-rmax // self.lanes) * self.lanes, g["REGION_MAX"])
         stride = -(-rmax // self.lanes)
         g["REGION_MAX"] = rmax
         g["REGION_W"] = rmax.bit_length()

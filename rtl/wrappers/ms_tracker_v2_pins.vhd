@@ -41,10 +41,10 @@ entity ms_tracker_v2_pins is
     MAX_ITER       : natural := 20;
     EPS2           : natural := 65536;
     HALF_W         : natural := 6;
-    REGION_MAX     : natural := 445;
+    REGION_MAX     : natural := 256;
     REGION_W       : natural := 9;
-    STRIDE         : natural := 112;
-    ADDR_W         : natural := 16;
+    STRIDE         : natural := 64;
+    ADDR_W         : natural := 14;
     KVAL_W         : natural := 1;
     HIST_W         : natural := 14;
     COUNT_W        : natural := 14;

@@ -76,6 +76,8 @@ SEEDS = (1, 2, 3)
 #: 5 LRAM, 56 18x18 multipliers; speed grade 7 = the slowest, like the ECP5 runs' default grade 6)
 NEXUS_DEVICE = "LIFCL-40-7BG400C"
 NEXUS_PDC = REPO_ROOT / "tools" / "hdl" / "ms_tracker_pins_lifcl40.pdc"
+#: the same sites for ms_tracker_v2_pins, plus its res_last pin
+NEXUS_PDC_V2 = REPO_ROOT / "tools" / "hdl" / "ms_tracker_v2_pins_lifcl40.pdc"
 
 #: AMD Vitis Vision xf::cv::MeanShift, 10 targets, 300 MHz, UltraScale+ (figures of the issue)
 VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
@@ -279,10 +281,11 @@ def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, 
 
 
 def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5",
-                speed: int = SPEED) -> dict[str, Any]:
+                speed: int = SPEED, pdc: Path | None = None) -> dict[str, Any]:
     """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381, speed grade *speed*) or nextpnr-nexus (family
     "nexus", :data:`NEXUS_DEVICE`) on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus``
-    netlist) with one seed.
+    netlist) with one seed; *pdc*: the Nexus pin constraints (default :data:`NEXUS_PDC`, the paper
+    core's pins wrapper).
 
     Writes ``nextpnr_s<seed>[_g<speed>].log`` / ``report_s<seed>[_g<speed>].json`` there (``_g<speed>``
     for an ECP5 grade other than 6).  Returns ``{"seed", "speed", "fmax_mhz", "utilization": {bel: (used,
@@ -301,7 +304,7 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
                + list(NEXTPNR_ECP5_OPTS))
     else:                   # the pins wrapper's I/O sites; the carry-in workaround of hdl.nexus_fix_carry_in
         # router1: router2 (the default) fails on the clock pad -> DCC arc of this design (nextpnr 0.11)
-        dev = ["--device", NEXUS_DEVICE, "--pdc", str(NEXUS_PDC), "--router", "router1"]
+        dev = ["--device", NEXUS_DEVICE, "--pdc", str(pdc or NEXUS_PDC), "--router", "router1"]
         netlist = "out_cin.json"
         if not (d / netlist).is_file() or (d / netlist).stat().st_mtime < (d / "out.json").stat().st_mtime:
             hdl.nexus_fix_carry_in(d / "out.json", d / netlist)
@@ -422,7 +425,8 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
             secs["nexus_pins_yosys"] = round(time.monotonic() - t0, 1)
             nruns = []
             for sd in seeds:
-                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus")
+                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus",
+                                 pdc=NEXUS_PDC_V2 if cfg.v2 else NEXUS_PDC)
                 nruns.append(pr)
                 secs[f"nextpnr_nexus_s{sd}"] = pr["seconds"]
                 cp = pr["critical_path"]

@@ -32,6 +32,7 @@ Outputs go to ``build/synth/`` (one folder per tool run, ``summary_<config>[_g<s
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import math
 import re
@@ -76,8 +77,8 @@ SEEDS = (1, 2, 3)
 #: 5 LRAM, 56 18x18 multipliers; speed grade 7 = the slowest, like the ECP5 runs' default grade 6)
 NEXUS_DEVICE = "LIFCL-40-7BG400C"
 NEXUS_PDC = REPO_ROOT / "tools" / "hdl" / "ms_tracker_pins_lifcl40.pdc"
-#: the same sites for ms_tracker_v2_pins, plus its res_last pin
-NEXUS_PDC_V2 = REPO_ROOT / "tools" / "hdl" / "ms_tracker_v2_pins_lifcl40.pdc"
+#: ms_tracker_v2_pins: NEXUS_PDC plus this file (its res_last pin)
+NEXUS_PDC_V2 = (NEXUS_PDC, REPO_ROOT / "tools" / "hdl" / "ms_tracker_v2_pins_lifcl40_extra.pdc")
 
 #: AMD Vitis Vision xf::cv::MeanShift, 10 targets, 300 MHz, UltraScale+ (figures of the issue)
 VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
@@ -281,11 +282,11 @@ def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, 
 
 
 def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5",
-                speed: int = SPEED, pdc: Path | None = None) -> dict[str, Any]:
+                speed: int = SPEED, pdc: Sequence[Path] = (NEXUS_PDC,)) -> dict[str, Any]:
     """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381, speed grade *speed*) or nextpnr-nexus (family
     "nexus", :data:`NEXUS_DEVICE`) on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus``
-    netlist) with one seed; *pdc*: the Nexus pin constraints (default :data:`NEXUS_PDC`, the paper
-    core's pins wrapper).
+    netlist) with one seed; *pdc*: the Nexus pin constraint files, joined into ``<synth_dir>/pins.pdc``
+    (default :data:`NEXUS_PDC`, the paper core's pins wrapper; :data:`NEXUS_PDC_V2` for core v2's).
 
     Writes ``nextpnr_s<seed>[_g<speed>].log`` / ``report_s<seed>[_g<speed>].json`` there (``_g<speed>``
     for an ECP5 grade other than 6).  Returns ``{"seed", "speed", "fmax_mhz", "utilization": {bel: (used,
@@ -304,7 +305,8 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
                + list(NEXTPNR_ECP5_OPTS))
     else:                   # the pins wrapper's I/O sites; the carry-in workaround of hdl.nexus_fix_carry_in
         # router1: router2 (the default) fails on the clock pad -> DCC arc of this design (nextpnr 0.11)
-        dev = ["--device", NEXUS_DEVICE, "--pdc", str(pdc or NEXUS_PDC), "--router", "router1"]
+        (d / "pins.pdc").write_text("".join(Path(p).read_text() for p in pdc))
+        dev = ["--device", NEXUS_DEVICE, "--pdc", "pins.pdc", "--router", "router1"]
         netlist = "out_cin.json"
         if not (d / netlist).is_file() or (d / netlist).stat().st_mtime < (d / "out.json").stat().st_mtime:
             hdl.nexus_fix_carry_in(d / "out.json", d / netlist)
@@ -313,6 +315,8 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
            "--timing-allow-fail"]
     # cached: same yosys netlist (stamp written by yosys_cached) and the same command
     key = ((d / "yosys.stamp").read_text().strip() if (d / "yosys.stamp").is_file() else "") + " ".join(cmd[1:])
+    if family != "ecp5":    # the constraints' text too (pins.pdc is rewritten each run)
+        key += " pdc:" + hashlib.sha1((d / "pins.pdc").read_bytes()).hexdigest()[:12]
     stamp = d / f"nextpnr_s{seed}{g}.stamp"
     if stamp.is_file() and (d / rep).is_file() and stamp.read_text().split("\n")[0] == key:
         secs = float(stamp.read_text().split("\n")[1])
@@ -426,7 +430,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
             nruns = []
             for sd in seeds:
                 pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus",
-                                 pdc=NEXUS_PDC_V2 if cfg.v2 else NEXUS_PDC)
+                                 pdc=NEXUS_PDC_V2 if cfg.v2 else (NEXUS_PDC,))
                 nruns.append(pr)
                 secs[f"nextpnr_nexus_s{sd}"] = pr["seconds"]
                 cp = pr["critical_path"]

@@ -321,11 +321,9 @@ def region_max_v2(tp: TrackerParams, fp: FixedParams, max_frame_size: int) -> in
         return min(2 * e + 2 * m + 1, ((max_frame_size - 1) // d + 1) - 2)
 
     win = 2 * fp.max_half + 1
-    half = (tp.max_window + 1) // 2
-    cases = [n(win, False, d) for d in (1, 2, 4, MAX_DECIMATION)]
-    cases += [n(min(half, win), True, d) for d in (2, 4, MAX_DECIMATION)]
-    cases.append(n(win, True, 2 * MAX_DECIMATION))
-    return max(cases)
+    half = min((tp.max_window + 1) // 2, win)
+    # n shrinks as D grows (S does), so each case's smallest D is its widest region
+    return max(n(win, False, 1), n(half, True, 2), n(win, True, 2 * MAX_DECIMATION))
 
 
 @dataclass

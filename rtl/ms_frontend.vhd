@@ -1,7 +1,7 @@
 -- ms_frontend: streaming front end of the tracker: ms_stream_check ->
 -- (ms_colour_bin | ms_grey) -> ms_sobel.
 --
--- Computes: the (x, y, colour bin, edge bin) of every interior pixel
+-- Computes: the (x, y, colour bin, edge bin, orientation bin) of every interior pixel
 -- (1 <= x <= W-2, 1 <= y <= H-2) of each frame, in raster order, PPC pixels
 -- per clock (PPC = 1, 2 or 4; lane k = column ip_x + k, valid where
 -- ip_mask(k) = 1; see ms_sobel: a line's first beat has lanes 0 .. 1 off), plus the
@@ -28,7 +28,8 @@
 -- Frame size: 3 <= frame_width <= MAX_FRAME_W, 3 <= frame_height, frame_width a multiple of
 -- PPC; ms_stream_check drops a frame out of that range (frame_error, ERR_SIZE).
 -- Python model: mstrack.fixed.blocks ms_colour_bin and
--- ms_edge_bin(ms_sobel(ms_grey(frame)), 2**EDGE_BINS_LOG2, EDGE_SHIFT).
+-- ms_edge_bin(ms_sobel(ms_grey(frame)), 2**EDGE_BINS_LOG2, EDGE_SHIFT);
+-- ip_obin: mstrack.fixed.blocks_v2 ms_orient_bin(ms_grey(frame), ORIENT_T).
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -41,6 +42,7 @@ entity ms_frontend is
     COLOUR_BITS    : natural range 1 to 8 := 3;  -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural range 1 to 8 := 4;  -- edge bin width
     EDGE_SHIFT     : natural range 0 to 11 := 5; -- edge bin = min(E-1, |G| >> EDGE_SHIFT)
+    ORIENT_T       : natural range 0 to 2047 := 64; -- orientation bin: flat (8) where |Gx| + |Gy| < ORIENT_T
     RGB_PACKING    : natural range 0 to 1 := 0;  -- pixel layout: 0 R 23:16 G 15:8 B 7:0 (mstrack);
                                                  -- 1 R 23:16 B 15:8 G 7:0 (AMD UG934, RGB video); wiring only
     PPC            : positive := 1               -- pixels per clock (beat): 1, 2 or 4
@@ -60,6 +62,7 @@ entity ms_frontend is
     ip_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (1 .. H-2)
     ip_cbin      : out std_logic_vector(PPC * 3 * COLOUR_BITS - 1 downto 0);  -- colour bin of lane k at lane k
     ip_ebin      : out std_logic_vector(PPC * EDGE_BINS_LOG2 - 1 downto 0);   -- edge bin of lane k at lane k
+    ip_obin      : out std_logic_vector(PPC * 4 - 1 downto 0);          -- orientation bin (0 .. 8) of lane k at 4k+3 .. 4k
     frame_start  : out std_logic;                                       -- pulse: a frame started (delayed)
     frame_end    : out std_logic;                                       -- pulse: good frame complete, after its last ip_valid
     frame_error  : out std_logic;                                       -- pulse: protocol error (delayed), no frame_end for that frame
@@ -145,10 +148,11 @@ begin
 
   u_sobel : entity work.ms_sobel
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
-                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, PPC => PPC)
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, ORIENT_T => ORIENT_T, PPC => PPC)
     port map (clk => clk, rst => rst, in_valid => pv1, in_x => x1, in_y => y1,
               in_grey => g_grey, in_cbin => cb_bin_d,
-              ip_valid => ip_valid, ip_mask => ip_mask, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin);
+              ip_valid => ip_valid, ip_mask => ip_mask, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
+              ip_obin => ip_obin);
 
   -- event delay line
   p_events : process (clk)

@@ -1,11 +1,13 @@
--- ms_sobel: 3x3 Sobel magnitude and edge bin of the frame interior, with the
--- interior pixel's colour bin; PPC pixels per clock.
+-- ms_sobel: 3x3 Sobel magnitude and edge bin, and gradient orientation bin, of the
+-- frame interior, with the interior pixel's colour bin; PPC pixels per clock.
 --
 -- Computes: for each input beat of PPC pixels (x .. x+PPC-1, y) (x a multiple
 -- of PPC) it emits, with y >= 2, the PPC interior candidates (x-1+k, y-1),
 -- k = 0 .. PPC-1 (lane k), each with
 --   ip_cbin = colour bin of (x-1+k, y-1) (from the line buffer)
 --   ip_ebin = min(2**EDGE_BINS_LOG2 - 1, (|Gx| + |Gy|) >> EDGE_SHIFT)
+--   ip_obin = 4 [Gx < 0] + 2 [Gy < 0] + [|Gy| > |Gx|] if |Gx| + |Gy| >= ORIENT_T,
+--             else 8 (the octant of the gradient, 8 = flat; tracker v2's joint bins)
 --   Gx = right column - left column, Gy = bottom row - top row (weights 1 2 1)
 -- of the 3x3 grey neighbourhood centred there; ip_mask(k) = 1 for the lanes
 -- inside the interior (x-1+k >= 1; x-1+k <= W-2 always holds), ip_valid = 1
@@ -37,7 +39,8 @@
 -- ip_valid of (x, y) (5 clocks from its in_grey); independent of input gaps.
 -- Throughput: 1 beat (PPC pixels)/clock, no stalls.
 -- Python model: ms_edge_bin(ms_sobel(ms_grey(frame))) and ms_colour_bin of
--- mstrack.fixed.blocks (interior (H-2) x (W-2) pixels).
+-- mstrack.fixed.blocks, ms_orient_bin(ms_grey(frame), ORIENT_T) of
+-- mstrack.fixed.blocks_v2 (interior (H-2) x (W-2) pixels).  ip_obin unused: no logic.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -50,6 +53,7 @@ entity ms_sobel is
     COLOUR_BITS    : natural range 1 to 8 := 3;  -- colour bin width / 3
     EDGE_BINS_LOG2 : natural range 1 to 8 := 4;  -- edge bin width
     EDGE_SHIFT     : natural range 0 to 11 := 5; -- |G| >> EDGE_SHIFT before saturation
+    ORIENT_T       : natural range 0 to 2047 := 64; -- |Gx| + |Gy| >= ORIENT_T: an orientation, else flat (8)
     PPC            : positive := 1               -- pixels per clock: 1, 2 or 4
   );
   port (
@@ -65,7 +69,8 @@ entity ms_sobel is
     ip_x     : out unsigned(COORD_W - 1 downto 0);                       -- column of lane 0 (1 .. W-2 when ip_mask(0))
     ip_y     : out unsigned(COORD_W - 1 downto 0);                       -- its row (1 .. H-2)
     ip_cbin  : out std_logic_vector(PPC * 3 * COLOUR_BITS - 1 downto 0); -- colour bin of lane k at lane k
-    ip_ebin  : out std_logic_vector(PPC * EDGE_BINS_LOG2 - 1 downto 0)   -- edge bin of lane k at lane k
+    ip_ebin  : out std_logic_vector(PPC * EDGE_BINS_LOG2 - 1 downto 0);  -- edge bin of lane k at lane k
+    ip_obin  : out std_logic_vector(PPC * 4 - 1 downto 0)                -- orientation bin (0 .. 8) of lane k at 4k+3 .. 4k
   );
 end entity;
 
@@ -121,6 +126,7 @@ architecture rtl of ms_sobel is
   signal x4, y4   : unsigned(COORD_W - 1 downto 0);
   signal c4       : c_arr(0 to PPC - 1);
   signal agx, agy : s_arr(0 to PPC - 1);                                      -- 0 .. 1020
+  signal ngx, ngy : std_logic_vector(PPC - 1 downto 0);                       -- Gx < 0, Gy < 0
   signal mask_o   : std_logic_vector(PPC - 1 downto 0) := (others => '0');
 begin
   assert MAX_FRAME_W >= 3 report "ms_sobel: MAX_FRAME_W must be >= 3" severity failure;
@@ -207,6 +213,8 @@ begin
         dyn := resize(syn(k), MAG_W) - resize(syp(k), MAG_W);
         if dxp(SUM_W) = '1' then agx(k) <= dxn(SUM_W - 1 downto 0); else agx(k) <= dxp(SUM_W - 1 downto 0); end if;
         if dyp(SUM_W) = '1' then agy(k) <= dyn(SUM_W - 1 downto 0); else agy(k) <= dyp(SUM_W - 1 downto 0); end if;
+        ngx(k) <= dxp(SUM_W);  -- borrow: right < left, Gx < 0
+        ngy(k) <= dyp(SUM_W);  -- bottom < top, Gy < 0
       end loop;
       v4  <= v3;
       x4  <= x3;
@@ -221,6 +229,14 @@ begin
           ip_ebin(EB_W * (k + 1) - 1 downto EB_W * k) <= (others => '1');
         else
           ip_ebin(EB_W * (k + 1) - 1 downto EB_W * k) <= std_logic_vector(sh(EB_W - 1 downto 0));
+        end if;
+        if mag >= ORIENT_T then
+          ip_obin(4 * k + 3) <= '0';
+          ip_obin(4 * k + 2) <= ngx(k);
+          ip_obin(4 * k + 1) <= ngy(k);
+          if agy(k) > agx(k) then ip_obin(4 * k) <= '1'; else ip_obin(4 * k) <= '0'; end if;
+        else
+          ip_obin(4 * k + 3 downto 4 * k) <= "1000";
         end if;
         ip_cbin(CB_W * (k + 1) - 1 downto CB_W * k) <= c4(k);
         any := any or v4(k);

@@ -1,6 +1,8 @@
 -- ms_decimate_tb_top: test wrapper (not part of the core) for tb/test_ms_decimate.py:
 -- ms_frontend -> ms_decimate -> ms_region_capture -> two ms_region_ram (colour, edge);
 -- the RAM read ports are exposed.  This is the v2 capture path (region in decimated px).
+-- ORIENT_T >= 0: the edge RAM captures ms_sobel's orientation bin instead of the edge bin
+-- (step 1 of the joint core: colour and orientation region RAMs, docs/results_v2_mean.md).
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -18,7 +20,9 @@ entity ms_decimate_tb_top is
     COLOUR_BITS    : natural := 3;     -- colour bits per channel
     EDGE_BINS_LOG2 : natural := 4;     -- edge bin width
     EDGE_SHIFT     : natural := 5;     -- edge shift
-    LOG2_D_MAX     : natural := 4      -- largest log2 D
+    LOG2_D_MAX     : natural := 4;     -- largest log2 D
+    ORIENT_T       : integer range -1 to 2047 := -1  -- -1: the edge RAM gets the edge bins; >= 0: the
+                                                     -- orientation bins of this threshold (EDGE_BINS_LOG2 = 4)
   );
   port (
     clk          : in  std_logic;                                                 -- clock
@@ -51,6 +55,8 @@ architecture tb of ms_decimate_tb_top is
   signal ip_x, ip_y, dp_x, dp_y : unsigned(COORD_W - 1 downto 0);
   signal ip_cbin, dp_cbin, wd_c : std_logic_vector(3 * COLOUR_BITS - 1 downto 0);
   signal ip_ebin, dp_ebin, wd_e : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal ip_edge : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal ip_obin : std_logic_vector(3 downto 0);
   signal fs, fe, ferr, ds, de, derr : std_logic;
   signal we : std_logic;
   signal wbank : unsigned(clog2(LANES) - 1 downto 0);
@@ -62,11 +68,21 @@ begin
 
   u_fe : entity work.ms_frontend
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
-                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT)
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT,
+                 ORIENT_T => maximum(ORIENT_T, 0))
     port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
               in_valid => in_valid, in_data => in_data, in_sof => in_sof, in_eol => in_eol,
-              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
+              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_edge,
+              ip_obin => ip_obin,
               frame_start => fs, frame_end => fe, frame_error => ferr, err_code => err_code);
+  assert ORIENT_T < 0 or EDGE_BINS_LOG2 = 4 report "ms_decimate_tb_top: ORIENT_T needs EDGE_BINS_LOG2 = 4"
+    severity failure;
+  g_edge : if ORIENT_T < 0 generate
+    ip_ebin <= ip_edge;
+  end generate;
+  g_orient : if ORIENT_T >= 0 generate
+    ip_ebin <= ip_obin;
+  end generate;
 
   u_dec : entity work.ms_decimate
     generic map (COORD_W => COORD_W, LOG2_D_MAX => LOG2_D_MAX, COLOUR_BITS => COLOUR_BITS,

@@ -9,7 +9,13 @@ back through the RAM read ports and compared with the model:
 
 * colour RAM = ``FixedTrackerV2._capture(frame[::D, ::D], region)`` (what tracker v2 tracks on);
 * edge RAM = the full-resolution edge bin of frame pixel (x D, y D) (ms_decimate passes it on;
-  v2 does not use it).
+  v2 does not use it);
+* with generic ORIENT_T >= 0 (the joint core's capture, step 1 of docs/results_v2_mean.md "Path
+  to adoption") the edge RAM holds ms_sobel's orientation bin instead: for the model cases
+  (``FixedTrackerV2`` with ``orient_T`` = ORIENT_T, whose capture is the region of its joint
+  bins 9 colour + orientation) colour RAM x 9 + orientation RAM = the model's joint bins, value
+  by value; for the corner cases the orientation RAM = ``ms_orient_bin(ms_grey(frame),
+  ORIENT_T)`` at frame pixel (x D, y D).
 
 Cases:
 
@@ -40,7 +46,7 @@ import cocotb
 from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
 
 from mstrack.fixed.blocks import Region, ms_edge_bin, ms_grey, ms_sobel, round_box
-from mstrack.fixed.blocks_v2 import PAD_FRAC, SIZE_FRAC, sixteenths
+from mstrack.fixed.blocks_v2 import PAD_FRAC, SIZE_FRAC, ms_orient_bin, sixteenths
 from mstrack.fixed.formats import FixedParams
 from mstrack.fixed.tracker_v2 import FixedTrackerV2
 from mstrack.track.params import TrackerParams
@@ -63,6 +69,7 @@ class Case:
     d: int
     reg: Region
     colour: np.ndarray   # model: FixedTrackerV2._capture(frame[::d, ::d], reg)
+    joint: bool = False  # colour holds the model's joint bins (orient_T > 0)
 
 
 def model_case(name: str, frame: np.ndarray, box: tuple[int, int, int, int], d: int, tp: TrackerParams,
@@ -105,7 +112,7 @@ def model_case(name: str, frame: np.ndarray, box: tuple[int, int, int, int], d: 
     assert res.extra["decimation"] == d, (name, d, res.extra["decimation"])
     img, reg, sub = seen[0]
     assert img.shape == frame[::d, ::d].shape
-    return Case(f"{name} D={d} {'lost ' if lost else ''}{reg.w}x{reg.h}", frame, d, reg, sub)
+    return Case(f"{name} D={d} {'lost ' if lost else ''}{reg.w}x{reg.h}", frame, d, reg, sub, tp.orient_T > 0)
 
 
 def corner_cases(frame: np.ndarray, d: int, region_max: int, tp: TrackerParams) -> list[Case]:
@@ -130,8 +137,10 @@ def job_cases(job: dict, g: dict) -> list[Case]:
     nrng = np.random.default_rng(job["seed"])
     fx = FixedParams(**job.get("fp", {}))
     out: list[Case] = []
+    orient_t = int(g.get("ORIENT_T", -1))
     for src in job["sources"]:
         tp = TrackerParams(preset="v2", colour_bits=int(g["COLOUR_BITS"]), max_window=src["max_window"])
+        tp_model = tp.with_(orient_T=orient_t) if orient_t > 0 else tp  # corner cases: colour bins
         if "seq" in src:
             from mstrack.io.data import load_sequence
             seq = load_sequence(src["seq"])
@@ -148,7 +157,7 @@ def job_cases(job: dict, g: dict) -> list[Case]:
             frame = random_frame(nrng, src["h"], src["w"])
             out += [c for d in src["d"] for c in corner_cases(frame, d, int(g["REGION_MAX"]), tp)]
             continue
-        out += [model_case(name, frame, box, d, tp, fx, rng) for d in src["d"]]
+        out += [model_case(name, frame, box, d, tp_model, fx, rng) for d in src["d"]]
     return out
 
 
@@ -164,6 +173,7 @@ class DecimateTB(TB):
         self.ew = int(self.g["EDGE_BINS_LOG2"])
         self.n_edge = 1 << self.ew
         self.edge_shift = int(self.g["EDGE_SHIFT"])
+        self.orient_t = int(self.g.get("ORIENT_T", -1))
         self.dones: list[int] = []
         dut.raddr.value = 0
         dut.dec_log2.value = 0
@@ -249,8 +259,11 @@ class DecimateTB(TB):
         return got_c, got_e
 
     def expected_edge(self, case: Case) -> np.ndarray:
-        full = ms_edge_bin(ms_sobel(ms_grey(case.frame)), self.n_edge, self.edge_shift)  # interior (H-2, W-2)
         d, reg = case.d, case.reg
+        if self.orient_t >= 0:   # orientation bins, defined on the whole frame (8 on its border)
+            full = ms_orient_bin(ms_grey(case.frame), self.orient_t)
+            return full[np.ix_((reg.y + np.arange(reg.h)) * d, (reg.x + np.arange(reg.w)) * d)]
+        full = ms_edge_bin(ms_sobel(ms_grey(case.frame)), self.n_edge, self.edge_shift)  # interior (H-2, W-2)
         ys = (reg.y + np.arange(reg.h)) * d - 1
         xs = (reg.x + np.arange(reg.w)) * d - 1
         return full[np.ix_(ys, xs)]
@@ -261,6 +274,9 @@ class DecimateTB(TB):
         assert max(reg.w, reg.h) <= int(self.g["REGION_MAX"]), f"{case.name}: region larger than REGION_MAX"
         self.set_inputs(case.d, reg)
         exp_c, exp_e = case.colour, self.expected_edge(case)
+        if case.joint:   # the model's joint bins = 9 colour + orientation
+            assert self.orient_t > 0
+            exp_c, exp_e = case.colour // 9, case.colour % 9
         # the last region word is addressed during the frame: a read in the done clock must see it
         last_j, last_b = (reg.w - 1) // self.lanes, (reg.w - 1) % self.lanes
         dut.raddr.value = self.bank_addr(self.addr(reg.h - 1, last_j))
@@ -284,6 +300,8 @@ class DecimateTB(TB):
             f"at {np.argwhere(got_c != exp_c)[:5].tolist()}"
         assert np.array_equal(got_e, exp_e), f"{case.name}: edge region differs at " \
             f"{np.argwhere(got_e != exp_e)[:5].tolist()}"
+        if case.joint:
+            assert np.array_equal(got_c * 9 + got_e, case.colour), f"{case.name}: joint bins differ"
 
 
 @cocotb.test()
@@ -329,10 +347,13 @@ MODULE = "test_ms_decimate"
 WRAPPER = hdl.TB_DIR / "ms_decimate_tb_top.vhd"
 
 
-def dec_generics(lanes: int, fp: FixedParams, max_frame_w: int, **tp_kw) -> dict:
+def dec_generics(lanes: int, fp: FixedParams, max_frame_w: int, orient_t: int | None = None, **tp_kw) -> dict:
     g = core_generics(TrackerParams(**tp_kw), fp, lanes=lanes)
     keys = ("LANES", "COORD_W", "REGION_MAX", "STRIDE", "ADDR_W", "COLOUR_BITS", "EDGE_BINS_LOG2", "EDGE_SHIFT")
-    return {**{k: g[k] for k in keys}, "MAX_FRAME_W": max_frame_w, "LOG2_D_MAX": 4}
+    out = {**{k: g[k] for k in keys}, "MAX_FRAME_W": max_frame_w, "LOG2_D_MAX": 4}
+    if orient_t is not None:
+        out["ORIENT_T"] = orient_t
+    return out
 
 
 def _seq(name: str) -> str:
@@ -386,6 +407,31 @@ def test_ms_decimate_real_640(gap, hdl_waves):
            else {"seq": _seq("Deer"), "d": [8], "max_window": 63})
     job = {"seed": 41, "gap": gap, "expect_d": src["d"], "sources": [src]}
     _run(f"real640_{'gap' if gap else 'full'}", g, job, hdl_waves)
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("gap", [0.0, 0.3], ids=["full_speed", "gaps"])
+def test_ms_decimate_orient(gap, hdl_waves):
+    """The joint core's capture (ORIENT_T 64, the candidate's threshold): colour and orientation
+    region RAMs against the fixed model's joint bins (generated scene, every D) and against
+    ms_orient_bin (corner regions of random frames: frame border, sizes D does not divide)."""
+    g = dec_generics(4 if gap else 2, FixedParams(**SMALL_FP), 128, orient_t=64)
+    job = {"seed": 51 + int(10 * gap), "gap": gap, "fp": SMALL_FP, "abandon": True,
+           "expect_d": list(DEC_VALUES),
+           "sources": [{"w": 45, "h": 37, "d": [1, 2, 4], "max_window": 7},
+                       {"w": 83, "h": 70, "d": [8, 16], "max_window": 7},
+                       {"scene": 6, "w": 96, "h": 80, "d": list(DEC_VALUES), "max_window": 7}]}
+    _run(f"orient_{'gap' if gap else 'full'}", g, job, hdl_waves)
+
+
+@pytest.mark.ghdl
+def test_ms_decimate_orient_real(hdl_waves):
+    """The joint core's capture on real frames: Girl (128x96) at every D, the model's regions
+    (FixedTrackerV2 with orient_T 64), default v2 region generics (LANES 2)."""
+    g = dec_generics(2, FixedParams(), 256, orient_t=64)
+    job = {"seed": 61, "gap": 0.0, "expect_d": list(DEC_VALUES),
+           "sources": [{"seq": _seq("Girl"), "d": list(DEC_VALUES), "max_window": 15}]}
+    _run("orient_girl", g, job, hdl_waves)
 
 
 @pytest.mark.verilator

@@ -4,9 +4,10 @@
 Frames are streamed beat by beat (in_valid/in_data/in_sof/in_eol), PPC pixels
 per beat (generic PPC = 1, 2, 4: pixel k in bits 24k+23 .. 24k, in_sof on the
 frame's first beat, in_eol on the line's last beat), at full speed and with
-random valid gaps.  Every interior pixel's (x, y, cbin, ebin) is
-compared exactly with the fixed model (``ms_colour_bin`` and
-``ms_edge_bin(ms_sobel(ms_grey(frame)))``); the frame events and error codes
+random valid gaps.  Every interior pixel's (x, y, cbin, ebin, obin) is
+compared exactly with the fixed model (``ms_colour_bin``,
+``ms_edge_bin(ms_sobel(ms_grey(frame)))`` and tracker v2's orientation bin
+``ms_orient_bin(ms_grey(frame), ORIENT_T)``); the frame events and error codes
 are checked against the expected sequence; protocol errors (short line, long
 line, missing sof, cut frame, frame size, and with PPC > 1 a width that is not a
 multiple of PPC) are each followed by a good frame that must be processed exactly.
@@ -28,11 +29,12 @@ from cocotb.triggers import ClockCycles, ReadOnly, RisingEdge
 from cocotb.utils import get_sim_time
 
 from mstrack.fixed.blocks import ms_colour_bin, ms_edge_bin, ms_grey, ms_sobel
+from mstrack.fixed.blocks_v2 import ms_orient_bin
 from mstrack.hw.hdl import dut_generics
 
 CLK_NS = 10
 DEFAULTS = {"COORD_W": 12, "MAX_FRAME_W": 64, "COLOUR_BITS": 3, "EDGE_BINS_LOG2": 4, "EDGE_SHIFT": 5,
-            "PPC": 1}
+            "ORIENT_T": 64, "PPC": 1}
 # error codes of rtl/ms_stream_pkg.vhd
 ERR_SHORT_LINE, ERR_LONG_LINE, ERR_NO_SOF, ERR_CUT, ERR_SIZE = 0, 1, 2, 3, 4
 #: input beat (last one accepted in clock c) -> frame_end high in clock c + FRAME_END_LAT
@@ -93,12 +95,13 @@ def pack_beats(beats, ppc: int) -> list[tuple[int, int, int, int, int]]:
     return out
 
 
-def model_interior(frame: np.ndarray, g: dict) -> list[tuple[int, int, int, int]]:
-    """(x, y, cbin, ebin) of every interior pixel in raster order, from the fixed model."""
+def model_interior(frame: np.ndarray, g: dict) -> list[tuple[int, int, int, int, int]]:
+    """(x, y, cbin, ebin, obin) of every interior pixel in raster order, from the fixed model."""
     cb = ms_colour_bin(frame, int(g["COLOUR_BITS"]))[1:-1, 1:-1]
     eb = ms_edge_bin(ms_sobel(ms_grey(frame)), 1 << int(g["EDGE_BINS_LOG2"]), int(g["EDGE_SHIFT"]))
+    ob = ms_orient_bin(ms_grey(frame), int(g["ORIENT_T"]))[1:-1, 1:-1]
     h, w = cb.shape
-    return [(x + 1, y + 1, int(cb[y, x]), int(eb[y, x])) for y in range(h) for x in range(w)]
+    return [(x + 1, y + 1, int(cb[y, x]), int(eb[y, x]), int(ob[y, x])) for y in range(h) for x in range(w)]
 
 
 # ---------------------------------------------------------------- TB
@@ -111,7 +114,7 @@ class TB:
         dut.in_valid.value = Immediate(0)
         cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start(start_high=False))
         self.ppc = int(self.g.get("PPC", 1))
-        self.ips: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin, ebin)), one per pixel
+        self.ips: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin, ebin, obin)), one per pixel
         self.events: list[tuple[int, tuple]] = []    # (cycle, ("start",) | ("end",) | ("error", code))
         self.last_beat_cycle = -1
 
@@ -129,6 +132,7 @@ class TB:
         d = self.dut
         has_code = hasattr(d, "err_code")
         has_ip = hasattr(d, "ip_valid") and (self.ppc == 1 or hasattr(d, "ip_mask"))
+        has_ob = hasattr(d, "ip_obin")   # (wrappers of other benches may not expose it: None then)
         while True:
             await RisingEdge(d.clk)
             await ReadOnly()
@@ -142,17 +146,19 @@ class TB:
             if has_ip and int(d.ip_valid.value):
                 if self.ppc == 1:
                     self.ips.append((c, (int(d.ip_x.value), int(d.ip_y.value), int(d.ip_cbin.value),
-                                         int(d.ip_ebin.value))))
+                                         int(d.ip_ebin.value), int(d.ip_obin.value) if has_ob else None)))
                     continue
                 # lanes: column ip_x + k where ip_mask(k) (ip_x wraps on a line's first beat)
                 mask, x0, y = int(d.ip_mask.value), int(d.ip_x.value), int(d.ip_y.value)
                 cb, eb = int(d.ip_cbin.value), int(d.ip_ebin.value)
+                ob = int(d.ip_obin.value) if has_ob else None
                 cw, ew = 3 * int(self.g["COLOUR_BITS"]), int(self.g["EDGE_BINS_LOG2"])
                 xm = (1 << int(self.g["COORD_W"])) - 1
                 for k in range(self.ppc):
                     if mask >> k & 1:
                         self.ips.append((c, ((x0 + k) & xm, y, (cb >> (k * cw)) & ((1 << cw) - 1),
-                                             (eb >> (k * ew)) & ((1 << ew) - 1))))
+                                             (eb >> (k * ew)) & ((1 << ew) - 1),
+                                             None if ob is None else (ob >> (4 * k)) & 15)))
 
     async def drive(self, beats, rng: random.Random, gap: float):
         """Drive pixel beats (frame_beats), packed PPC pixels per beat."""
@@ -350,11 +356,13 @@ TOP = "ms_frontend"
 MODULE = "test_ms_frontend"
 
 
-def fe_generics(max_frame_w: int = 64, ppc: int = 1, **tp_kw) -> dict:
-    """ms_frontend generics from the model parameters (core_generics)."""
+def fe_generics(max_frame_w: int = 64, ppc: int = 1, orient_t: int | None = None, **tp_kw) -> dict:
+    """ms_frontend generics from the model parameters (core_generics); ORIENT_T only when given."""
     g = core_generics(TrackerParams(**tp_kw), FixedParams(max_half=4, margin=2), lanes=2)
     out = {k: g[k] for k in ("COORD_W", "COLOUR_BITS", "EDGE_BINS_LOG2", "EDGE_SHIFT")}
     out["MAX_FRAME_W"] = max_frame_w
+    if orient_t is not None:
+        out["ORIENT_T"] = orient_t
     if ppc != 1:
         out["PPC"] = ppc
     return out
@@ -365,6 +373,12 @@ PARAMS = [
     pytest.param(fe_generics(max_frame_w=40), id="ppc1-maxw40"),
     pytest.param(fe_generics(colour_bits=2, edge_bins_log2=3, edge_shift=2), id="ppc1-cb2_e3_s2"),
     pytest.param(fe_generics(colour_bits=8, edge_bins_log2=8, edge_shift=0), id="ppc1-cb8_e8_s0"),
+    # orientation threshold at its ends: 0 (every interior pixel has an octant), 2040 (the edge
+    # frame's saturating pixels only), 2047 (none: always flat), and a middle value
+    pytest.param(fe_generics(orient_t=0), id="ppc1-orient0"),
+    pytest.param(fe_generics(orient_t=2040, ppc=2), id="ppc2-orient2040"),
+    pytest.param(fe_generics(orient_t=2047), id="ppc1-orient2047"),
+    pytest.param(fe_generics(orient_t=200, ppc=4), id="ppc4-orient200"),
     pytest.param(fe_generics(ppc=2), id="ppc2-default"),
     pytest.param(fe_generics(ppc=4), id="ppc4-default"),
     pytest.param(fe_generics(ppc=4, max_frame_w=40, colour_bits=2, edge_bins_log2=3, edge_shift=2),

@@ -562,3 +562,23 @@ def test_fixed_v2_joint_gate_tracks_like_float():
         Tracker(model="fixed", preset="v2", scale_test=0.05)
     with pytest.raises(ValueError):
         Tracker(model="fixed", preset="v2", motion_gain=0.5)
+
+
+def test_registered_v2_joint_tracker_is_the_candidate():
+    """``mstrack-v2-joint`` (make results, mstrack eval / bench / explore) builds tracker v2 with the
+    candidate's options and loss thresholds in both models, and tracks the scene of
+    test_fixed_v2_joint_gate_tracks_like_float exactly as those options given by hand do."""
+    from mstrack.eval.evaluate import V2_JOINT, make_tracker
+    from mstrack.explore import _base_params
+    frames, gt = _scene()
+    frames = frames[:12]
+    for model in ("float", "fixed"):
+        t = make_tracker("mstrack-v2-joint", model)
+        assert t.params == TrackerParams(preset="v2", **V2_JOINT), model
+        ref = Tracker(model=model, preset="v2", orient_T=64, scale_test=0.05, scale_test_gate=True,
+                      loss_rho=0.69, loss_contrast=0.25)
+        got = [t.init(frames[0], tuple(gt[0]))] + [t.update(f) for f in frames[1:]]
+        want = [ref.init(frames[0], tuple(gt[0]))] + [ref.update(f) for f in frames[1:]]
+        assert got == want, model
+    tp, kw = _base_params("mstrack-v2-joint")
+    assert tp == TrackerParams(preset="v2", **V2_JOINT) and kw["orient_T"] == 64

@@ -46,12 +46,19 @@ CACHE_VERSION = 3
 MODELS = ("float", "fixed")
 
 
-def _mstrack(features: str | None, kernel: str, preset: str = "paper") -> Callable[[str], Any]:
+def _mstrack(features: str | None, kernel: str, preset: str = "paper", **extra: Any) -> Callable[[str], Any]:
     def make(model: str = "float") -> Any:
         from ..track.tracker import Tracker  # imported late: written separately, may be absent
-        return Tracker(model=model, features=features, kernel=kernel, preset=preset)  # type: ignore[arg-type]
-    make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r})"
+        return Tracker(model=model, features=features, kernel=kernel, preset=preset, **extra)  # type: ignore[arg-type]
+    more = "".join(f", {k}={v!r}" for k, v in extra.items())
+    make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r}{more})"
     return make
+
+
+#: Tracker v2 with the joint colour x orientation histogram and the gated scale test, the loss
+#: flag's thresholds chosen for it (docs/results_v2_mean.md): experimental, the float and fixed
+#: models only (the RTL core v2 implements ``mstrack-v2``; this one needs the 9-bank bin pass).
+V2_JOINT = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
 
 
 def _baseline(fn: Callable[[], Any]) -> Callable[[str], Any]:
@@ -64,6 +71,7 @@ def _baseline(fn: Callable[[], Any]) -> Callable[[str], Any]:
 #: Tracker name -> factory ``f(model) -> tracker``.  Add entries here.
 TRACKERS: dict[str, Callable[[str], Any]] = {
     "mstrack-v2": _mstrack(None, "flat", "v2"),
+    "mstrack-v2-joint": _mstrack(None, "flat", "v2", **V2_JOINT),
     "mstrack-fused-flat": _mstrack("fused", "flat"),
     "mstrack-colour-flat": _mstrack("colour", "flat"),
     "mstrack-edge-flat": _mstrack("edge", "flat"),

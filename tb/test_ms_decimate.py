@@ -410,7 +410,7 @@ def test_ms_decimate_real_640(gap, hdl_waves):
 
 
 @pytest.mark.ghdl
-@pytest.mark.parametrize("gap", [0.0, 0.3], ids=["full_speed", "gaps"])
+@pytest.mark.parametrize("gap", [0.3], ids=["gaps"])   # (full speed: the Girl case below)
 def test_ms_decimate_orient(gap, hdl_waves):
     """The joint core's capture (ORIENT_T 64, the candidate's threshold): colour and orientation
     region RAMs against the fixed model's joint bins (generated scene, every D) and against

@@ -5,6 +5,7 @@ keeps the init pending.  The RTL is compared with this model in tb/test_ms_track
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import round_box
@@ -90,3 +91,15 @@ def test_bad_frame_while_lost_keeps_searching() -> None:
     assert m.results[2]["status"] == STATUS_V2.index("lost")
     assert m.kinds[3] == "error:short_line" and m.results[4]["searched"] == 8
     _check(m, frames, box, {3})
+
+
+@pytest.mark.parametrize("kw", [{"orient_T": 64}, {"scale_test": 0.05, "scale_test_gate": True},
+                                {"motion_gain": 0.5}])
+def test_core_config_v2_refuses_options_without_rtl(kw):
+    """The experimental v2 options (mstrack-v2-joint) are in the float and fixed models only: a core
+    configuration for them is refused with a one-line reason, not built as a colour-only core."""
+    from mstrack.fixed.formats import FixedParams
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import TrackerParams
+    with pytest.raises(ValueError, match="no RTL yet for " + next(iter(kw))):
+        CoreConfigV2(TrackerParams(preset="v2", **kw), FixedParams())

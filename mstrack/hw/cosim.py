@@ -335,6 +335,16 @@ class CoreConfigV2:
     lanes: int = DEFAULT_LANES
     max_frame_w: int = 2048
 
+    def __post_init__(self) -> None:
+        # the experimental options are in the float and fixed models only (mstrack-v2-joint):
+        # generics for them would build a core that tracks differently from the model they name
+        tp = self.tp
+        rtl_less = [k for k, off in (("orient_T", 0), ("scale_test", 0.0), ("motion_gain", 0.0))
+                    if getattr(tp, k) != off]
+        if rtl_less:
+            raise ValueError(f"core v2 has no RTL yet for {', '.join(rtl_less)} (float and fixed models only; "
+                             "docs/results_v2_mean.md \"Path to adoption\")")
+
     def generics(self) -> dict[str, int]:
         from ..fixed.blocks_v2 import q16, sixteenths
         from ..fixed.vhdl_pkg import result_width_v2, v2_scale_generics

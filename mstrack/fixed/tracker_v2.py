@@ -32,6 +32,7 @@ from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_
                         ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
+                        ORIENT_FLAT,
                         ms_scale_gate, ms_scale_test, ms_scale_test_size)
 from .formats import FixedParams, widths
 
@@ -39,6 +40,36 @@ from .formats import FixedParams, widths
 RESULT_FIELDS_V2 = ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "decimation")
 STATUS_CODES_V2 = {Status.OK: 0, Status.UNCERTAIN: 1, Status.LOST: 2, Status.REACQUIRED: 3,
                    Status.INIT: 4, Status.CLIPPED: 5, Status.ERROR: 6}
+
+
+def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region) -> np.ndarray:
+    """``ms_joint_bin(ms_colour_bin(img), ms_orient_bin(ms_grey(frame), T)[::d, ::d])`` of the
+    decimated image ``img = frame[::d, ::d]`` over region ``reg`` only (the region capture): the
+    grey of the frame pixels under the region and its 1-px ring, Gx, Gy as ms_orient_bin forms
+    them at the region's pixels (integers: the same values), 8 on the frame's 1-px border."""
+    fh, fw = frame.shape[:2]
+    c = ms_colour_bin(frame[::d, ::d][reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], bits)
+    n, m = c.shape
+    if n == 0 or m == 0:
+        return c
+    y0, y1 = d * reg.y, d * (reg.y + n - 1)  # frame rows / columns of the region's first and last pixel
+    x0, x1 = d * reg.x, d * (reg.x + m - 1)
+    a0, a1, b0, b1 = max(y0 - 1, 0), min(y1 + 2, fh), max(x0 - 1, 0), min(x1 + 2, fw)
+    g = ms_grey(frame[a0:a1, b0:b1])
+    # the ring beyond the frame: any value (those pixels are on the frame border: bin 8)
+    g = np.pad(g, ((a0 - (y0 - 1), y1 + 2 - a1), (b0 - (x0 - 1), x1 + 2 - b1)), mode="edge")
+
+    def at(dy: int, dx: int) -> np.ndarray:  # grey at (Y + dy, X + dx) for the region's pixels (Y, X)
+        return g[1 + dy: 1 + dy + d * (n - 1) + 1: d, 1 + dx: 1 + dx + d * (m - 1) + 1: d]
+
+    gx = (at(-1, 1) + 2 * at(0, 1) + at(1, 1)) - (at(-1, -1) + 2 * at(0, -1) + at(1, -1))
+    gy = (at(1, -1) + 2 * at(1, 0) + at(1, 1)) - (at(-1, -1) + 2 * at(-1, 0) + at(-1, 1))
+    ax, ay = np.abs(gx), np.abs(gy)
+    o = np.where(ax + ay >= T, 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax), ORIENT_FLAT)
+    ys, xs = d * np.arange(reg.y, reg.y + n), d * np.arange(reg.x, reg.x + m)
+    o[(ys == 0) | (ys == fh - 1), :] = ORIENT_FLAT
+    o[:, (xs == 0) | (xs == fw - 1)] = ORIENT_FLAT
+    return ms_joint_bin(c, o)
 
 
 class FixedTrackerV2:
@@ -215,8 +246,6 @@ class FixedTrackerV2:
         d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
         sh = d.bit_length() - 1
         img = frame[::d, ::d]
-        if p.orient_T > 0:
-            self._joint = self._bins(frame, d)
         wd, hd = self._geometry(d, img.shape[:2])
         ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
         Qw = ms_model_scale(self.model.Qn, ker.K)
@@ -225,7 +254,10 @@ class FixedTrackerV2:
         ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
         reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
-        sub = self._capture(img, reg)
+        if p.orient_T > 0:  # joint bins of the captured region only (the whole frame's, bit for bit)
+            sub = joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg)
+        else:
+            sub = self._capture(img, reg)
         c8d, S, it, stop, st = self._run(img, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter, sub)
         rho = ms_rho_out(S, ker.K, fx)
         share = ms_share(st)

@@ -50,7 +50,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from .features import colour_bins, edge_bins, grey_area
@@ -96,13 +95,19 @@ class Feature:
 
 
 def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gx, Gy (float32) of the 3x3 Sobel on the grey image; 0 on the 1-px frame border."""
-    grey = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0])
-    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
-    for g in (gx, gy):
-        g[0, :] = g[-1, :] = 0
-        g[:, 0] = g[:, -1] = 0
+    """Gx, Gy (float64) of the 3x3 Sobel on the float32 grey image; 0 on the 1-px frame border.
+
+    Gx = right column - left column (weights 1, 2, 1), Gy = bottom row - top row, formed in
+    float64 from the float32 grey: each is a sum of +-1 / +-2 times 6 grey values, all multiples
+    of 2**-27 below 256, so it is exact (as is |Gx| + |Gy|) and any order of the additions gives
+    the same value: the numba kernel (float_v2._nb_orient) computes it pixel by pixel, bit for bit.
+    (Before: cv2.Sobel in float32, whose rounding depends on the order OpenCV adds in.)"""
+    g = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0]).astype(np.float64)
+    gx = np.zeros_like(g)
+    gy = np.zeros_like(g)
+    if g.shape[0] >= 3 and g.shape[1] >= 3:
+        gx[1:-1, 1:-1] = (g[:-2, 2:] + 2.0 * g[1:-1, 2:] + g[2:, 2:]) - (g[:-2, :-2] + 2.0 * g[1:-1, :-2] + g[2:, :-2])
+        gy[1:-1, 1:-1] = (g[2:, :-2] + 2.0 * g[2:, 1:-1] + g[2:, 2:]) - (g[:-2, :-2] + 2.0 * g[:-2, 1:-1] + g[:-2, 2:])
     return gx, gy
 
 

@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 
 from . import float_model as _fm
-from .features import colour_bins
+from .features import _GREY_W, colour_bins
 from .frames import check_frame, clip_box
 from .numba_kernels import _SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3
 from .params import TrackerParams
@@ -168,13 +168,81 @@ def _nb_box(cx, cy, hx, hy, width, height):
             max(0, math.ceil(cy - hy)), min(height - 1, math.floor(cy + hy)))
 
 
+_WB, _WG, _WR = _GREY_W  # float32 constants: numba multiplies float32 by float32 in float32
+
+
 @_jit
-def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1):
-    """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once.
+def _nb_grey_px(full, y, x):
+    """:func:`grey_area` of one pixel, (B wb + G wg) + R wr in float32, as a float64 (exact)."""
+    return float((np.float32(full[y, x, 0]) * _WB + np.float32(full[y, x, 1]) * _WG) + np.float32(full[y, x, 2]) * _WR)
+
+
+@_jit
+def _nb_orient(full, y, x, T):
+    """The orientation bin of frame pixel (y, x) (:func:`~mstrack.track.features_v2.orientation_bins`
+    of :func:`~mstrack.track.features_v2.sobel`'s Gx, Gy): 8 on the frame's 1-px border; Gx, Gy
+    in float64 from the float32 grey, exact (so in any order the same values)."""
+    if y == 0 or x == 0 or y == full.shape[0] - 1 or x == full.shape[1] - 1:
+        return 8
+    a, b, c = _nb_grey_px(full, y - 1, x - 1), _nb_grey_px(full, y - 1, x), _nb_grey_px(full, y - 1, x + 1)
+    l, r = _nb_grey_px(full, y, x - 1), _nb_grey_px(full, y, x + 1)
+    e, f, g = _nb_grey_px(full, y + 1, x - 1), _nb_grey_px(full, y + 1, x), _nb_grey_px(full, y + 1, x + 1)
+    gx = (c + 2.0 * r + g) - (a + 2.0 * l + e)
+    gy = (e + 2.0 * f + g) - (a + 2.0 * b + c)
+    ax, ay = abs(gx), abs(gy)
+    if ax + ay < T:
+        return 8
+    return 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax)
+
+
+@_jit
+def _nb_orient_run(full, d, T, y, a, b, row, g):
+    """row[x] = row[x] x 9 + :func:`_nb_orient` of frame pixel (d y, d x) for x in [a, b): the grey
+    of frame rows d y - 1 .. d y + 1 over the run's columns (+-1) once into g (float64, exact),
+    then Gx, Gy of each pixel from it: the same values as :func:`_nb_orient`."""
+    if b <= a:
+        return
+    H, W = full.shape[0], full.shape[1]
+    Y = d * y
+    if Y == 0 or Y == H - 1:
+        for x in range(a, b):
+            row[x] = row[x] * 9 + 8
+        return
+    c0, c1 = max(d * a - 1, 0), min(d * (b - 1) + 1, W - 1)
+    for r in range(3):
+        px, gr = full[Y - 1 + r], g[r]
+        for X in range(c0, c1 + 1):
+            gr[X] = float((np.float32(px[X, 0]) * _WB + np.float32(px[X, 1]) * _WG) + np.float32(px[X, 2]) * _WR)
+    g0, g1, g2 = g[0], g[1], g[2]
+    tf = float(T)
+    xa, xb = a, b  # the pixels off the frame's left / right column
+    if d * a == 0:
+        row[a] = row[a] * 9 + 8
+        xa = a + 1
+    if d * (b - 1) == W - 1 and xb > xa:
+        row[b - 1] = row[b - 1] * 9 + 8
+        xb = b - 1
+    for x in range(xa, xb):  # (no branches: the flat test is as often true as not)
+        X = d * x
+        gx = (g0[X + 1] + 2.0 * g1[X + 1] + g2[X + 1]) - (g0[X - 1] + 2.0 * g1[X - 1] + g2[X - 1])
+        gy = (g2[X - 1] + 2.0 * g2[X] + g2[X + 1]) - (g0[X - 1] + 2.0 * g0[X] + g0[X + 1])
+        ax, ay = abs(gx), abs(gy)
+        o = 4 * np.int32(gx < 0.0) + 2 * np.int32(gy < 0.0) + np.int32(ay > ax)
+        o += np.int32(ax + ay < tf) * (8 - o)
+        row[x] = row[x] * 9 + o
+
+
+@_jit
+def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
+    """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once;
+    T > 0: joint bins, colour x 9 + :func:`_nb_orient` of frame pixel (d y, d x) of ``full``
+    (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``.
 
     rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
     to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    # T > 0: the grey of three frame rows (one row of decimated pixels' 3 x 3 neighbourhoods)
+    g = np.empty((3, full.shape[1] if T > 0 else 0))
     for y in range(y0, y1 + 1):
         lo, hi = rows[0, y], rows[1, y]
         if lo <= x0 and x1 < hi:
@@ -191,25 +259,144 @@ def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1):
         for x in range(hi, b):
             row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
                       | (np.uint32(px[x, 0]) >> s))
+        if T > 0:
+            _nb_orient_run(full, d, T, y, a, lo, row, g)
+            _nb_orient_run(full, d, T, y, hi, b, row, g)
         rows[0, y], rows[1, y] = a, b
 
 
+#: More bins than this (the joint colour x orientation bins, 4608): :func:`_nb_pass` works on the bins
+#: the window's pixels touch (:func:`_nb_scan_sparse`), not on every bin; fewer (colour, 512): as before.
+_SPARSE_BINS = 1024
+
+
 @_jit
-def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, cache, rows):
+def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, B, X, Y, h, ax, cnt, U, mark):
+    """numba_kernels._nb_scan on the bins image ``bins`` (the bins cache), for many bins: the same
+    pixels, B, X, Y and histogram h (the same sums in the same order), without clearing h and the
+    count tables first: they must be zero (as :func:`_nb_pass` leaves them).  The touched bins,
+    in order of first appearance, go to U (mark[u] = 1); h is set for them only.  Returns (n, nu)."""
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    nx = x1 - x0 + 1
+    jc = 0
+    for j in range(nx):
+        t = (x0 + j - cx) / hx
+        ax[j] = t * t
+        if ax[j] < ax[jc]:
+            jc = j
+    mask = cnt.shape[0] - 1
+    n = 0
+    for y in range(y0, y1 + 1):
+        t = (y - cy) / hy
+        by = t * t
+        if not ax[jc] + by < 1.0:
+            continue
+        lo, hi = 0, jc
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if ax[mid] + by < 1.0:
+                hi = mid
+            else:
+                lo = mid + 1
+        ja = lo
+        lo, hi = jc, nx - 1
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if ax[mid] + by < 1.0:
+                lo = mid
+            else:
+                hi = mid - 1
+        m = lo - ja + 1
+        xa = x0 + ja
+        b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
+        row = bins[y, xa:xa + m]
+        for k in range(m):
+            b[k] = row[k]
+            xs[k] = xa + k
+            ys[k] = y
+        if flat:
+            for k in range(m):
+                cnt[(n + k) & mask, b[k]] += 1
+        else:
+            axr = ax[ja:ja + m]
+            for k in range(m):
+                h[b[k]] += 1.0 - (axr[k] + by)
+        n += m
+    nu = 0
+    for k in range(n):
+        u = B[k]
+        if mark[u] == 0:
+            mark[u] = 1
+            U[nu] = u
+            nu += 1
+    if flat:
+        for i in range(nu):
+            u = U[i]
+            c = 0
+            for r in range(cnt.shape[0]):
+                c += cnt[r, u]
+            h[u] = float(c)
+    return n, nu
+
+
+@_jit
+def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
+                    cache, rows, full, d, T):
+    """:func:`_nb_pass` for many bins: the same numbers; the per-bin steps run on the touched bins
+    (h, p, the roots and the weights are 0 elsewhere, bit for bit what the dense steps give), and
+    h, p, wb, the count tables and the marks are cleared again for them at the end."""
+    nb = q.shape[0]
+    h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
+    U, mark = ubuf[0], ubuf[1]
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
+    if x1 < x0 or y1 < y0:  # no pixel in the box
+        n = nu = 0
+    else:
+        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
+        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, B, X, Y, h, ax, cnt, U, mark)
+    # _nb_normalise: p = h / total, roots sqrt(p q) (in wb), rho their pairwise sum over all bins
+    total = float(n) if flat else _nb_sum(h, nb)
+    for i in range(nu):
+        u = U[i]
+        p[u] = h[u] / total if total > 0 else h[u]
+        wb[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
+    rho = _nb_sum(wb, nb)
+    for i in range(nu):
+        u = U[i]
+        wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
+    sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+    for i in range(nu):
+        u = U[i]
+        h[u] = p[u] = wb[u] = 0.0
+        mark[u] = 0
+        for r in range(cnt.shape[0]):
+            cnt[r, u] = 0
+    return n, rho, sw, swx, swy
+
+
+@_jit
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf, cache, rows,
+             full, d, T):
     """The mean-shift part of :func:`window_pass` at (cx, cy): (n, rho, sw, swx, swy).
 
     Pixels and histogram by float_model's ``_nb_scan`` on the colour bins of
     ``frame``'s pixels (:func:`_nb_bins`, computed once per frame in ``cache``);
     the window's pixels stay in B, X, Y (n of them) and its column terms of d2 in
-    ``ax``, for :func:`_nb_stats`."""
+    ``ax``, for :func:`_nb_stats`.  More than _SPARSE_BINS bins: :func:`_nb_pass_sparse`."""
     nb = q.shape[0]
+    if nb > _SPARSE_BINS:
+        return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
+                               cache, rows, full, d, T)
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
         h[:] = 0.0
         n = 0
     else:
-        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1)
+        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
         n = _nb_scan(cx, cy, hx, hy, width, height, frame, 0, cache, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
     rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
     for u in range(nb):
@@ -252,18 +439,18 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
 
 @_jit
 def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
-                    ibuf, fbuf, ax, cnt, td, cache, rows):
+                    ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, full, d, T):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
     the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in, n).  Buffers: :func:`_nb_buffers_v2`."""
     n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
-                                    ibuf[2], fbuf, ax[0], cnt, cache, rows)
+                                    ibuf[2], fbuf, ax[0], cnt, ubuf, cache, rows, full, d, T)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
     return rho, sw, swx, swy, nt, st2, n_in, nt_in, n
 
 
 @_jit
 def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, t, max_iter, eps2,
-              ibuf, fbuf, ax, cnt, td, cache, rows):
+              ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, full, d, T):
     """FloatTrackerV2._track's mean shift from (sx, sy) after ``it0`` iterations.
 
     Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
@@ -277,7 +464,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
     c0x = min(max(sx, 0.0), width - 1.0)
     c0y = min(max(sy, 0.0), height - 1.0)
     n0, rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, B0, X0, Y0, fbuf,
-                                         ax0, cnt, cache, rows)
+                                         ax0, cnt, ubuf, cache, rows, full, d, T)
     it = it0
     for it in range(it0 + 1, max_iter + 1):
         if sw0 <= 0:
@@ -285,7 +472,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
         c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
         c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
         n1, rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, B1, X1, Y1,
-                                             fbuf, ax1, cnt, cache, rows)
+                                             fbuf, ax1, cnt, ubuf, cache, rows, full, d, T)
         if rho1 < rho0:
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
@@ -305,11 +492,14 @@ def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
     int32 bins and coordinates of two windows (6, box px); float64 histogram,
     normalised histogram, weights (3, bins); d2 column terms of two windows
     (2, box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins);
-    float64 t d2 (box px).
+    float64 t d2 (box px); int32 touched bins and their marks (2, bins).  The
+    histogram rows, the counts and the marks start at zero: with more than
+    _SPARSE_BINS bins :func:`_nb_pass_sparse` relies on it (and leaves them so).
     """
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
-    return (np.empty((6, box_w * box_h), np.int32), np.empty((3, n_bins)), np.empty((2, box_w)),
-            np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
+    return (np.empty((6, box_w * box_h), np.int32), np.zeros((3, n_bins)), np.empty((2, box_w)),
+            np.zeros((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h),
+            np.zeros((2, n_bins), np.int32))
 
 
 def _bins_cache(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -334,41 +524,8 @@ def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray
     if bufs is None or not _buffers_fit(bufs, hx, hy, q.shape[0]):
         bufs = _nb_buffers_v2(hx, hy, q.shape[0])
     return PassV2(*_nb_window_pass(frame, bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height,
-                                   float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width)))
-
-
-def joint_bins_area(frame: np.ndarray, d: int, bits: int, T: int, x0: int, x1: int, y0: int,
-                    y1: int) -> np.ndarray:
-    """Joint colour x orientation bins (``FloatTrackerV2._bins`` with orient_T = T) of the
-    decimated image's [y0, y1) x [x0, x1), from the frame's pixels around them only.
-
-    The Sobel runs on the grey of a strip of frame rows and SOBEL_ALIGN-aligned columns, as
-    :func:`~mstrack.track.float_model.edge_bins_area` does, so Gx, Gy equal the whole frame's bit for
-    bit; the frame's 1-px border is flat (bin 8), as :func:`~mstrack.track.features_v2.sobel` makes it.
-    """
-    from .features_v2 import orientation_bins
-    height, width = frame.shape[:2]
-    fx0, fx1, fy0, fy1 = d * x0, d * (x1 - 1) + 1, d * y0, d * (y1 - 1) + 1  # frame px of the area
-    gx0, gx1 = max(fx0 - 1, 0), min(fx1 + 1, width)
-    gy0, gy1 = max(fy0 - 1, 0), min(fy1 + 1, height)
-    sx0 = gx0 - gx0 % _fm.SOBEL_ALIGN
-    sx1 = -(-gx1 // _fm.SOBEL_ALIGN) * _fm.SOBEL_ALIGN
-    if sx1 > width - _fm.SOBEL_ALIGN:
-        sx1 = width
-    if (sx0, sx1) == (gx0, gx1):
-        strip = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
-    else:
-        strip = np.zeros((gy1 - gy0, sx1 - sx0), np.float32)
-        strip[:, gx0 - sx0: gx1 - sx0] = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
-    r0, c0 = fy0 - gy0, fx0 - sx0
-    gx = cv2.Sobel(strip, cv2.CV_32F, 1, 0, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
-    gy = cv2.Sobel(strip, cv2.CV_32F, 0, 1, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
-    o = orientation_bins(gx, gy, T)
-    ys = np.arange(y0, y1) * d
-    xs = np.arange(x0, x1) * d
-    o[(ys == 0) | (ys == height - 1), :] = 8
-    o[:, (xs == 0) | (xs == width - 1)] = 8
-    return colour_bins(frame[fy0:fy1:d, fx0:fx1:d], bits) * 9 + o
+                                   float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width),
+                                   frame, 1, 0))
 
 
 class LazyBins:
@@ -579,9 +736,9 @@ class FloatTrackerV2:
         eps2 = float(p.eps2)
         sx, sy, it0 = float(start[0]), float(start[1]), 0
         while True:
-            code, it, c0x, c0y, c1x, c1y, r = self._joint_checked(lambda: _nb_track(  # type: ignore[misc]
+            code, it, c0x, c0y, c1x, c1y, r = _nb_track(  # type: ignore[misc]
                 frame, p.colour_bits, sx, sy, it0, hx, hy, width, height, inner2, flat, self._qb, self._t,
-                int(max_iter), eps2, *self._bufs, *self._cache))
+                int(max_iter), eps2, *self._bufs, *self._cache, *self._source(frame))
             if code == 0:
                 return (c0x, c0y), PassV2(*r), it
             # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
@@ -593,46 +750,23 @@ class FloatTrackerV2:
     def _confidence(self, ps: PassV2) -> float:
         return confidence(ps, self._rho_ref, self._share_ref)
 
-    def _fill_joint(self, frame: np.ndarray, d: int, cx: float, cy: float, m: float) -> None:
-        """Joint bins of the decimated image within m px of (cx, cy) (all of it if m is None) into the
-        numba kernel's bins cache, those rows marked computed; the kernel must not compute any
-        other (it would compute colour bins): :meth:`_joint_checked` verifies it.  m = inf: all."""
-        p = self.params
-        hd, wd = (frame.shape[0] + d - 1) // d, (frame.shape[1] + d - 1) // d
-        if math.isinf(m):
-            x0, x1, y0, y1 = 0, wd, 0, hd
-        else:
-            x0, x1 = max(0, math.floor(cx - m)), min(wd, math.ceil(cx + m) + 1)
-            y0, y1 = max(0, math.floor(cy - m)), min(hd, math.ceil(cy + m) + 1)
-            if x1 <= x0 or y1 <= y0:
-                x0, x1, y0, y1 = 0, wd, 0, hd
-        cache, rows = self._cache  # type: ignore[misc]
-        cache[y0:y1, x0:x1] = joint_bins_area(frame, d, p.colour_bits, p.orient_T, x0, x1, y0, y1)
-        rows[:] = 0
-        rows[0, y0:y1], rows[1, y0:y1] = x0, x1
-        self._joint_rows = rows.copy()
-        self._joint_d = d
-
-    def _joint_checked(self, run):
-        """``run()`` (a numba kernel call on the bins cache) when every pixel it read had joint bins;
-        else the whole decimated image's joint bins and ``run()`` again (same results as if they
-        had been there from the start: the bins do not depend on what was computed before)."""
-        out = run()
-        if self.params.orient_T <= 0 or not (self._cache[1] != self._joint_rows).any():
-            return out
-        self._fill_joint(self._joint_frame, self._joint_d, 0.0, 0.0, float("inf"))
-        return run()
+    def _source(self, frame: np.ndarray) -> tuple[np.ndarray, int, int]:
+        """The numba kernels' (full frame, D, orient_T): joint bins need the frame's pixels around
+        each decimated pixel (set by :meth:`update`); colour bins only the decimated ``frame``."""
+        if self.params.orient_T > 0:
+            return self._src
+        return frame, 1, 0
 
     def _pass(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> PassV2:
         p = self.params
         inner2 = 1.0 / (1.0 + p.pad) ** 2
-        if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache (joint bins too)
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache
             if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):  # type: ignore[arg-type]
                 self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
             height, width = bins.shape[:2]
-            return PassV2(*self._joint_checked(lambda: _nb_window_pass(  # type: ignore[misc]
+            return PassV2(*_nb_window_pass(  # type: ignore[misc]
                 bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
-                p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache)))
+                p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache, *self._source(bins)))
         return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
 
     def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
@@ -697,11 +831,8 @@ class FloatTrackerV2:
                 self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
             else:
                 self._cache[1][:] = 0  # a new frame: no bins yet
-            if p.orient_T > 0:  # joint bins: a region around the start, marked as computed in the cache
-                self._joint_frame = frame
-                # the window + slack (lost: +-2 windows); anything beyond: _joint_checked
-                m = (3.5 if self._lost else 1.5) * max(hx, hy) + 8
-                self._fill_joint(frame, d, self._centre[0] / d, self._centre[1] / d, m)
+            # joint bins (orient_T > 0): the kernel adds each binned pixel's orientation from the frame
+            self._src = (frame, d, int(p.orient_T))
         elif p.orient_T > 0:
             bins = self._bins(frame, d)
         else:
@@ -804,10 +935,12 @@ def _numba_self_check() -> bool:
         if i != 3:  # frame 3: the target is gone
             f[10 + i:26 + i, 12 + 2 * i:30 + 2 * i] = (20, 40, 230)
         frames.append(f)
-    for kernel in ("flat", "epanechnikov"):
+    # (and the joint colour x orientation bins, off by default: the kernels' many-bins path)
+    for kernel, extra in (("flat", {}), ("epanechnikov", {}), ("flat", {"orient_T": 32}),
+                          ("epanechnikov", {"orient_T": 32})):
         runs = []
         for path in ("numpy", "numba"):
-            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel), path=path)  # type: ignore[arg-type]
+            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel, **extra), path=path)  # type: ignore[arg-type]
             trk._use_numba = path == "numba"  # (the self-check runs inside active_path)
             runs.append([trk.init(frames[0], (12, 10, 18, 16))] + [trk.update(f) for f in frames[1:]])
         if runs[0] != runs[1]:

@@ -198,8 +198,8 @@ def _nb_orient(full, y, x, T):
 @_jit
 def _nb_orient_run(full, d, T, y, a, b, row, g):
     """row[x] = row[x] x 9 + :func:`_nb_orient` of frame pixel (d y, d x) for x in [a, b): the grey
-    of frame rows d y - 1 .. d y + 1 over the run's columns (+-1) once into g (float64, exact),
-    then Gx, Gy of each pixel from it: the same values as :func:`_nb_orient`."""
+    of frame rows d y - 1 .. d y + 1 over the run's columns (+-1; D > 2: the 3 around each pixel's)
+    once into g (float64, exact), then Gx, Gy of each pixel from it: :func:`_nb_orient`'s values."""
     if b <= a:
         return
     H, W = full.shape[0], full.shape[1]
@@ -211,8 +211,14 @@ def _nb_orient_run(full, d, T, y, a, b, row, g):
     c0, c1 = max(d * a - 1, 0), min(d * (b - 1) + 1, W - 1)
     for r in range(3):
         px, gr = full[Y - 1 + r], g[r]
-        for X in range(c0, c1 + 1):
-            gr[X] = float((np.float32(px[X, 0]) * _WB + np.float32(px[X, 1]) * _WG) + np.float32(px[X, 2]) * _WR)
+        if d <= 2:  # every column of the run
+            for X in range(c0, c1 + 1):
+                gr[X] = float((np.float32(px[X, 0]) * _WB + np.float32(px[X, 1]) * _WG) + np.float32(px[X, 2]) * _WR)
+        else:  # the 3 columns around each pixel's
+            for x in range(a, b):
+                for X in range(max(d * x - 1, 0), min(d * x + 1, W - 1) + 1):
+                    gr[X] = float((np.float32(px[X, 0]) * _WB + np.float32(px[X, 1]) * _WG)
+                                  + np.float32(px[X, 2]) * _WR)
     g0, g1, g2 = g[0], g[1], g[2]
     tf = float(T)
     xa, xb = a, b  # the pixels off the frame's left / right column
@@ -344,10 +350,11 @@ def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, B, X, Y, h, ax, c
 
 @_jit
 def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
-                    cache, rows, full, d, T):
+                    cache, rows, full, d, T, rho_only):
     """:func:`_nb_pass` for many bins: the same numbers; the per-bin steps run on the touched bins
     (h, p, the roots and the weights are 0 elsewhere, bit for bit what the dense steps give), and
-    h, p, wb, the count tables and the marks are cleared again for them at the end."""
+    h, p, wb, the count tables and the marks are cleared again for them at the end.  rho_only:
+    no weights (sw, swx, swy returned 0)."""
     nb = q.shape[0]
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     U, mark = ubuf[0], ubuf[1]
@@ -364,10 +371,12 @@ def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y
         p[u] = h[u] / total if total > 0 else h[u]
         wb[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
     rho = _nb_sum(wb, nb)
-    for i in range(nu):
-        u = U[i]
-        wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
-    sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+    sw = swx = swy = 0.0
+    if not rho_only:
+        for i in range(nu):
+            u = U[i]
+            wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
+        sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
     for i in range(nu):
         u = U[i]
         h[u] = p[u] = wb[u] = 0.0
@@ -389,7 +398,7 @@ def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf,
     nb = q.shape[0]
     if nb > _SPARSE_BINS:
         return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
-                               cache, rows, full, d, T)
+                               cache, rows, full, d, T, False)
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
@@ -446,6 +455,17 @@ def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q,
                                     ibuf[2], fbuf, ax[0], cnt, ubuf, cache, rows, full, d, T)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
     return rho, sw, swx, swy, nt, st2, n_in, nt_in, n
+
+
+@_jit
+def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows,
+                   full, d, T):
+    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: without the weights' sums)."""
+    if q.shape[0] > _SPARSE_BINS:
+        return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2],
+                               fbuf, ax[0], cnt, ubuf, cache, rows, full, d, T, True)[1]
+    return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
+                    cnt, ubuf, cache, rows, full, d, T)[1]
 
 
 @_jit
@@ -769,13 +789,25 @@ class FloatTrackerV2:
                 p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache, *self._source(bins)))
         return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
 
-    def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
+    def _rho(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
+        """``self._pass(bins, c, hx, hy).rho`` (numba: :func:`_nb_window_rho`, the same value)."""
+        p = self.params
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):  # type: ignore[arg-type]
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
+            height, width = bins.shape[:2]
+            return _nb_window_rho(bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width,  # type: ignore[misc]
+                                  height, p.kernel == "flat", self._qb, *self._bufs, *self._cache, *self._source(bins))
+        return self._pass(bins, c, hx, hy).rho
+
+    def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
+                    rho: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
-        the largest (two more passes at the final centre)."""
+        the largest (two more passes at the final centre; ``rho``: the pass at c, hx, hy's)."""
         d = self.params.scale_test
-        best, rho = 1.0, self._pass(bins, c, hx, hy).rho
+        best = 1.0
         for s in (1.0 - d, 1.0 + d):
-            r = self._pass(bins, c, s * hx, s * hy).rho
+            r = self._rho(bins, c, s * hx, s * hy)
             if r > rho:
                 best, rho = s, r
         return best
@@ -870,7 +902,7 @@ class FloatTrackerV2:
             self._share_ref += a * (ps.share - self._share_ref)
         # scale: every frame (a lost or uncertain target changes size too), from the spread
         if p.scale_gain > 0 and ps.nt > 0:
-            est_rho = self._scale_test(bins, c, hx, hy) if p.scale_test > 0 else None
+            est_rho = self._scale_test(bins, c, hx, hy, ps.rho) if p.scale_test > 0 else None
             self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho)
         box = box_from_centre_index(*self._centre, *self._size)
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
@@ -935,9 +967,9 @@ def _numba_self_check() -> bool:
         if i != 3:  # frame 3: the target is gone
             f[10 + i:26 + i, 12 + 2 * i:30 + 2 * i] = (20, 40, 230)
         frames.append(f)
-    # (and the joint colour x orientation bins, off by default: the kernels' many-bins path)
-    for kernel, extra in (("flat", {}), ("epanechnikov", {}), ("flat", {"orient_T": 32}),
-                          ("epanechnikov", {"orient_T": 32})):
+    # (and the joint colour x orientation bins with the scale test, off by default: the many-bins path)
+    joint = {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True}
+    for kernel, extra in (("flat", {}), ("epanechnikov", {}), ("flat", joint), ("epanechnikov", joint)):
         runs = []
         for path in ("numpy", "numba"):
             trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel, **extra), path=path)  # type: ignore[arg-type]

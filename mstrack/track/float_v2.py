@@ -196,10 +196,13 @@ def _nb_orient(full, y, x, T):
 
 
 @_jit
-def _nb_orient_run(full, d, T, y, a, b, row, g):
+def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
     """row[x] = row[x] x 9 + :func:`_nb_orient` of frame pixel (d y, d x) for x in [a, b): the grey
     of frame rows d y - 1 .. d y + 1 over the run's columns (+-1; D > 2: the 3 around each pixel's)
-    once into g (float64, exact), then Gx, Gy of each pixel from it: :func:`_nb_orient`'s values."""
+    into g (float64, exact), then Gx, Gy of each pixel from it: :func:`_nb_orient`'s values.
+
+    g holds frame row R in g[R % 3]; gk[0, R % 3] = R and gk[1:3, R % 3] = the run [a', b') it
+    was computed for (-1: none): a row already there for a run containing [a, b) is reused."""
     if b <= a:
         return
     H, W = full.shape[0], full.shape[1]
@@ -210,7 +213,12 @@ def _nb_orient_run(full, d, T, y, a, b, row, g):
         return
     c0, c1 = max(d * a - 1, 0), min(d * (b - 1) + 1, W - 1)
     for r in range(3):
-        px, gr = full[Y - 1 + r], g[r]
+        R = Y - 1 + r
+        k = R % 3
+        if gk[0, k] == R and gk[1, k] <= a and b <= gk[2, k]:
+            continue
+        gk[0, k], gk[1, k], gk[2, k] = R, a, b
+        px, gr = full[R], g[k]
         if d <= 2:  # every column of the run
             for X in range(c0, c1 + 1):
                 gr[X] = float((np.float32(px[X, 0]) * _WB + np.float32(px[X, 1]) * _WG) + np.float32(px[X, 2]) * _WR)
@@ -219,7 +227,7 @@ def _nb_orient_run(full, d, T, y, a, b, row, g):
                 for X in range(max(d * x - 1, 0), min(d * x + 1, W - 1) + 1):
                     gr[X] = float((np.float32(px[X, 0]) * _WB + np.float32(px[X, 1]) * _WG)
                                   + np.float32(px[X, 2]) * _WR)
-    g0, g1, g2 = g[0], g[1], g[2]
+    g0, g1, g2 = g[(Y - 1) % 3], g[Y % 3], g[(Y + 1) % 3]
     tf = float(T)
     xa, xb = a, b  # the pixels off the frame's left / right column
     if d * a == 0:
@@ -249,6 +257,7 @@ def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
     # T > 0: the grey of three frame rows (one row of decimated pixels' 3 x 3 neighbourhoods)
     g = np.empty((3, full.shape[1] if T > 0 else 0))
+    gk = np.full((3, 3), -1, np.int64)  # which frame row / run each row of g holds (_nb_orient_run)
     for y in range(y0, y1 + 1):
         lo, hi = rows[0, y], rows[1, y]
         if lo <= x0 and x1 < hi:
@@ -266,8 +275,8 @@ def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
             row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
                       | (np.uint32(px[x, 0]) >> s))
         if T > 0:
-            _nb_orient_run(full, d, T, y, a, lo, row, g)
-            _nb_orient_run(full, d, T, y, hi, b, row, g)
+            _nb_orient_run(full, d, T, y, a, lo, row, g, gk)
+            _nb_orient_run(full, d, T, y, hi, b, row, g, gk)
         rows[0, y], rows[1, y] = a, b
 
 

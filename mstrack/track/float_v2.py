@@ -468,14 +468,107 @@ def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q,
 
 
 @_jit
+def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, fbuf, ax, cnt, ubuf):
+    """rho of :func:`_nb_pass_sparse` at (cx, cy) on bins already in ``bins`` (the cache), for many
+    bins, without the pixel lists: the same window pixels (the scan's runs), the same histogram
+    (counts; or bincount's sequential sums in row-major order), p and sqrt(p q) on the touched bins
+    and their pairwise sum over all bins; h, p, the roots, counts and marks cleared again after."""
+    nb = q.shape[0]
+    h, p, tmp = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
+    U, mark = ubuf[0], ubuf[1]
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    n = nu = 0
+    if x1 >= x0 and y1 >= y0:
+        nx = x1 - x0 + 1
+        jc = 0
+        for j in range(nx):
+            t = (x0 + j - cx) / hx
+            ax[j] = t * t
+            if ax[j] < ax[jc]:
+                jc = j
+        mask = cnt.shape[0] - 1
+        for y in range(y0, y1 + 1):
+            t = (y - cy) / hy
+            by = t * t
+            if not ax[jc] + by < 1.0:
+                continue
+            lo, hi = 0, jc
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if ax[mid] + by < 1.0:
+                    hi = mid
+                else:
+                    lo = mid + 1
+            ja = lo
+            lo, hi = jc, nx - 1
+            while lo < hi:
+                mid = (lo + hi + 1) // 2
+                if ax[mid] + by < 1.0:
+                    lo = mid
+                else:
+                    hi = mid - 1
+            m = lo - ja + 1
+            row = bins[y, x0 + ja:x0 + ja + m]
+            for k in range(m):
+                u = row[k]
+                if mark[u] == 0:
+                    mark[u] = 1
+                    U[nu] = u
+                    nu += 1
+            if flat:
+                for k in range(m):
+                    cnt[(n + k) & mask, row[k]] += 1
+            else:
+                axr = ax[ja:ja + m]
+                for k in range(m):
+                    h[row[k]] += 1.0 - (axr[k] + by)
+            n += m
+        if flat:
+            for i in range(nu):
+                u = U[i]
+                c = 0
+                for r in range(cnt.shape[0]):
+                    c += cnt[r, u]
+                h[u] = float(c)
+    total = float(n) if flat else _nb_sum(h, nb)
+    for i in range(nu):
+        u = U[i]
+        p[u] = h[u] / total if total > 0 else h[u]
+        tmp[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
+    rho = _nb_sum(tmp, nb)
+    for i in range(nu):
+        u = U[i]
+        h[u] = p[u] = tmp[u] = 0.0
+        mark[u] = 0
+        for r in range(cnt.shape[0]):
+            cnt[r, u] = 0
+    return rho
+
+
+@_jit
 def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows,
                    full, d, T):
-    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: without the weights' sums)."""
+    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_rho_sparse`)."""
     if q.shape[0] > _SPARSE_BINS:
-        return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2],
-                               fbuf, ax[0], cnt, ubuf, cache, rows, full, d, T, True)[1]
+        bx0, bx1, by0, by1 = _nb_box(cx, cy, hx, hy, width, height)
+        if bx1 >= bx0 and by1 >= by0:
+            _nb_bins(frame, bits, cache, rows, bx0, bx1, by0, by1, full, d, T)
+        return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, fbuf, ax[0], cnt, ubuf)
     return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
                     cnt, ubuf, cache, rows, full, d, T)[1]
+
+
+@_jit
+def _nb_window_rho2(frame, bits, cx, cy, hx1, hy1, hx2, hy2, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
+                    cache, rows, full, d, T):
+    """:func:`_nb_window_rho` at (cx, cy) for two window sizes (the scale test's), one call."""
+    return (_nb_window_rho(frame, bits, cx, cy, hx1, hy1, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
+                           cache, rows, full, d, T),
+            _nb_window_rho(frame, bits, cx, cy, hx2, hy2, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
+                           cache, rows, full, d, T))
 
 
 @_jit
@@ -810,14 +903,28 @@ class FloatTrackerV2:
                                   height, p.kernel == "flat", self._qb, *self._bufs, *self._cache, *self._source(bins))
         return self._pass(bins, c, hx, hy).rho
 
+    def _rho2(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
+              scales: tuple[float, float]) -> tuple[float, float]:
+        """:meth:`_rho` at (s hx, s hy) for the two scales s (numba: one :func:`_nb_window_rho2` call)."""
+        p = self.params
+        s1, s2 = scales
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            hm, hmy = max(s1, s2) * hx, max(s1, s2) * hy
+            if not _buffers_fit(self._bufs, hm, hmy, p.n_bins_v2):  # type: ignore[arg-type]
+                self._bufs = _nb_buffers_v2(1.25 * hm, 1.25 * hmy, p.n_bins_v2)
+            height, width = bins.shape[:2]
+            return _nb_window_rho2(bins, p.colour_bits, float(c[0]), float(c[1]), float(s1 * hx), float(s1 * hy),  # type: ignore[misc]
+                                   float(s2 * hx), float(s2 * hy), width, height, p.kernel == "flat", self._qb,
+                                   *self._bufs, *self._cache, *self._source(bins))
+        return self._rho(bins, c, s1 * hx, s1 * hy), self._rho(bins, c, s2 * hx, s2 * hy)
+
     def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
                     rho: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
         the largest (two more passes at the final centre; ``rho``: the pass at c, hx, hy's)."""
         d = self.params.scale_test
         best = 1.0
-        for s in (1.0 - d, 1.0 + d):
-            r = self._rho(bins, c, s * hx, s * hy)
+        for s, r in zip((1.0 - d, 1.0 + d), self._rho2(bins, c, hx, hy, (1.0 - d, 1.0 + d))):
             if r > rho:
                 best, rho = s, r
         return best

@@ -157,7 +157,9 @@ def test_scale_change(kernel):
 @needs_numba
 @pytest.mark.parametrize("extra", [{"scale_test": 0.05, "scale_test_gate": True},
                                    {"scale_test": 0.1, "scale_test_mix": 0.5}, {"motion_gain": 0.5},
-                                   {"orient_T": 64}, {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True}])
+                                   {"orient_T": 64}, {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True},
+                                   {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True,
+                                    "kernel": "epanechnikov"}])
 def test_experimental_options(extra):
     """The experimental options (off by default; docs/results_v2_mean.md) are bit-identical too."""
     sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]

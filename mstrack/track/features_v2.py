@@ -95,19 +95,24 @@ class Feature:
 
 
 def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gx, Gy (float64) of the 3x3 Sobel on the float32 grey image; 0 on the 1-px frame border.
+    """Gx, Gy (float32) of the 3x3 Sobel on the float32 grey image; 0 on the 1-px frame border.
 
-    Gx = right column - left column (weights 1, 2, 1), Gy = bottom row - top row, formed in
-    float64 from the float32 grey: each is a sum of +-1 / +-2 times 6 grey values, all multiples
-    of 2**-27 below 256, so it is exact (as is |Gx| + |Gy|) and any order of the additions gives
-    the same value: the numba kernel (float_v2._nb_orient) computes it pixel by pixel, bit for bit.
-    (Before: cv2.Sobel in float32, whose rounding depends on the order OpenCV adds in.)"""
-    g = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0]).astype(np.float64)
+    Element-wise float32 operations in a fixed order (so the numba kernel,
+    float_v2._nb_orient_run, computes the same values pixel by pixel):
+    Gx = (d[y-1] + d[y+1]) + 2 d[y] with d = g[x+1] - g[x-1] (the row difference), and
+    Gy = s[y+1] - s[y-1] with s = (g[x-1] + g[x+1]) + 2 g[x] (the row smoothing).  This is
+    cv2.Sobel(grey, CV_32F, ksize=3)'s order in its vector loop: equal to it bit for bit on
+    frames whose width is a multiple of 8 (every dev sequence); OpenCV's scalar tail (the last
+    columns of other widths) may round differently.  (Before: cv2.Sobel itself.)"""
+    g = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0])
     gx = np.zeros_like(g)
     gy = np.zeros_like(g)
     if g.shape[0] >= 3 and g.shape[1] >= 3:
-        gx[1:-1, 1:-1] = (g[:-2, 2:] + 2.0 * g[1:-1, 2:] + g[2:, 2:]) - (g[:-2, :-2] + 2.0 * g[1:-1, :-2] + g[2:, :-2])
-        gy[1:-1, 1:-1] = (g[2:, :-2] + 2.0 * g[2:, 1:-1] + g[2:, 2:]) - (g[:-2, :-2] + 2.0 * g[:-2, 1:-1] + g[:-2, 2:])
+        two = np.float32(2)
+        d = g[:, 2:] - g[:, :-2]
+        gx[1:-1, 1:-1] = (d[:-2] + d[2:]) + d[1:-1] * two
+        sm = (g[:, :-2] + g[:, 2:]) + g[:, 1:-1] * two
+        gy[1:-1, 1:-1] = sm[2:] - sm[:-2]
     return gx, gy
 
 

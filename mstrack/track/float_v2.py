@@ -160,6 +160,9 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
 # counts (t is 0 / 1), exact in any order, computed for the final window only.  The one Python
 # float operation of the loop, s2 = dx ** 2 + dy ** 2 (libm pow), is left to Python when s2 is
 # within rounding of eps2.  init() and everything per frame run the same Python for both paths.
+# With orient_T > 0 the kernels bin joint colour x orientation bins lazily too (_nb_bins_joint, the
+# Sobel in features_v2.sobel's float32 order), and with more than _SPARSE_BINS bins a pass runs its per-bin steps on the
+# bins its pixels touch (_nb_pass_sparse, _nb_rho_sparse), the same numbers.
 
 @_jit
 def _nb_box(cx, cy, hx, hy, width, height):
@@ -171,37 +174,16 @@ def _nb_box(cx, cy, hx, hy, width, height):
 _WB, _WG, _WR = _GREY_W  # float32 constants: numba multiplies float32 by float32 in float32
 # the three float32 products of grey_area as tables (the same IEEE products: v wb, v wg, v wr)
 _LB, _LG, _LR = (np.arange(256, dtype=np.float32) * w for w in _GREY_W)
-
-
-@_jit
-def _nb_grey_px(full, y, x):
-    """:func:`grey_area` of one pixel, (B wb + G wg) + R wr in float32, as a float64 (exact)."""
-    return float((np.float32(full[y, x, 0]) * _WB + np.float32(full[y, x, 1]) * _WG) + np.float32(full[y, x, 2]) * _WR)
-
-
-@_jit
-def _nb_orient(full, y, x, T):
-    """The orientation bin of frame pixel (y, x) (:func:`~mstrack.track.features_v2.orientation_bins`
-    of :func:`~mstrack.track.features_v2.sobel`'s Gx, Gy): 8 on the frame's 1-px border; Gx, Gy
-    in float64 from the float32 grey, exact (so in any order the same values)."""
-    if y == 0 or x == 0 or y == full.shape[0] - 1 or x == full.shape[1] - 1:
-        return 8
-    a, b, c = _nb_grey_px(full, y - 1, x - 1), _nb_grey_px(full, y - 1, x), _nb_grey_px(full, y - 1, x + 1)
-    l, r = _nb_grey_px(full, y, x - 1), _nb_grey_px(full, y, x + 1)
-    e, f, g = _nb_grey_px(full, y + 1, x - 1), _nb_grey_px(full, y + 1, x), _nb_grey_px(full, y + 1, x + 1)
-    gx = (c + 2.0 * r + g) - (a + 2.0 * l + e)
-    gy = (e + 2.0 * f + g) - (a + 2.0 * b + c)
-    ax, ay = abs(gx), abs(gy)
-    if ax + ay < T:
-        return 8
-    return 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax)
+_TWO = np.float32(2.0)
 
 
 @_jit
 def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
-    """row[x] = row[x] x 9 + :func:`_nb_orient` of frame pixel (d y, d x) for x in [a, b): the grey
+    """row[x] = row[x] x 9 + the orientation bin of frame pixel (d y, d x) for x in [a, b)
+    (:func:`~mstrack.track.features_v2.orientation_bins` of :func:`~mstrack.track.features_v2.sobel`'s
+    Gx, Gy, the same float32 operations in the same order; 8 on the frame's 1-px border): the grey
     of frame rows d y - 1 .. d y + 1 over the run's columns (+-1; D > 2: the 3 around each pixel's)
-    into g (float64, exact), then Gx, Gy of each pixel from it: :func:`_nb_orient`'s values.
+    into g (float32), then Gx, Gy of each pixel from it.
 
     g holds frame row R in g[R % 3]; gk[0, R % 3] = R and gk[1:3, R % 3] = the run [a', b') it
     was computed for (-1: none): a row already there for a run containing [a, b) is reused."""
@@ -223,11 +205,11 @@ def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
         px, gr = full[R], g[k]
         if d <= 2:  # every column of the run
             for X in range(c0, c1 + 1):
-                gr[X] = float((_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]])
+                gr[X] = (_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]]
         else:  # the 3 columns around each pixel's
             for x in range(a, b):
                 for X in range(max(d * x - 1, 0), min(d * x + 1, W - 1) + 1):
-                    gr[X] = float((_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]])
+                    gr[X] = (_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]]
     g0, g1, g2 = g[(Y - 1) % 3], g[Y % 3], g[(Y + 1) % 3]
     tf = float(T)
     xa, xb = a, b  # the pixels off the frame's left / right column
@@ -239,10 +221,10 @@ def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
         xb = b - 1
     for x in range(xa, xb):  # (no branches: the flat test is as often true as not)
         X = d * x
-        gx = (g0[X + 1] + 2.0 * g1[X + 1] + g2[X + 1]) - (g0[X - 1] + 2.0 * g1[X - 1] + g2[X - 1])
-        gy = (g2[X - 1] + 2.0 * g2[X] + g2[X + 1]) - (g0[X - 1] + 2.0 * g0[X] + g0[X + 1])
+        gx = ((g0[X + 1] - g0[X - 1]) + (g2[X + 1] - g2[X - 1])) + (g1[X + 1] - g1[X - 1]) * _TWO
+        gy = ((g2[X - 1] + g2[X + 1]) + g2[X] * _TWO) - ((g0[X - 1] + g0[X + 1]) + g0[X] * _TWO)
         ax, ay = abs(gx), abs(gy)
-        o = 4 * np.int32(gx < 0.0) + 2 * np.int32(gy < 0.0) + np.int32(ay > ax)
+        o = 4 * np.int32(gx < 0) + 2 * np.int32(gy < 0) + np.int32(ay > ax)
         o += np.int32(ax + ay < tf) * (8 - o)
         row[x] = row[x] * 9 + o
 
@@ -250,14 +232,41 @@ def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
 @_jit
 def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
     """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once;
-    T > 0: joint bins, colour x 9 + :func:`_nb_orient` of frame pixel (d y, d x) of ``full``
-    (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``.
+    T > 0: joint bins (:func:`_nb_bins_joint`).
 
     rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
     to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
+    if T > 0:
+        _nb_bins_joint(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
+        return
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
-    # T > 0: the grey of three frame rows (one row of decimated pixels' 3 x 3 neighbourhoods)
-    g = np.empty((3, full.shape[1] if T > 0 else 0))
+    for y in range(y0, y1 + 1):
+        lo, hi = rows[0, y], rows[1, y]
+        if lo <= x0 and x1 < hi:
+            continue
+        if lo >= hi:  # nothing yet in this row
+            a, b = x0, x1 + 1
+            lo, hi = x0, x0
+        else:
+            a, b = min(x0, lo), max(x1 + 1, hi)
+        px, row = frame[y], cache[y]
+        for x in range(a, lo):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        for x in range(hi, b):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        rows[0, y], rows[1, y] = a, b
+
+
+@_jit
+def _nb_bins_joint(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
+    """:func:`_nb_bins` with joint bins: colour x 9 + the orientation bin of frame pixel (d y, d x)
+    of ``full`` (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``
+    (:func:`_nb_orient_run` for each new run of a row)."""
+    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    # the grey of three frame rows (one row of decimated pixels' 3 x 3 neighbourhoods)
+    g = np.empty((3, full.shape[1]), np.float32)
     gk = np.full((3, 3), -1, np.int64)  # which frame row / run each row of g holds (_nb_orient_run)
     for y in range(y0, y1 + 1):
         lo, hi = rows[0, y], rows[1, y]
@@ -275,9 +284,8 @@ def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
         for x in range(hi, b):
             row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
                       | (np.uint32(px[x, 0]) >> s))
-        if T > 0:
-            _nb_orient_run(full, d, T, y, a, lo, row, g, gk)
-            _nb_orient_run(full, d, T, y, hi, b, row, g, gk)
+        _nb_orient_run(full, d, T, y, a, lo, row, g, gk)
+        _nb_orient_run(full, d, T, y, hi, b, row, g, gk)
         rows[0, y], rows[1, y] = a, b
 
 

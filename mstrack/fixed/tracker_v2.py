@@ -59,11 +59,18 @@ def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region)
     # the ring beyond the frame: any value (those pixels are on the frame border: bin 8)
     g = np.pad(g, ((a0 - (y0 - 1), y1 + 2 - a1), (b0 - (x0 - 1), x1 + 2 - b1)), mode="edge")
 
-    def at(dy: int, dx: int) -> np.ndarray:  # grey at (Y + dy, X + dx) for the region's pixels (Y, X)
-        return g[1 + dy: 1 + dy + d * (n - 1) + 1: d, 1 + dx: 1 + dx + d * (m - 1) + 1: d]
+    def rows(dy: int) -> np.ndarray:  # grey rows Y + dy of the region's pixels (Y, X), every column
+        return g[1 + dy: 1 + dy + d * (n - 1) + 1: d]
 
-    gx = (at(-1, 1) + 2 * at(0, 1) + at(1, 1)) - (at(-1, -1) + 2 * at(0, -1) + at(1, -1))
-    gy = (at(1, -1) + 2 * at(1, 0) + at(1, 1)) - (at(-1, -1) + 2 * at(-1, 0) + at(-1, 1))
+    def cols(a: np.ndarray, dx: int) -> np.ndarray:  # columns X + dx
+        return a[:, 1 + dx: 1 + dx + d * (m - 1) + 1: d]
+
+    # ms_orient_bin's sums regrouped (integers: the same values): Gx = V[x+1] - V[x-1] with the
+    # vertical 1 2 1 sum V; Gy = D[x-1] + 2 D[x] + D[x+1] with the vertical difference D
+    v = rows(-1) + 2 * rows(0) + rows(1)
+    dd = rows(1) - rows(-1)
+    gx = cols(v, 1) - cols(v, -1)
+    gy = cols(dd, -1) + 2 * cols(dd, 0) + cols(dd, 1)
     ax, ay = np.abs(gx), np.abs(gy)
     o = np.where(ax + ay >= T, 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax), ORIENT_FLAT)
     ys, xs = d * np.arange(reg.y, reg.y + n), d * np.arange(reg.x, reg.x + m)

@@ -103,6 +103,7 @@ class FixedTrackerV2:
             raise ValueError(f"max_window {p.max_window} > 2 max_half + 1 = {2 * self.fixed.max_half + 1}")
         self.widths = widths(p, self.fixed)
         self._shape: tuple[int, int] | None = None
+        self._kernels: dict[tuple[int, int], ms_kernel] = {}
 
     # ------------------------------------------------------------------ helpers
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
@@ -111,6 +112,17 @@ class FixedTrackerV2:
             return c
         # joint bins (experimental, off by default): Sobel on the full-resolution grey frame
         return ms_joint_bin(c, ms_orient_bin(ms_grey(frame), self.params.orient_T)[::d, ::d])
+
+    def _kernel(self, wd: int, hd: int) -> ms_kernel:
+        """The flat ms_kernel of a wd x hd window (its tables depend on wd, hd only: kept, not rebuilt
+        every frame; they are never modified)."""
+        key = (wd, hd)
+        ker = self._kernels.get(key)
+        if ker is None:
+            if len(self._kernels) > 64:
+                self._kernels.clear()
+            ker = self._kernels[key] = ms_kernel(wd, hd, "flat", self.fixed.kernel_bits)
+        return ker
 
     def _geometry(self, d: int, dims: tuple[int, int]) -> tuple[int, int]:
         """Window diameters (decimated px), limited to the decimated frame's interior."""
@@ -156,7 +168,7 @@ class FixedTrackerV2:
             h8 = ms_scale_test_size(self.h8, d256, up)
             wd = ms_window_size(w8, self.pad16, d, min(p.max_window, dims[1] - 2))
             hd = ms_window_size(h8, self.pad16, d, min(p.max_window, dims[0] - 2))
-            ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+            ker = self._kernel(wd, hd)
             if (win[0] - ker.ex < reg.x or win[1] - ker.ey < reg.y or win[0] + ker.ex >= reg.x + reg.w
                     or win[1] + ker.ey >= reg.y + reg.h):
                 rhos.append(None)
@@ -205,7 +217,7 @@ class FixedTrackerV2:
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
         self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2)
         wd, hd = self._geometry(d, bins.shape)
-        ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+        ker = self._kernel(wd, hd)
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one pass at the init centre (no iteration) gives the references
@@ -254,7 +266,7 @@ class FixedTrackerV2:
         sh = d.bit_length() - 1
         img = frame[::d, ::d]
         wd, hd = self._geometry(d, img.shape[:2])
-        ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+        ker = self._kernel(wd, hd)
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost

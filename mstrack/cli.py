@@ -595,11 +595,55 @@ def bench_fps(tracker: Any, frames: list[np.ndarray], box: Box) -> float:
     return (len(frames) - 1) / dt if dt > 0 else math.nan
 
 
+def parse_variant(text: str) -> dict[str, Any]:
+    """``KEY=VALUE[,KEY=VALUE...]`` (``bench --variant``) as TrackerParams overrides; values are
+    int, float, true / false, or else strings: ``"orient_T=64,scale_test=0.05,scale_test_gate=true"``."""
+    from .track.params import TrackerParams
+
+    out: dict[str, Any] = {}
+    for item in _csv_list(text) or []:
+        key, sep, val = item.partition("=")
+        key, val = key.strip(), val.strip()
+        if not sep or key not in TrackerParams.field_names():
+            raise ValueError(f"--variant: {item!r} is not KEY=VALUE with KEY a TrackerParams field")
+        v: Any = val
+        if val.lower() in ("true", "false"):
+            v = val.lower() == "true"
+        else:
+            for conv in (int, float):
+                try:
+                    v = conv(val)
+                    break
+                except ValueError:
+                    pass
+        out[key] = v
+    if not out:
+        raise ValueError("--variant needs KEY=VALUE")
+    return out
+
+
 def _cmd_bench(args: argparse.Namespace) -> int:
     from .eval.evaluate import make_tracker, run_label
 
     models = ["float", "fixed"] if args.model == "both" else [args.model]
-    runs = [(run_label(args.tracker, m), args.tracker, m) for m in models] + [("opencv-camshift", "opencv-camshift", "float")]
+    variants: list[tuple[str, dict[str, Any]]] = [("", {})]
+    for text in args.variant or []:
+        if not args.tracker.startswith("mstrack-"):
+            raise ValueError("--variant needs an mstrack tracker")
+        label, colon, rest = text.partition(":")
+        kv = parse_variant(rest if colon else text)
+        variants.append(("[" + (label if colon else ",".join(f"{k}={v}" for k, v in kv.items())) + "]", kv))
+    runs = [(run_label(args.tracker, m) + tag, (args.tracker, kv), m) for tag, kv in variants for m in models]
+    runs += [("opencv-camshift", ("opencv-camshift", {}), "float")]
+
+    def make(spec: tuple[str, dict[str, Any]], m: str) -> Any:
+        name, kv = spec
+        if not kv:
+            return make_tracker(name, m)
+        from .explore import _base_params
+        from .track.tracker import Tracker
+        _, base = _base_params(name)
+        return Tracker(model=m, **{**base, **kv})  # type: ignore[arg-type]
     cases: list[tuple[str, list[np.ndarray], Box]] = []
     if args.dataset:
         for s in load_dataset(args.dataset, _csv_list(args.sequences)):
@@ -616,7 +660,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     for name, frames, box in cases:
         fps = {}
         for label, tname, m in runs:
-            fps[label] = bench_fps(make_tracker(tname, m), frames, box)
+            fps[label] = bench_fps(make(tname, m), frames, box)
             tot[label][0] += len(frames) - 1
             tot[label][1] += (len(frames) - 1) / fps[label] if fps[label] > 0 else 0.0
         cam = fps["opencv-camshift"]
@@ -654,6 +698,10 @@ def register_bench(sub: argparse._SubParsersAction) -> None:
                    help="float reference, fixed-point model, or both (default)")
     p.add_argument("--tracker", default=DEFAULT_TRACKER, help=f"mstrack variant (default {DEFAULT_TRACKER})")
     p.add_argument("--frames", type=int, default=100, help="frames per sequence (default 100)")
+    p.add_argument("--variant", action="append", metavar="[LABEL:]KEY=VALUE[,KEY=VALUE...]",
+                   help="also run the tracker with these TrackerParams (repeatable; labelled tracker[LABEL], "
+                        "default tracker[KEY=VALUE,...]), e.g. tracker v2's joint candidate: "
+                        "--variant joint:orient_T=64,scale_test=0.05,scale_test_gate=true")
     p.add_argument("--write-docs", action="store_true", help="write the table to docs/bench.md")
     p.add_argument("--docs-file", default="docs/bench.md", help=argparse.SUPPRESS)
     p.set_defaults(func=_cmd_bench)

@@ -199,6 +199,20 @@ def test_bench_dataset_both_models(tiny_dataset, capsys):
     assert f"{cli.DEFAULT_TRACKER}@fixed fps" in out and "seq1" in out and out.splitlines()[-1].startswith("all")
 
 
+@needs_tracker
+def test_bench_variant(tiny_dataset, capsys):
+    """--variant runs the tracker with TrackerParams overrides beside the default (tracker v2's joint
+    candidate here), both models; a bad variant is refused."""
+    assert cli.main(["bench", str(tiny_dataset), "--frames", "3", "--model", "both", "--variant",
+                     "joint:orient_T=64,scale_test=0.05,scale_test_gate=true"]) == 0
+    out = capsys.readouterr().out
+    assert "mstrack-v2[joint] fps" in out and "mstrack-v2@fixed[joint] fps" in out
+    assert cli.parse_variant("orient_T=64,scale_test=0.05,scale_test_gate=true,kernel=flat") == {
+        "orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "kernel": "flat"}
+    with pytest.raises(ValueError):
+        cli.parse_variant("nonsense=1")
+
+
 def test_load_dataset_of_tiny(tiny_dataset):
     assert [s.name for s in load_dataset(tiny_dataset)] == ["seq0", "seq1"]
 

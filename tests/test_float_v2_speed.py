@@ -157,7 +157,9 @@ def test_scale_change(kernel):
 @needs_numba
 @pytest.mark.parametrize("extra", [{"scale_test": 0.05, "scale_test_gate": True},
                                    {"scale_test": 0.1, "scale_test_mix": 0.5}, {"motion_gain": 0.5},
-                                   {"orient_T": 64}, {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True}])
+                                   {"orient_T": 64}, {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True},
+                                   {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True,
+                                    "kernel": "epanechnikov"}])
 def test_experimental_options(extra):
     """The experimental options (off by default; docs/results_v2_mean.md) are bit-identical too."""
     sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]
@@ -281,16 +283,31 @@ def test_numba_switched_off_falls_back_to_numpy(monkeypatch):
         v2.FloatTrackerV2(path="numba").active_path()
 
 
-def test_joint_bins_area_equals_whole_frame():
-    """The joint bins of an area (numba path's region) equal the whole decimated image's."""
-    rng = np.random.default_rng(5)
+@needs_numba
+@pytest.mark.parametrize("T", [1, 32, 64, 300])
+def test_joint_bins_kernel_equals_whole_frame(T):
+    """The joint bins the numba kernel computes lazily (_nb_bins, pixel by pixel, areas in any
+    order) equal the whole decimated image's (FloatTrackerV2._bins, numpy), frame border included."""
+    rng = np.random.default_rng(5 + T)
     frame = np.ascontiguousarray(rng.integers(0, 256, (97, 203, 3), dtype=np.uint8))
     frame[20:60, 30:150] = cv2.GaussianBlur(frame[20:60, 30:150], (0, 0), 3)
-    for d in (1, 2, 4):
-        trk = v2.FloatTrackerV2(TrackerParams(preset="v2", orient_T=32), path="numpy")
+    frame[70:, 100:] //= 7
+    for d in (1, 2, 4, 8):
+        trk = v2.FloatTrackerV2(TrackerParams(preset="v2", orient_T=T), path="numpy")
         whole = trk._bins(frame, d)
         h, w = whole.shape
-        for x0, x1, y0, y1 in ((0, w, 0, h), (0, 5, 0, 7), (w - 9, w, h - 4, h), (3, 40, 2, 11),
-                               (w // 3, w // 2, h // 4, h - 1), (60 // d, 130 // d + 1, 1, h)):
-            got = v2.joint_bins_area(frame, d, 3, 32, x0, x1, y0, y1)
-            assert np.array_equal(got, whole[y0:y1, x0:x1]), (d, x0, x1, y0, y1)
+        cache, rows = v2._bins_cache(h, w)
+        src = frame[::d, ::d]
+        for x0, x1, y0, y1 in ((3, 40, 2, 11), (0, 4, 0, 6), (w - 9, w - 1, h - 4, h - 1), (1, 50, 5, 30),
+                               (w // 3, w // 2, h // 4, h - 2), (0, w - 1, 0, h - 1)):  # inclusive
+            x0, x1, y0, y1 = min(x0, w - 1), min(x1, w - 1), min(y0, h - 1), min(y1, h - 1)
+            v2._nb_bins(src, 3, cache, rows, x0, x1, y0, y1, frame, d, T)
+        assert np.array_equal(cache, whole), d
+    # features_v2.sobel's float32 order is cv2.Sobel's on frames whose width is a multiple of 8
+    from mstrack.track.features import grey_area
+    from mstrack.track.features_v2 import sobel
+    f2 = np.ascontiguousarray(rng.integers(0, 256, (61, 320, 3), dtype=np.uint8))
+    g = grey_area(f2, 0, f2.shape[1], 0, f2.shape[0])
+    gx, gy = sobel(f2)
+    assert np.array_equal(gx[1:-1, 1:-1], cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=3)[1:-1, 1:-1])
+    assert np.array_equal(gy[1:-1, 1:-1], cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=3)[1:-1, 1:-1])

@@ -32,6 +32,7 @@ from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_
                         ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
+                        ORIENT_FLAT,
                         ms_scale_gate, ms_scale_test, ms_scale_test_size)
 from .formats import FixedParams, widths
 
@@ -39,6 +40,43 @@ from .formats import FixedParams, widths
 RESULT_FIELDS_V2 = ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "decimation")
 STATUS_CODES_V2 = {Status.OK: 0, Status.UNCERTAIN: 1, Status.LOST: 2, Status.REACQUIRED: 3,
                    Status.INIT: 4, Status.CLIPPED: 5, Status.ERROR: 6}
+
+
+def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region) -> np.ndarray:
+    """``ms_joint_bin(ms_colour_bin(img), ms_orient_bin(ms_grey(frame), T)[::d, ::d])`` of the
+    decimated image ``img = frame[::d, ::d]`` over region ``reg`` only (the region capture): the
+    grey of the frame pixels under the region and its 1-px ring, Gx, Gy as ms_orient_bin forms
+    them at the region's pixels (integers: the same values), 8 on the frame's 1-px border."""
+    fh, fw = frame.shape[:2]
+    c = ms_colour_bin(frame[::d, ::d][reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], bits)
+    n, m = c.shape
+    if n == 0 or m == 0:
+        return c
+    y0, y1 = d * reg.y, d * (reg.y + n - 1)  # frame rows / columns of the region's first and last pixel
+    x0, x1 = d * reg.x, d * (reg.x + m - 1)
+    a0, a1, b0, b1 = max(y0 - 1, 0), min(y1 + 2, fh), max(x0 - 1, 0), min(x1 + 2, fw)
+    g = ms_grey(frame[a0:a1, b0:b1])
+    # the ring beyond the frame: any value (those pixels are on the frame border: bin 8)
+    g = np.pad(g, ((a0 - (y0 - 1), y1 + 2 - a1), (b0 - (x0 - 1), x1 + 2 - b1)), mode="edge")
+
+    def rows(dy: int) -> np.ndarray:  # grey rows Y + dy of the region's pixels (Y, X), every column
+        return g[1 + dy: 1 + dy + d * (n - 1) + 1: d]
+
+    def cols(a: np.ndarray, dx: int) -> np.ndarray:  # columns X + dx
+        return a[:, 1 + dx: 1 + dx + d * (m - 1) + 1: d]
+
+    # ms_orient_bin's sums regrouped (integers: the same values): Gx = V[x+1] - V[x-1] with the
+    # vertical 1 2 1 sum V; Gy = D[x-1] + 2 D[x] + D[x+1] with the vertical difference D
+    v = rows(-1) + 2 * rows(0) + rows(1)
+    dd = rows(1) - rows(-1)
+    gx = cols(v, 1) - cols(v, -1)
+    gy = cols(dd, -1) + 2 * cols(dd, 0) + cols(dd, 1)
+    ax, ay = np.abs(gx), np.abs(gy)
+    o = np.where(ax + ay >= T, 4 * (gx < 0) + 2 * (gy < 0) + (ay > ax), ORIENT_FLAT)
+    ys, xs = d * np.arange(reg.y, reg.y + n), d * np.arange(reg.x, reg.x + m)
+    o[(ys == 0) | (ys == fh - 1), :] = ORIENT_FLAT
+    o[:, (xs == 0) | (xs == fw - 1)] = ORIENT_FLAT
+    return ms_joint_bin(c, o)
 
 
 class FixedTrackerV2:
@@ -65,6 +103,7 @@ class FixedTrackerV2:
             raise ValueError(f"max_window {p.max_window} > 2 max_half + 1 = {2 * self.fixed.max_half + 1}")
         self.widths = widths(p, self.fixed)
         self._shape: tuple[int, int] | None = None
+        self._kernels: dict[tuple[int, int], ms_kernel] = {}
 
     # ------------------------------------------------------------------ helpers
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
@@ -73,6 +112,17 @@ class FixedTrackerV2:
             return c
         # joint bins (experimental, off by default): Sobel on the full-resolution grey frame
         return ms_joint_bin(c, ms_orient_bin(ms_grey(frame), self.params.orient_T)[::d, ::d])
+
+    def _kernel(self, wd: int, hd: int) -> ms_kernel:
+        """The flat ms_kernel of a wd x hd window (its tables depend on wd, hd only: kept, not rebuilt
+        every frame; they are never modified)."""
+        key = (wd, hd)
+        ker = self._kernels.get(key)
+        if ker is None:
+            if len(self._kernels) > 64:
+                self._kernels.clear()
+            ker = self._kernels[key] = ms_kernel(wd, hd, "flat", self.fixed.kernel_bits)
+        return ker
 
     def _geometry(self, d: int, dims: tuple[int, int]) -> tuple[int, int]:
         """Window diameters (decimated px), limited to the decimated frame's interior."""
@@ -118,7 +168,7 @@ class FixedTrackerV2:
             h8 = ms_scale_test_size(self.h8, d256, up)
             wd = ms_window_size(w8, self.pad16, d, min(p.max_window, dims[1] - 2))
             hd = ms_window_size(h8, self.pad16, d, min(p.max_window, dims[0] - 2))
-            ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+            ker = self._kernel(wd, hd)
             if (win[0] - ker.ex < reg.x or win[1] - ker.ey < reg.y or win[0] + ker.ex >= reg.x + reg.w
                     or win[1] + ker.ey >= reg.y + reg.h):
                 rhos.append(None)
@@ -167,7 +217,7 @@ class FixedTrackerV2:
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
         self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2)
         wd, hd = self._geometry(d, bins.shape)
-        ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+        ker = self._kernel(wd, hd)
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one pass at the init centre (no iteration) gives the references
@@ -215,17 +265,18 @@ class FixedTrackerV2:
         d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
         sh = d.bit_length() - 1
         img = frame[::d, ::d]
-        if p.orient_T > 0:
-            self._joint = self._bins(frame, d)
         wd, hd = self._geometry(d, img.shape[:2])
-        ker = ms_kernel(wd, hd, "flat", fx.kernel_bits)
+        ker = self._kernel(wd, hd)
         Qw = ms_model_scale(self.model.Qn, ker.K)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost
         ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
         reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
-        sub = self._capture(img, reg)
+        if p.orient_T > 0:  # joint bins of the captured region only (the whole frame's, bit for bit)
+            sub = joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg)
+        else:
+            sub = self._capture(img, reg)
         c8d, S, it, stop, st = self._run(img, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter, sub)
         rho = ms_rho_out(S, ker.K, fx)
         share = ms_share(st)

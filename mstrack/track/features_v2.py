@@ -50,7 +50,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from .features import colour_bins, edge_bins, grey_area
@@ -96,13 +95,24 @@ class Feature:
 
 
 def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Gx, Gy (float32) of the 3x3 Sobel on the grey image; 0 on the 1-px frame border."""
-    grey = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0])
-    gx = cv2.Sobel(grey, cv2.CV_32F, 1, 0, ksize=3)
-    gy = cv2.Sobel(grey, cv2.CV_32F, 0, 1, ksize=3)
-    for g in (gx, gy):
-        g[0, :] = g[-1, :] = 0
-        g[:, 0] = g[:, -1] = 0
+    """Gx, Gy (float32) of the 3x3 Sobel on the float32 grey image; 0 on the 1-px frame border.
+
+    Element-wise float32 operations in a fixed order (so the numba kernel,
+    float_v2._nb_orient_run, computes the same values pixel by pixel):
+    Gx = (d[y-1] + d[y+1]) + 2 d[y] with d = g[x+1] - g[x-1] (the row difference), and
+    Gy = s[y+1] - s[y-1] with s = (g[x-1] + g[x+1]) + 2 g[x] (the row smoothing).  This is
+    cv2.Sobel(grey, CV_32F, ksize=3)'s order in its vector loop: equal to it bit for bit on
+    frames whose width is a multiple of 8 (every dev sequence); OpenCV's scalar tail (the last
+    columns of other widths) may round differently.  (Before: cv2.Sobel itself.)"""
+    g = grey_area(frame, 0, frame.shape[1], 0, frame.shape[0])
+    gx = np.zeros_like(g)
+    gy = np.zeros_like(g)
+    if g.shape[0] >= 3 and g.shape[1] >= 3:
+        two = np.float32(2)
+        d = g[:, 2:] - g[:, :-2]
+        gx[1:-1, 1:-1] = (d[:-2] + d[2:]) + d[1:-1] * two
+        sm = (g[:, :-2] + g[:, 2:]) + g[:, 1:-1] * two
+        gy[1:-1, 1:-1] = sm[2:] - sm[:-2]
     return gx, gy
 
 

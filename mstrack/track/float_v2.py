@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 
 from . import float_model as _fm
-from .features import colour_bins
+from .features import _GREY_W, colour_bins
 from .frames import check_frame, clip_box
 from .numba_kernels import _SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3
 from .params import TrackerParams
@@ -160,6 +160,9 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
 # counts (t is 0 / 1), exact in any order, computed for the final window only.  The one Python
 # float operation of the loop, s2 = dx ** 2 + dy ** 2 (libm pow), is left to Python when s2 is
 # within rounding of eps2.  init() and everything per frame run the same Python for both paths.
+# With orient_T > 0 the kernels bin joint colour x orientation bins lazily too (_nb_bins_joint, the
+# Sobel in features_v2.sobel's float32 order), and with more than _SPARSE_BINS bins a pass runs its per-bin steps on the
+# bins its pixels touch (_nb_pass_sparse, _nb_rho_sparse), the same numbers.
 
 @_jit
 def _nb_box(cx, cy, hx, hy, width, height):
@@ -168,12 +171,74 @@ def _nb_box(cx, cy, hx, hy, width, height):
             max(0, math.ceil(cy - hy)), min(height - 1, math.floor(cy + hy)))
 
 
+_WB, _WG, _WR = _GREY_W  # float32 constants: numba multiplies float32 by float32 in float32
+# the three float32 products of grey_area as tables (the same IEEE products: v wb, v wg, v wr)
+_LB, _LG, _LR = (np.arange(256, dtype=np.float32) * w for w in _GREY_W)
+_TWO = np.float32(2.0)
+
+
 @_jit
-def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1):
-    """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once.
+def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
+    """row[x] = row[x] x 9 + the orientation bin of frame pixel (d y, d x) for x in [a, b)
+    (:func:`~mstrack.track.features_v2.orientation_bins` of :func:`~mstrack.track.features_v2.sobel`'s
+    Gx, Gy, the same float32 operations in the same order; 8 on the frame's 1-px border): the grey
+    of frame rows d y - 1 .. d y + 1 over the run's columns (+-1; D > 2: the 3 around each pixel's)
+    into g (float32), then Gx, Gy of each pixel from it.
+
+    g holds frame row R in g[R % 3]; gk[0, R % 3] = R and gk[1:3, R % 3] = the run [a', b') it
+    was computed for (-1: none): a row already there for a run containing [a, b) is reused."""
+    if b <= a:
+        return
+    H, W = full.shape[0], full.shape[1]
+    Y = d * y
+    if Y == 0 or Y == H - 1:
+        for x in range(a, b):
+            row[x] = row[x] * 9 + 8
+        return
+    c0, c1 = max(d * a - 1, 0), min(d * (b - 1) + 1, W - 1)
+    for r in range(3):
+        R = Y - 1 + r
+        k = R % 3
+        if gk[0, k] == R and gk[1, k] <= a and b <= gk[2, k]:
+            continue
+        gk[0, k], gk[1, k], gk[2, k] = R, a, b
+        px, gr = full[R], g[k]
+        if d <= 2:  # every column of the run
+            for X in range(c0, c1 + 1):
+                gr[X] = (_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]]
+        else:  # the 3 columns around each pixel's
+            for x in range(a, b):
+                for X in range(max(d * x - 1, 0), min(d * x + 1, W - 1) + 1):
+                    gr[X] = (_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]]
+    g0, g1, g2 = g[(Y - 1) % 3], g[Y % 3], g[(Y + 1) % 3]
+    tf = float(T)
+    xa, xb = a, b  # the pixels off the frame's left / right column
+    if d * a == 0:
+        row[a] = row[a] * 9 + 8
+        xa = a + 1
+    if d * (b - 1) == W - 1 and xb > xa:
+        row[b - 1] = row[b - 1] * 9 + 8
+        xb = b - 1
+    for x in range(xa, xb):  # (no branches: the flat test is as often true as not)
+        X = d * x
+        gx = ((g0[X + 1] - g0[X - 1]) + (g2[X + 1] - g2[X - 1])) + (g1[X + 1] - g1[X - 1]) * _TWO
+        gy = ((g2[X - 1] + g2[X + 1]) + g2[X] * _TWO) - ((g0[X - 1] + g0[X + 1]) + g0[X] * _TWO)
+        ax, ay = abs(gx), abs(gy)
+        o = 4 * np.int32(gx < 0) + 2 * np.int32(gy < 0) + np.int32(ay > ax)
+        o += np.int32(ax + ay < tf) * (8 - o)
+        row[x] = row[x] * 9 + o
+
+
+@_jit
+def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
+    """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once;
+    T > 0: joint bins (:func:`_nb_bins_joint`).
 
     rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
     to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
+    if T > 0:
+        _nb_bins_joint(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
+        return
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
     for y in range(y0, y1 + 1):
         lo, hi = rows[0, y], rows[1, y]
@@ -195,21 +260,170 @@ def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1):
 
 
 @_jit
-def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, cache, rows):
+def _nb_bins_joint(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
+    """:func:`_nb_bins` with joint bins: colour x 9 + the orientation bin of frame pixel (d y, d x)
+    of ``full`` (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``
+    (:func:`_nb_orient_run` for each new run of a row)."""
+    s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
+    # the grey of three frame rows (one row of decimated pixels' 3 x 3 neighbourhoods)
+    g = np.empty((3, full.shape[1]), np.float32)
+    gk = np.full((3, 3), -1, np.int64)  # which frame row / run each row of g holds (_nb_orient_run)
+    for y in range(y0, y1 + 1):
+        lo, hi = rows[0, y], rows[1, y]
+        if lo <= x0 and x1 < hi:
+            continue
+        if lo >= hi:  # nothing yet in this row
+            a, b = x0, x1 + 1
+            lo, hi = x0, x0
+        else:
+            a, b = min(x0, lo), max(x1 + 1, hi)
+        px, row = frame[y], cache[y]
+        for x in range(a, lo):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        for x in range(hi, b):
+            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
+                      | (np.uint32(px[x, 0]) >> s))
+        _nb_orient_run(full, d, T, y, a, lo, row, g, gk)
+        _nb_orient_run(full, d, T, y, hi, b, row, g, gk)
+        rows[0, y], rows[1, y] = a, b
+
+
+#: More bins than this (the joint colour x orientation bins, 4608): :func:`_nb_pass` works on the bins
+#: the window's pixels touch (:func:`_nb_scan_sparse`), not on every bin; fewer (colour, 512): as before.
+_SPARSE_BINS = 1024
+
+
+@_jit
+def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, B, X, Y, h, ax, cnt, U, mark):
+    """numba_kernels._nb_scan on the bins image ``bins`` (the bins cache), for many bins: the same
+    pixels, B, X, Y and histogram h (the same sums in the same order), without clearing h and the
+    count tables first: they must be zero (as :func:`_nb_pass` leaves them).  The touched bins,
+    in order of first appearance, go to U (mark[u] = 1); h is set for them only.  Returns (n, nu)."""
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    nx = x1 - x0 + 1
+    jc = 0
+    for j in range(nx):
+        t = (x0 + j - cx) / hx
+        ax[j] = t * t
+        if ax[j] < ax[jc]:
+            jc = j
+    mask = cnt.shape[0] - 1
+    n = 0
+    for y in range(y0, y1 + 1):
+        t = (y - cy) / hy
+        by = t * t
+        if not ax[jc] + by < 1.0:
+            continue
+        lo, hi = 0, jc
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if ax[mid] + by < 1.0:
+                hi = mid
+            else:
+                lo = mid + 1
+        ja = lo
+        lo, hi = jc, nx - 1
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if ax[mid] + by < 1.0:
+                lo = mid
+            else:
+                hi = mid - 1
+        m = lo - ja + 1
+        xa = x0 + ja
+        b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
+        row = bins[y, xa:xa + m]
+        for k in range(m):
+            b[k] = row[k]
+            xs[k] = xa + k
+            ys[k] = y
+        if flat:
+            for k in range(m):
+                cnt[(n + k) & mask, b[k]] += 1
+        else:
+            axr = ax[ja:ja + m]
+            for k in range(m):
+                h[b[k]] += 1.0 - (axr[k] + by)
+        n += m
+    nu = 0
+    for k in range(n):
+        u = B[k]
+        if mark[u] == 0:
+            mark[u] = 1
+            U[nu] = u
+            nu += 1
+    if flat:
+        for i in range(nu):
+            u = U[i]
+            c = 0
+            for r in range(cnt.shape[0]):
+                c += cnt[r, u]
+            h[u] = float(c)
+    return n, nu
+
+
+@_jit
+def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
+                    cache, rows, full, d, T, rho_only):
+    """:func:`_nb_pass` for many bins: the same numbers; the per-bin steps run on the touched bins
+    (h, p, the roots and the weights are 0 elsewhere, bit for bit what the dense steps give), and
+    h, p, wb, the count tables and the marks are cleared again for them at the end.  rho_only:
+    no weights (sw, swx, swy returned 0)."""
+    nb = q.shape[0]
+    h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
+    U, mark = ubuf[0], ubuf[1]
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
+    if x1 < x0 or y1 < y0:  # no pixel in the box
+        n = nu = 0
+    else:
+        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
+        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, B, X, Y, h, ax, cnt, U, mark)
+    # _nb_normalise: p = h / total, roots sqrt(p q) (in wb), rho their pairwise sum over all bins
+    total = float(n) if flat else _nb_sum(h, nb)
+    for i in range(nu):
+        u = U[i]
+        p[u] = h[u] / total if total > 0 else h[u]
+        wb[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
+    rho = _nb_sum(wb, nb)
+    sw = swx = swy = 0.0
+    if not rho_only:
+        for i in range(nu):
+            u = U[i]
+            wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
+        sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+    for i in range(nu):
+        u = U[i]
+        h[u] = p[u] = wb[u] = 0.0
+        mark[u] = 0
+        for r in range(cnt.shape[0]):
+            cnt[r, u] = 0
+    return n, rho, sw, swx, swy
+
+
+@_jit
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf, cache, rows,
+             full, d, T):
     """The mean-shift part of :func:`window_pass` at (cx, cy): (n, rho, sw, swx, swy).
 
     Pixels and histogram by float_model's ``_nb_scan`` on the colour bins of
     ``frame``'s pixels (:func:`_nb_bins`, computed once per frame in ``cache``);
     the window's pixels stay in B, X, Y (n of them) and its column terms of d2 in
-    ``ax``, for :func:`_nb_stats`."""
+    ``ax``, for :func:`_nb_stats`.  More than _SPARSE_BINS bins: :func:`_nb_pass_sparse`."""
     nb = q.shape[0]
+    if nb > _SPARSE_BINS:
+        return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
+                               cache, rows, full, d, T, False)
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
         h[:] = 0.0
         n = 0
     else:
-        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1)
+        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
         n = _nb_scan(cx, cy, hx, hy, width, height, frame, 0, cache, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
     rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
     for u in range(nb):
@@ -252,18 +466,122 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
 
 @_jit
 def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
-                    ibuf, fbuf, ax, cnt, td, cache, rows):
+                    ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, full, d, T):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
     the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in, n).  Buffers: :func:`_nb_buffers_v2`."""
     n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
-                                    ibuf[2], fbuf, ax[0], cnt, cache, rows)
+                                    ibuf[2], fbuf, ax[0], cnt, ubuf, cache, rows, full, d, T)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
     return rho, sw, swx, swy, nt, st2, n_in, nt_in, n
 
 
 @_jit
+def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, fbuf, ax, cnt, ubuf):
+    """rho of :func:`_nb_pass_sparse` at (cx, cy) on bins already in ``bins`` (the cache), for many
+    bins, without the pixel lists: the same window pixels (the scan's runs), the same histogram
+    (counts; or bincount's sequential sums in row-major order), p and sqrt(p q) on the touched bins
+    and their pairwise sum over all bins; h, p, the roots, counts and marks cleared again after."""
+    nb = q.shape[0]
+    h, p, tmp = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
+    U, mark = ubuf[0], ubuf[1]
+    x0 = max(0, math.ceil(cx - hx))
+    x1 = min(width - 1, math.floor(cx + hx))
+    y0 = max(0, math.ceil(cy - hy))
+    y1 = min(height - 1, math.floor(cy + hy))
+    n = nu = 0
+    if x1 >= x0 and y1 >= y0:
+        nx = x1 - x0 + 1
+        jc = 0
+        for j in range(nx):
+            t = (x0 + j - cx) / hx
+            ax[j] = t * t
+            if ax[j] < ax[jc]:
+                jc = j
+        mask = cnt.shape[0] - 1
+        for y in range(y0, y1 + 1):
+            t = (y - cy) / hy
+            by = t * t
+            if not ax[jc] + by < 1.0:
+                continue
+            lo, hi = 0, jc
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if ax[mid] + by < 1.0:
+                    hi = mid
+                else:
+                    lo = mid + 1
+            ja = lo
+            lo, hi = jc, nx - 1
+            while lo < hi:
+                mid = (lo + hi + 1) // 2
+                if ax[mid] + by < 1.0:
+                    lo = mid
+                else:
+                    hi = mid - 1
+            m = lo - ja + 1
+            row = bins[y, x0 + ja:x0 + ja + m]
+            for k in range(m):
+                u = row[k]
+                if mark[u] == 0:
+                    mark[u] = 1
+                    U[nu] = u
+                    nu += 1
+            if flat:
+                for k in range(m):
+                    cnt[(n + k) & mask, row[k]] += 1
+            else:
+                axr = ax[ja:ja + m]
+                for k in range(m):
+                    h[row[k]] += 1.0 - (axr[k] + by)
+            n += m
+        if flat:
+            for i in range(nu):
+                u = U[i]
+                c = 0
+                for r in range(cnt.shape[0]):
+                    c += cnt[r, u]
+                h[u] = float(c)
+    total = float(n) if flat else _nb_sum(h, nb)
+    for i in range(nu):
+        u = U[i]
+        p[u] = h[u] / total if total > 0 else h[u]
+        tmp[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
+    rho = _nb_sum(tmp, nb)
+    for i in range(nu):
+        u = U[i]
+        h[u] = p[u] = tmp[u] = 0.0
+        mark[u] = 0
+        for r in range(cnt.shape[0]):
+            cnt[r, u] = 0
+    return rho
+
+
+@_jit
+def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows,
+                   full, d, T):
+    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_rho_sparse`)."""
+    if q.shape[0] > _SPARSE_BINS:
+        bx0, bx1, by0, by1 = _nb_box(cx, cy, hx, hy, width, height)
+        if bx1 >= bx0 and by1 >= by0:
+            _nb_bins(frame, bits, cache, rows, bx0, bx1, by0, by1, full, d, T)
+        return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, fbuf, ax[0], cnt, ubuf)
+    return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
+                    cnt, ubuf, cache, rows, full, d, T)[1]
+
+
+@_jit
+def _nb_window_rho2(frame, bits, cx, cy, hx1, hy1, hx2, hy2, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
+                    cache, rows, full, d, T):
+    """:func:`_nb_window_rho` at (cx, cy) for two window sizes (the scale test's), one call."""
+    return (_nb_window_rho(frame, bits, cx, cy, hx1, hy1, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
+                           cache, rows, full, d, T),
+            _nb_window_rho(frame, bits, cx, cy, hx2, hy2, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
+                           cache, rows, full, d, T))
+
+
+@_jit
 def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, t, max_iter, eps2,
-              ibuf, fbuf, ax, cnt, td, cache, rows):
+              ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, full, d, T):
     """FloatTrackerV2._track's mean shift from (sx, sy) after ``it0`` iterations.
 
     Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
@@ -277,7 +595,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
     c0x = min(max(sx, 0.0), width - 1.0)
     c0y = min(max(sy, 0.0), height - 1.0)
     n0, rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, B0, X0, Y0, fbuf,
-                                         ax0, cnt, cache, rows)
+                                         ax0, cnt, ubuf, cache, rows, full, d, T)
     it = it0
     for it in range(it0 + 1, max_iter + 1):
         if sw0 <= 0:
@@ -285,7 +603,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
         c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
         c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
         n1, rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, B1, X1, Y1,
-                                             fbuf, ax1, cnt, cache, rows)
+                                             fbuf, ax1, cnt, ubuf, cache, rows, full, d, T)
         if rho1 < rho0:
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
@@ -305,11 +623,14 @@ def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
     int32 bins and coordinates of two windows (6, box px); float64 histogram,
     normalised histogram, weights (3, bins); d2 column terms of two windows
     (2, box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins);
-    float64 t d2 (box px).
+    float64 t d2 (box px); int32 touched bins and their marks (2, bins).  The
+    histogram rows, the counts and the marks start at zero: with more than
+    _SPARSE_BINS bins :func:`_nb_pass_sparse` relies on it (and leaves them so).
     """
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
-    return (np.empty((6, box_w * box_h), np.int32), np.empty((3, n_bins)), np.empty((2, box_w)),
-            np.empty((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h))
+    return (np.empty((6, box_w * box_h), np.int32), np.zeros((3, n_bins)), np.empty((2, box_w)),
+            np.zeros((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h),
+            np.zeros((2, n_bins), np.int32))
 
 
 def _bins_cache(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -334,41 +655,8 @@ def window_pass_numba(frame: np.ndarray, bits: int, q: np.ndarray, t: np.ndarray
     if bufs is None or not _buffers_fit(bufs, hx, hy, q.shape[0]):
         bufs = _nb_buffers_v2(hx, hy, q.shape[0])
     return PassV2(*_nb_window_pass(frame, bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height,
-                                   float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width)))
-
-
-def joint_bins_area(frame: np.ndarray, d: int, bits: int, T: int, x0: int, x1: int, y0: int,
-                    y1: int) -> np.ndarray:
-    """Joint colour x orientation bins (``FloatTrackerV2._bins`` with orient_T = T) of the
-    decimated image's [y0, y1) x [x0, x1), from the frame's pixels around them only.
-
-    The Sobel runs on the grey of a strip of frame rows and SOBEL_ALIGN-aligned columns, as
-    :func:`~mstrack.track.float_model.edge_bins_area` does, so Gx, Gy equal the whole frame's bit for
-    bit; the frame's 1-px border is flat (bin 8), as :func:`~mstrack.track.features_v2.sobel` makes it.
-    """
-    from .features_v2 import orientation_bins
-    height, width = frame.shape[:2]
-    fx0, fx1, fy0, fy1 = d * x0, d * (x1 - 1) + 1, d * y0, d * (y1 - 1) + 1  # frame px of the area
-    gx0, gx1 = max(fx0 - 1, 0), min(fx1 + 1, width)
-    gy0, gy1 = max(fy0 - 1, 0), min(fy1 + 1, height)
-    sx0 = gx0 - gx0 % _fm.SOBEL_ALIGN
-    sx1 = -(-gx1 // _fm.SOBEL_ALIGN) * _fm.SOBEL_ALIGN
-    if sx1 > width - _fm.SOBEL_ALIGN:
-        sx1 = width
-    if (sx0, sx1) == (gx0, gx1):
-        strip = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
-    else:
-        strip = np.zeros((gy1 - gy0, sx1 - sx0), np.float32)
-        strip[:, gx0 - sx0: gx1 - sx0] = _fm.grey_area(frame, gx0, gx1, gy0, gy1)
-    r0, c0 = fy0 - gy0, fx0 - sx0
-    gx = cv2.Sobel(strip, cv2.CV_32F, 1, 0, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
-    gy = cv2.Sobel(strip, cv2.CV_32F, 0, 1, ksize=3)[r0: r0 + fy1 - fy0: d, c0: c0 + fx1 - fx0: d]
-    o = orientation_bins(gx, gy, T)
-    ys = np.arange(y0, y1) * d
-    xs = np.arange(x0, x1) * d
-    o[(ys == 0) | (ys == height - 1), :] = 8
-    o[:, (xs == 0) | (xs == width - 1)] = 8
-    return colour_bins(frame[fy0:fy1:d, fx0:fx1:d], bits) * 9 + o
+                                   float(inner2), kernel == "flat", q, t, *bufs, *_bins_cache(height, width),
+                                   frame, 1, 0))
 
 
 class LazyBins:
@@ -579,9 +867,9 @@ class FloatTrackerV2:
         eps2 = float(p.eps2)
         sx, sy, it0 = float(start[0]), float(start[1]), 0
         while True:
-            code, it, c0x, c0y, c1x, c1y, r = self._joint_checked(lambda: _nb_track(  # type: ignore[misc]
+            code, it, c0x, c0y, c1x, c1y, r = _nb_track(  # type: ignore[misc]
                 frame, p.colour_bits, sx, sy, it0, hx, hy, width, height, inner2, flat, self._qb, self._t,
-                int(max_iter), eps2, *self._bufs, *self._cache))
+                int(max_iter), eps2, *self._bufs, *self._cache, *self._source(frame))
             if code == 0:
                 return (c0x, c0y), PassV2(*r), it
             # code 1: the shift test c0 -> c1 as _track does it (c1 accepted: rho1 >= rho0)
@@ -593,55 +881,58 @@ class FloatTrackerV2:
     def _confidence(self, ps: PassV2) -> float:
         return confidence(ps, self._rho_ref, self._share_ref)
 
-    def _fill_joint(self, frame: np.ndarray, d: int, cx: float, cy: float, m: float) -> None:
-        """Joint bins of the decimated image within m px of (cx, cy) (all of it if m is None) into the
-        numba kernel's bins cache, those rows marked computed; the kernel must not compute any
-        other (it would compute colour bins): :meth:`_joint_checked` verifies it.  m = inf: all."""
-        p = self.params
-        hd, wd = (frame.shape[0] + d - 1) // d, (frame.shape[1] + d - 1) // d
-        if math.isinf(m):
-            x0, x1, y0, y1 = 0, wd, 0, hd
-        else:
-            x0, x1 = max(0, math.floor(cx - m)), min(wd, math.ceil(cx + m) + 1)
-            y0, y1 = max(0, math.floor(cy - m)), min(hd, math.ceil(cy + m) + 1)
-            if x1 <= x0 or y1 <= y0:
-                x0, x1, y0, y1 = 0, wd, 0, hd
-        cache, rows = self._cache  # type: ignore[misc]
-        cache[y0:y1, x0:x1] = joint_bins_area(frame, d, p.colour_bits, p.orient_T, x0, x1, y0, y1)
-        rows[:] = 0
-        rows[0, y0:y1], rows[1, y0:y1] = x0, x1
-        self._joint_rows = rows.copy()
-        self._joint_d = d
-
-    def _joint_checked(self, run):
-        """``run()`` (a numba kernel call on the bins cache) when every pixel it read had joint bins;
-        else the whole decimated image's joint bins and ``run()`` again (same results as if they
-        had been there from the start: the bins do not depend on what was computed before)."""
-        out = run()
-        if self.params.orient_T <= 0 or not (self._cache[1] != self._joint_rows).any():
-            return out
-        self._fill_joint(self._joint_frame, self._joint_d, 0.0, 0.0, float("inf"))
-        return run()
+    def _source(self, frame: np.ndarray) -> tuple[np.ndarray, int, int]:
+        """The numba kernels' (full frame, D, orient_T): joint bins need the frame's pixels around
+        each decimated pixel (set by :meth:`update`); colour bins only the decimated ``frame``."""
+        if self.params.orient_T > 0:
+            return self._src
+        return frame, 1, 0
 
     def _pass(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> PassV2:
         p = self.params
         inner2 = 1.0 / (1.0 + p.pad) ** 2
-        if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache (joint bins too)
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:  # numba: the frame's bins cache
             if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):  # type: ignore[arg-type]
                 self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
             height, width = bins.shape[:2]
-            return PassV2(*self._joint_checked(lambda: _nb_window_pass(  # type: ignore[misc]
+            return PassV2(*_nb_window_pass(  # type: ignore[misc]
                 bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width, height, float(inner2),
-                p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache)))
+                p.kernel == "flat", self._qb, self._t, *self._bufs, *self._cache, *self._source(bins)))
         return window_pass(bins, p.n_bins_v2, self._qb, self._t, c, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
 
-    def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
+    def _rho(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float) -> float:
+        """``self._pass(bins, c, hx, hy).rho`` (numba: :func:`_nb_window_rho`, the same value)."""
+        p = self.params
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            if not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):  # type: ignore[arg-type]
+                self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)
+            height, width = bins.shape[:2]
+            return _nb_window_rho(bins, p.colour_bits, float(c[0]), float(c[1]), float(hx), float(hy), width,  # type: ignore[misc]
+                                  height, p.kernel == "flat", self._qb, *self._bufs, *self._cache, *self._source(bins))
+        return self._pass(bins, c, hx, hy).rho
+
+    def _rho2(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
+              scales: tuple[float, float]) -> tuple[float, float]:
+        """:meth:`_rho` at (s hx, s hy) for the two scales s (numba: one :func:`_nb_window_rho2` call)."""
+        p = self.params
+        s1, s2 = scales
+        if isinstance(bins, np.ndarray) and bins.ndim == 3:
+            hm, hmy = max(s1, s2) * hx, max(s1, s2) * hy
+            if not _buffers_fit(self._bufs, hm, hmy, p.n_bins_v2):  # type: ignore[arg-type]
+                self._bufs = _nb_buffers_v2(1.25 * hm, 1.25 * hmy, p.n_bins_v2)
+            height, width = bins.shape[:2]
+            return _nb_window_rho2(bins, p.colour_bits, float(c[0]), float(c[1]), float(s1 * hx), float(s1 * hy),  # type: ignore[misc]
+                                   float(s2 * hx), float(s2 * hy), width, height, p.kernel == "flat", self._qb,
+                                   *self._bufs, *self._cache, *self._source(bins))
+        return self._rho(bins, c, s1 * hx, s1 * hy), self._rho(bins, c, s2 * hx, s2 * hy)
+
+    def _scale_test(self, bins: np.ndarray | LazyBins, c: tuple[float, float], hx: float, hy: float,
+                    rho: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
-        the largest (two more passes at the final centre)."""
+        the largest (two more passes at the final centre; ``rho``: the pass at c, hx, hy's)."""
         d = self.params.scale_test
-        best, rho = 1.0, self._pass(bins, c, hx, hy).rho
-        for s in (1.0 - d, 1.0 + d):
-            r = self._pass(bins, c, s * hx, s * hy).rho
+        best = 1.0
+        for s, r in zip((1.0 - d, 1.0 + d), self._rho2(bins, c, hx, hy, (1.0 - d, 1.0 + d))):
             if r > rho:
                 best, rho = s, r
         return best
@@ -697,11 +988,8 @@ class FloatTrackerV2:
                 self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
             else:
                 self._cache[1][:] = 0  # a new frame: no bins yet
-            if p.orient_T > 0:  # joint bins: a region around the start, marked as computed in the cache
-                self._joint_frame = frame
-                # the window + slack (lost: +-2 windows); anything beyond: _joint_checked
-                m = (3.5 if self._lost else 1.5) * max(hx, hy) + 8
-                self._fill_joint(frame, d, self._centre[0] / d, self._centre[1] / d, m)
+            # joint bins (orient_T > 0): the kernel adds each binned pixel's orientation from the frame
+            self._src = (frame, d, int(p.orient_T))
         elif p.orient_T > 0:
             bins = self._bins(frame, d)
         else:
@@ -739,7 +1027,7 @@ class FloatTrackerV2:
             self._share_ref += a * (ps.share - self._share_ref)
         # scale: every frame (a lost or uncertain target changes size too), from the spread
         if p.scale_gain > 0 and ps.nt > 0:
-            est_rho = self._scale_test(bins, c, hx, hy) if p.scale_test > 0 else None
+            est_rho = self._scale_test(bins, c, hx, hy, ps.rho) if p.scale_test > 0 else None
             self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho)
         box = box_from_centre_index(*self._centre, *self._size)
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
@@ -804,10 +1092,12 @@ def _numba_self_check() -> bool:
         if i != 3:  # frame 3: the target is gone
             f[10 + i:26 + i, 12 + 2 * i:30 + 2 * i] = (20, 40, 230)
         frames.append(f)
-    for kernel in ("flat", "epanechnikov"):
+    # (and the joint colour x orientation bins with the scale test, off by default: the many-bins path)
+    joint = {"orient_T": 32, "scale_test": 0.05, "scale_test_gate": True}
+    for kernel, extra in (("flat", {}), ("epanechnikov", {}), ("flat", joint), ("epanechnikov", joint)):
         runs = []
         for path in ("numpy", "numba"):
-            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel), path=path)  # type: ignore[arg-type]
+            trk = FloatTrackerV2(TrackerParams(preset="v2", kernel=kernel, **extra), path=path)  # type: ignore[arg-type]
             trk._use_numba = path == "numba"  # (the self-check runs inside active_path)
             runs.append([trk.init(frames[0], (12, 10, 18, 16))] + [trk.update(f) for f in frames[1:]])
         if runs[0] != runs[1]:

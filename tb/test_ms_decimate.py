@@ -103,8 +103,8 @@ def model_case(name: str, frame: np.ndarray, box: tuple[int, int, int, int], d: 
     seen: list[tuple[np.ndarray, Region, np.ndarray]] = []
     capture = trk._capture
 
-    def record(img: np.ndarray, reg: Region) -> np.ndarray:
-        sub = capture(img, reg)
+    def record(img: np.ndarray, reg: Region, *frame_d) -> np.ndarray:
+        sub = capture(img, reg, *frame_d)
         seen.append((img, reg, sub))
         return sub
     trk._capture = record  # type: ignore[method-assign]

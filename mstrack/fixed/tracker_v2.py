@@ -146,10 +146,15 @@ class FixedTrackerV2:
         st = ms_target_stats(sub, self.model.T, win, ker, fx.kernel_bits, self.pad16)
         return r.c8, r.S, r.iterations, r.stop, st
 
-    def _capture(self, img: np.ndarray, reg: Region) -> np.ndarray:
+    def _capture(self, img: np.ndarray, reg: Region, frame: np.ndarray | None = None, d: int = 1) -> np.ndarray:
         """ms_region_capture for v2: the colour bins of the region's pixels of the decimated image
-        (joint bins: the region of the frame's joint bin image, ``self._joint``)."""
-        if self.params.orient_T > 0:
+        ``img`` = frame[::d, ::d].  Joint bins (orient_T > 0): from ``frame``, the orientation of the
+        region's pixels only (:func:`joint_bins_region`, the whole frame's bit for bit), or without
+        ``frame`` (init) the region of the init frame's joint bin image ``self._joint``."""
+        p = self.params
+        if p.orient_T > 0:
+            if frame is not None:
+                return joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg)
             return self._joint[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
         return ms_colour_bin(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], self.params.colour_bits)
 
@@ -273,10 +278,7 @@ class FixedTrackerV2:
         ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
         reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
-        if p.orient_T > 0:  # joint bins of the captured region only (the whole frame's, bit for bit)
-            sub = joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg)
-        else:
-            sub = self._capture(img, reg)
+        sub = self._capture(img, reg, frame, d)
         c8d, S, it, stop, st = self._run(img, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter, sub)
         rho = ms_rho_out(S, ker.K, fx)
         share = ms_share(st)

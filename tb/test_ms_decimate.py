@@ -371,6 +371,14 @@ def _run(name: str, generics: dict, job: dict, waves: bool) -> None:
 SMALL_FP = {"max_half": 4, "margin": 2}
 
 
+def synthetic_sources(scene: int) -> list[dict]:
+    """Random frames whose sizes D does not divide (corner regions, D 1-4 and 8-16) and a generated
+    scene (the model's own regions at every D), small generics (max_window 7)."""
+    return [{"w": 45, "h": 37, "d": [1, 2, 4], "max_window": 7},
+            {"w": 83, "h": 70, "d": [8, 16], "max_window": 7},
+            {"scene": scene, "w": 96, "h": 80, "d": list(DEC_VALUES), "max_window": 7}]
+
+
 @pytest.mark.ghdl
 @pytest.mark.parametrize("gap", [0.0, 0.3], ids=["full_speed", "gaps"])
 @pytest.mark.parametrize("lanes", [2, 4])
@@ -380,9 +388,7 @@ def test_ms_decimate_synthetic(lanes, gap, hdl_waves):
     g = dec_generics(lanes, FixedParams(**SMALL_FP), 128)
     job = {"seed": 21 + lanes + int(10 * gap), "gap": gap, "fp": SMALL_FP, "abandon": True,
            "expect_d": list(DEC_VALUES),
-           "sources": [{"w": 45, "h": 37, "d": [1, 2, 4], "max_window": 7},
-                       {"w": 83, "h": 70, "d": [8, 16], "max_window": 7},
-                       {"scene": 5, "w": 96, "h": 80, "d": list(DEC_VALUES), "max_window": 7}]}
+           "sources": synthetic_sources(scene=5)}
     _run(f"synth_l{lanes}_{'gap' if gap else 'full'}", g, job, hdl_waves)
 
 
@@ -410,18 +416,16 @@ def test_ms_decimate_real_640(gap, hdl_waves):
 
 
 @pytest.mark.ghdl
-@pytest.mark.parametrize("gap", [0.3], ids=["gaps"])   # (full speed: the Girl case below)
-def test_ms_decimate_orient(gap, hdl_waves):
+def test_ms_decimate_orient(hdl_waves):
     """The joint core's capture (ORIENT_T 64, the candidate's threshold): colour and orientation
     region RAMs against the fixed model's joint bins (generated scene, every D) and against
-    ms_orient_bin (corner regions of random frames: frame border, sizes D does not divide)."""
-    g = dec_generics(4 if gap else 2, FixedParams(**SMALL_FP), 128, orient_t=64)
-    job = {"seed": 51 + int(10 * gap), "gap": gap, "fp": SMALL_FP, "abandon": True,
+    ms_orient_bin (corner regions of random frames: frame border, sizes D does not divide); LANES 4,
+    input gaps (the Girl case below runs at full speed)."""
+    g = dec_generics(4, FixedParams(**SMALL_FP), 128, orient_t=64)
+    job = {"seed": 54, "gap": 0.3, "fp": SMALL_FP, "abandon": True,
            "expect_d": list(DEC_VALUES),
-           "sources": [{"w": 45, "h": 37, "d": [1, 2, 4], "max_window": 7},
-                       {"w": 83, "h": 70, "d": [8, 16], "max_window": 7},
-                       {"scene": 6, "w": 96, "h": 80, "d": list(DEC_VALUES), "max_window": 7}]}
-    _run(f"orient_{'gap' if gap else 'full'}", g, job, hdl_waves)
+           "sources": synthetic_sources(scene=6)}
+    _run("orient_gap", g, job, hdl_waves)
 
 
 @pytest.mark.ghdl
@@ -440,8 +444,6 @@ def test_ms_decimate_verilator(hdl_waves):
     the synthetic cases, LANES 2, with input gaps."""
     g = dec_generics(2, FixedParams(**SMALL_FP), 128)
     job = {"seed": 27, "gap": 0.3, "fp": SMALL_FP, "abandon": True, "expect_d": list(DEC_VALUES),
-           "sources": [{"w": 45, "h": 37, "d": [1, 2, 4], "max_window": 7},
-                       {"w": 83, "h": 70, "d": [8, 16], "max_window": 7},
-                       {"scene": 5, "w": 96, "h": 80, "d": list(DEC_VALUES), "max_window": 7}]}
+           "sources": synthetic_sources(scene=5)}
     hdl.run_verilator(TOP, MODULE, g, hdl.rtl_sources(TOP, extra=[WRAPPER]), waves=hdl_waves,
                       build_name="ms_decimate_verilator", extra_env={"MSTRACK_JOB": json.dumps(job)})

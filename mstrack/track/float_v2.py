@@ -37,7 +37,7 @@ import numpy as np
 from . import float_model as _fm
 from .features import _GREY_W, colour_bins
 from .frames import check_frame, clip_box
-from .numba_kernels import _SHIFT2_BAND, _jit, _nb_normalise, _nb_scan, _nb_sum, _nb_sum3
+from .numba_kernels import _SHIFT2_BAND, _jit, _nb_columns, _nb_normalise, _nb_run, _nb_scan, _nb_sum, _nb_sum3
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -300,40 +300,17 @@ def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, B, X, Y, h, ax, c
     pixels, B, X, Y and histogram h (the same sums in the same order), without clearing h and the
     count tables first: they must be zero (as :func:`_nb_pass` leaves them).  The touched bins,
     in order of first appearance, go to U (mark[u] = 1); h is set for them only.  Returns (n, nu)."""
-    x0 = max(0, math.ceil(cx - hx))
-    x1 = min(width - 1, math.floor(cx + hx))
-    y0 = max(0, math.ceil(cy - hy))
-    y1 = min(height - 1, math.floor(cy + hy))
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     nx = x1 - x0 + 1
-    jc = 0
-    for j in range(nx):
-        t = (x0 + j - cx) / hx
-        ax[j] = t * t
-        if ax[j] < ax[jc]:
-            jc = j
+    jc = _nb_columns(cx, hx, x0, nx, ax)
     mask = cnt.shape[0] - 1
     n = 0
     for y in range(y0, y1 + 1):
         t = (y - cy) / hy
         by = t * t
-        if not ax[jc] + by < 1.0:
+        ja, m = _nb_run(ax, jc, nx, by)
+        if m == 0:
             continue
-        lo, hi = 0, jc
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if ax[mid] + by < 1.0:
-                hi = mid
-            else:
-                lo = mid + 1
-        ja = lo
-        lo, hi = jc, nx - 1
-        while lo < hi:
-            mid = (lo + hi + 1) // 2
-            if ax[mid] + by < 1.0:
-                lo = mid
-            else:
-                hi = mid - 1
-        m = lo - ja + 1
         xa = x0 + ja
         b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
         row = bins[y, xa:xa + m]
@@ -484,41 +461,18 @@ def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, fbuf, ax, cnt, 
     nb = q.shape[0]
     h, p, tmp = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     U, mark = ubuf[0], ubuf[1]
-    x0 = max(0, math.ceil(cx - hx))
-    x1 = min(width - 1, math.floor(cx + hx))
-    y0 = max(0, math.ceil(cy - hy))
-    y1 = min(height - 1, math.floor(cy + hy))
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     n = nu = 0
     if x1 >= x0 and y1 >= y0:
         nx = x1 - x0 + 1
-        jc = 0
-        for j in range(nx):
-            t = (x0 + j - cx) / hx
-            ax[j] = t * t
-            if ax[j] < ax[jc]:
-                jc = j
+        jc = _nb_columns(cx, hx, x0, nx, ax)
         mask = cnt.shape[0] - 1
         for y in range(y0, y1 + 1):
             t = (y - cy) / hy
             by = t * t
-            if not ax[jc] + by < 1.0:
+            ja, m = _nb_run(ax, jc, nx, by)
+            if m == 0:
                 continue
-            lo, hi = 0, jc
-            while lo < hi:
-                mid = (lo + hi) // 2
-                if ax[mid] + by < 1.0:
-                    hi = mid
-                else:
-                    lo = mid + 1
-            ja = lo
-            lo, hi = jc, nx - 1
-            while lo < hi:
-                mid = (lo + hi + 1) // 2
-                if ax[mid] + by < 1.0:
-                    lo = mid
-                else:
-                    hi = mid - 1
-            m = lo - ja + 1
             row = bins[y, x0 + ja:x0 + ja + m]
             for k in range(m):
                 u = row[k]

@@ -225,6 +225,44 @@ def _nb_sum3(wb, B, X, Y, n):
 
 
 @_jit
+def _nb_columns(cx, hx, x0, nx, ax):
+    """The column terms of d2 for the box's nx columns from x0: ax[j] = ((x0 + j - cx) / hx) ** 2.
+    Returns jc, the first column of least ax (where each row's run of inside pixels lies)."""
+    jc = 0
+    for j in range(nx):
+        t = (x0 + j - cx) / hx
+        ax[j] = t * t
+        if ax[j] < ax[jc]:
+            jc = j
+    return jc
+
+
+@_jit
+def _nb_run(ax, jc, nx, by):
+    """A row's inside pixels (ax[j] + by < 1): (ja, m), the run's first column and length; m = 0
+    when the row has none.  d2 = ax + by is unimodal in x (every step rounds monotonically), so
+    two binary searches either side of jc find the run exactly."""
+    if not ax[jc] + by < 1.0:
+        return 0, 0
+    lo, hi = 0, jc
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if ax[mid] + by < 1.0:
+            hi = mid
+        else:
+            lo = mid + 1
+    ja = lo
+    lo, hi = jc, nx - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if ax[mid] + by < 1.0:
+            lo = mid
+        else:
+            hi = mid - 1
+    return ja, lo - ja + 1
+
+
+@_jit
 def _nb_scan(cx, cy, hx, hy, width, height, frame, bits, bins, ox, oy, flat, B, X, Y, h, ax, cnt):
     """:func:`kernel_window` and :func:`histogram` (unnormalised) at (cx, cy).
 
@@ -239,12 +277,7 @@ def _nb_scan(cx, cy, hx, hy, width, height, frame, bits, bins, ox, oy, flat, B, 
     y0 = max(0, math.ceil(cy - hy))
     y1 = min(height - 1, math.floor(cy + hy))
     nx = x1 - x0 + 1
-    jc = 0
-    for j in range(nx):
-        t = (x0 + j - cx) / hx
-        ax[j] = t * t
-        if ax[j] < ax[jc]:
-            jc = j
+    jc = _nb_columns(cx, hx, x0, nx, ax)
     h[:] = 0.0
     if flat:
         cnt[:] = 0
@@ -254,24 +287,9 @@ def _nb_scan(cx, cy, hx, hy, width, height, frame, bits, bins, ox, oy, flat, B, 
     for y in range(y0, y1 + 1):
         t = (y - cy) / hy
         by = t * t
-        if not ax[jc] + by < 1.0:
+        ja, m = _nb_run(ax, jc, nx, by)
+        if m == 0:
             continue
-        lo, hi = 0, jc
-        while lo < hi:
-            mid = (lo + hi) // 2
-            if ax[mid] + by < 1.0:
-                hi = mid
-            else:
-                lo = mid + 1
-        ja = lo
-        lo, hi = jc, nx - 1
-        while lo < hi:
-            mid = (lo + hi + 1) // 2
-            if ax[mid] + by < 1.0:
-                lo = mid
-            else:
-                hi = mid - 1
-        m = lo - ja + 1
         xa = x0 + ja
         b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
         if bits > 0:

@@ -104,7 +104,11 @@ def test_grey_area_equals_whole_frame_product():
     rng = np.random.default_rng(1)
     for frame in _random_frames(rng, 20):
         height, width = frame.shape[:2]
-        ref = frame.astype(np.float32) @ np.asarray(fm.GREY_WEIGHTS_BGR, np.float32)
+        # the definition element-wise in float32 ((B wb + G wg) + R wr); not ``frame @ weights``,
+        # whose rounding depends on the BLAS kernel the CPU selects (it differs on AVX-512 machines)
+        f = frame.astype(np.float32)
+        wb, wg, wr = (np.float32(w) for w in fm.GREY_WEIGHTS_BGR)
+        ref = (f[..., 0] * wb + f[..., 1] * wg) + f[..., 2] * wr
         for x0, x1, y0, y1 in _random_areas(rng, width, height, 10):
             np.testing.assert_array_equal(fm.grey_area(frame, x0, x1, y0, y1), ref[y0:y1, x0:x1])
 

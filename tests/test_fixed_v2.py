@@ -518,6 +518,40 @@ def test_joint_bin_and_scale_test_size_exhaustive():
                 assert ms_scale_test_size(s8, d256, up) == want
 
 
+@pytest.mark.parametrize("kernel", ["flat", "epanechnikov"])
+def test_histogram_banks_is_the_joint_histogram_by_colour_and_orientation(kernel):
+    """ms_histogram_banks (rtl/ms_histogram.vhd with N_ORIENT = 9: bank o, address u): H, N, SX, SY
+    at [u, o] are the sums over the window's inside pixels of colour u and orientation o, brute force."""
+    from mstrack.fixed.blocks import Region, ms_histogram, ms_histogram_banks
+    from mstrack.fixed.blocks_v2 import ms_joint_bin
+    rng = np.random.default_rng(9)
+    reg = Region(5, 7, 40, 30, (0, 0), (0, 0))           # lo, hi: not used by ms_histogram
+    colour = rng.integers(0, 4, (reg.h, reg.w))          # few colours: many (u, o) with several pixels
+    orient = rng.integers(0, 9, (reg.h, reg.w))
+    colour[12:15, :] = 511                                # the last colour address too (inside the window)
+    ker = ms_kernel(23, 17, kernel, 8)
+    win = (reg.x + 20, reg.y + 14)
+    h = ms_histogram(ms_joint_bin(colour, orient), reg, win, ker, 9 * 512)
+    b = ms_histogram_banks(h, 9)
+    assert b.H.shape == b.N.shape == b.SX.shape == b.SY.shape == (512, 9)
+    want = {k: np.zeros((512, 9), np.int64) for k in ("H", "N", "SX", "SY")}
+    for yy in range(-ker.ey, ker.ey + 1):
+        for xx in range(-ker.ex, ker.ex + 1):
+            if not ker.inside[yy + ker.ey, xx + ker.ex]:
+                continue
+            r, c = win[1] + yy - reg.y, win[0] + xx - reg.x
+            u, o = colour[r, c], orient[r, c]
+            want["H"][u, o] += ker.k[yy + ker.ey, xx + ker.ex]
+            want["N"][u, o] += 1
+            want["SX"][u, o] += xx
+            want["SY"][u, o] += yy
+    for k in want:
+        assert np.array_equal(getattr(b, k), want[k]), k
+    assert want["N"][511].sum() > 0 and (want["N"][:4] > 1).sum() > 20
+    with pytest.raises(ValueError):
+        ms_histogram_banks(h, 7)
+
+
 def test_scale_test_and_gate_exhaustive():
     from mstrack.fixed.blocks_v2 import ms_scale_gate, ms_scale_test
     vals = (None, 0, 1, 2, ONE)

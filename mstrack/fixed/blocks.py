@@ -245,6 +245,22 @@ def ms_histogram(bins: np.ndarray, reg: Region, win: tuple[int, int], ker: ms_ke
     return Hist(H=H, N=N, SX=acc(ker._dx_f), SY=acc(ker._dy_f))
 
 
+def ms_histogram_banks(hist: Hist, n_orient: int) -> Hist:
+    """The read-out of rtl/ms_histogram.vhd with N_ORIENT = ``n_orient`` banks per lane.
+
+    ``hist`` is :func:`ms_histogram` over joint bins ``n_orient * u + o`` (colour bin u,
+    orientation o in 0 .. n_orient - 1; ``blocks_v2.ms_joint_bin`` with n_orient = 9), so
+    ``n_bins = n_orient * n_colour``.  The RTL keeps joint bin ``n_orient * u + o`` in bank o at
+    address u and its read port returns the n_orient banks of one address u at once: H[u, o] etc.
+    Returns a Hist whose H, N, SX, SY are views of shape (n_colour, n_orient) (C order: no
+    arithmetic, the joint histogram seen as [colour][orientation]).
+    """
+    n = hist.N.shape[0]
+    if n_orient < 1 or n % n_orient:
+        raise ValueError(f"{n} joint bins are not n_colour x {n_orient} orientations")
+    return Hist(*(a.reshape(n // n_orient, n_orient) for a in (hist.H, hist.N, hist.SX, hist.SY)))
+
+
 # ----------------------------------------------------------------------------- bin pass
 @dataclass
 class BinPass:

@@ -280,3 +280,23 @@ CASES = [
 def test_ms_histogram(var, hdl_waves):
     gen = {**BASE, **var}
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves)
+
+
+@pytest.mark.ghdl
+def test_ms_histogram_synth_orient9(tmp_path):
+    """ghdl --synth (to Verilog) of tracker v2's size with 9 orientation banks: LANES 4, BIN_W 9,
+    flat, HIST_W = COUNT_W 14, POSSUM_W 21 (56-bit words): 36 RAMs of 512 words."""
+    gen = {"LANES": 4, "BIN_W": 9, "N_ORIENT": 9, "D_W": 9, "KERNEL_EPAN": 0, "KVAL_W": 1, "HIST_W": 14,
+           "COUNT_W": 14, "POSSUM_W": 21}
+    v = hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v").read_text()
+    assert "module ms_histogram" in v and "bin_sy_all" in v
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("var", [pytest.param({"N_ORIENT": 9, "LANES": 4}, id="orient9_L4"),
+                                 pytest.param({"N_ORIENT": 9, "LANES": 2, "KERNEL_EPAN": 1, "KVAL_W": 9,
+                                               "HIST_W": 18}, id="orient9_epan")])
+def test_ms_histogram_verilator(var, hdl_waves):
+    """Same bench on the GHDL -> Verilog -> Verilator netlist (the synthesis path) with the banks."""
+    gen = {**BASE, **var}
+    hdl.run_verilator(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves)

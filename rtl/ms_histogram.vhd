@@ -304,18 +304,20 @@ begin
 
     g_bank : for o in 0 to N_ORIENT - 1 generate
       type ram_t is array (0 to N_BINS - 1) of word_t;
-      signal ram : ram_t := (others => (others => '0'));
+      signal ram     : ram_t := (others => (others => '0'));
+      signal bank_we : std_logic;                            -- write bank o (one bank: wq_we itself)
     begin
+      bank_we <= wq_we(l) when N_ORIENT = 1 else wq_bwe(l)(o);
       p_ram : process (clk)
       begin
         if rising_edge(clk) then
-          if wq_bwe(l)(o) = '1' then
+          if bank_we = '1' then
             ram(to_integer(unsigned(wq_b))) <= wq_word(l);
           end if;
           -- the read data of a read/write collision is never used (stage 2 forwards that write,
           -- h3): 'X' lets synthesis map the RAM without emulating read-before-write across
           -- ports, which block RAM does not have
-          if wq_bwe(l)(o) = '1' and wq_b = rd_addr then
+          if bank_we = '1' and wq_b = rd_addr then
             rd_raw(l)(o) <= (others => 'X');
           else
             rd_raw(l)(o) <= ram(to_integer(unsigned(rd_addr)));

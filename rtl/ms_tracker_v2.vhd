@@ -1309,10 +1309,12 @@ begin
 
         ------------------------------------------------------------ the gated scale test (ST_ON)
         when T_ST_SIZE =>                      -- ms_scale_test_size x 2; the final centre's window, region-relative
-          st_w8 <= st_size(w8, st_up);
-          st_h8 <= st_size(h8, st_up);
-          st_rx <= rg_round(r_cx) - rg_s(reg_x);
-          st_ry <= rg_round(r_cy) - rg_s(reg_y);
+          if ST_ON then                        -- (no multiplier in the netlist without the test)
+            st_w8 <= st_size(w8, st_up);
+            st_h8 <= st_size(h8, st_up);
+            st_rx <= rg_round(r_cx) - rg_s(reg_x);
+            st_ry <= rg_round(r_cy) - rg_s(reg_y);
+          end if;
           state <= T_ST_WS;
 
         when T_ST_WS =>                        -- ms_window_size of the test sizes (ws_s8w, ws_s8h)

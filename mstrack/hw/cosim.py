@@ -336,11 +336,14 @@ class CoreConfigV2:
     max_frame_w: int = 2048
 
     def __post_init__(self) -> None:
-        # the experimental options are in the float and fixed models only (mstrack-v2-joint):
-        # generics for them would build a core that tracks differently from the model they name
+        # the experimental options orient_T and motion_gain are in the float and fixed models only
+        # (mstrack-v2-joint): generics for them would build a core that tracks differently from the
+        # model they name.  The gated scale test (scale_test with scale_test_gate) has RTL
+        # (ms_tracker_v2 generic SCALE_TEST_D256); the ungated one has no fixed model either.
         tp = self.tp
-        rtl_less = [k for k, off in (("orient_T", 0), ("scale_test", 0.0), ("motion_gain", 0.0))
-                    if getattr(tp, k) != off]
+        rtl_less = [k for k, off in (("orient_T", 0), ("motion_gain", 0.0)) if getattr(tp, k) != off]
+        if tp.scale_test != 0.0 and not tp.scale_test_gate:
+            rtl_less.append("scale_test without scale_test_gate")
         if rtl_less:
             raise ValueError(f"core v2 has no RTL yet for {', '.join(rtl_less)} (float and fixed models only; "
                              "docs/results_v2_mean.md \"Path to adoption\")")
@@ -380,11 +383,28 @@ class CoreConfigV2:
         g["ADDR_W"] = (rmax * stride - 1).bit_length()
         g["CENTRE_W"] = g["REGION_W"] + fp.centre_frac
         g["MAX_FRAME_W"] = self.max_frame_w
+        if tp.scale_test > 0:
+            # the gated scale test (experimental; off: the generic keeps its default 0 and is not
+            # listed, so the default generic set is that of ms_tracker and the hdl_config package)
+            g["SCALE_TEST_D256"] = self.scale_test_d256()
         return g
+
+    def scale_test_d256(self) -> int:
+        """d256 = round(256 scale_test) of the gated scale test (0: off), as FixedTrackerV2."""
+        if self.tp.scale_test <= 0:
+            return 0
+        d = round(self.tp.scale_test * 256)
+        if not 1 <= d <= 255:   # d256 = 0 would be the generic's "off", while the model still gates
+            raise ValueError(f"scale_test {self.tp.scale_test} gives d256 = {d}, core v2 needs 1 .. 255")
+        return d
 
     def tracker_generics(self) -> dict[str, int]:
         """The generics of ``ms_tracker`` for core v2: PRESET = 1 and :meth:`generics` (ms_tracker passes
-        them all to the engine ms_tracker_v2)."""
+        them all to the engine ms_tracker_v2).  The gated scale test is a generic of ms_tracker_v2 only
+        so far (ms_tracker does not pass SCALE_TEST_D256): refused here."""
+        if self.tp.scale_test > 0:
+            raise ValueError("the gated scale test (SCALE_TEST_D256) is a generic of ms_tracker_v2 only: "
+                             "build the engine ms_tracker_v2 (generics_for('ms_tracker_v2'))")
         return {"PRESET": 1, **self.generics()}
 
     def generics_for(self, top: str) -> dict[str, int]:

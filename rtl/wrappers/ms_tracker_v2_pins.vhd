@@ -91,7 +91,8 @@ entity ms_tracker_v2_pins is
     BG_O_W         : natural := 17;
     SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
     STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
-    MARGIN_MAX     : natural := 255       -- largest region margin (MARGIN + the search offset)
+    MARGIN_MAX     : natural := 255;      -- largest region margin (MARGIN + the search offset)
+    SCALE_TEST_D256 : natural range 0 to 255 := 0  -- the gated scale test: round(256 scale_test); 0 = off
   );
   port (
     clk           : in  std_logic;                      -- core clock
@@ -209,7 +210,8 @@ begin
       BG_O_W          => BG_O_W,
       SEARCH_ITER     => SEARCH_ITER,
       STEP16          => STEP16,
-      MARGIN_MAX      => MARGIN_MAX
+      MARGIN_MAX      => MARGIN_MAX,
+      SCALE_TEST_D256 => SCALE_TEST_D256
     )
     port map (
       clk => clk, rst => rst,

@@ -1,7 +1,14 @@
 -- ms_bg_model: background-weighted (CBWH) target model of tracker v2, learnt at init.
 --
--- Computes mstrack.fixed.blocks_v2.ms_bg_model(bins, cx, cy, wb, hb, ring16, N_BINS) bit for bit,
--- from the pixel stream of the (decimated) init frame:
+-- Computes mstrack.fixed.blocks_v2.ms_bg_model(bins, cx, cy, wb, hb, ring16, N_ORIENT N_BINS) bit for
+-- bit, from the pixel stream of the (decimated) init frame.  N_ORIENT = 1 (default): u = px_bin, the
+-- colour bin (px_obin, m_rd_obin ignored).  N_ORIENT > 1 (tracker v2's joint bins, N_ORIENT 9):
+-- u = the joint bin (colour px_bin, orientation px_obin), the model's N_ORIENT colour + obin
+-- (ms_joint_bin); it lives at address {obin, colour} = obin 2**BIN_W + colour, so each orientation is
+-- a bank of 2**BIN_W colour words (the model RAM is N_ORIENT such banks, read all at once through
+-- m_qn_all / m_t_all).  The passes below walk all N = N_ORIENT N_BINS joint bins in address order;
+-- min, sums and per-bin functions do not depend on the order, and the totals are the same pixels'
+-- (Q_W, O_W, the divider's widths unchanged).
 --   box  : pixels with |dx| <= ex, |dy| <= ey and |dx| <= XR[|dy|] (dx = x - cx, dy = y - cy,
 --          ex = (wb - 1) / 2, ey = (hb - 1) / 2, XR = the row extents of ms_kernel_tables: the
 --          exact flat-ellipse test TA[|dx|] + TB[|dy|] < D of ms_kernel)   -> Q[u] += 1
@@ -29,9 +36,9 @@
 -- {T | Q | O} at the pixel's bin with the forwarding of ms_histogram (any sequence of bins, runs
 -- of one bin included, counts exactly).
 --
--- Memories: count RAM N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32), model
--- RAM N_BINS x 18 {T | Qn} (1 DP16KD), XR table 2**HALF_W x HALF_W and the Q delay memory
--- (LUT RAM).
+-- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32; 9 at
+-- N_ORIENT 9), model RAM N_ORIENT banks of N_BINS x 18 {T | Qn} (1 DP16KD per bank), XR table
+-- 2**HALF_W x HALF_W and the Q delay memory (LUT RAM).
 -- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
 -- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz.
 --
@@ -40,21 +47,29 @@
 --                       215 clocks at HALF_W = 6) + 2 clocks, exactly; pixels before `counting` are
 --                       ignored (the top starts the block when the init box is taken, between
 --                       frames, so this costs nothing on the stream).
---   px_last -> done   : LAT_DONE = 3 N_BINS + 61 clocks at the default widths: drain 6, pass 1
---                       N_BINS + 3, pass 2 N_BINS + 30 (read 2, T products M(Q_W) = 4, T 1,
---                       divider 18, v Q M(9) = 4, end 1), pass 3 N_BINS + 22 (read 2, divider 18,
+--   px_last -> done   : LAT_DONE = 3 N + 61 clocks at the default widths, N = N_ORIENT N_BINS:
+--                       drain 6, pass 1 N + 3, pass 2 N + 30 (read 2, T products M(Q_W) = 4, T 1,
+--                       divider 18, v Q M(9) = 4, end 1), pass 3 N + 22 (read 2, divider 18,
 --                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
---                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N_BINS = 512
+--                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N = 512
 --                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.hw.synth
 --                       --v2-budget: init frame 5,800 clocks, so 5,846 with this block).
+--                       N_ORIENT 9 (N = 4,608): 13,885 clocks (passes 1 / 2 / 3: 4,611 / 4,638 /
+--                       4,630, drain 6), on the init frame only: the init frame's estimate becomes
+--                       about 18,100 of the 99,000 clocks of 1080p60 blanking.
 -- Throughput: one pixel per clock while counting; one model per init.
 -- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high
 --             until `done` (one-clock pulse); n_box, n_ring, o_min, qv_sum are stable from done
---             until the next start.  The model RAM read port (m_rd_addr -> m_qn, m_t one clock
---             later) may be used at any time; during a model computation it shows a mix of the
---             old and the new model.
--- Reset     : synchronous, active high; control state; then N_BINS clocks clear the count RAM
---             (busy = 1 meanwhile).  The model RAM keeps its contents.  To abandon an init frame
+--             until the next start.  The model RAM read port (m_rd_addr, m_rd_obin -> m_qn, m_t
+--             one clock later: bank m_rd_obin; m_qn_all, m_t_all: every bank at m_rd_addr, from
+--             the banks' read registers) may be used at any time; during a model computation it
+--             shows a mix of the old and the new model.
+--             Init stream with joint bins: one count port; pixels may come in any order with
+--             gaps, so the top can merge the Sobel's interior pixels and ms_frontend's border
+--             pixels through a small FIFO (or have ms_sobel emit the border, obin 8); two pixels
+--             in one clock need that merge (a second count port is not provided).
+-- Reset     : synchronous, active high; control state; then N clocks clear the count RAM
+--             (busy = 1 meanwhile; 4,608 at N_ORIENT 9).  The model RAM keeps its contents.  To abandon an init frame
 --             (stream error), reset the block.
 -- Model     : mstrack.fixed.blocks_v2.ms_bg_model (ModelV2 Qn, T; sums of Q, O).
 library ieee;

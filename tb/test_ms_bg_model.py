@@ -222,7 +222,9 @@ class BgTB:
             qn[u] = d.m_qn.value.to_unsigned()
             t[u] = int(d.m_t.value)
             if u % nor == 0:
-                qa, ta = d.m_qn_all.value.to_unsigned(), d.m_t_all.value.to_unsigned()
+                # m_t_all is one bit at N_ORIENT 1: a Logic in the Verilator netlist
+                ta = d.m_t_all.value
+                qa, ta = d.m_qn_all.value.to_unsigned(), ta.to_unsigned() if hasattr(ta, "to_unsigned") else int(ta)
                 for o in range(nor):
                     qn_all[u + o] = (qa >> (17 * o)) & 0x1FFFF
                     t_all[u + o] = (ta >> o) & 1
@@ -289,16 +291,18 @@ def synthetic_cases(g: dict, rng: random.Random) -> list[dict]:
     if nor > 1:
         nc = n // nor
         # every joint bin in the ring (72 x 72 > 4608 px at N_ORIENT 9, BIN_W 9; ring = the whole image)
-        side = int(np.ceil(np.sqrt(n))) + 4
+        side = max(int(np.ceil(np.sqrt(n))) + 4, 30)
         perm = np.resize(np.arange(n), side * side)
         rng.shuffle(perm)
         case("all_joint_bins", perm.reshape(side, side), side // 2, side // 2 - 1, 21, 21, rmax)
-        # box and ring differ in orientation only: one colour everywhere, box obins 0 .. 3 (and a few 8),
-        # ring obins 4 .. 8
+        # box and ring differ in orientation only: one colour everywhere, box obins 0 .. lo - 1 (and a
+        # few N_ORIENT - 1), ring obins lo .. N_ORIENT - 1 (lo = 4 at N_ORIENT 9)
         c0 = rng.randrange(nc)
         h, w = 40, 48
-        ob = np.array([[rng.randrange(4, nor) for _ in range(w)] for _ in range(h)], np.int64)
-        ob[13:26, 17:32] = [[rng.choice([0, 1, 2, 3, 3, 8]) for _ in range(15)] for _ in range(13)]
+        lo = nor // 2
+        ob = np.array([[rng.randrange(lo, nor) for _ in range(w)] for _ in range(h)], np.int64)
+        box_ob = list(range(lo)) + [lo - 1, nor - 1]
+        ob[13:26, 17:32] = [[rng.choice(box_ob) for _ in range(15)] for _ in range(13)]
         case("orient_only_one_colour", c0 * nor + ob, 24, 19, 15, 13, 12)
         # the same colour mix (3 colours) in box and ring, orientation biased: box mostly 0 .. 2,
         # ring all 9 obins
@@ -307,9 +311,10 @@ def synthetic_cases(g: dict, rng: random.Random) -> list[dict]:
         ob = np.array([[rng.randrange(nor) for _ in range(w)] for _ in range(h)], np.int64)
         ob[12:27, 16:33] = [[rng.choice([0, 1, 2, 2, rng.randrange(nor)]) for _ in range(17)] for _ in range(15)]
         case("orient_only_colour_mix", col * nor + ob, 24, 19, 17, 15, 10, order="shuffled")
-        # one colour, one obin per region: box obin 7, ring obin 7 and 2 (T only at obin 7)
-        ob = np.where(np.arange(w)[None, :] % 3 == 0, 2, 7) * np.ones((h, 1), np.int64)
-        ob[14:25, 18:31] = 7
+        # one colour, one obin per region: box obin N_ORIENT - 2, ring that obin and 0 (T only at
+        # obin N_ORIENT - 2)
+        ob = np.where(np.arange(w)[None, :] % 3 == 0, 0, nor - 2) * np.ones((h, 1), np.int64)
+        ob[14:25, 18:31] = nor - 2
         case("orient_two_bins", c0 * nor + ob, 24, 19, 13, 11, 16)
     return out
 

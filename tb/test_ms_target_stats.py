@@ -182,6 +182,22 @@ async def random_windows(dut, throttle):
 
     await ClockCycles(dut.clk, 3)
     dut.rst.value = 0
+    if c.get("REAL_ORIENT_T"):
+        # the windows FixedTrackerV2(orient_T) passed to ms_target_stats on real frames (joint bins,
+        # the model's T of the joint bins), played through the same scan
+        lastT = None
+        for k, rw in enumerate(real_windows(SEGMENTS_JOINT, max_window=max_win, orient_t=c["REAL_ORIENT_T"])):
+            assert int(rw["bins"].max()) < n_bins and len(rw["T"]) == n_bins
+            if lastT is None or not np.array_equal(lastT, rw["T"]):
+                T = rw["T"]
+                await write_T(T)
+                lastT = T
+            ker = ms_kernel(rw["w"], rw["h"], "flat", rw["kb"])
+            await write_kernel(ker)
+            await run_pass(ker, rw["bins"], rw["win"][0], rw["win"][1], f"real window {k} {rw['w']}x{rw['h']}")
+            assert expected[-1][1] == rw["stats"], "the replayed window's model differs from the tracker's"
+            await settle()
+        return
     T = (nrng.random(n_bins) < 0.4).astype(np.int64)
     await write_T(T)
     region_n = min(2 * max_win + 8, (1 << c["REGION_W"]) - 1)
@@ -216,10 +232,15 @@ SEGMENTS = (("Couple", 0, 3), ("MotorRolling", 0, 3), ("Deer", 0, 3), ("Couple",
             ("bag_vot", 10, 3))
 
 
-def real_windows(segments=SEGMENTS, max_window: int = 127) -> list[dict]:
+#: joint-bin segments (FixedTrackerV2(orient_T=64)): init and first frames at D = 1 and 2
+SEGMENTS_JOINT = (("Girl", 0, 3), ("MotorRolling", 0, 2), ("Couple", 0, 2))
+
+
+def real_windows(segments=SEGMENTS, max_window: int = 127, orient_t: int = 0) -> list[dict]:
     """The (bins, T, win, ker) of every ms_target_stats call FixedTrackerV2 makes on the frames of
     ``segments`` (the tracker runs from frame 0; frame 0 is the init pass), with the model's result;
-    bins cropped to the window box plus 2 px (the statistics see only the window)."""
+    bins cropped to the window box plus 2 px (the statistics see only the window).  ``orient_t`` > 0:
+    the tracker with joint colour x orientation bins (bins and T over 9 2**(3 colour_bits))."""
     import mstrack.fixed.tracker_v2 as tv2
     from mstrack.io.data import load_sequence
     from mstrack.track.params import TrackerParams
@@ -241,7 +262,7 @@ def real_windows(segments=SEGMENTS, max_window: int = 127) -> list[dict]:
     try:
         for name, first, n in segments:
             seq = load_sequence(SEQ_ROOT / name)
-            t = tv2.FixedTrackerV2(TrackerParams(preset="v2", max_window=max_window))
+            t = tv2.FixedTrackerV2(TrackerParams(preset="v2", max_window=max_window, orient_T=orient_t))
             on[0] = first == 0
             t.init(seq.frame(0), seq.init_box())
             for i in range(1, first + n):
@@ -395,6 +416,19 @@ def test_ms_target_stats_orient_ghdl(tp, fp, lanes, extra, hdl_waves):
     gen = {**stats_generics(tp, fp, lanes), "N_ORIENT": 9}
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase=None,
                  test_filter="random_windows", extra_env={CFG_ENV: json.dumps({**gen, **extra})})
+
+
+@pytest.mark.ghdl
+def test_ms_target_stats_orient_real_ghdl(hdl_waves):
+    """N_ORIENT 9 at core v2's size (LANES 4, 4,608 joint bins) on the windows, joint bins and T of
+    FixedTrackerV2(orient_T=64) on real frames (SEGMENTS_JOINT)."""
+    missing = [s for s, _, _ in SEGMENTS_JOINT if not (SEQ_ROOT / s).is_dir()]
+    if missing:
+        pytest.skip(f"{SEQ_ROOT} has no {', '.join(missing)}: the real windows need ../shared/data/sequences")
+    gen = {**stats_generics(TrackerParams(preset="v2"), FixedParams(), 4), "N_ORIENT": 9}
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase=None,
+                 test_filter="random_windows", build_name=f"ghdl_{TOP}_real_o9",
+                 extra_env={CFG_ENV: json.dumps({**gen, "REAL_ORIENT_T": 64})})
 
 
 @pytest.mark.ghdl

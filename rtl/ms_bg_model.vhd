@@ -69,8 +69,8 @@
 --             pixels through a small FIFO (or have ms_sobel emit the border, obin 8); two pixels
 --             in one clock need that merge (a second count port is not provided).
 -- Reset     : synchronous, active high; control state; then N clocks clear the count RAM
---             (busy = 1 meanwhile; 4,608 at N_ORIENT 9).  The model RAM keeps its contents.  To abandon an init frame
---             (stream error), reset the block.
+--             (busy = 1 meanwhile; 4,608 at N_ORIENT 9).  The model RAM keeps its contents.  To
+--             abandon an init frame (stream error), reset the block.
 -- Model     : mstrack.fixed.blocks_v2.ms_bg_model (ModelV2 Qn, T; sums of Q, O).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -518,7 +518,7 @@ begin
   end process;
 
   ---------------------------------------------------------------------------- bin passes
-  -- issue: bins 0 .. N_BINS - 1, one per clock, at the start of each pass
+  -- issue: joint addresses 0 .. NJ - 1 ({obin, colour}), one per clock, at the start of each pass
   p_issue : process (clk)
     variable first : boolean;
   begin

@@ -1,6 +1,7 @@
 """cocotb test bench + pytest entry points for rtl/ms_bg_model.vhd.
 
-Model: :func:`mstrack.fixed.blocks_v2.ms_bg_model` (CBWH target model of tracker v2).  Each case
+Model: :func:`mstrack.fixed.blocks_v2.ms_bg_model` (CBWH target model of tracker v2; with N_ORIENT > 1 on
+joint colour x orientation bins, n_bins = N_ORIENT 2**BIN_W, px_bin / px_obin = colour / obin).  Each case
 starts the block with (cx, cy, wb, hb, ring16), streams every pixel of a bins image (with its
 coordinates; raster order, or shuffled: the block takes any order), then reads the model RAM
 back and compares Qn[u] and T[u] for every bin, and the totals nq = sum Q, no = sum O,

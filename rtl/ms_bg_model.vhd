@@ -1,7 +1,14 @@
 -- ms_bg_model: background-weighted (CBWH) target model of tracker v2, learnt at init.
 --
--- Computes mstrack.fixed.blocks_v2.ms_bg_model(bins, cx, cy, wb, hb, ring16, N_BINS) bit for bit,
--- from the pixel stream of the (decimated) init frame:
+-- Computes mstrack.fixed.blocks_v2.ms_bg_model(bins, cx, cy, wb, hb, ring16, N_ORIENT N_BINS) bit for
+-- bit, from the pixel stream of the (decimated) init frame.  N_ORIENT = 1 (default): u = px_bin, the
+-- colour bin (px_obin, m_rd_obin ignored).  N_ORIENT > 1 (tracker v2's joint bins, N_ORIENT 9):
+-- u = the joint bin (colour px_bin, orientation px_obin), the model's N_ORIENT colour + obin
+-- (ms_joint_bin); it lives at address {obin, colour} = obin 2**BIN_W + colour, so each orientation is
+-- a bank of 2**BIN_W colour words (the model RAM is N_ORIENT such banks, read all at once through
+-- m_qn_all / m_t_all).  The passes below walk all N = N_ORIENT N_BINS joint bins in address order;
+-- min, sums and per-bin functions do not depend on the order, and the totals are the same pixels'
+-- (Q_W, O_W, the divider's widths unchanged).
 --   box  : pixels with |dx| <= ex, |dy| <= ey and |dx| <= XR[|dy|] (dx = x - cx, dy = y - cy,
 --          ex = (wb - 1) / 2, ey = (hb - 1) / 2, XR = the row extents of ms_kernel_tables: the
 --          exact flat-ellipse test TA[|dx|] + TB[|dy|] < D of ms_kernel)   -> Q[u] += 1
@@ -29,9 +36,9 @@
 -- {T | Q | O} at the pixel's bin with the forwarding of ms_histogram (any sequence of bins, runs
 -- of one bin included, counts exactly).
 --
--- Memories: count RAM N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32), model
--- RAM N_BINS x 18 {T | Qn} (1 DP16KD), XR table 2**HALF_W x HALF_W and the Q delay memory
--- (LUT RAM).
+-- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32; 9 at
+-- N_ORIENT 9), model RAM N_ORIENT banks of N_BINS x 18 {T | Qn} (1 DP16KD per bank), XR table
+-- 2**HALF_W x HALF_W and the Q delay memory (LUT RAM).
 -- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
 -- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz.
 --
@@ -40,22 +47,30 @@
 --                       215 clocks at HALF_W = 6) + 2 clocks, exactly; pixels before `counting` are
 --                       ignored (the top starts the block when the init box is taken, between
 --                       frames, so this costs nothing on the stream).
---   px_last -> done   : LAT_DONE = 3 N_BINS + 61 clocks at the default widths: drain 6, pass 1
---                       N_BINS + 3, pass 2 N_BINS + 30 (read 2, T products M(Q_W) = 4, T 1,
---                       divider 18, v Q M(9) = 4, end 1), pass 3 N_BINS + 22 (read 2, divider 18,
+--   px_last -> done   : LAT_DONE = 3 N + 61 clocks at the default widths, N = N_ORIENT N_BINS:
+--                       drain 6, pass 1 N + 3, pass 2 N + 30 (read 2, T products M(Q_W) = 4, T 1,
+--                       divider 18, v Q M(9) = 4, end 1), pass 3 N + 22 (read 2, divider 18,
 --                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
---                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N_BINS = 512
+--                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N = 512
 --                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.hw.synth
 --                       --v2-budget: init frame 5,800 clocks, so 5,846 with this block).
+--                       N_ORIENT 9 (N = 4,608): 13,885 clocks (passes 1 / 2 / 3: 4,611 / 4,638 /
+--                       4,630, drain 6), on the init frame only: the init frame's estimate becomes
+--                       about 18,100 of the 99,000 clocks of 1080p60 blanking.
 -- Throughput: one pixel per clock while counting; one model per init.
 -- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high
 --             until `done` (one-clock pulse); n_box, n_ring, o_min, qv_sum are stable from done
---             until the next start.  The model RAM read port (m_rd_addr -> m_qn, m_t one clock
---             later) may be used at any time; during a model computation it shows a mix of the
---             old and the new model.
--- Reset     : synchronous, active high; control state; then N_BINS clocks clear the count RAM
---             (busy = 1 meanwhile).  The model RAM keeps its contents.  To abandon an init frame
---             (stream error), reset the block.
+--             until the next start.  The model RAM read port (m_rd_addr, m_rd_obin -> m_qn, m_t
+--             one clock later: bank m_rd_obin; m_qn_all, m_t_all: every bank at m_rd_addr, from
+--             the banks' read registers) may be used at any time; during a model computation it
+--             shows a mix of the old and the new model.
+--             Init stream with joint bins: one count port; pixels may come in any order with
+--             gaps, so the top can merge the Sobel's interior pixels and ms_frontend's border
+--             pixels through a small FIFO (or have ms_sobel emit the border, obin 8); two pixels
+--             in one clock need that merge (a second count port is not provided).
+-- Reset     : synchronous, active high; control state; then N clocks clear the count RAM
+--             (busy = 1 meanwhile; 4,608 at N_ORIENT 9).  The model RAM keeps its contents.  To
+--             abandon an init frame (stream error), reset the block.
 -- Model     : mstrack.fixed.blocks_v2.ms_bg_model (ModelV2 Qn, T; sums of Q, O).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -70,7 +85,10 @@ entity ms_bg_model is
     RING_W  : natural := 5;   -- ring16 bits (bg_ring = ring16 / 16)
     Q_W     : natural := 14;  -- Q[u] and sum Q bits: must hold (2 ex + 1)(2 ey + 1)
     O_W     : natural := 17;  -- O[u] and sum O bits: must hold the ring area (>= 8)
-    KD_W    : natural := 29   -- kernel-table width (ms_kernel_tables: holds w^2 h^2)
+    KD_W    : natural := 29;  -- kernel-table width (ms_kernel_tables: holds w^2 h^2)
+    N_ORIENT : natural range 1 to 16 := 1;  -- orientation banks: the joint bin (px_bin, px_obin) has
+                              -- N_ORIENT 2**BIN_W values (RAM depths, clocks per pass); 1 = colour only
+    ORIENT_W : natural := 4   -- width of px_obin, m_rd_obin (2**ORIENT_W >= N_ORIENT)
   );
   port (
     clk       : in  std_logic;                             -- clock
@@ -87,7 +105,9 @@ entity ms_bg_model is
     done      : out std_logic;                             -- pulse: model written
     -- pixels of the init frame
     px_valid  : in  std_logic;                             -- a pixel (ignored unless counting)
-    px_bin    : in  unsigned(BIN_W - 1 downto 0);          -- its bin
+    px_bin    : in  unsigned(BIN_W - 1 downto 0);          -- its bin (colour bin when N_ORIENT > 1)
+    px_obin   : in  unsigned(ORIENT_W - 1 downto 0) := (others => '0');  -- its orientation bin
+                                                           -- 0 .. N_ORIENT - 1 (ignored if N_ORIENT = 1)
     px_x      : in  unsigned(COORD_W - 1 downto 0);        -- its column
     px_y      : in  unsigned(COORD_W - 1 downto 0);        -- its row
     px_last   : in  std_logic;                             -- with px_valid: the frame's last pixel
@@ -97,14 +117,21 @@ entity ms_bg_model is
     o_min     : out unsigned(O_W - 1 downto 0);            -- o* (all ones when no = 0)
     qv_sum    : out unsigned(Q_W + 7 downto 0);            -- tot = sum Q v
     -- model read port
-    m_rd_addr : in  unsigned(BIN_W - 1 downto 0);          -- bin
+    m_rd_addr : in  unsigned(BIN_W - 1 downto 0);          -- bin (colour bin when N_ORIENT > 1)
+    m_rd_obin : in  unsigned(ORIENT_W - 1 downto 0) := (others => '0');  -- orientation bank (N_ORIENT > 1)
     m_qn      : out unsigned(16 downto 0);                 -- Qn[bin] (Q0.16, <= 2**16), 1 clock later
-    m_t       : out std_logic                              -- T[bin], 1 clock later
+    m_t       : out std_logic;                             -- T[bin], 1 clock later
+    m_qn_all  : out std_logic_vector(N_ORIENT * 17 - 1 downto 0);  -- Qn of bank o at o*17, 1 clock later
+    m_t_all   : out std_logic_vector(N_ORIENT - 1 downto 0)        -- T of bank o at bit o, 1 clock later
   );
 end entity;
 
 architecture rtl of ms_bg_model is
-  constant N_BINS  : natural := 2 ** BIN_W;
+  constant N_BINS  : natural := 2 ** BIN_W;                   -- colour bins (words per model bank)
+  constant OB_W    : natural := clog2(N_ORIENT) * boolean'pos(N_ORIENT > 1);  -- bank bits of an address
+  constant AW      : natural := BIN_W + OB_W;                -- joint address {obin, colour}
+  constant NJ      : natural := N_ORIENT * N_BINS;           -- joint bins: count RAM depth, clocks per pass
+  constant GUARD   : boolean := NJ < 2 ** AW;                -- addresses >= NJ exist (N_ORIENT not 2**k)
   constant BG_FRAC : natural := 8;                 -- v in Q.8 (blocks_v2.BG_FRAC)
   constant QN_FRAC : natural := 16;                -- Qn in Q.16 (blocks_v2.QN_BITS)
   constant QN_W    : natural := QN_FRAC + 1;       -- Qn bits (<= 2**16)
@@ -121,16 +148,16 @@ architecture rtl of ms_bg_model is
   constant DVT_W  : natural := 3;                 -- divider tag [last | qz | T]
   constant QD_W   : natural := clog2(QN_W + 2);   -- Q delay memory address (holds > divider latency)
   constant MTT_W  : natural := Q_W + O_W + 1;    -- T product tag [last | O | Q]
-  constant MVT_W  : natural := BIN_W + 2;         -- v Q product tag [last | T | u]
+  constant MVT_W  : natural := AW + 2;            -- v Q product tag [last | T | u]
   -- ms_mult_r4 latency for an A_W-bit digit operand: 1 + max(1, ceil(log2(ceil(A_W / 2))))
   function mult_lat(a_w : natural) return natural is
   begin
     return 1 + max(1, clog2((a_w + 1) / 2));
   end function;
   -- px_last -> done (documentation; the test measures it): drain, pass 1, pass 2, pass 3
-  constant LAT_DONE : natural := DRAIN + (N_BINS + 3)
-                                 + (N_BINS + 2 + mult_lat(Q_W) + 1 + (QN_W + 1) + mult_lat(V_W) + 1)
-                                 + (N_BINS + 2 + (QN_W + 1) + 2);
+  constant LAT_DONE : natural := DRAIN + (NJ + 3)
+                                 + (NJ + 2 + mult_lat(Q_W) + 1 + (QN_W + 1) + mult_lat(V_W) + 1)
+                                 + (NJ + 2 + (QN_W + 1) + 2);
 
   type state_t is (S_CLEAR, S_IDLE, S_SETUP, S_COUNT, S_DRAIN, S_P1, S_P2, S_P3, S_DONE);
   signal state : state_t := S_CLEAR;
@@ -151,41 +178,41 @@ architecture rtl of ms_bg_model is
   signal xr_ram         : xr_ram_t := (others => (others => '0'));
 
   -- reset clear
-  signal clr_addr       : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal clr_addr       : unsigned(AW - 1 downto 0) := (others => '0');
   signal drain_cnt      : natural range 0 to DRAIN := 0;
 
   -- pixel stages A (|dx|, |dy|), B (XR, rectangles), C (b_*: box / ring flags)
   signal a_v            : std_logic := '0';
-  signal a_bin          : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal a_bin          : unsigned(AW - 1 downto 0) := (others => '0');
   signal a_adx, a_ady   : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal xb_v, xb_in, xb_ring : std_logic := '0';
   signal xb_xr, xb_adx  : unsigned(HALF_W - 1 downto 0) := (others => '0');
-  signal xb_bin         : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal xb_bin         : unsigned(AW - 1 downto 0) := (others => '0');
   signal b_acc, b_box   : std_logic := '0';
-  signal b_bin          : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal b_bin          : unsigned(AW - 1 downto 0) := (others => '0');
   signal nq_r           : unsigned(Q_W - 1 downto 0) := (others => '0');
   signal no_r           : unsigned(O_W - 1 downto 0) := (others => '0');
 
   -- count RAM and its read-modify-write pipeline (ms_histogram's scheme, one lane)
-  type cnt_ram_t is array (0 to N_BINS - 1) of std_logic_vector(CW - 1 downto 0);
+  type cnt_ram_t is array (0 to NJ - 1) of std_logic_vector(CW - 1 downto 0);
   signal cram           : cnt_ram_t := (others => (others => '0'));
-  signal rd_addr        : unsigned(BIN_W - 1 downto 0);
+  signal rd_addr        : unsigned(AW - 1 downto 0);
   signal rd_raw, rd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
   signal s1_acc, s1_box, s2_acc, s2_box : std_logic := '0';
-  signal s1_b, s2_b     : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal s1_b, s2_b     : unsigned(AW - 1 downto 0) := (others => '0');
   signal old_w, new_w   : std_logic_vector(CW - 1 downto 0);
   signal wq_we, wq2_we  : std_logic := '0';
-  signal wq_b, wq2_b    : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal wq_b, wq2_b    : unsigned(AW - 1 downto 0) := (others => '0');
   signal wq_word, wq2_word, fwd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
   signal h1, h2, h3, fwd_hit : std_logic := '0';
 
   -- passes: issue side and read stages
   signal iss_en         : std_logic := '0';
-  signal iss_addr       : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal iss_addr       : unsigned(AW - 1 downto 0) := (others => '0');
   signal r1_v, r2_v, r1_last, r2_last : std_logic := '0';
-  signal r1_u, r2_u     : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal r1_u, r2_u     : unsigned(AW - 1 downto 0) := (others => '0');
   signal pass_we        : std_logic;                        -- count RAM write of a pass
-  signal pass_wa        : unsigned(BIN_W - 1 downto 0);
+  signal pass_wa        : unsigned(AW - 1 downto 0);
   signal pass_wd        : std_logic_vector(CW - 1 downto 0);
   signal omin           : unsigned(O_W - 1 downto 0) := (others => '1');
   signal tot            : unsigned(TOT_W - 1 downto 0) := (others => '0');
@@ -207,7 +234,7 @@ architecture rtl of ms_bg_model is
   signal dv_d           : unsigned(DD_W - 1 downto 0);
   signal dv_tag_in, dv_tag : std_logic_vector(DVT_W - 1 downto 0);
   signal dv_q           : unsigned(QN_W - 1 downto 0);
-  signal dv_cnt         : unsigned(BIN_W - 1 downto 0) := (others => '0');  -- results out of the divider
+  signal dv_cnt         : unsigned(AW - 1 downto 0) := (others => '0');  -- results out of the divider
   signal qd_wp, qd_rp   : unsigned(QD_W - 1 downto 0) := (others => '0');   -- Q delay memory pointers
   type qd_ram_t is array (0 to 2 ** QD_W - 1) of std_logic_vector(Q_W - 1 downto 0);
   signal qd_ram         : qd_ram_t;                  -- Q beside the divider (pass 2), LUT RAM
@@ -217,13 +244,15 @@ architecture rtl of ms_bg_model is
   signal mv_tag_in, mv_tag : std_logic_vector(MVT_W - 1 downto 0);
   signal mv_p           : std_logic_vector(QV_W - 1 downto 0);
 
-  -- model RAM
+  -- model RAM: N_ORIENT banks of N_BINS words (bank = the address's obin)
   type m_ram_t is array (0 to N_BINS - 1) of std_logic_vector(MW - 1 downto 0);
-  signal mram           : m_ram_t := (others => (others => '0'));
+  type m_rd_arr_t is array (0 to N_ORIENT - 1) of std_logic_vector(MW - 1 downto 0);
+  signal m_rd_all       : m_rd_arr_t := (others => (others => '0'));
+  signal m_obin_r       : unsigned(ORIENT_W - 1 downto 0) := (others => '0');
   signal m_we           : std_logic := '0';
-  signal m_wa           : unsigned(BIN_W - 1 downto 0) := (others => '0');
+  signal m_wa           : unsigned(AW - 1 downto 0) := (others => '0');
   signal m_wd           : std_logic_vector(MW - 1 downto 0) := (others => '0');
-  signal m_rd           : std_logic_vector(MW - 1 downto 0) := (others => '0');
+  signal m_rd           : std_logic_vector(MW - 1 downto 0);
 
   signal done_r         : std_logic := '0';
 
@@ -232,7 +261,14 @@ architecture rtl of ms_bg_model is
     if b then return '1'; end if;
     return '0';
   end function;
+  -- joint address {obin, colour} = obin 2**BIN_W + colour (N_ORIENT = 1: the colour bin)
+  function jaddr(ob : unsigned(ORIENT_W - 1 downto 0); c : unsigned(BIN_W - 1 downto 0)) return unsigned is
+  begin
+    return shift_left(resize(ob, AW), BIN_W) or resize(c, AW);
+  end function;
 begin
+  assert N_ORIENT = 1 or 2 ** ORIENT_W >= N_ORIENT
+    report "ms_bg_model: ORIENT_W too narrow for N_ORIENT" severity failure;
   assert O_W >= BG_FRAC report "ms_bg_model: O_W must be >= 8 (count word holds [T | qv])" severity failure;
   assert HALF_W >= 2 and BIN_W >= 1 report "ms_bg_model: HALF_W >= 2, BIN_W >= 1" severity failure;
 
@@ -266,7 +302,7 @@ begin
       case state is
         when S_CLEAR =>                                  -- reset clear of the count RAM
           clr_addr <= clr_addr + 1;
-          if clr_addr = N_BINS - 1 then
+          if clr_addr = NJ - 1 then
             state <= S_IDLE;
           end if;
         when S_IDLE =>
@@ -361,7 +397,9 @@ begin
       end if;
       a_adx <= resize(unsigned(dx), COORD_W);
       a_ady <= resize(unsigned(dy), COORD_W);
-      a_bin <= px_bin;
+      a_bin <= jaddr(px_obin, px_bin);
+      assert not (px_valid = '1' and state = S_COUNT and N_ORIENT > 1 and px_obin >= N_ORIENT)
+        report "ms_bg_model: px_obin >= N_ORIENT" severity error;
       a_v   <= px_valid and to_sl(state = S_COUNT);
       -- stage B: XR[|dy|] registered (LUT RAM read), the rectangle tests
       in_ex := a_adx <= resize(ex_r, COORD_W);
@@ -424,6 +462,8 @@ begin
       -- a read/write collision's data is never used (forwarded: h3)
       if wq_we = '1' and wq_b = rd_addr then
         rd_raw <= (others => 'X');
+      elsif GUARD and rd_addr >= NJ then                 -- junk address of an idle pixel slot
+        rd_raw <= (others => 'X');
       else
         rd_raw <= cram(to_integer(rd_addr));
       end if;
@@ -478,7 +518,7 @@ begin
   end process;
 
   ---------------------------------------------------------------------------- bin passes
-  -- issue: bins 0 .. N_BINS - 1, one per clock, at the start of each pass
+  -- issue: joint addresses 0 .. NJ - 1 ({obin, colour}), one per clock, at the start of each pass
   p_issue : process (clk)
     variable first : boolean;
   begin
@@ -489,7 +529,7 @@ begin
         iss_en   <= '1';
         iss_addr <= (others => '0');
       elsif iss_en = '1' then
-        if iss_addr = N_BINS - 1 then
+        if iss_addr = NJ - 1 then
           iss_en <= '0';
         else
           iss_addr <= iss_addr + 1;
@@ -498,7 +538,7 @@ begin
       -- read stages: r1 = RAM read register, r2 = rd_word
       r1_v    <= iss_en;
       r1_u    <= iss_addr;
-      r1_last <= iss_en and to_sl(iss_addr = N_BINS - 1);
+      r1_last <= iss_en and to_sl(iss_addr = NJ - 1);
       r2_v    <= r1_v;
       r2_u    <= r1_u;
       r2_last <= r1_last;
@@ -618,8 +658,8 @@ begin
     pass_wd <= (others => '0');
     if state = S_P2 and mv_v = '1' then
       pass_we <= '1';
-      pass_wa <= unsigned(mv_tag(BIN_W - 1 downto 0));
-      pass_wd(CW - 1) <= mv_tag(BIN_W);
+      pass_wa <= unsigned(mv_tag(AW - 1 downto 0));
+      pass_wd(CW - 1) <= mv_tag(AW);
       pass_wd(QV_W - 1 downto 0) <= mv_p;
     elsif state = S_P3 and r2_v = '1' then
       pass_we <= '1';
@@ -659,14 +699,38 @@ begin
           m_wd(QN_W - 1 downto 0) <= std_logic_vector(dv_q);
         end if;
       end if;
-      if m_we = '1' then
-        mram(to_integer(m_wa)) <= m_wd;
-      end if;
-      m_rd <= mram(to_integer(m_rd_addr));
+      m_obin_r <= m_rd_obin;
       if rst = '1' then
         m_we <= '0';
       end if;
     end if;
+  end process;
+
+  -- the banks: bank o holds the joint bins (colour, o), written at m_wa = {o, colour}, all read at
+  -- m_rd_addr (one clock); m_qn / m_t select bank m_rd_obin (after the read registers)
+  g_mbank : for o in 0 to N_ORIENT - 1 generate
+    signal mram : m_ram_t := (others => (others => '0'));
+  begin
+    p_mb : process (clk)
+    begin
+      if rising_edge(clk) then
+        if m_we = '1' and shift_right(m_wa, BIN_W) = o then
+          mram(to_integer(m_wa(BIN_W - 1 downto 0))) <= m_wd;
+        end if;
+        m_rd_all(o) <= mram(to_integer(m_rd_addr));
+      end if;
+    end process;
+    m_qn_all((o + 1) * QN_W - 1 downto o * QN_W) <= m_rd_all(o)(QN_W - 1 downto 0);
+    m_t_all(o) <= m_rd_all(o)(MW - 1);
+  end generate;
+  p_msel : process (all)
+  begin
+    m_rd <= m_rd_all(0);
+    for o in 1 to N_ORIENT - 1 loop
+      if m_obin_r = o then
+        m_rd <= m_rd_all(o);
+      end if;
+    end loop;
   end process;
   m_qn <= unsigned(m_rd(QN_W - 1 downto 0));
   m_t  <= m_rd(MW - 1);

@@ -8,11 +8,16 @@
 -- (in: the pixel lies in the box inside the padded window).  The inner test is a compare with the
 -- constant IN_LIM = ceil(2**(KERNEL_BITS + 8) / (16 + PAD16)^2): d2q c < L <=> d2q < ceil(L / c).
 -- Model: mstrack.fixed.blocks_v2.ms_target_stats(bins, T, win, ms_kernel(w, h, "flat", KB), KB, pad16).
+-- Joint bins (N_ORIENT > 1, tracker v2's colour x orientation, N_ORIENT 9): a pixel's bin is the pair
+-- (colour on ram_data, orientation on ram_obin), the model's N_ORIENT colour + obin (ms_joint_bin), and
+-- t = T[(colour, obin)]: each lane's T table holds N_ORIENT 2**BIN_W entries at address
+-- {obin, colour} = obin 2**BIN_W + colour, written through (t_addr, t_obin).  N_ORIENT = 1: the colour
+-- bin only (ram_obin, t_obin ignored; the block as before).
 --
 -- Attachment: it sits on ms_pixel_pass's scan tap (px_valid, px_mask, px_dx, px_dy, px_last: the beat
 -- whose ram_addr is out in cycle t) and on the region RAM's read data (ram_data, the beat's bins in
 -- cycle t + 1, the same wires as ms_pixel_pass's ram_data); ms_pixel_pass is not changed otherwise.
--- Tables: T (2**BIN_W x 1 b, written through t_* at init: ms_bg_model's T) and the kernel tables
+-- Tables: T (N_ORIENT 2**BIN_W x 1 b, written through t_* at init: ms_bg_model's T) and the kernel tables
 -- KA (one copy per lane) and KB (one copy: dy is the same for all lanes of a beat), written through
 -- the kt_* port of ms_kernel_tables run with KERNEL_EPAN = 1, KVAL_W = KERNEL_BITS + 1 (the flat
 -- pixel pass ignores KA/KB).  Entries used: |dx| <= ex, |dy| <= ey (exact there, < 2**KERNEL_BITS).
@@ -31,7 +36,8 @@
 -- Handshake  : none on the input (the tap is a stream); done is a one-clock pulse, nt/st2/n_in/nt_in
 --              are registered and held until the next pass's done.  Tables must not be written
 --              during a pass.
--- Cost       : LANES KA tables (2**HALF_W x KT_W), one KB table, LANES T tables (2**BIN_W x 1 b),
+-- Cost       : LANES KA tables (2**HALF_W x KT_W), one KB table, LANES T tables (N_ORIENT 2**BIN_W x 1 b:
+--              one DP16KD each up to 16,384 entries, so N_ORIENT 9 adds no block RAM),
 --              LANES (KT_W + 1)-bit adders, a compare per lane, an adder tree and 4 accumulators.
 -- Reset      : synchronous, active high: the pipeline valid/last flags and the accumulators.
 library ieee;
@@ -49,14 +55,18 @@ entity ms_target_stats is
     KT_W        : natural := 9;   -- KA, KB entry width (ms_kernel_tables KVAL_W; >= KERNEL_BITS)
     PAD16       : natural := 4;   -- pad in sixteenths (TrackerParams.pad = 0.25 -> 4): the inner test
     COUNT_W     : natural := 14;  -- nt, n_in, nt_in bits (pixels of the largest window)
-    ST2_W       : natural := 23   -- st2 bits (largest window x largest d2q)
+    ST2_W       : natural := 23;  -- st2 bits (largest window x largest d2q)
+    N_ORIENT    : natural range 1 to 16 := 1;  -- orientation bins: T has N_ORIENT 2**BIN_W entries per lane,
+                                  -- looked up at the joint bin (colour, obin); 1 = colour only (obins ignored)
+    ORIENT_W    : natural := 4    -- width of an orientation bin in t_obin, ram_obin (2**ORIENT_W >= N_ORIENT)
   );
   port (
     clk      : in  std_logic;                                    -- clock
     rst      : in  std_logic;                                    -- synchronous reset (pipeline flags, accumulators)
     -- T table write port (at init, between passes)
     t_we     : in  std_logic;                                    -- write T[t_addr]
-    t_addr   : in  unsigned(BIN_W - 1 downto 0);                 -- bin
+    t_addr   : in  unsigned(BIN_W - 1 downto 0);                 -- bin (colour bin when N_ORIENT > 1)
+    t_obin   : in  unsigned(ORIENT_W - 1 downto 0) := (others => '0');  -- its orientation bin (N_ORIENT > 1)
     t_data   : in  std_logic;                                    -- T[bin]: 1 target-coloured
     -- kernel table write port (ms_kernel_tables kt_*, KERNEL_EPAN = 1)
     kt_we    : in  std_logic;                                    -- write entry kt_addr
@@ -70,6 +80,9 @@ entity ms_target_stats is
     px_dy    : in  signed(REGION_W downto 0);                    -- dy of the beat
     px_last  : in  std_logic;                                    -- last beat of the pass
     ram_data : in  std_logic_vector(LANES * BIN_W - 1 downto 0); -- the beat's bins (lane l at l*BIN_W), cycle t + 1
+    ram_obin : in  std_logic_vector(LANES * ORIENT_W - 1 downto 0) := (others => '0');
+                                                                 -- their orientation bins (lane l at l*ORIENT_W),
+                                                                 -- cycle t + 1 (ignored if N_ORIENT = 1)
     -- results of the last pass (held)
     done     : out std_logic;                                    -- pulse: results of the pass just ended
     nt       : out unsigned(COUNT_W - 1 downto 0);               -- target-coloured pixels
@@ -88,6 +101,8 @@ architecture rtl of ms_target_stats is
   constant IN_LIM  : natural := (2 ** (KERNEL_BITS + 8) + C_SQ - 1) / C_SQ;  -- d2q < IN_LIM: inner
   constant TS_W    : natural := D2Q_W + TL;                      -- tree: sum of t d2q
   constant TC_W    : natural := TL + 1;                          -- tree: counts (<= LANES)
+  constant OB_W    : natural := clog2(N_ORIENT) * boolean'pos(N_ORIENT > 1);  -- obin bits of a T address
+  constant AW      : natural := BIN_W + OB_W;                    -- T address {obin, colour}
 
   type ka_ram_t is array (0 to 2 ** HALF_W - 1) of unsigned(KT_W - 1 downto 0);
   type a_arr_t is array (0 to LANES - 1) of unsigned(HALF_W - 1 downto 0);
@@ -108,6 +123,7 @@ architecture rtl of ms_target_stats is
   signal last2     : std_logic := '0';
   signal m2        : std_logic_vector(LANES - 1 downto 0) := (others => '0');
   signal bin2      : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
+  signal obin2     : std_logic_vector(LANES * ORIENT_W - 1 downto 0) := (others => '0');
   signal ka2       : k_arr_t := (others => (others => '0'));
   signal kb2       : unsigned(KT_W - 1 downto 0) := (others => '0');
   -- stage 3 (edge s + 2): T read (u_t), d2q; stage 4 (edge s + 3): T read data out of u_t
@@ -125,7 +141,16 @@ architecture rtl of ms_target_stats is
   signal done_r    : std_logic := '0';
   signal r_nt, r_ni, r_nti : unsigned(COUNT_W - 1 downto 0) := (others => '0');
   signal r_st      : unsigned(ST2_W - 1 downto 0) := (others => '0');
+  signal t_waddr   : unsigned(AW - 1 downto 0);
+
+  -- T address of the joint bin (colour c, orientation ob): {ob, c} = ob 2**BIN_W + c (N_ORIENT = 1: c)
+  function jaddr(ob : unsigned(ORIENT_W - 1 downto 0); c : unsigned(BIN_W - 1 downto 0)) return unsigned is
+  begin
+    return shift_left(resize(ob, AW), BIN_W) or resize(c, AW);
+  end function;
 begin
+  assert N_ORIENT = 1 or 2 ** ORIENT_W >= N_ORIENT
+    report "ms_target_stats: ORIENT_W too narrow for N_ORIENT" severity failure;
   assert LANES = 1 or 2 ** clog2(LANES) = LANES
     report "ms_target_stats: LANES must be a power of 2" severity failure;
   assert KT_W >= KERNEL_BITS
@@ -172,11 +197,14 @@ begin
     end if;
   end process;
 
+  t_waddr <= jaddr(t_obin, t_addr);
+
   -- per lane: KA table (stage 2 read) and T table (stage 3 read, address = the registered bin)
   g_lane : for l in 0 to LANES - 1 generate
     signal ka_ram : ka_ram_t := (others => (others => '0'));
     signal t_wd   : std_logic_vector(0 downto 0);
     signal t_rd   : std_logic_vector(0 downto 0);
+    signal t_raddr : unsigned(AW - 1 downto 0);
   begin
     p_ka : process (clk)
     begin
@@ -193,10 +221,11 @@ begin
     -- register and one more), address = the registered bin (edge s + 2), data after edge s + 3;
     -- the write port registered (WR_LAT 1: written at init only, one clock later is harmless)
     t_wd(0) <= t_data;
+    t_raddr <= jaddr(unsigned(obin2((l + 1) * ORIENT_W - 1 downto l * ORIENT_W)),
+                     unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W)));
     u_t : entity work.ms_ram_sdp
-      generic map (DEPTH => 2 ** BIN_W, DATA_W => 1, ADDR_W => BIN_W, RD_LAT => 2, WR_LAT => 1)
-      port map (clk => clk, we => t_we, waddr => t_addr, wdata => t_wd,
-                raddr => unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W)), rdata => t_rd);
+      generic map (DEPTH => N_ORIENT * 2 ** BIN_W, DATA_W => 1, ADDR_W => AW, RD_LAT => 2, WR_LAT => 1)
+      port map (clk => clk, we => t_we, waddr => t_waddr, wdata => t_wd, raddr => t_raddr, rdata => t_rd);
     t4(l) <= t_rd(0);
 
     p_d2q : process (clk)
@@ -213,6 +242,7 @@ begin
   begin
     if rising_edge(clk) then
       bin2  <= ram_data;
+      obin2 <= ram_obin;
       m2    <= m1;
       last2 <= last1;
       m3    <= m2;

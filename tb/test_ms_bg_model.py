@@ -1,6 +1,7 @@
 """cocotb test bench + pytest entry points for rtl/ms_bg_model.vhd.
 
-Model: :func:`mstrack.fixed.blocks_v2.ms_bg_model` (CBWH target model of tracker v2).  Each case
+Model: :func:`mstrack.fixed.blocks_v2.ms_bg_model` (CBWH target model of tracker v2; with N_ORIENT > 1 on
+joint colour x orientation bins, n_bins = N_ORIENT 2**BIN_W, px_bin / px_obin = colour / obin).  Each case
 starts the block with (cx, cy, wb, hb, ring16), streams every pixel of a bins image (with its
 coordinates; raster order, or shuffled: the block takes any order), then reads the model RAM
 back and compares Qn[u] and T[u] for every bin, and the totals nq = sum Q, no = sum O,
@@ -42,10 +43,16 @@ def mult_lat(a_w: int) -> int:
     return 1 + max(1, (((a_w + 1) // 2) - 1).bit_length())
 
 
+def n_orient(g: dict) -> int:
+    """N_ORIENT of the run (1 when the generic is not given: the block's default)."""
+    return int(g.get("N_ORIENT", 1))
+
+
 def lat_done(g: dict) -> int:
-    """px_last -> done of rtl/ms_bg_model.vhd (header: LAT_DONE; 3 N_BINS + 61 at the defaults):
-    drain 6, pass 1 N + 3, pass 2 N + 2 + M(Q_W) + 1 + 18 + M(9) + 1, pass 3 N + 2 + 18 + 2."""
-    n = 1 << int(g["BIN_W"])
+    """px_last -> done of rtl/ms_bg_model.vhd (header: LAT_DONE; 3 N + 61 at the defaults, N =
+    N_ORIENT 2**BIN_W joint bins): drain 6, pass 1 N + 3, pass 2 N + 2 + M(Q_W) + 1 + 18 + M(9) + 1,
+    pass 3 N + 2 + 18 + 2."""
+    n = n_orient(g) << int(g["BIN_W"])
     return 6 + (n + 3) + (n + 2 + mult_lat(int(g["Q_W"])) + 1 + 18 + mult_lat(9) + 1) + (n + 2 + 18 + 2)
 
 
@@ -104,7 +111,9 @@ class BgTB:
     def __init__(self, dut):
         self.dut = dut
         self.g = dut_generics(DEFAULTS)
-        self.n_bins = 1 << int(self.g["BIN_W"])
+        self.n_or = n_orient(self.g)
+        # joint bins j = N_ORIENT colour + obin (ms_joint_bin): px_bin = j // N_ORIENT, px_obin = j % N_ORIENT
+        self.n_bins = self.n_or << int(self.g["BIN_W"])
         self.cyc = 0
 
     async def clock_count(self):
@@ -121,6 +130,8 @@ class BgTB:
         d.px_valid.value = 0
         d.px_last.value = 0
         d.px_bin.value = 0
+        d.px_obin.value = 0
+        d.m_rd_obin.value = 0
         d.px_x.value = 0
         d.px_y.value = 0
         d.m_rd_addr.value = 0
@@ -168,14 +179,16 @@ class BgTB:
         while i <= last:
             if gap and rng.random() < gap:
                 d.px_valid.value = 0
-                # junk on the data lines while not valid
-                d.px_bin.value = rng.randrange(self.n_bins)
+                # junk on the data lines while not valid (obin also beyond N_ORIENT - 1)
+                d.px_bin.value = rng.randrange(self.n_bins // self.n_or)
+                d.px_obin.value = rng.randrange(16)
             else:
                 y, x = pix[i]
                 d.start.value = int(i == last // 2)         # ignored while busy
                 d.cx.value = rng.randrange(1 << int(g["COORD_W"])) if i == last // 2 else cx
                 d.px_valid.value = 1
-                d.px_bin.value = int(bins[y, x])
+                d.px_bin.value = int(bins[y, x]) // self.n_or
+                d.px_obin.value = int(bins[y, x]) % self.n_or
                 d.px_x.value = x
                 d.px_y.value = y
                 d.px_last.value = int(i == last)
@@ -186,6 +199,7 @@ class BgTB:
         d.cx.value = cx
         d.px_valid.value = 0
         d.px_last.value = 0
+        await ClockCycles(d.clk, lat_done(g) - 2)     # done earlier than that is missed: a failure
         while True:
             await RisingEdge(d.clk)
             await ReadOnly()
@@ -198,12 +212,23 @@ class BgTB:
         await Timer(1, "ns")
         qn = np.zeros(self.n_bins, np.int64)
         t = np.zeros(self.n_bins, np.int64)
+        qn_all = np.zeros(self.n_bins, np.int64)     # from m_qn_all / m_t_all (all banks of a colour)
+        t_all = np.zeros(self.n_bins, np.int64)
+        nor = self.n_or
         for u in range(self.n_bins):                 # read port: address before the edge, data after it
-            d.m_rd_addr.value = u
+            d.m_rd_addr.value = u // nor             # colour bin
+            d.m_rd_obin.value = u % nor              # orientation bank
             await RisingEdge(d.clk)
             await ReadOnly()
             qn[u] = d.m_qn.value.to_unsigned()
             t[u] = int(d.m_t.value)
+            if u % nor == 0:
+                # m_t_all is one bit at N_ORIENT 1: a Logic in the Verilator netlist
+                ta = d.m_t_all.value
+                qa, ta = d.m_qn_all.value.to_unsigned(), ta.to_unsigned() if hasattr(ta, "to_unsigned") else int(ta)
+                for o in range(nor):
+                    qn_all[u + o] = (qa >> (17 * o)) & 0x1FFFF
+                    t_all[u + o] = (ta >> o) & 1
             await Timer(1, "ns")
         msg = f"{name}: cx={cx} cy={cy} wb={wb} hb={hb} ring16={ring16} image {w}x{h} gap={gap}"
         for k in ("nq", "no", "omin", "tot"):
@@ -212,14 +237,18 @@ class BgTB:
         assert bad.size == 0, (f"{msg}: {bad.size} bins differ, first {bad[:5].tolist()}: "
                                f"Qn {qn[bad[:5]].tolist()} model {exp['Qn'][bad[:5]].tolist()}, "
                                f"T {t[bad[:5]].tolist()} model {exp['T'][bad[:5]].tolist()}")
+        bad = np.nonzero((qn_all != exp["Qn"]) | (t_all != exp["T"]))[0]
+        assert bad.size == 0, f"{msg}: m_qn_all / m_t_all: {bad.size} joint bins differ, first {bad[:5].tolist()}"
         assert lat == lat_done(g), f"{msg}: px_last -> done {lat} clocks, header says {lat_done(g)}"
         d._log.info("%s: ok (nq %d, no %d, o* %d, tot %d, %d bins with T; set-up %d, last -> done %d clocks)",
                     msg, exp["nq"], exp["no"], exp["omin"], exp["tot"], int(exp["T"].sum()), setup, lat)
 
 
 def synthetic_cases(g: dict, rng: random.Random) -> list[dict]:
-    """(name, bins, cx, cy, wb, hb, ring16) cases within the generics' limits."""
-    n = 1 << int(g["BIN_W"])
+    """(name, bins, cx, cy, wb, hb, ring16) cases within the generics' limits; bins are joint bins
+    N_ORIENT colour + obin (the colour bins when N_ORIENT = 1)."""
+    nor = n_orient(g)
+    n = nor << int(g["BIN_W"])
     wmax = (1 << (int(g["HALF_W"]) + 1)) - 1
     rmax = (1 << int(g["RING_W"])) - 1
     out = []
@@ -260,6 +289,34 @@ def synthetic_cases(g: dict, rng: random.Random) -> list[dict]:
     case("even", rand_img(h, w), 20, 16, 10, 8, 12)
     big = wmax                                         # 127 x 127 at HALF_W = 6
     case("largest", rand_img(big + 6, big + 10), (big + 10) // 2, (big + 6) // 2, big, big, rmax)
+    if nor > 1:
+        nc = n // nor
+        # every joint bin in the ring (72 x 72 > 4608 px at N_ORIENT 9, BIN_W 9; ring = the whole image)
+        side = max(int(np.ceil(np.sqrt(n))) + 4, 30)
+        perm = np.resize(np.arange(n), side * side)
+        rng.shuffle(perm)
+        case("all_joint_bins", perm.reshape(side, side), side // 2, side // 2 - 1, 21, 21, rmax)
+        # box and ring differ in orientation only: one colour everywhere, box obins 0 .. lo - 1 (and a
+        # few N_ORIENT - 1), ring obins lo .. N_ORIENT - 1 (lo = 4 at N_ORIENT 9)
+        c0 = rng.randrange(nc)
+        h, w = 40, 48
+        lo = nor // 2
+        ob = np.array([[rng.randrange(lo, nor) for _ in range(w)] for _ in range(h)], np.int64)
+        box_ob = list(range(lo)) + [lo - 1, nor - 1]
+        ob[13:26, 17:32] = [[rng.choice(box_ob) for _ in range(15)] for _ in range(13)]
+        case("orient_only_one_colour", c0 * nor + ob, 24, 19, 15, 13, 12)
+        # the same colour mix (3 colours) in box and ring, orientation biased: box mostly 0 .. 2,
+        # ring all 9 obins
+        cols = [rng.randrange(nc) for _ in range(3)]
+        col = np.array([[rng.choice(cols) for _ in range(w)] for _ in range(h)], np.int64)
+        ob = np.array([[rng.randrange(nor) for _ in range(w)] for _ in range(h)], np.int64)
+        ob[12:27, 16:33] = [[rng.choice([0, 1, 2, 2, rng.randrange(nor)]) for _ in range(17)] for _ in range(15)]
+        case("orient_only_colour_mix", col * nor + ob, 24, 19, 17, 15, 10, order="shuffled")
+        # one colour, one obin per region: box obin N_ORIENT - 2, ring that obin and 0 (T only at
+        # obin N_ORIENT - 2)
+        ob = np.where(np.arange(w)[None, :] % 3 == 0, 0, nor - 2) * np.ones((h, 1), np.int64)
+        ob[14:25, 18:31] = nor - 2
+        case("orient_two_bins", c0 * nor + ob, 24, 19, 13, 11, 16)
     return out
 
 
@@ -298,7 +355,8 @@ async def bg_model_abandoned(dut):
     h, w = c["bins"].shape
     for i in range(h * w // 2):                       # half the frame, then reset
         d.px_valid.value = 1
-        d.px_bin.value = int(c["bins"][i // w, i % w])
+        d.px_bin.value = int(c["bins"][i // w, i % w]) // tb.n_or
+        d.px_obin.value = int(c["bins"][i // w, i % w]) % tb.n_or
         d.px_x.value = i % w
         d.px_y.value = i // w
         await RisingEdge(d.clk)
@@ -351,12 +409,51 @@ def real_cases(g: dict) -> list[dict]:
     return out
 
 
+def real_cases_joint(g: dict, orient_t: int = 64) -> list[dict]:
+    """The ms_bg_model calls of FixedTrackerV2(orient_T=orient_t).init on the init frame of real
+    sequences, recorded as the tracker makes them: the joint bins of the decimated frame
+    (ms_joint_bin(ms_colour_bin(frame[::D, ::D]), ms_orient_bin(ms_grey(frame), T)[::D, ::D])),
+    the geometry, and n_bins = N_ORIENT 2**BIN_W."""
+    import mstrack.fixed.tracker_v2 as tv2
+    from mstrack.io.data import load_sequence
+    from mstrack.track.params import TrackerParams
+
+    colour_bits = int(g["BIN_W"]) // 3
+    tp = TrackerParams(preset="v2", colour_bits=colour_bits, orient_T=orient_t)
+    assert tp.n_bins_v2 == n_orient(g) << int(g["BIN_W"]), "N_ORIENT / BIN_W do not match the joint bins"
+    out: list[dict] = []
+    orig = tv2.ms_bg_model
+    calls: list[tuple] = []
+
+    def rec(bins, cx, cy, wb, hb, ring16, n_bins):
+        calls.append((bins.copy(), cx, cy, wb, hb, ring16, n_bins))
+        return orig(bins, cx, cy, wb, hb, ring16, n_bins)
+
+    tv2.ms_bg_model = rec
+    try:
+        for name in REAL_SEQS:
+            seq = load_sequence(SEQ_ROOT / name)
+            calls.clear()
+            trk = tv2.FixedTrackerV2(tp)
+            trk.init(seq.frame(0), seq.init_box())
+            assert len(calls) == 1, name
+            bins, cx, cy, wb, hb, ring16, n_bins = calls[0]
+            assert n_bins == tp.n_bins_v2 and int(bins.max()) < n_bins
+            d = seq.frame(0).shape[1] // bins.shape[1] if bins.shape[1] else 1
+            out.append({"name": f"{name} frame 0 joint (T={orient_t}, {bins.shape[1]}x{bins.shape[0]}, D~{d})",
+                        "bins": bins, "cx": cx, "cy": cy, "wb": wb, "hb": hb, "ring16": ring16})
+    finally:
+        tv2.ms_bg_model = orig
+    return out
+
+
 @cocotb.test()
 async def bg_model_real(dut):
     tb = BgTB(dut)
     await tb.reset()
     rng = random.Random(1200)
-    for i, c in enumerate(real_cases(tb.g)):
+    cases = real_cases(tb.g) if tb.n_or == 1 else real_cases_joint(tb.g)
+    for i, c in enumerate(cases):
         await tb.run(c["bins"], c["cx"], c["cy"], c["wb"], c["hb"], c["ring16"], 0.3 if i % 2 else 0.0, rng,
                      name=c["name"])
 
@@ -375,6 +472,9 @@ PARAMS = [
     pytest.param({**DEFAULTS, "BIN_W": 6}, id="colour2"),                       # 64 bins
     pytest.param({**DEFAULTS, "BIN_W": 3, "HALF_W": 4, "COORD_W": 8, "RING_W": 6, "Q_W": 10, "O_W": 12,
                   "KD_W": 21}, id="small"),                                     # 8 bins, boxes <= 31
+    pytest.param({**DEFAULTS, "N_ORIENT": 9}, id="orient9"),                    # 9 x 512 joint bins
+    pytest.param({**DEFAULTS, "BIN_W": 3, "HALF_W": 4, "COORD_W": 8, "RING_W": 6, "Q_W": 10, "O_W": 12,
+                  "KD_W": 21, "N_ORIENT": 4}, id="small_orient4"),              # 4 x 8, banks 2**k
 ]
 
 
@@ -386,17 +486,29 @@ def test_ms_bg_model_ghdl(generics, hdl_waves):
 
 
 @pytest.mark.ghdl
-@pytest.mark.parametrize("generics", PARAMS[:2])
+@pytest.mark.parametrize("generics", PARAMS[:2] + [PARAMS[3]])
 def test_ms_bg_model_real_ghdl(generics, hdl_waves):
+    """The init frames of real sequences: colour bins (512, 64), and at N_ORIENT 9 the joint bins of
+    FixedTrackerV2(orient_T=64) (colour_bits 3: 4608 bins)."""
     missing = [s for s in REAL_SEQS if not (SEQ_ROOT / s).is_dir()]
     if missing:
         pytest.skip(f"{SEQ_ROOT} has no {', '.join(missing)}: the real-frame cases need ../shared/data/sequences")
     hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves, test_filter="bg_model_real",
-                 build_name=f"ghdl_{TOP}_real_{generics['BIN_W']}")
+                 build_name=f"ghdl_{TOP}_real_{generics['BIN_W']}_o{generics.get('N_ORIENT', 1)}")
+
+
+@pytest.mark.ghdl
+def test_ms_bg_model_synth_orient9(tmp_path):
+    """ghdl --synth (to Verilog) at N_ORIENT 9, tracker v2's widths: 4608-word count RAM, 9 model banks."""
+    gen = {**DEFAULTS, "N_ORIENT": 9}
+    v = hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v").read_text()
+    assert "module ms_bg_model" in v and "m_qn_all" in v and "px_obin" in v
 
 
 @pytest.mark.verilator
-def test_ms_bg_model_verilator(hdl_waves):
-    """The synthesised netlist (GHDL -> Verilog -> Verilator) on the synthetic cases."""
-    hdl.run_verilator(TOP, MODULE, DEFAULTS, hdl.rtl_sources(TOP), waves=hdl_waves,
+@pytest.mark.parametrize("generics", [PARAMS[0], PARAMS[3]])
+def test_ms_bg_model_verilator(generics, hdl_waves):
+    """The synthesised netlist (GHDL -> Verilog -> Verilator) on the synthetic cases (512 colour bins,
+    and 9 x 512 joint bins)."""
+    hdl.run_verilator(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves,
                       test_filter="bg_model_synthetic|bg_model_abandoned")

@@ -93,7 +93,11 @@ async def random_windows(dut, throttle):
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
     for s in ("rst", "t_we", "kt_we", "px_valid", "px_last"):
         getattr(dut, s).value = Immediate(1 if s == "rst" else 0)
-    n_bins = 1 << bw
+    # N_ORIENT > 1: joint bins j = N_ORIENT colour + obin (ms_joint_bin); T indexed by j as in the
+    # model; the block gets colour = j // N_ORIENT on ram_data / t_addr and obin = j % N_ORIENT on
+    # ram_obin / t_obin (masked lanes and idle beats: random obins 0 .. 15)
+    nor = int(c.get("N_ORIENT", 1))
+    n_bins = nor << bw
     cycle = 0
     got: list[tuple[int, tuple[int, int, int, int]]] = []     # (edge sampling done = 1, results)
     expected: list[tuple[int, TargetStats, str]] = []        # (edge sampling the last beat, model, what)
@@ -120,7 +124,9 @@ async def random_windows(dut, throttle):
     async def write_T(T: np.ndarray):
         for u in range(n_bins):
             dut.t_we.value = 1
-            dut.t_addr.value = u
+            dut.t_addr.value = u // nor
+            if nor > 1:
+                dut.t_obin.value = u % nor
             dut.t_data.value = int(T[u])
             await tick()
         dut.t_we.value = 0
@@ -136,11 +142,13 @@ async def random_windows(dut, throttle):
 
     async def run_pass(ker: ms_kernel, bins: np.ndarray, wx: int, wy: int, what: str):
         beats = scan_beats(ker, wx, wy, lanes)
-        prev = None
+        prev, prev_o = None, 0
         i = 0
         while i < len(beats) or prev is not None:
             # this cycle: the bins of the beat driven one cycle ago (random otherwise), and the next beat
             dut.ram_data.value = prev if prev is not None else rng.getrandbits(lanes * bw)
+            if nor > 1:
+                dut.ram_obin.value = prev_o if prev is not None else rng.getrandbits(lanes * 4)
             prev = None
             drive = i < len(beats) and not (throttle and rng.random() < 0.3)
             if drive:
@@ -150,10 +158,15 @@ async def random_windows(dut, throttle):
                 dut.px_dx.value = signed_bits(x0 - wx, dw)
                 dut.px_dy.value = signed_bits(dy, dw)
                 dut.px_last.value = last
-                prev = 0
+                prev, prev_o = 0, 0
                 for l in range(lanes):
-                    v = int(bins[wy + dy, x0 + l]) if (mask >> l) & 1 else rng.randrange(n_bins)
+                    if (mask >> l) & 1:
+                        j = int(bins[wy + dy, x0 + l])
+                        v, o = j // nor, j % nor
+                    else:
+                        v, o = rng.randrange(n_bins // nor), rng.randrange(16)
                     prev |= v << (l * bw)
+                    prev_o |= o << (l * 4)
                 i += 1
             else:
                 dut.px_valid.value = 0
@@ -169,6 +182,22 @@ async def random_windows(dut, throttle):
 
     await ClockCycles(dut.clk, 3)
     dut.rst.value = 0
+    if c.get("REAL_ORIENT_T"):
+        # the windows FixedTrackerV2(orient_T) passed to ms_target_stats on real frames (joint bins,
+        # the model's T of the joint bins), played through the same scan
+        lastT = None
+        for k, rw in enumerate(real_windows(SEGMENTS_JOINT, max_window=max_win, orient_t=c["REAL_ORIENT_T"])):
+            assert int(rw["bins"].max()) < n_bins and len(rw["T"]) == n_bins
+            if lastT is None or not np.array_equal(lastT, rw["T"]):
+                T = rw["T"]
+                await write_T(T)
+                lastT = T
+            ker = ms_kernel(rw["w"], rw["h"], "flat", rw["kb"])
+            await write_kernel(ker)
+            await run_pass(ker, rw["bins"], rw["win"][0], rw["win"][1], f"real window {k} {rw['w']}x{rw['h']}")
+            assert expected[-1][1] == rw["stats"], "the replayed window's model differs from the tracker's"
+            await settle()
+        return
     T = (nrng.random(n_bins) < 0.4).astype(np.int64)
     await write_T(T)
     region_n = min(2 * max_win + 8, (1 << c["REGION_W"]) - 1)
@@ -203,10 +232,15 @@ SEGMENTS = (("Couple", 0, 3), ("MotorRolling", 0, 3), ("Deer", 0, 3), ("Couple",
             ("bag_vot", 10, 3))
 
 
-def real_windows(segments=SEGMENTS, max_window: int = 127) -> list[dict]:
+#: joint-bin segments (FixedTrackerV2(orient_T=64)): init and first frames at D = 1 and 2
+SEGMENTS_JOINT = (("Girl", 0, 3), ("MotorRolling", 0, 2), ("Couple", 0, 2))
+
+
+def real_windows(segments=SEGMENTS, max_window: int = 127, orient_t: int = 0) -> list[dict]:
     """The (bins, T, win, ker) of every ms_target_stats call FixedTrackerV2 makes on the frames of
     ``segments`` (the tracker runs from frame 0; frame 0 is the init pass), with the model's result;
-    bins cropped to the window box plus 2 px (the statistics see only the window)."""
+    bins cropped to the window box plus 2 px (the statistics see only the window).  ``orient_t`` > 0:
+    the tracker with joint colour x orientation bins (bins and T over 9 2**(3 colour_bits))."""
     import mstrack.fixed.tracker_v2 as tv2
     from mstrack.io.data import load_sequence
     from mstrack.track.params import TrackerParams
@@ -228,7 +262,7 @@ def real_windows(segments=SEGMENTS, max_window: int = 127) -> list[dict]:
     try:
         for name, first, n in segments:
             seq = load_sequence(SEQ_ROOT / name)
-            t = tv2.FixedTrackerV2(TrackerParams(preset="v2", max_window=max_window))
+            t = tv2.FixedTrackerV2(TrackerParams(preset="v2", max_window=max_window, orient_T=orient_t))
             on[0] = first == 0
             t.init(seq.frame(0), seq.init_box())
             for i in range(1, first + n):
@@ -362,6 +396,56 @@ def test_ms_target_stats_ghdl(tp, fp, lanes, extra, hdl_waves):
     gen = stats_generics(tp, fp, lanes)
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase=None,
                  test_filter="random_windows", extra_env={CFG_ENV: json.dumps({**gen, **extra})})
+
+
+ORIENT_CASES = [
+    pytest.param(TrackerParams(preset="v2", colour_bits=2), FixedParams(max_half=7, margin=4), 4, {"N": 20},
+                 id="small_L4_o9"),
+    pytest.param(TrackerParams(preset="v2", colour_bits=2), FixedParams(max_half=7, margin=4), 1, {"N": 12},
+                 id="small_L1_o9"),
+    pytest.param(TrackerParams(preset="v2"), FixedParams(), 4, {"N": 3}, id="default_L4_o9"),
+]
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("tp,fp,lanes,extra", ORIENT_CASES)
+def test_ms_target_stats_orient_ghdl(tp, fp, lanes, extra, hdl_waves):
+    """N_ORIENT 9: T over the 9 x 2**BIN_W joint bins (colour bits 2: 576, 3: 4608), looked up per lane
+    at (ram_data, ram_obin), written at (t_addr, t_obin); random joint bins, compared with
+    ms_target_stats(joint bins, T of the joint bins, ...)."""
+    gen = {**stats_generics(tp, fp, lanes), "N_ORIENT": 9}
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase=None,
+                 test_filter="random_windows", extra_env={CFG_ENV: json.dumps({**gen, **extra})})
+
+
+@pytest.mark.ghdl
+def test_ms_target_stats_orient_real_ghdl(hdl_waves):
+    """N_ORIENT 9 at core v2's size (LANES 4, 4,608 joint bins) on the windows, joint bins and T of
+    FixedTrackerV2(orient_T=64) on real frames (SEGMENTS_JOINT)."""
+    missing = [s for s, _, _ in SEGMENTS_JOINT if not (SEQ_ROOT / s).is_dir()]
+    if missing:
+        pytest.skip(f"{SEQ_ROOT} has no {', '.join(missing)}: the real windows need ../shared/data/sequences")
+    gen = {**stats_generics(TrackerParams(preset="v2"), FixedParams(), 4), "N_ORIENT": 9}
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase=None,
+                 test_filter="random_windows", build_name=f"ghdl_{TOP}_real_o9",
+                 extra_env={CFG_ENV: json.dumps({**gen, "REAL_ORIENT_T": 64})})
+
+
+@pytest.mark.ghdl
+def test_ms_target_stats_synth_orient9(tmp_path):
+    """ghdl --synth (to Verilog) at core v2's size with N_ORIENT 9: LANES 4 T tables of 4608 x 1 b."""
+    gen = {**stats_generics(TrackerParams(preset="v2"), FixedParams(), 4), "N_ORIENT": 9}
+    v = hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v").read_text()
+    assert "module ms_target_stats" in v and "ram_obin" in v and "t_obin" in v
+
+
+@pytest.mark.verilator
+def test_ms_target_stats_orient_verilator(hdl_waves):
+    """The N_ORIENT 9 bench on the GHDL -> Verilog -> Verilator netlist (colour bits 2, LANES 4)."""
+    gen = {**stats_generics(TrackerParams(preset="v2", colour_bits=2), FixedParams(max_half=7, margin=4), 4),
+           "N_ORIENT": 9}
+    hdl.run_verilator(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, test_filter="random_windows",
+                      extra_env={CFG_ENV: json.dumps({**gen, "N": 20})})
 
 
 @pytest.mark.verilator

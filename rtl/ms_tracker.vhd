@@ -284,6 +284,8 @@ architecture rtl of ms_tracker is
   signal err_code_r     : std_logic_vector(ERR_CODE_W - 1 downto 0);
   signal overflow       : std_logic := '0';
   signal init_ready     : std_logic;
+  signal io_idle        : std_logic;                         -- both inputs may open (registered terms)
+  signal init_free      : std_logic;                         -- init_ready's own registered terms
 
   function pack(cx, cy : unsigned; rho_c, rho_e : unsigned; alpha : unsigned;
                 iter_c, iter_e : unsigned; stop_c, stop_e : std_logic_vector;
@@ -491,8 +493,13 @@ begin
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W
                      and width_ppc_ok(frame_width) else '0';
   -- (err_push: the error word is loaded, the FIFO takes it at the end of the next clock)
-  accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
-                     and err_push = '0' and fe_err_now = '0' and init_take = '0' else '0';
+  -- written so that s_init_tvalid enters accept in one AND with registered terms (init_free), not
+  -- through init_ready and init_take: the same function (accept needs io_idle, which init_ready
+  -- has too), a shorter ready chain s_init_tvalid / state -> s_axis_tready -> the stream check
+  io_idle <= '1' when state = T_IDLE and gate_closed = '0' and err_hold = '0' and err_push = '0'
+                      and fe_err_now = '0' else '0';
+  init_free <= '1' when cap_done = '0' and err_pending = '0' and in_frame = '0' else '0';
+  accept <= io_idle and region_ok and not (s_init_tvalid and init_free);
   s_axis_tready <= accept;
   beat <= s_axis_tvalid and accept;
 
@@ -901,8 +908,7 @@ begin
   -- at the next edge, not yet counted by fifo_ready)
   push_now <= '1' when state = T_PUSH and fifo_ready = '1' and fifo_valid = '0' else '0';
 
-  init_ready <= '1' when state = T_IDLE and cap_done = '0' and err_pending = '0' and in_frame = '0'
-                         and gate_closed = '0' and err_hold = '0' and err_push = '0' and fe_err_now = '0' else '0';
+  init_ready <= io_idle and init_free;
   init_take <= s_init_tvalid and init_ready;
   s_init_tready <= init_ready;
   end generate g_paper;

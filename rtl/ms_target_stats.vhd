@@ -10,21 +10,23 @@
 -- Model: mstrack.fixed.blocks_v2.ms_target_stats(bins, T, win, ms_kernel(w, h, "flat", KB), KB, pad16).
 -- Joint bins (N_ORIENT > 1, tracker v2's colour x orientation, N_ORIENT 9): a pixel's bin is the pair
 -- (colour on ram_data, orientation on ram_obin), the model's N_ORIENT colour + obin (ms_joint_bin), and
--- t = T[(colour, obin)]: each lane's T table holds N_ORIENT 2**BIN_W entries at address
--- {obin, colour} = obin 2**BIN_W + colour, written through (t_addr, t_obin).  N_ORIENT = 1: the colour
--- bin only (ram_obin, t_obin ignored; the block as before).
+-- t = T[(colour, obin)]: each lane's T table holds 2**BIN_W words of N_ORIENT bits, word = colour,
+-- bit o = T[(colour, o)] (ms_bg_model's m_t_all layout), written one colour address per clock through
+-- (t_addr, t_data_all): a whole T load is 2**BIN_W clocks, as the Qw load beside it; the lookup reads
+-- the word of the pixel's colour and selects bit obin after the RAM's output register.  N_ORIENT = 1:
+-- the colour bin only (ram_obin, t_data_all ignored; t_data; the block as before).
 --
 -- Attachment: it sits on ms_pixel_pass's scan tap (px_valid, px_mask, px_dx, px_dy, px_last: the beat
 -- whose ram_addr is out in cycle t) and on the region RAM's read data (ram_data, the beat's bins in
 -- cycle t + 1, the same wires as ms_pixel_pass's ram_data); ms_pixel_pass is not changed otherwise.
--- Tables: T (N_ORIENT 2**BIN_W x 1 b, written through t_* at init: ms_bg_model's T) and the kernel tables
+-- Tables: T (2**BIN_W x N_ORIENT b, written through t_* at init: ms_bg_model's T) and the kernel tables
 -- KA (one copy per lane) and KB (one copy: dy is the same for all lanes of a beat), written through
 -- the kt_* port of ms_kernel_tables run with KERNEL_EPAN = 1, KVAL_W = KERNEL_BITS + 1 (the flat
 -- pixel pass ignores KA/KB).  Entries used: |dx| <= ex, |dy| <= ey (exact there, < 2**KERNEL_BITS).
 --
 -- Pipeline (edge s samples the beat): s: |dx + l|, |dy|, mask -> s+1: bins registered, KA/KB read
 -- -> s+2: T read (ms_ram_sdp, RD_LAT 2), d2q = KA + KB -> s+3: T read data out of the RAM's output register
--- -> s+4: per-lane terms (t, t d2q, in, t in) -> s+5 .. s+4+log2(LANES): adder tree over the lanes
+-- -> s+4: per-lane terms (t = bit obin of the T word, t d2q, in, t in) -> s+5 .. s+4+log2(LANES): adder tree over the lanes
 -- (one level per clock) -> s+5+log2(LANES): accumulators; on the last beat the sums go to the
 -- outputs and the accumulators restart from 0 (the next pass needs no clear).
 -- Latency    : STATS_LAT = 6 + log2(LANES) clocks: if edge s samples px_valid = px_last = 1, edge
@@ -36,8 +38,9 @@
 -- Handshake  : none on the input (the tap is a stream); done is a one-clock pulse, nt/st2/n_in/nt_in
 --              are registered and held until the next pass's done.  Tables must not be written
 --              during a pass.
--- Cost       : LANES KA tables (2**HALF_W x KT_W), one KB table, LANES T tables (N_ORIENT 2**BIN_W x 1 b:
---              one DP16KD each up to 16,384 entries, so N_ORIENT 9 adds no block RAM),
+-- Cost       : LANES KA tables (2**HALF_W x KT_W), one KB table, LANES T tables (2**BIN_W x N_ORIENT b:
+--              one DP16KD each (512 x 36 mode) up to 9 bits at BIN_W 9, so N_ORIENT 9 adds no block RAM;
+--              N_ORIENT > 1: an N_ORIENT:1 bit select per lane and 2 ORIENT_W-bit delay registers),
 --              LANES (KT_W + 1)-bit adders, a compare per lane, an adder tree and 4 accumulators.
 -- Reset      : synchronous, active high: the pipeline valid/last flags and the accumulators.
 library ieee;
@@ -56,18 +59,19 @@ entity ms_target_stats is
     PAD16       : natural := 4;   -- pad in sixteenths (TrackerParams.pad = 0.25 -> 4): the inner test
     COUNT_W     : natural := 14;  -- nt, n_in, nt_in bits (pixels of the largest window)
     ST2_W       : natural := 23;  -- st2 bits (largest window x largest d2q)
-    N_ORIENT    : natural range 1 to 16 := 1;  -- orientation bins: T has N_ORIENT 2**BIN_W entries per lane,
-                                  -- looked up at the joint bin (colour, obin); 1 = colour only (obins ignored)
+    N_ORIENT    : natural range 1 to 16 := 1;  -- orientation bins: T has 2**BIN_W words of N_ORIENT bits per
+                                  -- lane, looked up at the joint bin (colour, obin); 1 = colour only (obins ignored)
     ORIENT_W    : natural := 4    -- width of an orientation bin in t_obin, ram_obin (2**ORIENT_W >= N_ORIENT)
   );
   port (
     clk      : in  std_logic;                                    -- clock
     rst      : in  std_logic;                                    -- synchronous reset (pipeline flags, accumulators)
     -- T table write port (at init, between passes)
-    t_we     : in  std_logic;                                    -- write T[t_addr]
+    t_we     : in  std_logic;                                    -- write T[t_addr] (N_ORIENT > 1: the word t_addr)
     t_addr   : in  unsigned(BIN_W - 1 downto 0);                 -- bin (colour bin when N_ORIENT > 1)
-    t_obin   : in  unsigned(ORIENT_W - 1 downto 0) := (others => '0');  -- its orientation bin (N_ORIENT > 1)
-    t_data   : in  std_logic;                                    -- T[bin]: 1 target-coloured
+    t_data   : in  std_logic;                                    -- N_ORIENT = 1: T[bin], 1 target-coloured
+    t_data_all : in std_logic_vector(N_ORIENT - 1 downto 0) := (others => '0');
+                                                                 -- N_ORIENT > 1: bit o = T[(t_addr, o)]
     -- kernel table write port (ms_kernel_tables kt_*, KERNEL_EPAN = 1)
     kt_we    : in  std_logic;                                    -- write entry kt_addr
     kt_addr  : in  unsigned(HALF_W - 1 downto 0);                -- entry index i
@@ -101,8 +105,6 @@ architecture rtl of ms_target_stats is
   constant IN_LIM  : natural := (2 ** (KERNEL_BITS + 8) + C_SQ - 1) / C_SQ;  -- d2q < IN_LIM: inner
   constant TS_W    : natural := D2Q_W + TL;                      -- tree: sum of t d2q
   constant TC_W    : natural := TL + 1;                          -- tree: counts (<= LANES)
-  constant OB_W    : natural := clog2(N_ORIENT) * boolean'pos(N_ORIENT > 1);  -- obin bits of a T address
-  constant AW      : natural := BIN_W + OB_W;                    -- T address {obin, colour}
 
   type ka_ram_t is array (0 to 2 ** HALF_W - 1) of unsigned(KT_W - 1 downto 0);
   type a_arr_t is array (0 to LANES - 1) of unsigned(HALF_W - 1 downto 0);
@@ -124,6 +126,7 @@ architecture rtl of ms_target_stats is
   signal m2        : std_logic_vector(LANES - 1 downto 0) := (others => '0');
   signal bin2      : std_logic_vector(LANES * BIN_W - 1 downto 0) := (others => '0');
   signal obin2     : std_logic_vector(LANES * ORIENT_W - 1 downto 0) := (others => '0');
+  signal obin3, obin4 : std_logic_vector(LANES * ORIENT_W - 1 downto 0) := (others => '0');
   signal ka2       : k_arr_t := (others => (others => '0'));
   signal kb2       : unsigned(KT_W - 1 downto 0) := (others => '0');
   -- stage 3 (edge s + 2): T read (u_t), d2q; stage 4 (edge s + 3): T read data out of u_t
@@ -141,13 +144,7 @@ architecture rtl of ms_target_stats is
   signal done_r    : std_logic := '0';
   signal r_nt, r_ni, r_nti : unsigned(COUNT_W - 1 downto 0) := (others => '0');
   signal r_st      : unsigned(ST2_W - 1 downto 0) := (others => '0');
-  signal t_waddr   : unsigned(AW - 1 downto 0);
-
-  -- T address of the joint bin (colour c, orientation ob): {ob, c} = ob 2**BIN_W + c (N_ORIENT = 1: c)
-  function jaddr(ob : unsigned(ORIENT_W - 1 downto 0); c : unsigned(BIN_W - 1 downto 0)) return unsigned is
-  begin
-    return shift_left(resize(ob, AW), BIN_W) or resize(c, AW);
-  end function;
+  signal t_wd      : std_logic_vector(N_ORIENT - 1 downto 0);
 begin
   assert N_ORIENT = 1 or 2 ** ORIENT_W >= N_ORIENT
     report "ms_target_stats: ORIENT_W too narrow for N_ORIENT" severity failure;
@@ -197,14 +194,12 @@ begin
     end if;
   end process;
 
-  t_waddr <= jaddr(t_obin, t_addr);
+  t_wd <= t_data_all when N_ORIENT > 1 else (others => t_data);
 
   -- per lane: KA table (stage 2 read) and T table (stage 3 read, address = the registered bin)
   g_lane : for l in 0 to LANES - 1 generate
     signal ka_ram : ka_ram_t := (others => (others => '0'));
-    signal t_wd   : std_logic_vector(0 downto 0);
-    signal t_rd   : std_logic_vector(0 downto 0);
-    signal t_raddr : unsigned(AW - 1 downto 0);
+    signal t_rd   : std_logic_vector(N_ORIENT - 1 downto 0);
   begin
     p_ka : process (clk)
     begin
@@ -220,13 +215,27 @@ begin
     -- ~5.8 ns clock-to-out no longer reaches the fabric; the inferred architecture: a read
     -- register and one more), address = the registered bin (edge s + 2), data after edge s + 3;
     -- the write port registered (WR_LAT 1: written at init only, one clock later is harmless)
-    t_wd(0) <= t_data;
-    t_raddr <= jaddr(unsigned(obin2((l + 1) * ORIENT_W - 1 downto l * ORIENT_W)),
-                     unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W)));
     u_t : entity work.ms_ram_sdp
-      generic map (DEPTH => N_ORIENT * 2 ** BIN_W, DATA_W => 1, ADDR_W => AW, RD_LAT => 2, WR_LAT => 1)
-      port map (clk => clk, we => t_we, waddr => t_waddr, wdata => t_wd, raddr => t_raddr, rdata => t_rd);
-    t4(l) <= t_rd(0);
+      generic map (DEPTH => 2 ** BIN_W, DATA_W => N_ORIENT, ADDR_W => BIN_W, RD_LAT => 2, WR_LAT => 1)
+      port map (clk => clk, we => t_we, waddr => t_addr, wdata => t_wd,
+                raddr => unsigned(bin2((l + 1) * BIN_W - 1 downto l * BIN_W)), rdata => t_rd);
+    -- the lane's orientation selects its bit of the word (after the RAM's output register; an
+    -- orientation >= N_ORIENT, only on masked lanes, reads 0)
+    p_tsel : process (t_rd, obin4)
+      variable ob : natural;
+    begin
+      if N_ORIENT = 1 then
+        t4(l) <= t_rd(0);
+      else
+        ob := to_integer(unsigned(obin4((l + 1) * ORIENT_W - 1 downto l * ORIENT_W)));
+        t4(l) <= '0';
+        for o in 0 to N_ORIENT - 1 loop
+          if ob = o then
+            t4(l) <= t_rd(o);
+          end if;
+        end loop;
+      end if;
+    end process;
 
     p_d2q : process (clk)
     begin
@@ -243,6 +252,8 @@ begin
     if rising_edge(clk) then
       bin2  <= ram_data;
       obin2 <= ram_obin;
+      obin3 <= obin2;
+      obin4 <= obin3;
       m2    <= m1;
       last2 <= last1;
       m3    <= m2;

@@ -95,7 +95,7 @@ async def random_windows(dut, throttle):
         getattr(dut, s).value = Immediate(1 if s == "rst" else 0)
     # N_ORIENT > 1: joint bins j = N_ORIENT colour + obin (ms_joint_bin); T indexed by j as in the
     # model; the block gets colour = j // N_ORIENT on ram_data / t_addr and obin = j % N_ORIENT on
-    # ram_obin / t_obin (masked lanes and idle beats: random obins 0 .. 15)
+    # ram_obin (masked lanes and idle beats: random obins 0 .. 15); T written as N_ORIENT-bit words
     nor = int(c.get("N_ORIENT", 1))
     n_bins = nor << bw
     cycle = 0
@@ -122,12 +122,16 @@ async def random_windows(dut, throttle):
         expected.clear()
 
     async def write_T(T: np.ndarray):
-        for u in range(n_bins):
+        # N_ORIENT > 1: one colour address per clock, bit o = T[N_ORIENT colour + o] (ms_bg_model's
+        # m_t_all), t_data random (ignored); N_ORIENT = 1: one bin per clock on t_data
+        for u in range(n_bins // nor):
             dut.t_we.value = 1
-            dut.t_addr.value = u // nor
+            dut.t_addr.value = u
             if nor > 1:
-                dut.t_obin.value = u % nor
-            dut.t_data.value = int(T[u])
+                dut.t_data_all.value = sum(int(T[nor * u + o]) << o for o in range(nor))
+                dut.t_data.value = rng.getrandbits(1)
+            else:
+                dut.t_data.value = int(T[u])
             await tick()
         dut.t_we.value = 0
 
@@ -411,7 +415,7 @@ ORIENT_CASES = [
 @pytest.mark.parametrize("tp,fp,lanes,extra", ORIENT_CASES)
 def test_ms_target_stats_orient_ghdl(tp, fp, lanes, extra, hdl_waves):
     """N_ORIENT 9: T over the 9 x 2**BIN_W joint bins (colour bits 2: 576, 3: 4608), looked up per lane
-    at (ram_data, ram_obin), written at (t_addr, t_obin); random joint bins, compared with
+    at (ram_data, ram_obin), written as 2**BIN_W words of 9 bits (t_addr, t_data_all); random joint bins, compared with
     ms_target_stats(joint bins, T of the joint bins, ...)."""
     gen = {**stats_generics(tp, fp, lanes), "N_ORIENT": 9}
     hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves, testcase=None,
@@ -433,10 +437,10 @@ def test_ms_target_stats_orient_real_ghdl(hdl_waves):
 
 @pytest.mark.ghdl
 def test_ms_target_stats_synth_orient9(tmp_path):
-    """ghdl --synth (to Verilog) at core v2's size with N_ORIENT 9: LANES 4 T tables of 4608 x 1 b."""
+    """ghdl --synth (to Verilog) at core v2's size with N_ORIENT 9: LANES 4 T tables of 512 x 9 b."""
     gen = {**stats_generics(TrackerParams(preset="v2"), FixedParams(), 4), "N_ORIENT": 9}
     v = hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v").read_text()
-    assert "module ms_target_stats" in v and "ram_obin" in v and "t_obin" in v
+    assert "module ms_target_stats" in v and "ram_obin" in v and "t_data_all" in v
 
 
 @pytest.mark.verilator

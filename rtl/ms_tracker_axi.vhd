@@ -124,6 +124,7 @@ entity ms_tracker_axi is
     SEARCH_ITER    : natural := 5;               -- iterations per start point while lost
     STEP16         : natural := 16;              -- search_step in 1/16
     MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
+    SCALE_TEST_D256: natural range 0 to 255 := 0; -- the gated scale test (experimental, PRESET 1): round(256 scale_test); 0 = off
     RESULT_STREAM  : boolean := true              -- true: m_axis_result_* carries each result word
   );
   port (
@@ -520,7 +521,8 @@ begin
       BG_O_W         => BG_O_W,
       SEARCH_ITER    => SEARCH_ITER,
       STEP16         => STEP16,
-      MARGIN_MAX     => MARGIN_MAX
+      MARGIN_MAX     => MARGIN_MAX,
+      SCALE_TEST_D256=> SCALE_TEST_D256
     )
     port map (
       clk => clk, rst => rst, frame_width => fw, frame_height => fh,

@@ -246,8 +246,9 @@ def scale_test_trace(frames: list, box: tuple[int, int, int, int],
 
 def test_tracker_v2_scale_test(tmp_path):
     """GHDL: the gated scale test (generic SCALE_TEST_D256 = 13: scale_test 0.05 + gate) on a generated
-    scene with a size change: init + 7 tracking frames, every field of every result word v2 bit-exact
-    with FixedTrackerV2, frame by frame, throttled.  The scene (checked on the model) gives verdicts
+    scene with a size change, through ``ms_tracker`` with PRESET 1 (the entity integrators instantiate,
+    which passes SCALE_TEST_D256 to ms_tracker_v2): init + 7 tracking frames, every field of every result
+    word v2 bit-exact with FixedTrackerV2, frame by frame, throttled.  The scene (checked on the model) gives verdicts
     -1 and +1, a x(1 + d) window that does not fit the region, the gate passing and blocking, and a
     size that changes."""
     job = {"render": SCALE_SCENE, "box": SCALE_SCENE["boxes"][0], "tp": SCALE_TP, "pause_in": True,
@@ -259,7 +260,7 @@ def test_tracker_v2_scale_test(tmp_path):
     assert any(gates) and not all(gates)
     exp = expected_results_v2(frames, box, tp)
     assert len({e["w8"] for e in exp}) > 2                    # the size changes
-    _run(job, "ms_tracker_v2_scale_test")
+    _run(job, "ms_tracker_ghdl", top="ms_tracker")   # the paper core's GHDL build (generics at run time)
     rep = json.loads((tmp_path / "r.json").read_text())
     assert rep["frames"] == 8 and not rep["mismatches"]
 

@@ -109,19 +109,19 @@ def test_core_config_v2_refuses_options_without_rtl(kw, what):
 
 def test_core_config_v2_gated_scale_test():
     """The gated scale test (mstrack-v2-joint's scale_test 0.05 + gate) has RTL: generic SCALE_TEST_D256 =
-    round(256 scale_test) = 13 of ms_tracker_v2; off, the generic set is the default one (no key);
-    ms_tracker (PRESET 1) does not pass it yet: tracker_generics refuses."""
+    round(256 scale_test) = 13 of ms_tracker_v2 and of ms_tracker (PRESET 1 passes it on); off, it is 0,
+    the VHDL default, and every other generic is the same."""
     from mstrack.fixed.formats import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import TrackerParams
     on = CoreConfigV2(TrackerParams(preset="v2", scale_test=0.05, scale_test_gate=True), FixedParams())
     off = CoreConfigV2(TrackerParams(preset="v2"), FixedParams())
-    g = on.generics()
-    assert g.pop("SCALE_TEST_D256") == 13
-    assert g == off.generics() and "SCALE_TEST_D256" not in off.generics()
+    g, g_off = on.generics(), off.generics()
+    assert g.pop("SCALE_TEST_D256") == 13 and g_off.pop("SCALE_TEST_D256") == 0
+    assert g == g_off
     assert on.generics_for("ms_tracker_v2")["SCALE_TEST_D256"] == 13
-    with pytest.raises(ValueError, match="ms_tracker_v2 only"):
-        on.tracker_generics()
+    assert on.tracker_generics() == {"PRESET": 1, **on.generics()}
+    assert on.generics_for("ms_tracker")["SCALE_TEST_D256"] == 13
     with pytest.raises(ValueError, match="d256"):   # d256 = 0: the generic's "off" while the model gates
         CoreConfigV2(TrackerParams(preset="v2", scale_test=0.001, scale_test_gate=True), FixedParams()).generics()
     assert CoreConfigV2(TrackerParams(preset="v2", scale_test=0.5, scale_test_gate=True),

@@ -38,6 +38,24 @@ def test_preset_v2_gives_core_v2_generics():
     assert g["RGB_PACKING"] == 1
 
 
+def test_scale_test_choice():
+    """Preset v2's experimental gated scale test reaches SCALE_TEST_D256 (round(256 x), the generics of
+    CoreConfigV2 with scale_test + gate, the header says so); off it is 0, the VHDL default; the paper
+    preset, a step that rounds to 0 and one above 0.5 are refused with the reason."""
+    cfg = derive(CoreChoices(preset="v2", scale_test=0.05))
+    tp = TrackerParams(preset="v2", scale_test=0.05, scale_test_gate=True)
+    assert cfg.tp == tp and cfg.generics["SCALE_TEST_D256"] == 13
+    assert {k: cfg.generics[k] for k in CoreConfigV2(tp, FixedParams()).tracker_generics()} == \
+        CoreConfigV2(tp, FixedParams()).tracker_generics()
+    assert derive(CoreChoices(preset="v2")).generics["SCALE_TEST_D256"] == 0
+    assert "the gated scale test 0.05 (SCALE_TEST_D256 13" in render(cfg, "package")
+    for bad, why in ((dict(scale_test=0.05), "core v2's"), (dict(preset="v2", scale_test=0.001), "d256 = 0"),
+                     (dict(preset="v2", scale_test=0.7), "up to 0.5")):
+        with pytest.raises(ConfigError, match=why):
+            derive(CoreChoices(**bad))
+    assert "SCALE_TEST_D256" not in derive(CoreChoices()).generics
+
+
 def test_ppc_choice():
     """PPC 1, 2, 4 (<= LANES) reaches the generic; other values and PPC > LANES are refused."""
     assert derive(CoreChoices(ppc=4)).generics["PPC"] == 4
@@ -157,7 +175,7 @@ def _vhdl_defaults(path, entity):
     text = re.sub(r"--[^\n]*", "", path.read_text())
     m = re.search(rf"entity\s+{entity}\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
     assert m, f"no generic clause in {path}"
-    return {k: int(v) for k, v in re.findall(r"(\w+)\s*:\s*(?:natural|integer)\s*:=\s*(-?\d+)\b", m.group(1), re.I)}
+    return {k: int(v) for k, v in re.findall(r"(\w+)\s*:\s*(?:natural|integer)(?:\s+range\s+\d+\s+to\s+\d+)?\s*:=\s*(-?\d+)\b", m.group(1), re.I)}
 
 
 def test_core_v2_vhdl_defaults_are_the_models():

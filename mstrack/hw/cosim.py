@@ -383,10 +383,8 @@ class CoreConfigV2:
         g["ADDR_W"] = (rmax * stride - 1).bit_length()
         g["CENTRE_W"] = g["REGION_W"] + fp.centre_frac
         g["MAX_FRAME_W"] = self.max_frame_w
-        if tp.scale_test > 0:
-            # the gated scale test (experimental; off: the generic keeps its default 0 and is not
-            # listed, so the default generic set is that of ms_tracker and the hdl_config package)
-            g["SCALE_TEST_D256"] = self.scale_test_d256()
+        # the gated scale test (experimental; 0 = off, the default of ms_tracker / ms_tracker_v2)
+        g["SCALE_TEST_D256"] = self.scale_test_d256()
         return g
 
     def scale_test_d256(self) -> int:
@@ -400,11 +398,7 @@ class CoreConfigV2:
 
     def tracker_generics(self) -> dict[str, int]:
         """The generics of ``ms_tracker`` for core v2: PRESET = 1 and :meth:`generics` (ms_tracker passes
-        them all to the engine ms_tracker_v2).  The gated scale test is a generic of ms_tracker_v2 only
-        so far (ms_tracker does not pass SCALE_TEST_D256): refused here."""
-        if self.tp.scale_test > 0:
-            raise ValueError("the gated scale test (SCALE_TEST_D256) is a generic of ms_tracker_v2 only: "
-                             "build the engine ms_tracker_v2 (generics_for('ms_tracker_v2'))")
+        them all, SCALE_TEST_D256 included, to the engine ms_tracker_v2)."""
         return {"PRESET": 1, **self.generics()}
 
     def generics_for(self, top: str) -> dict[str, int]:

@@ -51,7 +51,7 @@ PRESET_GENERIC = {"paper": 0, "v2": 1}
 V2_GENERICS = ("PAD16", "RING16", "MAX_WINDOW", "KT_W", "ST2_W", "SHARE_W", "SPREAD_W", "SIZE_W", "SCALE_W",
                "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "SCALE_RATIO_Q_W", "WR_Q_W", "CON_W", "LOSS_K", "REF_K",
                "LOSS_RHO", "LOSS_CONTRAST", "CONF_LOST", "CONF_UNCERTAIN", "CONF_REACQUIRE", "SPREAD_DEFAULT",
-               "BG_Q_W", "BG_O_W", "SEARCH_ITER", "STEP16", "MARGIN_MAX")
+               "BG_Q_W", "BG_O_W", "SEARCH_ITER", "STEP16", "MARGIN_MAX", "SCALE_TEST_D256")
 #: generics of type integer (the others are natural)
 INTEGER_GENERICS = ("LOSS_CONTRAST",)
 #: window range of core v2 (decimated px): TrackerParams.max_window >= 7; ms_bg_model's count widths
@@ -97,6 +97,10 @@ class CoreChoices:
         Layout of s_axis_tdata (:data:`RGB_PACKINGS`).
     ppc : {1, 2, 4}
         PPC: pixels per clock of the video input (s_axis_tdata of 24 PPC bits); at most LANES.
+    scale_test : float
+        Preset v2 only, experimental: the gated scale test (TrackerParams scale_test with
+        scale_test_gate; mstrack-v2-joint's is 0.05), generic SCALE_TEST_D256 = round(256 scale_test);
+        0 (default) = off.
     """
 
     max_frame_width: int = 2048
@@ -109,6 +113,7 @@ class CoreChoices:
     coord_bits: int = FixedParams.coord_bits
     rgb_packing: str = "mstrack"
     ppc: int = 1
+    scale_test: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -157,9 +162,13 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         if not V2_MIN_TARGET <= c.max_target <= V2_MAX_TARGET:
             raise ConfigError(f"largest window {c.max_target} px: core v2 windows are {V2_MIN_TARGET} .. "
                               f"{V2_MAX_TARGET} decimated px (larger targets are tracked on a decimated frame)")
+        if not 0 <= c.scale_test <= 0.5:
+            raise ConfigError(f"scale test {c.scale_test}: 0 (off) or a relative size step up to 0.5")
         if c.coord_bits != V2_COORD_BITS:
             raise ConfigError(f"COORD_W {c.coord_bits}: core v2 is built for COORD_W {V2_COORD_BITS} (frames up to "
                               "4095 px; result word v2 of 160 bits)")
+    elif c.scale_test:
+        raise ConfigError(f"scale test {c.scale_test}: the gated scale test is core v2's (--preset v2)")
     max_half = c.max_target // 2
     if max_half > MAX_HALF_LIMIT:
         raise ConfigError(f"largest target {c.max_target} px > {2 * MAX_HALF_LIMIT + 1} px, the largest window "
@@ -179,6 +188,8 @@ def derive(c: CoreChoices) -> CoreConfiguration:
                           f"more lanes than pixels in a region row")
     try:
         tp_kw: dict[str, Any] = {"max_window": 2 * max_half + 1} if v2 else {}
+        if c.scale_test:
+            tp_kw.update(scale_test=c.scale_test, scale_test_gate=True)
         tp = TrackerParams(features=features, kernel=c.kernel, preset=c.preset, **tp_kw)  # type: ignore[arg-type]
         fp = FixedParams(max_half=max_half, margin=c.margin, coord_bits=c.coord_bits)
     except ValueError as exc:  # the model's own checks (one line each)
@@ -189,7 +200,10 @@ def derive(c: CoreChoices) -> CoreConfiguration:
     if not v2:
         return CoreConfiguration(c, tp, fp, {**head, **base})
     from .cosim import CoreConfigV2
-    gv2 = {**CoreConfigV2(tp, fp, c.lanes, c.max_frame_width).tracker_generics(), **V2_BG_WIDTHS}
+    try:
+        gv2 = {**CoreConfigV2(tp, fp, c.lanes, c.max_frame_width).tracker_generics(), **V2_BG_WIDTHS}
+    except ValueError as exc:  # e.g. a scale test whose d256 rounds to 0
+        raise ConfigError(str(exc)) from None
     g = {**head, **{k: gv2[k] for k in base}, **{k: gv2[k] for k in V2_GENERICS}}
     missing = set(gv2) - set(g)
     if missing:    # CoreConfigV2 sets a generic this module does not know: keep the two in step
@@ -223,7 +237,9 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
               if c.preset != "v2" else
               f"  windows up to {2 * g['MAX_HALF'] + 1} decimated px (MAX_HALF {g['MAX_HALF']}; larger targets are "
               f"decimated), search margin {c.margin} decimated px;"),
-             f"  LANES {c.lanes}, features {cfg.tp.features}, kernel {c.kernel}, preset {c.preset} (PRESET {g['PRESET']});",
+             f"  LANES {c.lanes}, features {cfg.tp.features}, kernel {c.kernel}, preset {c.preset} (PRESET {g['PRESET']})"
+             + (f", the gated scale test {c.scale_test} (SCALE_TEST_D256 {g['SCALE_TEST_D256']}, experimental);"
+                if c.scale_test else ";"),
              f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]}, {c.ppc} pixel(s) per clock (PPC);",
              f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout"
              f"{'_v2' if c.preset == 'v2' else ''})."]
@@ -276,6 +292,9 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
                    help="s_axis_tdata layout: mstrack (R, G, B from the MSB) or ug934 (R, B, G)")
     p.add_argument("--ppc", type=int, choices=(1, 2, 4), default=d.ppc,
                    help="pixels per clock of the video input (PPC, <= LANES; default 1)")
+    p.add_argument("--scale-test", type=float, default=d.scale_test,
+                   help="preset v2, experimental: the gated scale test's relative size step (SCALE_TEST_D256 = "
+                        "round(256 x); mstrack-v2-joint's 0.05; default 0 = off)")
     p.add_argument("--format", choices=FORMATS, default="package", help="output (default: VHDL package)")
     p.add_argument("--name", default="ms_tracker_config_pkg", help="package name (--format package)")
     p.add_argument("--out", help="output file (default: standard output)")
@@ -284,7 +303,8 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
 def run_config(args: argparse.Namespace) -> int:
     choices = CoreChoices(max_frame_width=args.max_frame_width, max_target=args.max_target, lanes=args.lanes,
                           features=args.features, kernel=args.kernel, preset=args.preset, margin=args.margin,
-                          coord_bits=args.coord_bits, rgb_packing=args.rgb_packing, ppc=args.ppc)
+                          coord_bits=args.coord_bits, rgb_packing=args.rgb_packing, ppc=args.ppc,
+                          scale_test=args.scale_test)
     cfg = derive(choices)
     command = getattr(args, "command_line", None) or "mstrack hdl config"
     text = render(cfg, args.format, args.name, command)

@@ -148,7 +148,12 @@ entity ms_tracker_v2 is
     -- Costs a 9-bit constant multiply per axis, a 2-input mux on the window-size inputs, the fit
     -- compares, 2 x 17-bit rho compares and one SPREAD_W compare (the gate); buys rho-checked scale
     -- updates at 2 x (tables + Qw load + one pass + rho) clocks more per tracking frame
-    SCALE_TEST_D256 : natural range 0 to 255 := 0
+    SCALE_TEST_D256 : natural range 0 to 255 := 0;
+    -- the joint colour x gradient-orientation bins (experimental; FixedTrackerV2 with orient_T =
+    -- ORIENT_T, mstrack-v2-joint's 64): -1 = off (colour bins, the core without them, bit for bit);
+    -- >= 0: a pixel's bin is 9 colour + ms_orient_bin(grey, ORIENT_T) (4,608 bins: N_ORIENT 9 banks of
+    -- the histogram, the bin pass, the model and T; a 4-bit orientation region RAM beside the colour one)
+    ORIENT_T        : integer range -1 to 2047 := -1
   );
   port (
     clk                  : in  std_logic;
@@ -176,6 +181,8 @@ end entity;
 
 architecture rtl of ms_tracker_v2 is
   constant BIN_C_W   : natural := 3 * COLOUR_BITS;
+  constant OR_ON     : boolean := ORIENT_T >= 0;
+  constant N_OR      : natural := 9 * boolean'pos(OR_ON) + boolean'pos(not OR_ON);   -- orientation banks
   constant N_BINS    : natural := 2 ** BIN_C_W;
   constant DEPTH     : natural := REGION_MAX * STRIDE;
   constant REGION_RD_LAT : positive := 4;  -- ms_ram_sdp ecp5: 25 rows per bank, the row multiplexer in two registered levels
@@ -310,6 +317,10 @@ architecture rtl of ms_tracker_v2 is
   signal cap_done     : std_logic;
   signal ram_addr     : std_logic_vector(LANES * ADDR_W - 1 downto 0);
   signal ram_data     : std_logic_vector(LANES * BIN_C_W - 1 downto 0);
+  signal ip_obin      : std_logic_vector(3 downto 0);
+  signal ip_edge      : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal cap_e        : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
+  signal ram_obin     : std_logic_vector(LANES * 4 - 1 downto 0) := (others => '0');   -- orientation RAM data
 
   -- geometry blocks
   signal dec_in_valid, dec_out_valid : std_logic := '0';
@@ -339,6 +350,9 @@ architecture rtl of ms_tracker_v2 is
   signal m_rd_addr    : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
   signal m_qn         : unsigned(16 downto 0);
   signal m_t          : std_logic;
+  signal m_qn_all     : std_logic_vector(N_OR * 17 - 1 downto 0);   -- ORIENT_T >= 0: the 9 banks of m_rd_addr
+  signal m_t_all      : std_logic_vector(N_OR - 1 downto 0);
+  signal ms_out_qw_all : std_logic_vector(N_OR * HIST_W - 1 downto 0) := (others => '0');  -- Qw of the 9 banks
 
   -- kernel tables
   signal kt_start, kt_done, kt_we : std_logic := '0';
@@ -549,13 +563,22 @@ begin
   ---------------------------------------------------------------------------- front end, decimation, capture
   u_fe : entity work.ms_frontend
     generic map (COORD_W => COORD_W, MAX_FRAME_W => MAX_FRAME_W, COLOUR_BITS => COLOUR_BITS,
-                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, RGB_PACKING => RGB_PACKING)
+                 EDGE_BINS_LOG2 => EDGE_BINS_LOG2, EDGE_SHIFT => EDGE_SHIFT, RGB_PACKING => RGB_PACKING,
+                 ORIENT_T => maximum(ORIENT_T, 0))
     port map (clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
               in_valid => beat, in_data => s_axis_tdata, in_sof => s_axis_tuser, in_eol => s_axis_tlast,
-              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_ebin,
+              ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin, ip_ebin => ip_edge,
+              ip_obin => ip_obin,
               frame_start => fe_start, frame_end => fe_end, frame_error => fe_error,
               error_now => fe_err_now, err_code => fe_code,
               av_valid => av_valid, av_x => av_x, av_y => av_y, av_cbin => av_cbin);
+
+  -- the edge-bin path of the capture carries the orientation bin (ORIENT_T >= 0); off, the edge
+  -- bin as before (captured into no RAM: core v2 tracks colour)
+  ip_ebin <= ip_obin when OR_ON else ip_edge;
+  assert not OR_ON or EDGE_BINS_LOG2 = 4
+    report "ms_tracker_v2: ORIENT_T >= 0 carries the orientation bin on the 4-bit edge path: EDGE_BINS_LOG2 must be 4"
+    severity failure;
 
   u_dec : entity work.ms_decimate
     generic map (COORD_W => COORD_W, LOG2_D_MAX => 4, COLOUR_BITS => COLOUR_BITS, EDGE_BINS_LOG2 => EDGE_BINS_LOG2)
@@ -575,13 +598,22 @@ begin
               frame_error => dp_error, reg_x => reg_x, reg_y => reg_y, reg_w => reg_w_c,
               reg_h => reg_h_c, ip_valid => dp_valid, ip_x => dp_x, ip_y => dp_y, ip_cbin => dp_cbin,
               ip_ebin => dp_ebin, we => cap_we, wbank => cap_bank, waddr => cap_addr,
-              wdata_colour => cap_c, wdata_edge => open, done => cap_done);
+              wdata_colour => cap_c, wdata_edge => cap_e, done => cap_done);
 
   u_ram : entity work.ms_region_ram
     generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => BIN_C_W, ADDR_W => ADDR_W,
                  RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
     port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_c,
               raddr => ram_addr, rdata => ram_data);
+
+  -- the orientation region RAM (ORIENT_T >= 0): 4 bits per pixel, same addresses and latency
+  g_oram : if OR_ON generate
+    u_oram : entity work.ms_region_ram
+      generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => 4, ADDR_W => ADDR_W,
+                   RD_LAT => REGION_RD_LAT, WR_LAT => REGION_WR_LAT)
+      port map (clk => clk, we => cap_we, wbank => cap_bank, waddr => cap_addr, wdata => cap_e,
+                raddr => ram_addr, rdata => ram_obin);
+  end generate;
 
   ---------------------------------------------------------------------------- background model
   -- every pixel (x, y) of the decimated frame frame[::D, ::D] (x mod D = 0, y mod D = 0, border
@@ -617,13 +649,13 @@ begin
 
   u_bg : entity work.ms_bg_model
     generic map (BIN_W => BIN_C_W, HALF_W => HALF_W, COORD_W => COORD_W, RING_W => 5, Q_W => BG_Q_W,
-                 O_W => BG_O_W, KD_W => KD_W)
+                 O_W => BG_O_W, KD_W => KD_W, N_ORIENT => N_OR)
     port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy,
               wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1), ring16 => to_unsigned(RING16, 5),
               busy => bg_busy, counting => bg_counting, done => bg_done,
               px_valid => bg_px_valid, px_bin => unsigned(bg_px_bin), px_x => bg_px_x, px_y => bg_px_y,
               px_last => bg_px_last, n_box => open, n_ring => open, o_min => open, qv_sum => open,
-              m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t);
+              m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all, m_t_all => m_t_all);
 
   ---------------------------------------------------------------------------- geometry
   u_decim : entity work.ms_decimation
@@ -683,6 +715,29 @@ begin
     port map (clk => clk, rst => rst, in_valid => ql_v2, in_qn => m_qn_r, in_k => k_acc, in_tag => ms_in_tag,
               out_valid => ms_out_valid, out_qw => ms_out_qw, out_tag => ms_out_tag);
 
+  -- ORIENT_T >= 0: the 9 banks of one colour address per clock (ms_bg_model's m_qn_all), 8 more
+  -- ms_model_scale in lockstep with u_mscale (bank 0 is u_mscale's, m_qn = bank m_rd_obin = 0),
+  -- into the engine's parallel Q load; the walk stays N_BINS colour addresses
+  g_mscale : if OR_ON generate
+    ms_out_qw_all(HIST_W - 1 downto 0) <= std_logic_vector(ms_out_qw);
+    g_bank : for o in 1 to N_OR - 1 generate
+      signal qn_r : unsigned(16 downto 0);
+      signal qw   : unsigned(HIST_W - 1 downto 0);
+    begin
+      p_r : process (clk)
+      begin
+        if rising_edge(clk) then
+          qn_r <= unsigned(m_qn_all(o * 17 + 16 downto o * 17));
+        end if;
+      end process;
+      u_ms : entity work.ms_model_scale
+        generic map (HIST_W => HIST_W, QN_FRAC => 16, TAG_W => 1)
+        port map (clk => clk, rst => rst, in_valid => ql_v2, in_qn => qn_r, in_k => k_acc, in_tag => "0",
+                  out_valid => open, out_qw => qw, out_tag => open);
+      ms_out_qw_all((o + 1) * HIST_W - 1 downto o * HIST_W) <= std_logic_vector(qw);
+    end generate;
+  end generate;
+
   ---------------------------------------------------------------------------- engine + statistics
   u_colour : entity work.ms_meanshift
     generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
@@ -723,13 +778,14 @@ begin
 
   u_stats : entity work.ms_target_stats
     generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
-                 KERNEL_BITS => KERNEL_BITS, KT_W => KT_W, PAD16 => PAD16, COUNT_W => COUNT_W, ST2_W => ST2_W)
-    port map (clk => clk, rst => rst, t_we => t_we, t_addr => t_addr, t_data => t_data,
+                 KERNEL_BITS => KERNEL_BITS, KT_W => KT_W, PAD16 => PAD16, COUNT_W => COUNT_W, ST2_W => ST2_W,
+                 N_ORIENT => N_OR)
+    port map (clk => clk, rst => rst, t_we => t_we, t_addr => t_addr, t_data => t_data, t_data_all => m_t_all,
               kt_we => kt_we, kt_addr => kt_addr, kt_ka => kt_ka, kt_kb => kt_kb,
               px_valid => tap(REGION_RD_LAT - 1).v, px_mask => tap(REGION_RD_LAT - 1).m,
               px_dx => tap(REGION_RD_LAT - 1).dx, px_dy => tap(REGION_RD_LAT - 1).dy,
               px_last => tap(REGION_RD_LAT - 1).l,
-              ram_data => ram_data, done => st_done, nt => st_nt, st2 => st_st2, n_in => st_n_in,
+              ram_data => ram_data, ram_obin => ram_obin, done => st_done, nt => st_nt, st2 => st_st2, n_in => st_n_in,
               nt_in => st_nt_in);
 
   busy <= c_busy;

@@ -48,9 +48,11 @@
 -- window pixel in one bin), S = sum isqrt(H Q 2**2RF) <= K 2**RF (Cauchy-Schwarz, sum Q <= K),
 -- sw <= w_max sum N <= w_max pixels, |swx|, |swy| <= w_max sum |SX| <= w_max pixels MAX_HALF;
 -- per-bin values (H, Q, N, SX, SY, H Q) are bounded by the same window sums.  So the generics are
--- unchanged.  External Q load: one word per clock as before, q_ext_bank selects the bank
--- (joint bin N_ORIENT q_ext_addr + q_ext_bank): a full load takes N_ORIENT N_BINS clocks (a
--- per-bank word port, N_BINS clocks, is not done).
+-- unchanged.  External Q load, two ports (both only while idle, not in the same clock): one word
+-- per clock as before, q_ext_bank selects the bank (joint bin N_ORIENT q_ext_addr + q_ext_bank; a
+-- full load takes N_ORIENT N_BINS clocks), or all N_ORIENT banks of address q_ext_addr in one
+-- clock (q_ext_all_we, q_ext_all_data: bank o at bits o*HIST_W; a full load takes N_BINS clocks).
+-- With N_ORIENT = 1 the parallel port writes Q[q_ext_addr] as the word port does.
 --
 -- Latency    : learn (both): done 2 + N_BINS + BIN_RD_LAT + TL clocks after start (TL above;
 --              N_ORIENT = 1: TL = 0; N_ORIENT 9: TL = 4; every track latency below is + TL too);
@@ -125,8 +127,11 @@ entity ms_bin_pass is
     q_ext_we     : in  std_logic := '0';                      -- write Q[q_ext_addr]
     q_ext_addr   : in  unsigned(BIN_W - 1 downto 0) := (others => '0');
     q_ext_data   : in  unsigned(HIST_W - 1 downto 0) := (others => '0');
-    q_ext_bank   : in  unsigned(3 downto 0) := (others => '0')  -- N_ORIENT > 1: bank written (joint bin
+    q_ext_bank   : in  unsigned(3 downto 0) := (others => '0'); -- N_ORIENT > 1: bank written (joint bin
                                                                  -- N_ORIENT q_ext_addr + q_ext_bank)
+    -- parallel external Q write: every bank at q_ext_addr in one clock (not with q_ext_we; only while idle)
+    q_ext_all_we   : in  std_logic := '0';                      -- write Q_o[q_ext_addr], o = 0 .. N_ORIENT - 1
+    q_ext_all_data : in  std_logic_vector(N_ORIENT * HIST_W - 1 downto 0) := (others => '0')  -- bank o at o*HIST_W
   );
 end entity;
 
@@ -272,8 +277,9 @@ begin
   -- (read-before-write within the port): no write/read collision logic after the block RAM,
   -- whose output register then holds q_a.
   -- N_ORIENT banks share the address; a learn writes every bank (bank o: H of bank o), an
-  -- external write only bank q_ext_bank (N_ORIENT = 1: always bank 0).
-  q_addr_p <= q_ext_addr when q_ext_we = '1' else
+  -- external write only bank q_ext_bank (N_ORIENT = 1: always bank 0), a parallel external write
+  -- every bank (bank o: its slice of q_ext_all_data).
+  q_addr_p <= q_ext_addr when q_ext_we = '1' or q_ext_all_we = '1' else
               ret_nx when bin_rd_valid = '1' and learn_r = '0' else ret_cnt;
 
   g_qram : for o in 0 to N_ORIENT - 1 generate
@@ -283,8 +289,10 @@ begin
     signal q_wdata : std_logic_vector(HIST_W - 1 downto 0);   -- Q RAM write data (H, or q_ext_data)
   begin
     q_sel   <= '1' when N_ORIENT = 1 or q_ext_bank = o else '0';
-    q_we    <= (bin_rd_valid and learn_r) or (q_ext_we and q_sel);
-    q_wdata <= std_logic_vector(q_ext_data) when q_ext_we = '1' else std_logic_vector(h_in(o));
+    q_we    <= (bin_rd_valid and learn_r) or (q_ext_we and q_sel) or q_ext_all_we;
+    q_wdata <= std_logic_vector(q_ext_data) when q_ext_we = '1' else
+               q_ext_all_data((o + 1) * HIST_W - 1 downto o * HIST_W) when q_ext_all_we = '1' else
+               std_logic_vector(h_in(o));
 
     p_ram : process (clk)
     begin

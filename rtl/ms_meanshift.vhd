@@ -18,6 +18,15 @@
 -- groups of each row's ellipse extent, + 6) + the bin pass (N_BINS + ~35) + ms_centre
 -- (SHIFT_Q_W + 6) + 6 of control; docs/realtime.md, docs/performance.md.
 -- Handshake: `start` pulse while `busy` = 0; `done` pulse with the results (held).
+-- N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o, u the
+-- colour bin on ram_data, o the orientation bin on ram_obin from an orientation region RAM read at
+-- the same address and latency): ms_pixel_pass accumulates into N_ORIENT banks per lane and
+-- ms_bin_pass reads the N_ORIENT banks of a colour address per clock (bin_*_all), so a pass still
+-- walks N_BINS addresses (bin pass + TL = ceil(log2 N_ORIENT) clocks: 4 at N_ORIENT 9, per pass).
+-- Q (N_ORIENT banks) is learnt as before or loaded while idle, one word per clock (q_ext_we,
+-- q_ext_bank: N_ORIENT N_BINS clocks for all of Q) or one colour address of every bank per clock
+-- (q_ext_all_we, q_ext_all_data: N_BINS clocks).  Model: ms_meanshift on the joint bins with
+-- n_bins = N_ORIENT 2**BIN_W.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -55,7 +64,9 @@ entity ms_meanshift is
     ITER_W       : natural := 5;      -- iteration counter bits
     EPS2         : natural := 65536;  -- shift stop threshold, Q.2CF px^2
     RAM_LAT      : positive := 1;     -- region RAM read latency (ms_pixel_pass, 1 .. 4; cycles do not change)
-    ITER_BINS    : natural := 0       -- ms_bin_pass ITERATIVE: 1 = iterative arithmetic (few bins; slower pass)
+    ITER_BINS    : natural := 0;      -- ms_bin_pass ITERATIVE: 1 = iterative arithmetic (few bins; slower pass)
+    N_ORIENT     : natural range 1 to 16 := 1  -- orientation banks (joint bins N_ORIENT u + o, ITER_BINS = 0 only);
+                                      -- 1 = colour bins only (ram_obin, q_ext_bank ignored)
   );
   port (
     clk       : in  std_logic;                                    -- clock
@@ -92,12 +103,17 @@ entity ms_meanshift is
     -- region RAM read port (one address per bank, data 1 clock later)
     ram_addr  : out std_logic_vector(LANES * ADDR_W - 1 downto 0);
     ram_data  : in  std_logic_vector(LANES * BIN_W - 1 downto 0);
+    ram_obin  : in  std_logic_vector(LANES * 4 - 1 downto 0) := (others => '0');  -- N_ORIENT > 1: orientation
+                                                                  -- bin per bank (lane l at l*4), as ram_data
     -- core v2 (all optional; the paper core leaves them at their defaults / open):
     single    : in  std_logic := '0';                             -- with start: one track pass, no iteration (iter 0)
     max_it    : in  unsigned(ITER_W - 1 downto 0) := to_unsigned(MAX_ITER, ITER_W);  -- iteration limit (1 .. MAX_ITER)
     q_ext_we  : in  std_logic := '0';                             -- write Q[q_ext_addr] (while idle)
     q_ext_addr: in  unsigned(BIN_W - 1 downto 0) := (others => '0');
     q_ext_data: in  unsigned(HIST_W - 1 downto 0) := (others => '0');
+    q_ext_bank: in  unsigned(3 downto 0) := (others => '0');      -- N_ORIENT > 1: bank of the q_ext_we write
+    q_ext_all_we   : in std_logic := '0';                         -- write every bank at q_ext_addr (while idle)
+    q_ext_all_data : in std_logic_vector(N_ORIENT * HIST_W - 1 downto 0) := (others => '0');  -- bank o at o*HIST_W
     px_valid  : out std_logic;                                    -- pixel-pass scan tap (ms_pixel_pass)
     px_mask   : out std_logic_vector(LANES - 1 downto 0);
     px_dx     : out signed(REGION_W downto 0);
@@ -161,6 +177,10 @@ architecture rtl of ms_meanshift is
   signal bin_h             : unsigned(HIST_W - 1 downto 0);
   signal bin_n             : unsigned(COUNT_W - 1 downto 0);
   signal bin_sx, bin_sy    : signed(POSSUM_W - 1 downto 0);
+  signal bin_h_all         : std_logic_vector(N_ORIENT * HIST_W - 1 downto 0);
+  signal bin_n_all         : std_logic_vector(N_ORIENT * COUNT_W - 1 downto 0);
+  signal bin_sx_all        : std_logic_vector(N_ORIENT * POSSUM_W - 1 downto 0);
+  signal bin_sy_all        : std_logic_vector(N_ORIENT * POSSUM_W - 1 downto 0);
   signal lo_x, lo_y        : unsigned(REGION_W - 1 downto 0);
 
   function round_c(c : unsigned) return unsigned is
@@ -175,25 +195,28 @@ begin
     generic map (LANES => LANES, BIN_W => BIN_W, HALF_W => HALF_W, REGION_W => REGION_W,
                  STRIDE => STRIDE, ADDR_W => ADDR_W, KERNEL_EPAN => KERNEL_EPAN,
                  KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
-                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, RAM_LAT => RAM_LAT)
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, RAM_LAT => RAM_LAT, N_ORIENT => N_ORIENT)
     port map (clk => clk, rst => rst, ready => pp_ready, start => pp_start, win_x => win_x, win_y => win_y,
               ex => ex, ey => ey, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d,
-              ram_addr => ram_addr, ram_data => ram_data, done => pp_done,
+              ram_addr => ram_addr, ram_data => ram_data, ram_obin => ram_obin, done => pp_done,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
+              bin_h_all => bin_h_all, bin_n_all => bin_n_all, bin_sx_all => bin_sx_all, bin_sy_all => bin_sy_all,
               px_valid => px_valid, px_mask => px_mask, px_dx => px_dx, px_dy => px_dy, px_last => px_last);
 
   u_bins : entity work.ms_bin_pass
     generic map (BIN_W => BIN_W, HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W,
                  SQRT_IN_W => SQRT_IN_W, RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W,
                  WEIGHT_W => WEIGHT_W, WF => WF, RF => RF, SW_W => SW_W, SWX_W => SWX_W,
-                 BIN_RD_LAT => BIN_RD_LAT, ITERATIVE => ITER_BINS)
+                 BIN_RD_LAT => BIN_RD_LAT, ITERATIVE => ITER_BINS, N_ORIENT => N_ORIENT)
     port map (clk => clk, rst => rst, start => bp_start, learn => learn_r, busy => open,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
+              bin_h_all => bin_h_all, bin_n_all => bin_n_all, bin_sx_all => bin_sx_all, bin_sy_all => bin_sy_all,
               done => bp_done, s_sum => bp_s, sw => bp_sw, swx => bp_swx, swy => bp_swy,
-              k_sum => bp_k, q_ext_we => q_ext_we, q_ext_addr => q_ext_addr, q_ext_data => q_ext_data);
+              k_sum => bp_k, q_ext_we => q_ext_we, q_ext_addr => q_ext_addr, q_ext_data => q_ext_data,
+              q_ext_bank => q_ext_bank, q_ext_all_we => q_ext_all_we, q_ext_all_data => q_ext_all_data);
 
   u_centre : entity work.ms_centre
     generic map (SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,

@@ -30,7 +30,16 @@
 -- ram_addr is out, for ms_target_stats (v2), which reads the same beat's bins from ram_data one
 -- clock later (so with RAM_LAT = 1 only; ms_tracker_v2 delays the tap RAM_LAT - 1 clocks); wires from the
 -- scan's registers, the pass itself is unchanged.
--- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins).
+-- N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o): ram_obin
+-- carries each lane's orientation bin o (0 .. N_ORIENT - 1, 4 bits per lane) from an orientation
+-- region RAM read at the same address with the same latency as ram_data; it travels beside the
+-- colour bin u through the same delay stages to ms_histogram's in_obin (bank o), and the read
+-- port returns, per colour address u, the N_ORIENT banks on bin_*_all (bank o at bits o*width;
+-- bin_h .. bin_sy = bank 0).  Cycle count, PASS_LAT and BIN_RD_LAT are unchanged.  N_ORIENT = 1:
+-- ram_obin is ignored (no delay stages for it), bin_*_all = bin_h .. bin_sy.
+-- Model: mstrack.fixed.blocks.ms_histogram(bins, region, win, ms_kernel(w, h, ...), n_bins); with
+-- N_ORIENT > 1 on the joint bins N_ORIENT u + o, n_bins = N_ORIENT 2**BIN_W, read out as
+-- mstrack.fixed.blocks.ms_histogram_banks.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -50,7 +59,9 @@ entity ms_pixel_pass is
     HIST_W      : natural := 14;  -- width of H
     COUNT_W     : natural := 14;  -- width of N
     POSSUM_W    : natural := 21;  -- width of the signed SX, SY
-    RAM_LAT     : positive := 1   -- region RAM read latency, 1 .. 4 (3 / 4: ms_ram_sdp on ECP5): no clock more, RAM_LAT - 1 bin delay stages fewer
+    RAM_LAT     : positive := 1;  -- region RAM read latency, 1 .. 4 (3 / 4: ms_ram_sdp on ECP5): no clock more, RAM_LAT - 1 bin delay stages fewer
+    N_ORIENT    : natural range 1 to 16 := 1  -- orientation banks of the histogram (joint bins; 1 = colour bins only,
+                                  -- ram_obin ignored)
   );
   port (
     clk          : in  std_logic;                                    -- clock
@@ -75,6 +86,8 @@ entity ms_pixel_pass is
     -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
     ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
     ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, RAM_LAT clocks after ram_addr
+    ram_obin     : in  std_logic_vector(LANES * 4 - 1 downto 0) := (others => '0');  -- N_ORIENT > 1: per bank
+                                                                     -- orientation bin (lane l at l*4), as ram_data
     -- scan tap (ms_target_stats sits beside the pass on it; the bins of a beat are ram_data one clock later)
     px_valid     : out std_logic;                                    -- beat valid (the beat whose ram_addr is out now)
     px_mask      : out std_logic_vector(LANES - 1 downto 0);          -- lane l inside the kernel ellipse
@@ -88,7 +101,12 @@ entity ms_pixel_pass is
     bin_h        : out unsigned(HIST_W - 1 downto 0);                -- H of the bin (sum over lanes)
     bin_n        : out unsigned(COUNT_W - 1 downto 0);               -- N of the bin
     bin_sx       : out signed(POSSUM_W - 1 downto 0);                -- SX of the bin
-    bin_sy       : out signed(POSSUM_W - 1 downto 0)                 -- SY of the bin
+    bin_sy       : out signed(POSSUM_W - 1 downto 0);                -- SY of the bin (bank 0)
+    -- N_ORIENT banks of the bin (bank o at bits o*width, ms_histogram's bin_*_all; with bin_rd_valid)
+    bin_h_all    : out std_logic_vector(N_ORIENT * HIST_W - 1 downto 0);
+    bin_n_all    : out std_logic_vector(N_ORIENT * COUNT_W - 1 downto 0);
+    bin_sx_all   : out std_logic_vector(N_ORIENT * POSSUM_W - 1 downto 0);
+    bin_sy_all   : out std_logic_vector(N_ORIENT * POSSUM_W - 1 downto 0)
   );
 end entity;
 
@@ -105,6 +123,7 @@ architecture rtl of ms_pixel_pass is
   -- delays to the histogram input (cycle t + KERNEL_LAT); index i = value of cycle t + i
   type d_arr_t is array (1 to KERNEL_LAT) of signed(D_W - 1 downto 0);
   signal hist_bin          : std_logic_vector(LANES * BIN_W - 1 downto 0);  -- the bins at cycle t + KERNEL_LAT
+  signal hist_obin         : std_logic_vector(LANES * 4 - 1 downto 0);      -- their orientation bins (N_ORIENT > 1)
   signal last_d            : std_logic_vector(1 to KERNEL_LAT) := (others => '0');
   signal dx_d, dy_d        : d_arr_t := (others => (others => '0'));
 
@@ -189,13 +208,38 @@ begin
     hist_bin <= bin_d(KERNEL_LAT);
   end generate;
 
+  -- the orientation bins: the same delay as the colour bins (N_ORIENT > 1 only)
+  g_obin1 : if N_ORIENT = 1 generate
+    hist_obin <= (others => '0');
+  end generate;
+  g_obin0 : if N_ORIENT > 1 and RAM_LAT = KERNEL_LAT generate
+    hist_obin <= ram_obin;
+  end generate;
+  g_obin : if N_ORIENT > 1 and RAM_LAT < KERNEL_LAT generate
+    type obin_arr_t is array (RAM_LAT + 1 to KERNEL_LAT) of std_logic_vector(LANES * 4 - 1 downto 0);
+    signal obin_d : obin_arr_t := (others => (others => '0'));
+  begin
+    p_obin : process (clk)
+    begin
+      if rising_edge(clk) then
+        obin_d(RAM_LAT + 1) <= ram_obin;
+        for i in RAM_LAT + 2 to KERNEL_LAT loop
+          obin_d(i) <= obin_d(i - 1);
+        end loop;
+      end if;
+    end process;
+    hist_obin <= obin_d(KERNEL_LAT);
+  end generate;
+
   u_hist : entity work.ms_histogram
-    generic map (LANES => LANES, BIN_W => BIN_W, D_W => D_W, KERNEL_EPAN => KERNEL_EPAN, KVAL_W => KVAL_W,
+    generic map (LANES => LANES, BIN_W => BIN_W, N_ORIENT => N_ORIENT, ORIENT_W => 4, D_W => D_W,
+                 KERNEL_EPAN => KERNEL_EPAN, KVAL_W => KVAL_W,
                  HIST_W => HIST_W, COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, BIN_RD_LAT => 3)
     port map (
       clk => clk, rst => rst, ready => ready,
-      in_valid => h_valid, in_bin => hist_bin, in_k => k_val, in_dx => h_dx, in_dy => dy_d(KERNEL_LAT),
+      in_valid => h_valid, in_bin => hist_bin, in_obin => hist_obin, in_k => k_val, in_dx => h_dx, in_dy => dy_d(KERNEL_LAT),
       in_last => last_d(KERNEL_LAT), last_done => done,
       bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
-      bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy);
+      bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
+      bin_h_all => bin_h_all, bin_n_all => bin_n_all, bin_sx_all => bin_sx_all, bin_sy_all => bin_sy_all);
 end architecture;

@@ -91,6 +91,10 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_kernel_tables.py::test_ms_kernel_tables_v2[v2_default]":
         "test_ms_kernel_tables_v2[v2_w31_kb6] (every window size of a smaller table) and core v2",
     "tb/test_ms_meanshift.py::test_ms_meanshift[colour_default]": "colour_l2, colour_l4_epan, edge_l1 and the core",
+    "tb/test_ms_meanshift.py::test_ms_meanshift_orient_real_verilator":
+        "test_ms_meanshift_orient_real_ghdl (the same bench at core v2's size on one real call, learn and both Q "
+        "ports) and test_ms_meanshift_orient_ghdl (every stop code, both Q ports); this case: 71 real calls "
+        "(Girl, MotorRolling, Couple) on the Verilator netlist, 7 min with its build",
     "tb/test_ms_bg_model.py::test_ms_bg_model_real_ghdl[colour2]": "test_ms_bg_model_real_ghdl[colour3]",
     "tb/test_ms_bg_model.py::test_ms_bg_model_ghdl[colour2]": "test_ms_bg_model_ghdl[colour3], [small]",
     "tb/test_ms_decimate.py::test_ms_decimate_real_640[full_speed]": "test_ms_decimate_real_640[gaps]",

@@ -6,7 +6,8 @@ BIN_RD_LAT clocks of latency (throttled run: random extra delay, still in order)
 Sequence per run: learn pass (Q := H), several track passes with random histograms
 (many zero bins, H = 0 with Q > 0, Q = 0 with H > 0, saturating weights Q >> H),
 a re-learn and more track passes, and a pass on a Q written through the external port
-(q_ext_*: random Q with zeros and full-scale words).  Results compared exactly; full-speed
+(q_ext_*: random Q with zeros and full-scale words; one random Q through the parallel port
+q_ext_all_we / q_ext_all_data, every bank of an address per clock).  Results compared exactly; full-speed
 runs assert the documented pass latency; outputs must stay stable after done until the next start.
 
 With N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o) the
@@ -189,10 +190,23 @@ def random_q(g: dict, rng: random.Random, full: bool) -> np.ndarray:
     return q
 
 
-async def load_q(dut, g: dict, q: np.ndarray) -> None:
+async def load_q(dut, g: dict, q: np.ndarray, parallel: bool = False) -> None:
     """Write Q through q_ext_we / q_ext_addr / q_ext_bank / q_ext_data, one word per clock (idle
-    block), joint bin N_ORIENT a + o at address a, bank o; random order."""
+    block), joint bin N_ORIENT a + o at address a, bank o; random order.  ``parallel``: through
+    q_ext_all_we / q_ext_all_data instead, the N_ORIENT banks of one address a per clock (bank o at
+    bits o*HIST_W; random address order)."""
     no = int(g.get("N_ORIENT", 1))
+    if parallel:
+        hw = int(g["HIST_W"])
+        addrs = list(range(len(q) // no))
+        random.Random(int(q.sum()) + 1).shuffle(addrs)
+        for a in addrs:
+            dut.q_ext_all_we.value = 1
+            dut.q_ext_addr.value = a
+            dut.q_ext_all_data.value = sum(int(q[no * a + o]) << (o * hw) for o in range(no))
+            await RisingEdge(dut.clk)
+        dut.q_ext_all_we.value = 0
+        return
     order = list(range(len(q)))
     random.Random(int(q.sum())).shuffle(order)
     for j in order:
@@ -244,6 +258,7 @@ async def bin_pass_sequence(dut, jitter):
     cocotb.start_soon(Clock(dut.clk, CLK_NS, unit="ns").start())
     hm = HistModel(dut, int(g["BIN_RD_LAT"]), rng, jitter, g)
     dut.q_ext_we.value = 0
+    dut.q_ext_all_we.value = 0
     dut.start.value = 0
     dut.learn.value = 0
     dut.rst.value = 1
@@ -254,12 +269,12 @@ async def bin_pass_sequence(dut, jitter):
 
     q = None
     plan = ["learn", "track", "track", "same", "max", "zero", "learn", "track", "track", "ext", "track",
-            "ext_full", "max"]
+            "ext_par", "track", "ext_full", "max"]
     for step, kind in enumerate(plan):
         learn = kind == "learn"
         if kind.startswith("ext"):         # Q written through the external port, then a track pass
             q = random_q(g, rng, kind == "ext_full")
-            await load_q(dut, g, q)
+            await load_q(dut, g, q, parallel=kind == "ext_par")
             hist = random_hist(g, rng, q, "rand")
         elif kind == "same":
             hist = Hist(H=q.copy(), N=cap_counts(q, (1 << int(g["COUNT_W"])) - 1),

@@ -341,6 +341,17 @@ def test_ms_pixel_pass_synth(kernel, lanes, tmp_path):
     hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")
 
 
+@pytest.mark.ghdl
+def test_ms_pixel_pass_synth_orient9(tmp_path):
+    """ghdl --synth of the default-size pass (LANES 4) with N_ORIENT 9 (joint bins; the input ram_obin and
+    the banked read port bin_*_all).  Its values are checked through ms_meanshift (tb/test_ms_meanshift.py
+    test_ms_meanshift_orient_*)."""
+    gen, _ = pass_generics(TrackerParams(), FixedParams(), 4)
+    v = hdl.ghdl_to_verilog(TOP, {**gen, "N_ORIENT": 9}, hdl.rtl_sources(TOP),
+                            out_path=tmp_path / f"{TOP}.v").read_text()
+    assert "module ms_pixel_pass" in v and "ram_obin" in v and "bin_sy_all" in v
+
+
 @pytest.mark.verilator
 @pytest.mark.parametrize("kernel,lanes", [("epanechnikov", 2)])
 def test_ms_pixel_pass_verilator(kernel, lanes, hdl_waves):

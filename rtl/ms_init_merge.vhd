@@ -31,8 +31,9 @@
 -- raises `overflow` (sticky; a simulation assertion too).  The FIFO drains after dp_end in at most
 -- min(W - 1, 2 RX + 1) + 5 clocks, before the next frame's first dp pixel (2 W + 2 beats after its
 -- sof beat), so px_last always precedes the next frame's pixels (simulation assertion).
--- Latency: av beat -> px_* 11 clocks; dp_* -> px_* 4 clocks (when the pixel leaves at once);
--- dp_end -> px_last: 4 clocks + the FIFO's backlog.  Throughput: 1 pixel per clock out, no
+-- Latency: av pixel -> px_* 13 clocks (delay 8, 2 stages, FIFO write, read, output register) when
+-- the FIFO is empty and no dp pixel comes; dp_* -> px_* 4 clocks; dp_end -> px_last: 5 clocks + the
+-- FIFO's backlog.  Throughput: 1 pixel per clock out, no
 -- handshake (ms_bg_model never stalls); the backlog is absorbed by the FIFO.
 -- Python model: the pixel set of mstrack.fixed.tracker_v2.FixedTrackerV2._bins(frame, D) (orient_T
 -- > 0), which ms_bg_model counts; the order is free.

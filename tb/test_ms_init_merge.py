@@ -153,6 +153,13 @@ class MergeTB(TB):
         self.watch_quiet = False
         self.quiet_bad = 0
         self.dones = 0
+        self.peak = 0                                     # FIFO entries + head, largest (GHDL only)
+        try:                                              # (the netlist under Verilator has no hierarchy)
+            m = dut.u_merge
+            self.fifo = (m.wp, m.rp, m.head_v)
+            self.fifo_aw = len(m.wp) - 1
+        except AttributeError:
+            self.fifo = None
 
     async def done_monitor(self):
         """Edge-triggered: counts ms_bg_model's done pulses (one may come while a next frame streams)."""
@@ -166,6 +173,9 @@ class MergeTB(TB):
         while True:
             await RisingEdge(d.clk)
             await ReadOnly()
+            if self.fifo is not None:
+                wp, rp, hv = (int(v.value) for v in self.fifo)
+                self.peak = max(self.peak, (wp - rp) % (2 << self.fifo_aw) + hv)
             if int(d.px_valid.value):
                 if self.watch_quiet:
                     self.quiet_bad += 1
@@ -224,14 +234,19 @@ class MergeTB(TB):
         missing = sorted(need - seen.keys())
         assert not missing, f"{c['name']}: {len(missing)} pixels of the rectangle missing, first {missing[:5]}"
         border = sum(1 for (x, y) in seen if seen[(x, y)] % 9 == 8)
-        self.dut._log.info("%s: merged stream ok (%d pixels, %d in the rectangle, %d with obin 8)",
-                           c["name"], len(seen), len(need), border)
+        # the FIFO's worst case of rtl/ms_init_merge.vhd's header: min(W - 1, 2 RX + 1) + 4 at D = 1,
+        # 4 at D >= 2
+        bound = (min(wd - 1, 2 * rx + 1) if c["d"] == 1 else 0) + 4
+        peak = "-" if self.fifo is None else self.peak
+        self.dut._log.info("%s: merged stream ok (%d pixels, %d in the rectangle, %d with obin 8; FIFO peak %s "
+                           "entries, bound %d)", c["name"], len(seen), len(need), border, peak, bound)
+        assert self.fifo is None or self.peak <= bound, f"{c['name']}: FIFO peak {self.peak} > bound {bound}"
 
     async def run_case(self, c: dict, rng: random.Random, follower: np.ndarray | None) -> None:
         d = self.dut
         gap = float(c.get("gap", 0.0))
         await self.start_model(c)
-        self.out, self.last_seen, self.arm = [], False, True
+        self.out, self.last_seen, self.arm, self.peak = [], False, True, 0
         n_done = self.dones
         await self.drive(frame_beats(c["frame"]), rng, gap)
         if follower is not None:                          # the next frame at once
@@ -388,3 +403,15 @@ def test_ms_init_merge_real(hdl_waves):
     job = {"seed": 81, "cases": [{"kind": "tracker", "seq": str(p), "gap": 0.3, "follow": True},
                                  {"kind": "tracker", "seq": str(p), "max_window": 15}]}
     _run("girl", job, hdl_waves)
+
+
+@pytest.mark.verilator
+def test_ms_init_merge_verilator(hdl_waves):
+    """The GHDL -> Verilog netlist (the av delay line's LUT RAM, the FIFO, the rectangle's product and
+    |dx|) under Verilator: the D = 1 worst case (abandoned frame before it, next frame at once), D = 2
+    with a size D does not divide, D = 16; with gaps."""
+    job = synthetic_job(0.3)
+    job["cases"] = [job["cases"][i] for i in (0, 3, 7)]
+    del job["expect_d"]
+    hdl.run_verilator(TOP, MODULE, GENERICS, hdl.rtl_sources(TOP, extra=[WRAPPER]), waves=hdl_waves,
+                      build_name="ms_init_merge_verilator", extra_env={"MSTRACK_JOB": json.dumps(job)})

@@ -191,7 +191,7 @@ begin
     variable m      : unsigned(LW - 1 downto 0);
     variable k      : natural range 0 to 7;
     variable ax, ay : unsigned(COORD_W - 1 downto 0);
-    variable dx, dy : signed(COORD_W downto 0);
+    variable adx, ady : unsigned(COORD_W - 1 downto 0);
   begin
     if rising_edge(clk) then
       i1_v <= dp_valid;
@@ -226,11 +226,12 @@ begin
       e2 <= dp_end;
       r2 <= dp_error;
       -- stage 3
-      dx := signed('0' & b2_x) - signed('0' & rcx);
-      dy := signed('0' & b2_y) - signed('0' & rcy);
+      -- |x - cx|, |y - cy| as larger - smaller (no `abs`: GHDL's Verilog output has none)
+      if b2_x >= rcx then adx := b2_x - rcx; else adx := rcx - b2_x; end if;
+      if b2_y >= rcy then ady := b2_y - rcy; else ady := rcy - b2_y; end if;
       b3_v <= '0';
-      if b2_v = '1' and resize(unsigned(abs(dx)), COORD_W + R_W) <= resize(rx, COORD_W + R_W)
-         and resize(unsigned(abs(dy)), COORD_W + R_W) <= resize(ry, COORD_W + R_W) then
+      if b2_v = '1' and resize(adx, COORD_W + R_W) <= resize(rx, COORD_W + R_W)
+         and resize(ady, COORD_W + R_W) <= resize(ry, COORD_W + R_W) then
         b3_v <= '1';
       end if;
       b3_x <= b2_x;

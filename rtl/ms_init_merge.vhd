@@ -101,6 +101,8 @@ architecture rtl of ms_init_merge is
   signal ring_r       : unsigned(RING_W - 1 downto 0) := (others => '0');
   signal rcx, rcy     : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal rx, ry       : unsigned(R_W - 1 downto 0) := (others => '0');
+  signal gxa, gya     : unsigned(R_W - 1 downto 0) := (others => '0');  -- ring16 wb, ring16 hb (serial)
+  signal gcnt         : natural range 0 to RING_W := 0;                  -- bits still to add
   -- frame size of the av stream
   signal wl, hl       : unsigned(COORD_W - 1 downto 0) := (others => '1');  -- W - 1, H - 1
   -- av delay line (LUT RAM ring)
@@ -135,8 +137,13 @@ architecture rtl of ms_init_merge is
   signal lasts        : unsigned(1 downto 0) := (others => '0');  -- px_last markers not yet out
 begin
   assert FIFO_AW <= 16 report "ms_init_merge: FIFO too deep" severity failure;
+  assert RING_W + 2 < 3 * (HALF_W + 1) + 7
+    report "ms_init_merge: the rectangle would not be ready before ms_bg_model counts" severity failure;
 
-  -- the box's rectangle, as ms_bg_model's set-up computes it: rx = ex + gx = (wb - 1) / 2 + (ring16 wb) >> 4
+  -- the box's rectangle, as ms_bg_model's set-up computes it: rx = ex + gx = (wb - 1) / 2 + (ring16 wb) >> 4;
+  -- ring16 wb, ring16 hb by shift-and-add, MSB first (RING_W clocks after start; no multiplier, so no
+  -- DSP block), then rx, ry one clock later: valid RING_W + 2 clocks after start, long before
+  -- ms_bg_model counts (its set-up takes at least 3 (HALF_W + 1) + 7 clocks)
   p_box : process (clk)
   begin
     if rising_edge(clk) then
@@ -146,11 +153,22 @@ begin
         wb_r <= wb;
         hb_r <= hb;
         ring_r <= ring16;
+        gxa <= (others => '0');
+        gya <= (others => '0');
+        gcnt <= RING_W;
         assert ring16 <= RING16_MAX report "ms_init_merge: ring16 > RING16_MAX (FIFO sized too small)"
           severity error;
+      elsif gcnt > 0 then
+        gxa <= shift_left(gxa, 1);
+        gya <= shift_left(gya, 1);
+        if ring_r(gcnt - 1) = '1' then
+          gxa <= shift_left(gxa, 1) + resize(wb_r, R_W);
+          gya <= shift_left(gya, 1) + resize(hb_r, R_W);
+        end if;
+        gcnt <= gcnt - 1;
       end if;
-      rx <= resize(shift_right(wb_r - 1, 1), R_W) + resize(shift_right(ring_r * wb_r, 4), R_W);
-      ry <= resize(shift_right(hb_r - 1, 1), R_W) + resize(shift_right(ring_r * hb_r, 4), R_W);
+      rx <= resize(shift_right(wb_r - 1, 1), R_W) + shift_right(gxa, 4);
+      ry <= resize(shift_right(hb_r - 1, 1), R_W) + shift_right(gya, 4);
     end if;
   end process;
 

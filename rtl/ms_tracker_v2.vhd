@@ -343,6 +343,9 @@ architecture rtl of ms_tracker_v2 is
   signal bg_cx, bg_cy : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal bg_px_valid, bg_px_last : std_logic := '0';
   signal bg_px_bin    : std_logic_vector(BIN_C_W - 1 downto 0);
+  signal bg_px_obin   : unsigned(3 downto 0) := (others => '0');
+  signal bg_px_bin_u  : unsigned(BIN_C_W - 1 downto 0);
+  signal dec_q        : unsigned(2 downto 0);
   signal av_valid     : std_logic;
   signal av_x, av_y   : unsigned(COORD_W - 1 downto 0);
   signal av_cbin      : std_logic_vector(BIN_C_W - 1 downto 0);
@@ -352,6 +355,7 @@ architecture rtl of ms_tracker_v2 is
   signal m_t          : std_logic;
   signal m_qn_all     : std_logic_vector(N_OR * 17 - 1 downto 0);   -- ORIENT_T >= 0: the 9 banks of m_rd_addr
   signal m_t_all      : std_logic_vector(N_OR - 1 downto 0);
+  signal q_we_one, q_we_all : std_logic;
   signal ms_out_qw_all : std_logic_vector(N_OR * HIST_W - 1 downto 0) := (others => '0');  -- Qw of the 9 banks
 
   -- kernel tables
@@ -586,7 +590,7 @@ begin
               frame_error => fe_error, ip_valid => ip_valid, ip_x => ip_x, ip_y => ip_y, ip_cbin => ip_cbin,
               ip_ebin => ip_ebin, dp_start => dp_start, dp_end => dp_end, dp_error => dp_error,
               dp_valid => dp_valid, dp_x => dp_x, dp_y => dp_y, dp_cbin => dp_cbin, dp_ebin => dp_ebin,
-              dec_q => open);
+              dec_q => dec_q);
 
   reg_w_c <= resize(reg_w, COORD_W);
   reg_h_c <= resize(reg_h, COORD_W);
@@ -619,32 +623,53 @@ begin
   -- every pixel (x, y) of the decimated frame frame[::D, ::D] (x mod D = 0, y mod D = 0, border
   -- included: the front end's av_* stream), at (x / D, y / D); one extra beat at dp_end, after the
   -- frame's last pixel (coordinates all ones: outside the box and its ring), carries px_last
-  p_bgpx : process(clk)
-    variable m : unsigned(COORD_W - 1 downto 0);
-  begin
-    if rising_edge(clk) then
-      m := shift_left(to_unsigned(1, COORD_W), to_integer(l2d)) - 1;
-      if dp_end = '1' then
-        bg_px_valid <= '1';
-        bg_px_last <= '1';
-        bg_px_x <= (others => '1');
-        bg_px_y <= (others => '1');
-      else
-        bg_px_valid <= '0';
-        if av_valid = '1' and (av_x and m) = 0 and (av_y and m) = 0 then
+  g_bg_colour : if not OR_ON generate
+    p_bgpx : process(clk)
+      variable m : unsigned(COORD_W - 1 downto 0);
+    begin
+      if rising_edge(clk) then
+        m := shift_left(to_unsigned(1, COORD_W), to_integer(l2d)) - 1;
+        if dp_end = '1' then
           bg_px_valid <= '1';
+          bg_px_last <= '1';
+          bg_px_x <= (others => '1');
+          bg_px_y <= (others => '1');
+        else
+          bg_px_valid <= '0';
+          if av_valid = '1' and (av_x and m) = 0 and (av_y and m) = 0 then
+            bg_px_valid <= '1';
+          end if;
+          bg_px_last <= '0';
+          bg_px_x <= shift_right(av_x, to_integer(l2d));
+          bg_px_y <= shift_right(av_y, to_integer(l2d));
         end if;
-        bg_px_last <= '0';
-        bg_px_x <= shift_right(av_x, to_integer(l2d));
-        bg_px_y <= shift_right(av_y, to_integer(l2d));
+        bg_px_bin <= av_cbin;
+        if rst = '1' then
+          bg_px_valid <= '0';
+          bg_px_last <= '0';
+        end if;
       end if;
-      bg_px_bin <= av_cbin;
-      if rst = '1' then
-        bg_px_valid <= '0';
-        bg_px_last <= '0';
-      end if;
-    end if;
-  end process;
+    end process;
+  end generate;
+
+  -- ORIENT_T >= 0: the joint bins need each pixel's orientation: frame-interior pixels come from the
+  -- Sobel (ms_decimate's dp_*, one line later), frame-border pixels (orientation 8) from av_*;
+  -- ms_init_merge merges the two into ms_bg_model's one count port (docs/blocks/ms_init_merge.md)
+  g_bg_joint : if OR_ON generate
+    u_merge : entity work.ms_init_merge
+      generic map (COORD_W => COORD_W, BIN_W => BIN_C_W, HALF_W => HALF_W, RING_W => 5, RING16_MAX => RING16,
+                   MAX_FRAME_W => MAX_FRAME_W, LOG2_D_MAX => 4)
+      port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy,
+                wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1), ring16 => to_unsigned(RING16, 5),
+                frame_width => frame_width, frame_height => frame_height,
+                av_valid => av_valid, av_x => av_x, av_y => av_y, av_cbin => av_cbin,
+                dec_q => dec_q, dp_start => dp_start, dp_end => dp_end, dp_error => dp_error,
+                dp_valid => dp_valid, dp_x => dp_x, dp_y => dp_y, dp_cbin => dp_cbin, dp_obin => dp_ebin,
+                px_valid => bg_px_valid, px_bin => bg_px_bin_u, px_obin => bg_px_obin,
+                px_x => bg_px_x, px_y => bg_px_y, px_last => bg_px_last, overflow => open);
+    bg_px_bin <= std_logic_vector(bg_px_bin_u);
+  end generate;
+
   bg_rst      <= rst or bg_rst_p;
 
   u_bg : entity work.ms_bg_model
@@ -653,7 +678,8 @@ begin
     port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy,
               wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1), ring16 => to_unsigned(RING16, 5),
               busy => bg_busy, counting => bg_counting, done => bg_done,
-              px_valid => bg_px_valid, px_bin => unsigned(bg_px_bin), px_x => bg_px_x, px_y => bg_px_y,
+              px_valid => bg_px_valid, px_bin => unsigned(bg_px_bin), px_obin => bg_px_obin,
+              px_x => bg_px_x, px_y => bg_px_y,
               px_last => bg_px_last, n_box => open, n_ring => open, o_min => open, qv_sum => open,
               m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all, m_t_all => m_t_all);
 
@@ -739,6 +765,9 @@ begin
   end generate;
 
   ---------------------------------------------------------------------------- engine + statistics
+  -- the Qw load: one bin per clock (colour bins), or every bank of a colour address (ORIENT_T >= 0)
+  q_we_one <= ms_out_valid when not OR_ON else '0';
+  q_we_all <= ms_out_valid when OR_ON else '0';
   u_colour : entity work.ms_meanshift
     generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
                  STRIDE => STRIDE, ADDR_W => ADDR_W, COORD_W => COORD_W, KERNEL_EPAN => 0,
@@ -747,16 +776,17 @@ begin
                  RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
                  RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
-                 ITER_W => ITER_W, EPS2 => EPS2, RAM_LAT => REGION_RD_LAT)
+                 ITER_W => ITER_W, EPS2 => EPS2, RAM_LAT => REGION_RD_LAT, N_ORIENT => N_OR)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka(KVAL_W - 1 downto 0), kt_kb => kt_kb(KVAL_W - 1 downto 0),
               kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
               reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
               learn => '0', start_cx => eng_cx, start_cy => eng_cy, busy => c_busy, done => c_done,
               res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
-              res_k => c_k, ram_addr => ram_addr, ram_data => ram_data,
+              res_k => c_k, ram_addr => ram_addr, ram_data => ram_data, ram_obin => ram_obin,
               single => eng_single, max_it => eng_max_it,
-              q_ext_we => ms_out_valid, q_ext_addr => unsigned(ms_out_tag), q_ext_data => ms_out_qw,
+              q_ext_we => q_we_one, q_ext_addr => unsigned(ms_out_tag), q_ext_data => ms_out_qw,
+              q_ext_all_we => q_we_all, q_ext_all_data => ms_out_qw_all,
               px_valid => px_valid, px_mask => px_mask, px_dx => px_dx, px_dy => px_dy, px_last => px_last);
 
   -- the tap is aligned with ram_addr; ms_target_stats wants the bins one clock after it

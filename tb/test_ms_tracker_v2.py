@@ -265,6 +265,35 @@ def test_tracker_v2_scale_test(tmp_path):
     assert rep["frames"] == 8 and not rep["mismatches"]
 
 
+#: mstrack-v2-joint (mstrack.eval.evaluate.V2_JOINT): the joint colour x orientation bins (ORIENT_T 64),
+#: the gated scale test and its loss thresholds
+JOINT_TP = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
+
+
+def test_tracker_v2_joint(tmp_path):
+    """GHDL: the joint bins (generic ORIENT_T = 64, with mstrack-v2-joint's gated scale test and loss
+    thresholds) on the rendered scale scene: the orientation region RAM, ms_init_merge into ms_bg_model
+    (N_ORIENT 9), the 9-bank Qw and T loads, the banked engine and target statistics; every field of
+    every result word v2 bit-exact with FixedTrackerV2(orient_T=64), frame by frame, throttled.  The
+    scene is checked on the model first: its init model uses several orientation bins."""
+    import numpy as np
+    from mstrack.eval.evaluate import V2_JOINT
+    from mstrack.fixed.tracker_v2 import FixedTrackerV2
+    assert JOINT_TP == dict(V2_JOINT)
+    job = {"render": SCALE_SCENE, "box": SCALE_SCENE["boxes"][0], "tp": JOINT_TP, "pause_in": True,
+           "pause_out": True, "report": str(tmp_path / "r.json")}
+    frames, box = load_frames_v2(job), tuple(job["box"])
+    cfg = config_of(job)
+    assert cfg.generics()["ORIENT_T"] == 64
+    trk = FixedTrackerV2(cfg.tp, cfg.fp)
+    trk.init(frames[0], box)
+    bins = trk._bins(frames[0], 1)
+    assert len(np.unique(bins % 9)) >= 5                      # the orientation bins are in use
+    _run(job, "ms_tracker_v2_joint")
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["frames"] == 8 and not rep["mismatches"]
+
+
 def test_tracker_v2_preset_generic(tmp_path):
     """GHDL: core v2 as integrators instantiate it, ``ms_tracker`` with generic PRESET = 1 (every port and
     generic passed to ms_tracker_v2): init + 2 tracking frames of a generated 48x40 scene, every field of

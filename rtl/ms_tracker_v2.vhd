@@ -31,6 +31,18 @@
 --   window tables, K, Q RAM and S are overwritten (nothing after T_DECIDE reads them: rho, share,
 --   spread, ring share, confidence and the loss flag are registered by then; the next frame rebuilds
 --   them); the window registers wd, hd, ex, ey, hi_x, hi_y likewise (set up again before the frame).
+--   With ORIENT_T >= 0 (the joint colour x gradient-orientation bins, experimental: FixedTrackerV2
+--   with orient_T = ORIENT_T, tracker mstrack-v2-joint with the gated scale test): a pixel's bin is
+--   (colour, ms_orient_bin(ms_grey(frame), ORIENT_T)) = 9 colour + obin, 4,608 bins.  ms_frontend's
+--   ip_obin rides ms_decimate's edge path into a 4-bit orientation region RAM beside the colour one
+--   (same addresses, same latency: ram_obin); on the init frame ms_init_merge feeds ms_bg_model
+--   (N_ORIENT 9) the decimated frame's interior pixels from the Sobel (dp_*) and its border pixels
+--   (obin 8) from av_*; the Qw load walks the 512 colour addresses with 9 ms_model_scale in lockstep
+--   (m_qn_all -> the engine's q_ext_all_*) and writes ms_target_stats' 512 x 9 T words (m_t_all)
+--   beside it; ms_meanshift, ms_pixel_pass, ms_histogram, ms_bin_pass and ms_target_stats run with
+--   N_ORIENT 9 (9 banks per colour address, a pass still walks 512 addresses).  Cost in clocks: the
+--   init frame's ms_bg_model passes walk 4,608 joint bins (13,885 clocks instead of 1,597), the bin
+--   pass + 4 clocks (its adder tree); everything else as with colour bins.
 -- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
 -- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
 --

@@ -185,7 +185,7 @@ def _base_params(tracker: str) -> tuple[TrackerParams, dict[str, Any]]:
     if tracker == "mstrack-v2":
         kw: dict[str, Any] = {"preset": "v2"}
     elif tracker == "mstrack-v2-joint":
-        from .eval.evaluate import V2_JOINT
+        from .track.params import V2_JOINT
         kw = {"preset": "v2", **V2_JOINT}
     else:
         _, feat, ker = tracker.split("-")

@@ -135,7 +135,8 @@ entity ms_tracker is
     SEARCH_ITER    : natural := 5;               -- iterations per start point while lost
     STEP16         : natural := 16;              -- search_step in 1/16
     MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
-    SCALE_TEST_D256: natural range 0 to 255 := 0 -- the gated scale test (experimental): round(256 scale_test); 0 = off
+    SCALE_TEST_D256: natural range 0 to 255 := 0; -- the gated scale test (experimental): round(256 scale_test); 0 = off
+    ORIENT_T       : integer range -1 to 2047 := -1 -- the joint colour x orientation bins (experimental): orient_T; -1 = off
   );
   port (
     clk                  : in  std_logic;                                -- core and pixel clock
@@ -403,6 +404,8 @@ architecture rtl of ms_tracker is
     end if;
     assert SCALE_TEST_D256 = 0 report "ms_tracker: SCALE_TEST_D256 = " & img(SCALE_TEST_D256)
              & ": the gated scale test is core v2's (PRESET 1)" severity failure;
+    assert ORIENT_T = -1 report "ms_tracker: ORIENT_T = " & integer'image(ORIENT_T)
+             & ": the joint bins are core v2's (PRESET 1)" severity failure;
     assert LANES = 1 or (LANES >= 1 and 2 ** clog2(LANES) = LANES)
       report "ms_tracker: LANES = " & img(LANES) & " is not a power of two" severity failure;
     assert FEATURES <= 2 report "ms_tracker: FEATURES = " & img(FEATURES) & " (0 fused, 1 colour, 2 edge)"
@@ -473,7 +476,7 @@ begin
         LOSS_RHO => LOSS_RHO, LOSS_CONTRAST => LOSS_CONTRAST, CONF_LOST => CONF_LOST,
         CONF_UNCERTAIN => CONF_UNCERTAIN, CONF_REACQUIRE => CONF_REACQUIRE, SPREAD_DEFAULT => SPREAD_DEFAULT,
         BG_Q_W => BG_Q_W, BG_O_W => BG_O_W, SEARCH_ITER => SEARCH_ITER, STEP16 => STEP16,
-        MARGIN_MAX => MARGIN_MAX, SCALE_TEST_D256 => SCALE_TEST_D256)
+        MARGIN_MAX => MARGIN_MAX, SCALE_TEST_D256 => SCALE_TEST_D256, ORIENT_T => ORIENT_T)
       port map (
         clk => clk, rst => rst, frame_width => frame_width, frame_height => frame_height,
         s_init_tvalid => s_init_tvalid, s_init_tready => s_init_tready, s_init_x => s_init_x,

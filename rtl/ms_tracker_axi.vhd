@@ -125,6 +125,7 @@ entity ms_tracker_axi is
     STEP16         : natural := 16;              -- search_step in 1/16
     MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
     SCALE_TEST_D256: natural range 0 to 255 := 0; -- the gated scale test (experimental, PRESET 1): round(256 scale_test); 0 = off
+    ORIENT_T       : integer range -1 to 2047 := -1; -- the joint colour x orientation bins (experimental, PRESET 1): orient_T; -1 = off
     RESULT_STREAM  : boolean := true              -- true: m_axis_result_* carries each result word
   );
   port (
@@ -522,7 +523,8 @@ begin
       SEARCH_ITER    => SEARCH_ITER,
       STEP16         => STEP16,
       MARGIN_MAX     => MARGIN_MAX,
-      SCALE_TEST_D256=> SCALE_TEST_D256
+      SCALE_TEST_D256=> SCALE_TEST_D256,
+      ORIENT_T       => ORIENT_T
     )
     port map (
       clk => clk, rst => rst, frame_width => fw, frame_height => fh,

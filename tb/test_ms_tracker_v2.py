@@ -214,7 +214,7 @@ def test_tracker_v2_synthetic(variant, tmp_path):
 #: border, then shrinks to 20 px there (the x(1 + d) window leaves the captured region on the last frames)
 SCALE_SCENE = {"boxes": [[x, 20, s, s] for x, s in zip((40, 30, 20, 10, 2, 0, 0, 4), (20, 22, 24, 26, 28, 26, 23, 20))],
                "w": 96, "h": 72, "seed": 2}
-SCALE_TP = {"scale_test": 0.05, "scale_test_gate": True}   # mstrack-v2-joint's (mstrack.eval.evaluate.V2_JOINT)
+SCALE_TP = {"scale_test": 0.05, "scale_test_gate": True}   # mstrack-v2-joint's (mstrack.track.params.V2_JOINT)
 
 
 def scale_test_trace(frames: list, box: tuple[int, int, int, int],
@@ -265,7 +265,7 @@ def test_tracker_v2_scale_test(tmp_path):
     assert rep["frames"] == 8 and not rep["mismatches"]
 
 
-#: mstrack-v2-joint (mstrack.eval.evaluate.V2_JOINT): the joint colour x orientation bins (ORIENT_T 64),
+#: mstrack-v2-joint (mstrack.track.params.V2_JOINT): the joint colour x orientation bins (ORIENT_T 64),
 #: the gated scale test and its loss thresholds
 JOINT_TP = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
 
@@ -277,7 +277,7 @@ def test_tracker_v2_joint(tmp_path):
     every result word v2 bit-exact with FixedTrackerV2(orient_T=64), frame by frame, throttled.  The
     scene is checked on the model first: its init model uses several orientation bins."""
     import numpy as np
-    from mstrack.eval.evaluate import V2_JOINT
+    from mstrack.track.params import V2_JOINT
     from mstrack.fixed.tracker_v2 import FixedTrackerV2
     assert JOINT_TP == dict(V2_JOINT)
     job = {"render": SCALE_SCENE, "box": SCALE_SCENE["boxes"][0], "tp": JOINT_TP, "pause_in": True,

@@ -93,11 +93,11 @@ def test_bad_frame_while_lost_keeps_searching() -> None:
     _check(m, frames, box, {3})
 
 
-@pytest.mark.parametrize("kw,what", [({"orient_T": 64}, "orient_T"), ({"motion_gain": 0.5}, "motion_gain"),
+@pytest.mark.parametrize("kw,what", [({"motion_gain": 0.5}, "motion_gain"),
                                      ({"scale_test": 0.05}, "scale_test without scale_test_gate"),
-                                     ({"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True}, "orient_T")])
+                                     ({"orient_T": 64, "motion_gain": 0.5}, "motion_gain")])
 def test_core_config_v2_refuses_options_without_rtl(kw, what):
-    """The experimental v2 options without RTL (orient_T, motion_gain; the ungated scale test) are in
+    """The experimental v2 options without RTL (motion_gain; the ungated scale test) are in
     the float (and fixed) models only: a core configuration for them is refused with a one-line
     reason, not built as a core that tracks differently."""
     from mstrack.fixed.formats import FixedParams
@@ -105,6 +105,20 @@ def test_core_config_v2_refuses_options_without_rtl(kw, what):
     from mstrack.track.params import TrackerParams
     with pytest.raises(ValueError, match="no RTL yet for " + what):
         CoreConfigV2(TrackerParams(preset="v2", **kw), FixedParams())
+
+
+def test_core_config_v2_joint():
+    """mstrack-v2-joint has RTL (session 15): ORIENT_T = orient_T (64) beside SCALE_TEST_D256 13 and the
+    loss thresholds, for ms_tracker_v2 and ms_tracker (PRESET 1); every other generic as without it."""
+    from mstrack.fixed.formats import FixedParams
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import V2_JOINT, TrackerParams
+    j = CoreConfigV2(TrackerParams(preset="v2", **V2_JOINT), FixedParams()).generics()
+    o = CoreConfigV2(TrackerParams(preset="v2", **{**V2_JOINT, "orient_T": 0}), FixedParams()).generics()
+    assert j.pop("ORIENT_T") == 64 and o.pop("ORIENT_T") == -1 and j == o
+    assert CoreConfigV2(TrackerParams(preset="v2", **V2_JOINT), FixedParams()).tracker_generics()["ORIENT_T"] == 64
+    with pytest.raises(ValueError, match="edge_bins_log2"):
+        CoreConfigV2(TrackerParams(preset="v2", **V2_JOINT, edge_bins_log2=3), FixedParams()).generics()
 
 
 def test_core_config_v2_gated_scale_test():
@@ -122,6 +136,7 @@ def test_core_config_v2_gated_scale_test():
     assert on.generics_for("ms_tracker_v2")["SCALE_TEST_D256"] == 13
     assert on.tracker_generics() == {"PRESET": 1, **on.generics()}
     assert on.generics_for("ms_tracker")["SCALE_TEST_D256"] == 13
+    assert g_off["ORIENT_T"] == -1
     with pytest.raises(ValueError, match="d256"):   # d256 = 0: the generic's "off" while the model gates
         CoreConfigV2(TrackerParams(preset="v2", scale_test=0.001, scale_test_gate=True), FixedParams()).generics()
     assert CoreConfigV2(TrackerParams(preset="v2", scale_test=0.5, scale_test_gate=True),

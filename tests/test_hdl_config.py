@@ -56,6 +56,26 @@ def test_scale_test_choice():
     assert "SCALE_TEST_D256" not in derive(CoreChoices()).generics
 
 
+def test_joint_choice():
+    """Preset v2's experimental --joint builds mstrack-v2-joint: TrackerParams(preset="v2", **V2_JOINT),
+    ORIENT_T 64 and SCALE_TEST_D256 13 (CoreConfigV2's generics), the header says so; off, ORIENT_T is
+    -1 (the VHDL default, rendered as an integer constant); the paper preset and --joint with
+    --scale-test are refused with the reason."""
+    from mstrack.track.params import V2_JOINT
+    cfg = derive(CoreChoices(preset="v2", joint=True))
+    tp = TrackerParams(preset="v2", **V2_JOINT)
+    assert cfg.tp == tp and cfg.generics["ORIENT_T"] == 64 and cfg.generics["SCALE_TEST_D256"] == 13
+    want = CoreConfigV2(tp, FixedParams()).tracker_generics()
+    assert {k: cfg.generics[k] for k in want} == want
+    text = render(cfg, "package")
+    assert "tracker mstrack-v2-joint (ORIENT_T 64" in text
+    assert re.search(r"constant C_ORIENT_T +: integer := 64;", text)
+    assert re.search(r"constant C_ORIENT_T +: integer := -1;", render(derive(CoreChoices(preset="v2")), "package"))
+    for bad, why in ((dict(joint=True), "core v2's"), (dict(preset="v2", joint=True, scale_test=0.05), "leave")):
+        with pytest.raises(ConfigError, match=why):
+            derive(CoreChoices(**bad))
+
+
 def test_ppc_choice():
     """PPC 1, 2, 4 (<= LANES) reaches the generic; other values and PPC > LANES are refused."""
     assert derive(CoreChoices(ppc=4)).generics["PPC"] == 4
@@ -175,7 +195,7 @@ def _vhdl_defaults(path, entity):
     text = re.sub(r"--[^\n]*", "", path.read_text())
     m = re.search(rf"entity\s+{entity}\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
     assert m, f"no generic clause in {path}"
-    return {k: int(v) for k, v in re.findall(r"(\w+)\s*:\s*(?:natural|integer)(?:\s+range\s+\d+\s+to\s+\d+)?\s*:=\s*(-?\d+)\b", m.group(1), re.I)}
+    return {k: int(v) for k, v in re.findall(r"(\w+)\s*:\s*(?:natural|integer)(?:\s+range\s+-?\d+\s+to\s+\d+)?\s*:=\s*(-?\d+)\b", m.group(1), re.I)}
 
 
 def test_core_v2_vhdl_defaults_are_the_models():

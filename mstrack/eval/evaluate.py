@@ -40,6 +40,7 @@ from tqdm import tqdm
 from . import baselines
 from ..io.data import DataError, Sequence
 from .metrics import Scores, concat_scores, score, valid_gt
+from ..track.params import V2_JOINT  # mstrack-v2-joint's parameters (re-exported)
 from ..track.types import Box, Status
 
 CACHE_VERSION = 3
@@ -53,12 +54,6 @@ def _mstrack(features: str | None, kernel: str, preset: str = "paper", **extra: 
     more = "".join(f", {k}={v!r}" for k, v in extra.items())
     make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r}{more})"
     return make
-
-
-#: Tracker v2 with the joint colour x orientation histogram and the gated scale test, the loss
-#: flag's thresholds chosen for it (docs/results_v2_mean.md): experimental, the float and fixed
-#: models only (the RTL core v2 implements ``mstrack-v2``; this one needs the 9-bank bin pass).
-V2_JOINT = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
 
 
 def _baseline(fn: Callable[[], Any]) -> Callable[[str], Any]:

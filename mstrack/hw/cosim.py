@@ -336,10 +336,10 @@ class CoreConfigV2:
     max_frame_w: int = 2048
 
     def __post_init__(self) -> None:
-        # the experimental options orient_T and motion_gain are in the float and fixed models only
-        # (mstrack-v2-joint): generics for them would build a core that tracks differently from the
-        # model they name.  The gated scale test (scale_test with scale_test_gate) has RTL
-        # (ms_tracker_v2 generic SCALE_TEST_D256); the ungated one has no fixed model either.
+        # the experimental option motion_gain is in the float model only: a generic for it would build
+        # a core that tracks differently from the model it names.  mstrack-v2-joint's options have RTL:
+        # the gated scale test (scale_test with scale_test_gate: generic SCALE_TEST_D256) and the joint
+        # bins (orient_T: generic ORIENT_T); the ungated scale test has no fixed model either.
         tp = self.tp
         rtl_less = [k for k, off in (("motion_gain", 0.0),) if getattr(tp, k) != off]
         if tp.scale_test != 0.0 and not tp.scale_test_gate:
@@ -385,11 +385,10 @@ class CoreConfigV2:
         g["MAX_FRAME_W"] = self.max_frame_w
         # the gated scale test (experimental; 0 = off, the default of ms_tracker / ms_tracker_v2)
         g["SCALE_TEST_D256"] = self.scale_test_d256()
-        if tp.orient_T > 0:
-            # the joint colour x orientation bins (experimental; ms_tracker_v2 only so far)
-            if g["EDGE_BINS_LOG2"] != 4:
-                raise ValueError("the joint bins carry the orientation on the 4-bit edge path: edge_bins_log2 must be 4")
-            g["ORIENT_T"] = int(tp.orient_T)
+        # the joint colour x orientation bins (experimental; -1 = off, the VHDL default)
+        if tp.orient_T > 0 and g["EDGE_BINS_LOG2"] != 4:
+            raise ValueError("the joint bins carry the orientation on the 4-bit edge path: edge_bins_log2 must be 4")
+        g["ORIENT_T"] = int(tp.orient_T) if tp.orient_T > 0 else -1
         return g
 
     def scale_test_d256(self) -> int:
@@ -403,11 +402,7 @@ class CoreConfigV2:
 
     def tracker_generics(self) -> dict[str, int]:
         """The generics of ``ms_tracker`` for core v2: PRESET = 1 and :meth:`generics` (ms_tracker passes
-        them all, SCALE_TEST_D256 included, to the engine ms_tracker_v2).  The joint bins (ORIENT_T) are
-        a generic of ms_tracker_v2 only so far: refused here."""
-        if self.tp.orient_T > 0:
-            raise ValueError("the joint bins (ORIENT_T) are a generic of ms_tracker_v2 only so far: build the "
-                             "engine ms_tracker_v2 (generics_for('ms_tracker_v2'))")
+        them all, SCALE_TEST_D256 and ORIENT_T included, to the engine ms_tracker_v2)."""
         return {"PRESET": 1, **self.generics()}
 
     def generics_for(self, top: str) -> dict[str, int]:

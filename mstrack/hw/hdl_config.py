@@ -29,7 +29,7 @@ from typing import Any
 
 from ..fixed.formats import FixedParams
 from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
-from ..track.params import TrackerParams
+from ..track.params import V2_JOINT, TrackerParams
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TRACKER_VHD = REPO_ROOT / "rtl" / "ms_tracker.vhd"
@@ -51,9 +51,9 @@ PRESET_GENERIC = {"paper": 0, "v2": 1}
 V2_GENERICS = ("PAD16", "RING16", "MAX_WINDOW", "KT_W", "ST2_W", "SHARE_W", "SPREAD_W", "SIZE_W", "SCALE_W",
                "SCALE_GAIN", "SCALE_REG", "SCALE_STEP", "SCALE_RATIO_Q_W", "WR_Q_W", "CON_W", "LOSS_K", "REF_K",
                "LOSS_RHO", "LOSS_CONTRAST", "CONF_LOST", "CONF_UNCERTAIN", "CONF_REACQUIRE", "SPREAD_DEFAULT",
-               "BG_Q_W", "BG_O_W", "SEARCH_ITER", "STEP16", "MARGIN_MAX", "SCALE_TEST_D256")
+               "BG_Q_W", "BG_O_W", "SEARCH_ITER", "STEP16", "MARGIN_MAX", "SCALE_TEST_D256", "ORIENT_T")
 #: generics of type integer (the others are natural)
-INTEGER_GENERICS = ("LOSS_CONTRAST",)
+INTEGER_GENERICS = ("LOSS_CONTRAST", "ORIENT_T")
 #: window range of core v2 (decimated px): TrackerParams.max_window >= 7; ms_bg_model's count widths
 #: (BG_Q_W 14, BG_O_W 17, ms_tracker_v2's defaults, which CoreConfigV2 does not derive) hold windows up to 127
 V2_MIN_TARGET, V2_MAX_TARGET = 7, 127
@@ -97,6 +97,10 @@ class CoreChoices:
         Layout of s_axis_tdata (:data:`RGB_PACKINGS`).
     ppc : {1, 2, 4}
         PPC: pixels per clock of the video input (s_axis_tdata of 24 PPC bits); at most LANES.
+    joint : bool
+        Preset v2 only, experimental: tracker mstrack-v2-joint (mstrack.track.params.V2_JOINT: the
+        joint colour x gradient-orientation bins, orient_T 64 -> ORIENT_T; the gated scale test 0.05;
+        its loss thresholds); ``scale_test`` must then be left at 0.
     scale_test : float
         Preset v2 only, experimental: the gated scale test (TrackerParams scale_test with
         scale_test_gate; mstrack-v2-joint's is 0.05), generic SCALE_TEST_D256 = round(256 scale_test);
@@ -114,6 +118,7 @@ class CoreChoices:
     rgb_packing: str = "mstrack"
     ppc: int = 1
     scale_test: float = 0.0
+    joint: bool = False
 
 
 @dataclass(frozen=True)
@@ -167,8 +172,12 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         if c.coord_bits != V2_COORD_BITS:
             raise ConfigError(f"COORD_W {c.coord_bits}: core v2 is built for COORD_W {V2_COORD_BITS} (frames up to "
                               "4095 px; result word v2 of 160 bits)")
+        if c.joint and c.scale_test:
+            raise ConfigError("--joint sets mstrack-v2-joint's scale test (0.05): leave --scale-test out")
     elif c.scale_test:
         raise ConfigError(f"scale test {c.scale_test}: the gated scale test is core v2's (--preset v2)")
+    elif c.joint:
+        raise ConfigError("the joint bins (mstrack-v2-joint) are core v2's (--preset v2)")
     max_half = c.max_target // 2
     if max_half > MAX_HALF_LIMIT:
         raise ConfigError(f"largest target {c.max_target} px > {2 * MAX_HALF_LIMIT + 1} px, the largest window "
@@ -190,6 +199,8 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         tp_kw: dict[str, Any] = {"max_window": 2 * max_half + 1} if v2 else {}
         if c.scale_test:
             tp_kw.update(scale_test=c.scale_test, scale_test_gate=True)
+        if c.joint:
+            tp_kw.update(V2_JOINT)
         tp = TrackerParams(features=features, kernel=c.kernel, preset=c.preset, **tp_kw)  # type: ignore[arg-type]
         fp = FixedParams(max_half=max_half, margin=c.margin, coord_bits=c.coord_bits)
     except ValueError as exc:  # the model's own checks (one line each)
@@ -238,8 +249,10 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
               f"  windows up to {2 * g['MAX_HALF'] + 1} decimated px (MAX_HALF {g['MAX_HALF']}; larger targets are "
               f"decimated), search margin {c.margin} decimated px;"),
              f"  LANES {c.lanes}, features {cfg.tp.features}, kernel {c.kernel}, preset {c.preset} (PRESET {g['PRESET']})"
-             + (f", the gated scale test {c.scale_test} (SCALE_TEST_D256 {g['SCALE_TEST_D256']}, experimental);"
-                if c.scale_test else ";"),
+             + (f", the gated scale test {c.scale_test} (SCALE_TEST_D256 {g['SCALE_TEST_D256']}, experimental)"
+                if c.scale_test else "")
+             + (f", tracker mstrack-v2-joint (ORIENT_T {g['ORIENT_T']}, SCALE_TEST_D256 {g['SCALE_TEST_D256']}, "
+                "experimental)" if c.joint else "") + ";",
              f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]}, {c.ppc} pixel(s) per clock (PPC);",
              f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout"
              f"{'_v2' if c.preset == 'v2' else ''})."]
@@ -295,6 +308,9 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scale-test", type=float, default=d.scale_test,
                    help="preset v2, experimental: the gated scale test's relative size step (SCALE_TEST_D256 = "
                         "round(256 x); mstrack-v2-joint's 0.05; default 0 = off)")
+    p.add_argument("--joint", action="store_true",
+                   help="preset v2, experimental: tracker mstrack-v2-joint (the joint colour x orientation bins, "
+                        "ORIENT_T 64; the gated scale test 0.05; its loss thresholds)")
     p.add_argument("--format", choices=FORMATS, default="package", help="output (default: VHDL package)")
     p.add_argument("--name", default="ms_tracker_config_pkg", help="package name (--format package)")
     p.add_argument("--out", help="output file (default: standard output)")
@@ -304,7 +320,7 @@ def run_config(args: argparse.Namespace) -> int:
     choices = CoreChoices(max_frame_width=args.max_frame_width, max_target=args.max_target, lanes=args.lanes,
                           features=args.features, kernel=args.kernel, preset=args.preset, margin=args.margin,
                           coord_bits=args.coord_bits, rgb_packing=args.rgb_packing, ppc=args.ppc,
-                          scale_test=args.scale_test)
+                          scale_test=args.scale_test, joint=args.joint)
     cfg = derive(choices)
     command = getattr(args, "command_line", None) or "mstrack hdl config"
     text = render(cfg, args.format, args.name, command)

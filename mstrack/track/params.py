@@ -65,6 +65,13 @@ def check_param_types(obj: Any) -> None:
             object.__setattr__(obj, f.name, float(v))
 
 
+#: Tracker v2 with the joint colour x orientation histogram and the gated scale test, the loss
+#: flag's thresholds chosen for it (docs/results_v2_mean.md): tracker ``mstrack-v2-joint``,
+#: ``TrackerParams(preset="v2", **V2_JOINT)``; experimental, in the float and fixed models and in core
+#: v2 (generics ORIENT_T 64, SCALE_TEST_D256 13: mstrack.hw.cosim.CoreConfigV2).
+V2_JOINT = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
+
+
 @dataclass(frozen=True)
 class TrackerParams:
     """Algorithm parameters (identical meaning in every layer).

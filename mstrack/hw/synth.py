@@ -138,6 +138,10 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
            max_frame_w=3840, ppc=4),
     Config("v2", "core v2 (ms_tracker_v2, tracker preset v2, CoreConfigV2 generics: colour only, REGION_MAX 445, "
                  "result word v2 of 160 bits)", core=TOP_V2),
+    Config("v2-joint", "core v2 with the joint colour x orientation bins of tracker mstrack-v2-joint (ORIENT_T 64: "
+                       "9 histogram / bin-pass banks, 4-bit orientation region RAM) and its gated scale test "
+                       "(SCALE_TEST_D256 13), loss_rho 0.69, loss_contrast 0.25", core=TOP_V2,
+           tp={"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}),
 )}
 
 

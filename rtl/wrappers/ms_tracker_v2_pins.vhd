@@ -92,7 +92,8 @@ entity ms_tracker_v2_pins is
     SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
     STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
     MARGIN_MAX     : natural := 255;      -- largest region margin (MARGIN + the search offset)
-    SCALE_TEST_D256 : natural range 0 to 255 := 0  -- the gated scale test: round(256 scale_test); 0 = off
+    SCALE_TEST_D256 : natural range 0 to 255 := 0;  -- the gated scale test: round(256 scale_test); 0 = off
+    ORIENT_T        : integer range -1 to 2047 := -1  -- joint colour x orientation bins (mstrack-v2-joint: 64); -1 = off
   );
   port (
     clk           : in  std_logic;                      -- core clock
@@ -211,7 +212,8 @@ begin
       SEARCH_ITER     => SEARCH_ITER,
       STEP16          => STEP16,
       MARGIN_MAX      => MARGIN_MAX,
-      SCALE_TEST_D256 => SCALE_TEST_D256
+      SCALE_TEST_D256 => SCALE_TEST_D256,
+      ORIENT_T        => ORIENT_T
     )
     port map (
       clk => clk, rst => rst,

@@ -153,10 +153,10 @@ class MergeTB(TB):
         self.watch_quiet = False
         self.quiet_bad = 0
         self.dones = 0
-        self.peak = 0                                     # FIFO entries + head, largest (GHDL only)
-        try:                                              # (the netlist under Verilator has no hierarchy)
+        self.peak = 0                                     # FIFO words + reads in flight + prefetch buffer
+        try:                                              # (if the simulator shows the hierarchy)
             m = dut.u_merge
-            self.fifo = (m.wp, m.rp, m.head_v)
+            self.fifo = (m.wp, m.rp, m.qn, m.rv)
             self.fifo_aw = len(m.wp) - 1
         except AttributeError:
             self.fifo = None
@@ -174,8 +174,9 @@ class MergeTB(TB):
             await RisingEdge(d.clk)
             await ReadOnly()
             if self.fifo is not None:
-                wp, rp, hv = (int(v.value) for v in self.fifo)
-                self.peak = max(self.peak, (wp - rp) % (2 << self.fifo_aw) + hv)
+                wp, rp, qn = (int(v.value) for v in self.fifo[:3])
+                rv = bin(int(self.fifo[3].value)).count("1")
+                self.peak = max(self.peak, (wp - rp) % (2 << self.fifo_aw) + qn + rv)
             if int(d.px_valid.value):
                 if self.watch_quiet:
                     self.quiet_bad += 1
@@ -234,9 +235,9 @@ class MergeTB(TB):
         missing = sorted(need - seen.keys())
         assert not missing, f"{c['name']}: {len(missing)} pixels of the rectangle missing, first {missing[:5]}"
         border = sum(1 for (x, y) in seen if seen[(x, y)] % 9 == 8)
-        # the FIFO's worst case of rtl/ms_init_merge.vhd's header: min(W - 1, 2 RX + 1) + 4 at D = 1,
-        # 4 at D >= 2
-        bound = (min(wd - 1, 2 * rx + 1) if c["d"] == 1 else 0) + 4
+        # the FIFO's worst case of rtl/ms_init_merge.vhd's header: min(W - 1, 2 RX + 1) + 7 at D = 1,
+        # 7 at D >= 2 (memory, reads in flight and prefetch buffer together)
+        bound = (min(wd - 1, 2 * rx + 1) if c["d"] == 1 else 0) + 7
         peak = "-" if self.fifo is None else self.peak
         self.dut._log.info("%s: merged stream ok (%d pixels, %d in the rectangle, %d with obin 8; FIFO peak %s "
                            "entries, bound %d)", c["name"], len(seen), len(need), border, peak, bound)

@@ -17,24 +17,33 @@
 -- with the frame's last beat, dp_error); so a frame's pixels and events are in order with the next
 -- frame's (an error cut included).  A simulation assertion checks it (dp_start with av (0, 0)).
 -- Merge: dp pixels go straight to the output; border pixels (and px_last, on the frame's last
--- border pixel or alone, coordinates all ones = outside any box) go through a FIFO that is read in
--- every clock without a dp pixel.  dp_error empties the FIFO (the caller resets ms_bg_model).
+-- border pixel or alone, coordinates all ones = outside any box) go through a FIFO whose words
+-- leave in every clock without a dp pixel.  The FIFO memory is an ms_ram_sdp (RD_LAT 3: on ECP5
+-- the DP16KD output register) followed by a 5-word prefetch ring (flip-flops / LUT RAM); a word is
+-- read when the ring has room for it whatever the pops, so the dp pixel's priority reaches neither
+-- the RAM nor the ring's inputs.  dp_error empties FIFO and ring (the caller resets ms_bg_model).
+-- px_* hold their values while px_valid is low (see docs/blocks/ms_init_merge.md: a chain netlist
+-- under Verilator went wrong when they did not).
 -- FIFO depth (worst case): in one clock b's border pixel and dp (x - 1, y - 1) are both decimated
 -- pixels only if x = x - 1 mod D, i.e. D = 1; at D >= 2 at most one pixel per clock arrives and
--- the FIFO holds at most 4 entries (its 2-clock read latency, px_last beside the frame's last dp).
--- At D = 1 the two arrive together on the right column (x = W - 1, y >= 2: one entry, read at
--- (1, y + 1), which brings neither) and on the bottom row (x >= 2, y = H - 1: no free clock until
--- the frame ends), so the FIFO holds at most min(W - 1, 2 RX + 1) + 4 entries, RX = ex + gx: the
--- bottom row's pixels inside the rectangle.  FIFO_DEPTH = 2**clog2(min(MAX_FRAME_W - 1,
--- 2 RX_MAX + 1) + 8), RX_MAX = 2**HALF_W - 1 + (RING16_MAX (2**(HALF_W + 1) - 1)) / 16 (core v2:
--- HALF_W 6, ring16 10: RX_MAX 142, 512 words x 34 b: 1 DP16KD).  A full FIFO drops the pixel and
--- raises `overflow` (sticky; a simulation assertion too).  The FIFO drains after dp_end in at most
--- min(W - 1, 2 RX + 1) + 5 clocks, before the next frame's first dp pixel (2 W + 2 beats after its
--- sof beat), so px_last always precedes the next frame's pixels (simulation assertion).
--- Latency: av pixel -> px_* 13 clocks (delay 8, 2 stages, FIFO write, read, output register) when
--- the FIFO is empty and no dp pixel comes; dp_* -> px_* 4 clocks; dp_end -> px_last: 5 clocks + the
--- FIFO's backlog.  Throughput: 1 pixel per clock out, no
+-- the FIFO (memory + reads in flight + ring) holds at most 7 words (its 6-clock path to the output,
+-- px_last beside the frame's last dp).  At D = 1 the two arrive together on the right column
+-- (x = W - 1, y >= 2: one word, paid back at (1, y + 1), which brings neither) and on the bottom
+-- row (x >= 2, y = H - 1: no free clock until the frame ends), so it holds at most
+-- min(W - 1, 2 RX + 1) + 7 words, RX = ex + gx: the bottom row's pixels inside the rectangle.
+-- FIFO_DEPTH = 2**clog2(min(MAX_FRAME_W - 1, 2 RX_MAX + 1) + 8) (the memory's share of that),
+-- RX_MAX = 2**HALF_W - 1 + (RING16_MAX (2**(HALF_W + 1) - 1)) / 16 (core v2: HALF_W 6, ring16 10:
+-- RX_MAX 142, 512 words x 34 b).  A full FIFO drops the pixel and raises `overflow` (sticky; a
+-- simulation assertion too).  The FIFO drains after dp_end in at most min(W - 1, 2 RX + 1) + 8
+-- clocks, before the next frame's first dp pixel (2 W + 2 beats after its sof beat; rows 0 and 1
+-- bring border pixels only, which queue behind px_last), so px_last always precedes the next
+-- frame's pixels (simulation assertion).
+-- Latency (counted from the RTL): av pixel -> px_* 16 clocks when the FIFO is empty and no dp pixel
+-- comes (delay 8, 2 stages, write, RAM read 3, ring, output register); dp_* -> px_* 4 clocks;
+-- dp_end -> px_last: 8 clocks + the FIFO's backlog.  Throughput: 1 pixel per clock out, no
 -- handshake (ms_bg_model never stalls); the backlog is absorbed by the FIFO.
+-- Cost (ECP5, RING16_MAX 10, yosys synth_ecp5 + nextpnr, block alone; docs/blocks/ms_init_merge.md):
+-- about 340 LUT4, 555 FF, 2 DP16KD, 18 TRELLIS_DPR16X4, no MULT18X18D.
 -- Python model: the pixel set of mstrack.fixed.tracker_v2.FixedTrackerV2._bins(frame, D) (orient_T
 -- > 0), which ms_bg_model counts; the order is free.
 -- Reset: synchronous, active high: control state (FIFO empty, no pixel out, overflow cleared).
@@ -340,8 +349,8 @@ begin
         px_obin <= unsigned(i3_o);
         assert lasts = 0 or r3 = '1'
           report "ms_init_merge: a pixel of the next frame before px_last (FIFO backlog)" severity failure;
-      else
-        px_last <= q(qh)(E_W - 1) when pop else '0';
+      elsif pop then
+        px_last <= q(qh)(E_W - 1);
         px_x <= unsigned(q(qh)(E_W - 2 downto E_W - 1 - COORD_W));
         px_y <= unsigned(q(qh)(E_W - 2 - COORD_W downto BIN_W));
         px_bin <= unsigned(q(qh)(BIN_W - 1 downto 0));

@@ -17,24 +17,33 @@
 -- with the frame's last beat, dp_error); so a frame's pixels and events are in order with the next
 -- frame's (an error cut included).  A simulation assertion checks it (dp_start with av (0, 0)).
 -- Merge: dp pixels go straight to the output; border pixels (and px_last, on the frame's last
--- border pixel or alone, coordinates all ones = outside any box) go through a FIFO that is read in
--- every clock without a dp pixel.  dp_error empties the FIFO (the caller resets ms_bg_model).
+-- border pixel or alone, coordinates all ones = outside any box) go through a FIFO whose words
+-- leave in every clock without a dp pixel.  The FIFO memory is an ms_ram_sdp (RD_LAT 3: on ECP5
+-- the DP16KD output register) followed by a 5-word prefetch ring (flip-flops / LUT RAM); a word is
+-- read when the ring has room for it whatever the pops, so the dp pixel's priority reaches neither
+-- the RAM nor the ring's inputs.  dp_error empties FIFO and ring (the caller resets ms_bg_model).
+-- px_* hold their values while px_valid is low (see docs/blocks/ms_init_merge.md: a chain netlist
+-- under Verilator went wrong when they did not).
 -- FIFO depth (worst case): in one clock b's border pixel and dp (x - 1, y - 1) are both decimated
 -- pixels only if x = x - 1 mod D, i.e. D = 1; at D >= 2 at most one pixel per clock arrives and
--- the FIFO holds at most 4 entries (its 2-clock read latency, px_last beside the frame's last dp).
--- At D = 1 the two arrive together on the right column (x = W - 1, y >= 2: one entry, read at
--- (1, y + 1), which brings neither) and on the bottom row (x >= 2, y = H - 1: no free clock until
--- the frame ends), so the FIFO holds at most min(W - 1, 2 RX + 1) + 4 entries, RX = ex + gx: the
--- bottom row's pixels inside the rectangle.  FIFO_DEPTH = 2**clog2(min(MAX_FRAME_W - 1,
--- 2 RX_MAX + 1) + 8), RX_MAX = 2**HALF_W - 1 + (RING16_MAX (2**(HALF_W + 1) - 1)) / 16 (core v2:
--- HALF_W 6, ring16 10: RX_MAX 142, 512 words x 34 b: 1 DP16KD).  A full FIFO drops the pixel and
--- raises `overflow` (sticky; a simulation assertion too).  The FIFO drains after dp_end in at most
--- min(W - 1, 2 RX + 1) + 5 clocks, before the next frame's first dp pixel (2 W + 2 beats after its
--- sof beat), so px_last always precedes the next frame's pixels (simulation assertion).
--- Latency: av pixel -> px_* 13 clocks (delay 8, 2 stages, FIFO write, read, output register) when
--- the FIFO is empty and no dp pixel comes; dp_* -> px_* 4 clocks; dp_end -> px_last: 5 clocks + the
--- FIFO's backlog.  Throughput: 1 pixel per clock out, no
+-- the FIFO (memory + reads in flight + ring) holds at most 7 words (its 6-clock path to the output,
+-- px_last beside the frame's last dp).  At D = 1 the two arrive together on the right column
+-- (x = W - 1, y >= 2: one word, paid back at (1, y + 1), which brings neither) and on the bottom
+-- row (x >= 2, y = H - 1: no free clock until the frame ends), so it holds at most
+-- min(W - 1, 2 RX + 1) + 7 words, RX = ex + gx: the bottom row's pixels inside the rectangle.
+-- FIFO_DEPTH = 2**clog2(min(MAX_FRAME_W - 1, 2 RX_MAX + 1) + 8) (the memory's share of that),
+-- RX_MAX = 2**HALF_W - 1 + (RING16_MAX (2**(HALF_W + 1) - 1)) / 16 (core v2: HALF_W 6, ring16 10:
+-- RX_MAX 142, 512 words x 34 b).  A full FIFO drops the pixel and raises `overflow` (sticky; a
+-- simulation assertion too).  The FIFO drains after dp_end in at most min(W - 1, 2 RX + 1) + 8
+-- clocks, before the next frame's first dp pixel (2 W + 2 beats after its sof beat; rows 0 and 1
+-- bring border pixels only, which queue behind px_last), so px_last always precedes the next
+-- frame's pixels (simulation assertion).
+-- Latency (counted from the RTL): av pixel -> px_* 16 clocks when the FIFO is empty and no dp pixel
+-- comes (delay 8, 2 stages, write, RAM read 3, ring, output register); dp_* -> px_* 4 clocks;
+-- dp_end -> px_last: 8 clocks + the FIFO's backlog.  Throughput: 1 pixel per clock out, no
 -- handshake (ms_bg_model never stalls); the backlog is absorbed by the FIFO.
+-- Cost (ECP5, RING16_MAX 10, yosys synth_ecp5 + nextpnr, block alone; docs/blocks/ms_init_merge.md):
+-- about 340 LUT4, 555 FF, 2 DP16KD, 18 TRELLIS_DPR16X4, no MULT18X18D.
 -- Python model: the pixel set of mstrack.fixed.tracker_v2.FixedTrackerV2._bins(frame, D) (orient_T
 -- > 0), which ms_bg_model counts; the order is free.
 -- Reset: synchronous, active high: control state (FIFO empty, no pixel out, overflow cleared).
@@ -92,9 +101,13 @@ architecture rtl of ms_init_merge is
   constant RX_MAX   : natural := 2 ** HALF_W - 1 + (RING16_MAX * (2 ** (HALF_W + 1) - 1)) / 16;
   constant FIFO_AW  : natural := clog2(minimum(MAX_FRAME_W - 1, 2 * RX_MAX + 1) + 8);
   constant R_W      : natural := RING_W + HALF_W + 2;   -- rx, ry bits (ex + (ring16 wb) >> 4)
+  constant S_W      : natural := maximum(COORD_W, R_W) + 2;  -- signed bounds cx -+ rx
   constant AV_W     : natural := 1 + 2 * COORD_W + BIN_W;   -- {border, x, y, cbin}
   constant E_W      : natural := 1 + 2 * COORD_W + BIN_W;   -- FIFO word {last, x, y, cbin}
   constant LW       : natural := LOG2_D_MAX + 1;
+  constant RD_LAT   : natural := 3;                     -- FIFO memory read latency (ms_ram_sdp: ECP5 OUTREG)
+  constant NQ       : natural := RD_LAT + 2;            -- prefetch buffer words (a read per clock; the
+                                                        -- read decision does not wait for the pop)
 
   -- box rectangle
   signal wb_r, hb_r   : unsigned(HALF_W downto 0) := (others => '0');
@@ -102,6 +115,7 @@ architecture rtl of ms_init_merge is
   signal rcx, rcy     : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal rx, ry       : unsigned(R_W - 1 downto 0) := (others => '0');
   signal gxa, gya     : unsigned(R_W - 1 downto 0) := (others => '0');  -- ring16 wb, ring16 hb (serial)
+  signal x_lo, x_hi, y_lo, y_hi : signed(S_W - 1 downto 0) := (others => '0');  -- cx -+ rx, cy -+ ry
   signal gcnt         : natural range 0 to RING_W := 0;                  -- bits still to add
   -- frame size of the av stream
   signal wl, hl       : unsigned(COORD_W - 1 downto 0) := (others => '1');  -- W - 1, H - 1
@@ -128,21 +142,26 @@ architecture rtl of ms_init_merge is
   signal b3_c, i3_c   : std_logic_vector(BIN_W - 1 downto 0) := (others => '0');
   signal i3_o         : std_logic_vector(3 downto 0) := (others => '0');
   -- FIFO of border pixels and px_last markers
-  type fifo_t is array (0 to 2 ** FIFO_AW - 1) of std_logic_vector(E_W - 1 downto 0);
-  signal fmem         : fifo_t;
+  signal f_we         : std_logic;
+  signal f_wdata, f_rdata : std_logic_vector(E_W - 1 downto 0);
+  type q_t is array (0 to NQ - 1) of std_logic_vector(E_W - 1 downto 0);
+  signal q            : q_t := (others => (others => '0'));          -- prefetch buffer (a ring)
+  signal qh, qt       : natural range 0 to NQ - 1 := 0;              -- its head, its next free word
+  signal qn           : natural range 0 to NQ := 0;                  -- its words
+  signal fcnt         : unsigned(FIFO_AW downto 0) := (others => '0');  -- words in the FIFO memory (wp - rp)
+  signal f_ne, f_full : std_logic := '0';                            -- fcnt /= 0, fcnt = 2**FIFO_AW (registered)
+  signal rv           : std_logic_vector(1 to RD_LAT) := (others => '0');  -- reads in flight
   signal wp, rp       : unsigned(FIFO_AW downto 0) := (others => '0');
-  signal head         : std_logic_vector(E_W - 1 downto 0) := (others => '0');
-  signal head_v       : std_logic := '0';
   signal ovf          : std_logic := '0';
   signal lasts        : unsigned(1 downto 0) := (others => '0');  -- px_last markers not yet out
 begin
   assert FIFO_AW <= 16 report "ms_init_merge: FIFO too deep" severity failure;
-  assert RING_W + 2 < 3 * (HALF_W + 1) + 7
+  assert RING_W + 3 < 3 * (HALF_W + 1) + 7
     report "ms_init_merge: the rectangle would not be ready before ms_bg_model counts" severity failure;
 
   -- the box's rectangle, as ms_bg_model's set-up computes it: rx = ex + gx = (wb - 1) / 2 + (ring16 wb) >> 4;
   -- ring16 wb, ring16 hb by shift-and-add, MSB first (RING_W clocks after start; no multiplier, so no
-  -- DSP block), then rx, ry one clock later: valid RING_W + 2 clocks after start, long before
+  -- DSP block), then rx, ry, then the bounds: valid RING_W + 3 clocks after start, long before
   -- ms_bg_model counts (its set-up takes at least 3 (HALF_W + 1) + 7 clocks)
   p_box : process (clk)
   begin
@@ -169,6 +188,12 @@ begin
       end if;
       rx <= resize(shift_right(wb_r - 1, 1), R_W) + shift_right(gxa, 4);
       ry <= resize(shift_right(hb_r - 1, 1), R_W) + shift_right(gya, 4);
+      -- the rectangle's bounds (signed: they may leave the frame), so that the per-pixel test is
+      -- four compares in parallel (one carry chain deep)
+      x_lo <= signed(resize(rcx, S_W)) - signed(resize(rx, S_W));
+      x_hi <= signed(resize(rcx, S_W)) + signed(resize(rx, S_W));
+      y_lo <= signed(resize(rcy, S_W)) - signed(resize(ry, S_W));
+      y_hi <= signed(resize(rcy, S_W)) + signed(resize(ry, S_W));
     end if;
   end process;
 
@@ -209,7 +234,6 @@ begin
     variable m      : unsigned(LW - 1 downto 0);
     variable k      : natural range 0 to 7;
     variable ax, ay : unsigned(COORD_W - 1 downto 0);
-    variable adx, ady : unsigned(COORD_W - 1 downto 0);
   begin
     if rising_edge(clk) then
       i1_v <= dp_valid;
@@ -244,12 +268,9 @@ begin
       e2 <= dp_end;
       r2 <= dp_error;
       -- stage 3
-      -- |x - cx|, |y - cy| as larger - smaller (no `abs`: GHDL's Verilog output has none)
-      if b2_x >= rcx then adx := b2_x - rcx; else adx := rcx - b2_x; end if;
-      if b2_y >= rcy then ady := b2_y - rcy; else ady := rcy - b2_y; end if;
       b3_v <= '0';
-      if b2_v = '1' and resize(adx, COORD_W + R_W) <= resize(rx, COORD_W + R_W)
-         and resize(ady, COORD_W + R_W) <= resize(ry, COORD_W + R_W) then
+      if b2_v = '1' and signed(resize(b2_x, S_W)) >= x_lo and signed(resize(b2_x, S_W)) <= x_hi
+         and signed(resize(b2_y, S_W)) >= y_lo and signed(resize(b2_y, S_W)) <= y_hi then
         b3_v <= '1';
       end if;
       b3_x <= b2_x;
@@ -288,27 +309,40 @@ begin
     end if;
   end process;
 
-  -- merge: dp pixel out at once; else the FIFO's head
+  -- FIFO memory: ms_ram_sdp (block RAM; on ECP5 its DP16KD output register, RD_LAT clocks)
+  u_fifo : entity work.ms_ram_sdp
+    generic map (DEPTH => 2 ** FIFO_AW, DATA_W => E_W, ADDR_W => FIFO_AW, RD_LAT => RD_LAT, WR_LAT => 0)
+    port map (clk => clk, we => f_we, waddr => wp(FIFO_AW - 1 downto 0), wdata => f_wdata,
+              raddr => rp(FIFO_AW - 1 downto 0), rdata => f_rdata);
+
+  -- merge: dp pixel out at once; else the head of the prefetch buffer (the words read from the FIFO
+  -- memory, a ring of NQ = RD_LAT + 2 flip-flop words: one read per clock while words are popped; the
+  -- read is decided on the buffer's words and the reads in flight, not on this clock's pop, and the
+  -- word read goes to the ring's tail, so that the dp pixel's priority reaches no RAM or ring input)
   p_merge : process (clk)
     variable push, pop, rd, full : boolean;
-    variable word : std_logic_vector(E_W - 1 downto 0);
     variable lasts_n : unsigned(1 downto 0);
+    variable qn_n, inflight : natural range 0 to NQ + RD_LAT;
+    variable rd_bit : std_logic;
+    variable fc : unsigned(FIFO_AW downto 0);
   begin
     if rising_edge(clk) then
       push := b3_v = '1' or e3 = '1';
-      if b3_v = '1' then
-        word := e3 & std_logic_vector(b3_x) & std_logic_vector(b3_y) & b3_c;
-      else                                               -- px_last alone: coordinates all ones
-        word := e3 & (2 * COORD_W - 1 downto 0 => '1') & b3_c;
-      end if;
-      pop := head_v = '1' and i3_v = '0' and r3 = '0';  -- (dp_error: the head is dropped)
-      rd := wp /= rp and (head_v = '0' or pop) and r3 = '0';
-      full := wp - rp = 2 ** FIFO_AW and r3 = '0';       -- (dp_error empties it)
+      pop := qn > 0 and i3_v = '0' and r3 = '0';         -- (dp_error: the buffer is dropped)
+      inflight := 0;
+      for i in 1 to RD_LAT loop
+        if rv(i) = '1' then
+          inflight := inflight + 1;
+        end if;
+      end loop;
+      -- read when the word will find room when it arrives (pops only add room)
+      rd := f_ne = '1' and qn + inflight < NQ and r3 = '0';
+      full := f_full = '1' and r3 = '0';                 -- (dp_error empties it)
       -- output
-      px_valid <= '0';
+      -- (the data registers load every clock, a 2:1 multiplexer: no clock enable from i3_v)
+      px_valid <= '1' when i3_v = '1' or pop else '0';
       px_last <= '0';
       if i3_v = '1' then
-        px_valid <= '1';
         px_x <= i3_x;
         px_y <= i3_y;
         px_bin <= unsigned(i3_c);
@@ -316,31 +350,39 @@ begin
         assert lasts = 0 or r3 = '1'
           report "ms_init_merge: a pixel of the next frame before px_last (FIFO backlog)" severity failure;
       elsif pop then
-        px_valid <= '1';
-        px_last <= head(E_W - 1);
-        px_x <= unsigned(head(E_W - 2 downto E_W - 1 - COORD_W));
-        px_y <= unsigned(head(E_W - 2 - COORD_W downto BIN_W));
-        px_bin <= unsigned(head(BIN_W - 1 downto 0));
+        px_last <= q(qh)(E_W - 1);
+        px_x <= unsigned(q(qh)(E_W - 2 downto E_W - 1 - COORD_W));
+        px_y <= unsigned(q(qh)(E_W - 2 - COORD_W downto BIN_W));
+        px_bin <= unsigned(q(qh)(BIN_W - 1 downto 0));
         px_obin <= to_unsigned(8, 4);
       end if;
       lasts_n := lasts;
-      if pop and head(E_W - 1) = '1' then
+      if pop and q(qh)(E_W - 1) = '1' then
         lasts_n := lasts_n - 1;
       end if;
-      -- FIFO
-      if rd then
-        head <= fmem(to_integer(rp(FIFO_AW - 1 downto 0)));
-        rp <= rp + 1;
-        head_v <= '1';
-      elsif pop then
-        head_v <= '0';
+      -- prefetch ring
+      qn_n := qn;
+      if pop then
+        qh <= (qh + 1) mod NQ;
+        qn_n := qn_n - 1;
       end if;
+      if rv(RD_LAT) = '1' then
+        q(qt) <= f_rdata;                                -- (room was reserved at the read)
+        qt <= (qt + 1) mod NQ;
+        qn_n := qn_n + 1;
+      end if;
+      qn <= qn_n;
+      rd_bit := '1' when rd else '0';
+      rv <= rd_bit & rv(1 to RD_LAT - 1);               -- rv(RD_LAT): the word in f_rdata now
+      if rd then
+        rp <= rp + 1;
+      end if;
+      -- FIFO write (f_we, f_wdata below: the memory writes at this edge)
       if push then
         if full then
           ovf <= '1';
           assert false report "ms_init_merge: FIFO full, border pixel lost" severity error;
         else
-          fmem(to_integer(wp(FIFO_AW - 1 downto 0))) <= word;
           wp <= wp + 1;
           if e3 = '1' then
             lasts_n := lasts_n + 1;
@@ -348,21 +390,47 @@ begin
         end if;
       end if;
       lasts <= lasts_n;
+      -- words in the memory, and its flags for the next clock (registered: no wp / rp compare in
+      -- front of the read and write decisions)
+      fc := fcnt;
+      if r3 = '1' then
+        fc := (others => '0');
+      elsif rd then
+        fc := fc - 1;
+      end if;
+      if push and not full then
+        fc := fc + 1;
+      end if;
+      fcnt <= fc;
+      f_ne <= '1' when fc /= 0 else '0';
+      f_full <= '1' when fc = 2 ** FIFO_AW else '0';
       if r3 = '1' then                                   -- abandoned frame: drop its border pixels
-        rp <= wp;
-        head_v <= '0';
-        lasts <= (others => '0');                        -- (a push of this clock, the pixel (0, 0) of
-      end if;                                            -- the frame that cut it, stays: wp + 1)
+        rp <= wp;                                        -- (a push of this clock, the pixel (0, 0) of
+        qn <= 0;                                         -- the frame that cut it, stays: wp + 1)
+        qh <= 0;
+        qt <= 0;
+        rv <= (others => '0');
+        lasts <= (others => '0');
+      end if;
       if rst = '1' then
         px_valid <= '0';
         px_last <= '0';
         wp <= (others => '0');
         rp <= (others => '0');
-        head_v <= '0';
+        qn <= 0;
+        qh <= 0;
+        qt <= 0;
+        rv <= (others => '0');
+        fcnt <= (others => '0');
+        f_ne <= '0';
+        f_full <= '0';
         ovf <= '0';
         lasts <= (others => '0');
       end if;
     end if;
   end process;
+  f_we <= '1' when (b3_v = '1' or e3 = '1') and not (f_full = '1' and r3 = '0') else '0';
+  f_wdata <= e3 & std_logic_vector(b3_x) & std_logic_vector(b3_y) & b3_c when b3_v = '1' else
+             e3 & (2 * COORD_W - 1 downto 0 => '1') & b3_c;  -- px_last alone: coordinates all ones
   overflow <= ovf;
 end architecture;

@@ -129,6 +129,9 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker.py::test_tracker_ghdl_synthetic[plain]":
         "test_tracker_ghdl_synthetic[throttled] (the same scene with input gaps and back-pressure)",
     "tb/test_ms_decimate.py::test_ms_decimate_synthetic[4-full_speed]": "[4-gaps], test_ms_decimate_real_small[full_speed]",
+    "tb/test_ms_init_merge.py::test_ms_init_merge_synthetic[gaps_first]":
+        "test_ms_init_merge_synthetic[full_speed_first] (the same 10 cases, each with the other gap setting; "
+        "about 70 s)",
     # Verilator block builds (a clean machine has no ccache: ~20-60 s of C++ each): one set per block
     # stays, and the cores' netlists run under Verilator in the long set
     "tb/test_ms_loss_filter.py::test_ms_loss_filter_verilator[w6_k3]": "test_ms_loss_filter_verilator[core]",

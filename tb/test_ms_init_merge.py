@@ -153,10 +153,10 @@ class MergeTB(TB):
         self.watch_quiet = False
         self.quiet_bad = 0
         self.dones = 0
-        self.peak = 0                                     # FIFO entries + head, largest (GHDL only)
-        try:                                              # (the netlist under Verilator has no hierarchy)
+        self.peak = 0                                     # FIFO words + reads in flight + prefetch buffer
+        try:                                              # (if the simulator shows the hierarchy)
             m = dut.u_merge
-            self.fifo = (m.wp, m.rp, m.head_v)
+            self.fifo = (m.wp, m.rp, m.qn, m.rv)
             self.fifo_aw = len(m.wp) - 1
         except AttributeError:
             self.fifo = None
@@ -174,14 +174,16 @@ class MergeTB(TB):
             await RisingEdge(d.clk)
             await ReadOnly()
             if self.fifo is not None:
-                wp, rp, hv = (int(v.value) for v in self.fifo)
-                self.peak = max(self.peak, (wp - rp) % (2 << self.fifo_aw) + hv)
+                wp, rp, qn = (int(v.value) for v in self.fifo[:3])
+                rv = bin(int(self.fifo[3].value)).count("1")
+                self.peak = max(self.peak, (wp - rp) % (2 << self.fifo_aw) + qn + rv)
             if int(d.px_valid.value):
                 if self.watch_quiet:
                     self.quiet_bad += 1
                 if self.arm:
                     self.out.append((int(d.px_x.value), int(d.px_y.value), int(d.px_bin.value),
                                      int(d.px_obin.value)))
+                    self.out_t.append((self.cycle(), int(d.px_last.value)))
                     if int(d.px_last.value):
                         self.arm = False
                         self.last_seen = True
@@ -210,6 +212,7 @@ class MergeTB(TB):
                 break
         else:
             raise AssertionError("ms_bg_model does not start counting")
+        self.t_count = self.cycle()
         await Timer(1, "ns")
 
     def check_stream(self, c: dict) -> None:
@@ -234,9 +237,9 @@ class MergeTB(TB):
         missing = sorted(need - seen.keys())
         assert not missing, f"{c['name']}: {len(missing)} pixels of the rectangle missing, first {missing[:5]}"
         border = sum(1 for (x, y) in seen if seen[(x, y)] % 9 == 8)
-        # the FIFO's worst case of rtl/ms_init_merge.vhd's header: min(W - 1, 2 RX + 1) + 4 at D = 1,
-        # 4 at D >= 2
-        bound = (min(wd - 1, 2 * rx + 1) if c["d"] == 1 else 0) + 4
+        # the FIFO's worst case of rtl/ms_init_merge.vhd's header: min(W - 1, 2 RX + 1) + 7 at D = 1,
+        # 7 at D >= 2 (memory, reads in flight and prefetch buffer together)
+        bound = (min(wd - 1, 2 * rx + 1) if c["d"] == 1 else 0) + 7
         peak = "-" if self.fifo is None else self.peak
         self.dut._log.info("%s: merged stream ok (%d pixels, %d in the rectangle, %d with obin 8; FIFO peak %s "
                            "entries, bound %d)", c["name"], len(seen), len(need), border, peak, bound)
@@ -247,6 +250,7 @@ class MergeTB(TB):
         gap = float(c.get("gap", 0.0))
         await self.start_model(c)
         self.out, self.last_seen, self.arm, self.peak = [], False, True, 0
+        self.out_t = []
         n_done = self.dones
         await self.drive(frame_beats(c["frame"]), rng, gap)
         if follower is not None:                          # the next frame at once
@@ -277,6 +281,11 @@ class MergeTB(TB):
         self.check_stream(c)
         assert (nq, no) == (exp["nq"], exp["no"]), f"{c['name']}: sum Q, sum O = {nq}, {no}, model " \
             f"{exp['nq']}, {exp['no']}"
+        if os.environ.get("MSTRACK_DUMP"):                # (debug: the stream into ms_bg_model, replayable)
+            with open(os.environ["MSTRACK_DUMP"], "a") as f:
+                f.write(json.dumps({"name": c["name"], "box": [int(c[k]) for k in ("cx", "cy", "wb", "hb", "ring16")],
+                                    "px": self.out, "t": self.out_t, "t_count": self.t_count, "Qn": exp["Qn"].tolist(),
+                                    "T": exp["T"].tolist(), "got": qn.tolist()}) + "\n")
         bad = np.nonzero((qn != exp["Qn"]) | (t != exp["T"]))[0]
         assert bad.size == 0, (f"{c['name']}: {bad.size} joint bins differ, first {bad[:5].tolist()}: Qn "
                                f"{qn[bad[:5]].tolist()} model {exp['Qn'][bad[:5]].tolist()}")
@@ -415,3 +424,70 @@ def test_ms_init_merge_verilator(hdl_waves):
     del job["expect_d"]
     hdl.run_verilator(TOP, MODULE, GENERICS, hdl.rtl_sources(TOP, extra=[WRAPPER]), waves=hdl_waves,
                       build_name="ms_init_merge_verilator", extra_env={"MSTRACK_JOB": json.dumps(job)})
+
+
+@cocotb.test(skip=os.environ.get("MSTRACK_REPLAY") is None)
+async def bg_replay(dut):
+    """Debug: replay a recorded merge output (MSTRACK_REPLAY, one JSON line) into ms_bg_model alone,
+    clock by clock, and compare its model."""
+    from cocotb.clock import Clock
+    rec = json.loads(open(os.environ["MSTRACK_REPLAY"]).readline())
+    cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start())
+    for k in ("start", "px_valid", "px_last", "px_bin", "px_obin", "px_x", "px_y", "m_rd_addr", "m_rd_obin"):
+        getattr(dut, k).value = 0
+    dut.rst.value = 1
+    await ClockCycles(dut.clk, 3)
+    dut.rst.value = 0
+    while True:
+        await RisingEdge(dut.clk)
+        await ReadOnly()
+        if int(dut.busy.value) == 0:
+            break
+    await Timer(1, "ns")
+    for k, v in zip(("cx", "cy", "wb", "hb", "ring16"), rec["box"]):
+        getattr(dut, k).value = v
+    dut.start.value = 1
+    await RisingEdge(dut.clk)
+    dut.start.value = 0
+    while True:
+        await RisingEdge(dut.clk)
+        await ReadOnly()
+        if int(dut.counting.value):
+            break
+    await Timer(1, "ns")
+    t0 = rec["t"][0][0]
+    cyc = rec.get("t_count", t0) if os.environ.get("MSTRACK_REPLAY_ABS") else t0
+    junk = bool(os.environ.get("MSTRACK_REPLAY_JUNK"))
+    rng = random.Random(5)
+    for (x, y, b, o), (t, last) in zip(rec["px"], rec["t"]):
+        while cyc < t:
+            dut.px_valid.value = 0
+            if junk:                                      # data lines change while px_valid is low
+                dut.px_x.value, dut.px_y.value = rng.randrange(64), rng.randrange(48)
+                dut.px_bin.value, dut.px_obin.value = rng.randrange(512), rng.randrange(9)
+            await RisingEdge(dut.clk)
+            cyc += 1
+        dut.px_valid.value = 1
+        dut.px_x.value, dut.px_y.value, dut.px_bin.value, dut.px_obin.value, dut.px_last.value = x, y, b, o, last
+        await RisingEdge(dut.clk)
+        cyc += 1
+    dut.px_valid.value = 0
+    dut.px_last.value = 0
+    while True:
+        await RisingEdge(dut.clk)
+        await ReadOnly()
+        if int(dut.done.value):
+            break
+    await Timer(1, "ns")
+    qn = []
+    for u in range(N_OR * 512):
+        dut.m_rd_addr.value = u // N_OR
+        dut.m_rd_obin.value = u % N_OR
+        await RisingEdge(dut.clk)
+        await ReadOnly()
+        qn.append(int(dut.m_qn.value))
+        await Timer(1, "ns")
+    bad = [u for u in range(len(qn)) if qn[u] != rec["Qn"][u]]
+    dut._log.info("replay %s: %d bins differ from the model %s; %d differ from the recorded chain run",
+                  rec["name"], len(bad), bad[:5], sum(1 for u in range(len(qn)) if qn[u] != rec["got"][u]))
+    assert not bad

@@ -187,7 +187,7 @@ def test_v2_config_has_v2_generics_and_wrapper():
 def test_v2_joint_config_is_mstrack_v2_joint():
     """Configuration "v2-joint": ms_tracker_v2 with the generics of tracker mstrack-v2-joint's parameters
     (ORIENT_T 64, the gated scale test SCALE_TEST_D256 13), placed through ms_tracker_v2_pins, which
-    passes ORIENT_T (default -1 = off, so configuration "v2" is unchanged)."""
+    passes ORIENT_T (default -1 = off, the value configuration "v2" gives, so "v2" is unchanged)."""
     import re
 
     from mstrack.fixed import FixedParams
@@ -200,7 +200,7 @@ def test_v2_joint_config_is_mstrack_v2_joint():
                        loss_contrast=0.25)
     assert g == CoreConfigV2(tp, FixedParams()).generics()
     assert g["ORIENT_T"] == 64 and g["SCALE_TEST_D256"] == 13 and g["REGION_MAX"] == 256
-    assert "ORIENT_T" not in synth.CONFIGS["v2"].generics()
+    assert synth.CONFIGS["v2"].generics()["ORIENT_T"] == -1          # off: the VHDL default
     body = synth.PINS_VHD_V2.read_text()
     assert re.search(r"^\s+ORIENT_T\s*: integer range -1 to 2047 := -1", body, re.M)
 

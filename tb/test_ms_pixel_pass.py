@@ -67,6 +67,7 @@ class TB:
         self.kernel = "epanechnikov" if c["KERNEL_EPAN"] else "flat"
         self.kb = c["KERNEL_BITS"]
         self.ram_lat = c.get("RAM_LAT", 1)
+        self.no = c.get("N_ORIENT", 1)          # > 1: mem holds joint bins no u + o (ram_data u, ram_obin o)
         self.mem = [dict() for _ in range(self.L)]
         dut.rst.value = Immediate(1)
         for name in ("start", "kt_we", "bin_rd_en"):
@@ -78,15 +79,19 @@ class TB:
         """Region RAM model (registered read: data RAM_LAT clocks after the address) and a cycle counter."""
         L, aw, bw = self.L, self.aw, self.bw
         amask = (1 << aw) - 1
-        pipe = [0] * self.ram_lat          # pipe[0]: read at this edge; pipe[-1]: on ram_data now
+        pipe = [(0, 0)] * self.ram_lat     # (bins, orientations); pipe[0]: read at this edge; pipe[-1]: on ram_data now
         while True:
             await RisingEdge(self.dut.clk)
             a = int(self.dut.ram_addr.value)
-            d = 0
+            d = o = 0
             for lane in range(L):
-                d |= self.mem[lane].get((a >> (lane * aw)) & amask, 0) << (lane * bw)
-            pipe = [d] + pipe[:-1]
-            self.dut.ram_data.value = pipe[-1]
+                v = self.mem[lane].get((a >> (lane * aw)) & amask, 0)
+                d |= (v // self.no) << (lane * bw)
+                o |= (v % self.no) << (lane * 4)
+            pipe = [(d, o)] + pipe[:-1]
+            self.dut.ram_data.value = pipe[-1][0]
+            if self.no > 1:
+                self.dut.ram_obin.value = pipe[-1][1]
 
     def load_region(self, bins: np.ndarray, rng: random.Random):
         """bins (rmax, rmax) -> bank memories; padding words get random bins (must be masked)."""
@@ -94,7 +99,7 @@ class TB:
         self.mem = [dict() for _ in range(L)]
         for ry in range(self.rmax):
             for rx in range(self.stride * L):
-                v = int(bins[ry, rx]) if rx < self.rmax else rng.randrange(self.n_bins)
+                v = int(bins[ry, rx]) if rx < self.rmax else rng.randrange(self.n_bins * self.no)
                 self.mem[rx % L][ry * self.stride + rx // L] = v
 
     async def reset(self):
@@ -149,7 +154,10 @@ class TB:
     async def read_bins(self, rng: random.Random | None) -> dict[str, np.ndarray]:
         """Read and clear every bin; rng: random idle cycles between reads (throttled)."""
         d = self.dut
-        out = {k: np.zeros(self.n_bins, np.int64) for k in ("H", "N", "SX", "SY")}
+        no = self.no
+        out = {k: np.zeros(self.n_bins * no, np.int64) for k in ("H", "N", "SX", "SY")}
+        widths = {"H": self.cfg["HIST_W"], "N": self.cfg["COUNT_W"], "SX": self.cfg["POSSUM_W"],
+                  "SY": self.cfg["POSSUM_W"]}
         issued: list[tuple[int, int]] = []
         got = 0
         nxt = 0
@@ -162,10 +170,21 @@ class TB:
                 u, c_issue = issued.pop(0)
                 # en high in cycle c_issue+1 -> valid in cycle c_issue+1+BIN_RD_LAT, sampled one edge later
                 assert cyc - c_issue == BIN_RD_LAT + 1, f"read latency {cyc - c_issue - 1}"
-                out["H"][u] = int(d.bin_h.value)
-                out["N"][u] = int(d.bin_n.value)
-                out["SX"][u] = d.bin_sx.value.to_signed()
-                out["SY"][u] = d.bin_sy.value.to_signed()
+                if no == 1:
+                    out["H"][u] = int(d.bin_h.value)
+                    out["N"][u] = int(d.bin_n.value)
+                    out["SX"][u] = d.bin_sx.value.to_signed()
+                    out["SY"][u] = d.bin_sy.value.to_signed()
+                else:                  # bank o of address u = joint bin no u + o (bin_*_all, o*width)
+                    for k, port in (("H", d.bin_h_all), ("N", d.bin_n_all), ("SX", d.bin_sx_all),
+                                    ("SY", d.bin_sy_all)):
+                        w, word = widths[k], int(port.value)
+                        for ob in range(no):
+                            v = (word >> (ob * w)) & ((1 << w) - 1)
+                            if k in ("SX", "SY") and v >> (w - 1):
+                                v -= 1 << w
+                            out[k][no * u + ob] = v
+                    assert int(d.bin_h.value) == out["H"][no * u]     # bank 0 on the scalar port
                 got += 1
             # drive
             if nxt < self.n_bins and (rng is None or rng.random() < 0.6):
@@ -190,6 +209,13 @@ def random_kernel(rng: random.Random, tb: TB, big: bool = False, p: int = 0) -> 
 
 def region_bins(rng: np.random.Generator, tb: TB, runs: bool) -> np.ndarray:
     n = tb.rmax
+    if tb.no > 1:       # joint bins no u + o; runs: few colours and orientations (one joint bin, or one
+        if not runs:    # colour with changing orientations, stress the per-bank forwarding)
+            return rng.integers(0, tb.n_bins * tb.no, size=(n, n), dtype=np.int64)
+        b = tb.no * rng.integers(0, min(2, tb.n_bins), size=(n, n)) + rng.integers(0, tb.no, size=(n, n))
+        b[n // 3] = tb.no + 2
+        b[n // 2: n // 2 + 4, : n // 2] = tb.no * (n // 2 % 2) + np.arange(n // 2) % tb.no
+        return b
     if not runs:
         return rng.integers(0, tb.n_bins, size=(n, n), dtype=np.int64)
     # long runs of equal bins (stress the read-modify-write forwarding): horizontal runs of a few
@@ -221,7 +247,7 @@ async def check_passes(dut, n_passes: int, runs: bool, throttle: bool, seed: int
         wy = rng.randint(ker.ey, tb.rmax - 1 - ker.ey)
         clocks = await tb.run_pass(ker, wx, wy)
         got = await tb.read_bins(rng if throttle else None)
-        exp = ms_histogram(bins, reg, (wx, wy), ker, tb.n_bins)
+        exp = ms_histogram(bins, reg, (wx, wy), ker, tb.n_bins * tb.no)
         for name in ("H", "N", "SX", "SY"):
             e = getattr(exp, name)
             bad = np.nonzero(got[name] != e)[0]
@@ -339,6 +365,19 @@ def test_ms_pixel_pass_synth(kernel, lanes, tmp_path):
     """ghdl --synth (to Verilog, as the Verilator/yosys flow does) of the default-size pass succeeds."""
     gen, _ = pass_generics(TrackerParams(kernel=kernel), FixedParams(), lanes)
     hdl.ghdl_to_verilog(TOP, gen, hdl.rtl_sources(TOP), out_path=tmp_path / f"{TOP}.v")
+
+
+@pytest.mark.ghdl
+@pytest.mark.parametrize("kernel,lanes,ram_lat", [("flat", 4, 4), ("epanechnikov", 2, 1), ("flat", 1, 3)])
+def test_ms_pixel_pass_orient_ghdl(kernel, lanes, ram_lat, hdl_waves):
+    """N_ORIENT 9 (joint bins 9 u + o: colour u on ram_data, orientation o on ram_obin, both RAM_LAT clocks
+    after the address; RAM_LAT 4 = core v2's, no delay stage, 1 and 3: 3 and 1 stages): every bank of
+    every address read through bin_*_all, value by value against ms_histogram on the joint bins."""
+    gen, cfg = pass_generics(TrackerParams(colour_bits=2, kernel=kernel), SMALL_FP, lanes)
+    gen["RAM_LAT"] = cfg["RAM_LAT"] = ram_lat
+    gen["N_ORIENT"] = cfg["N_ORIENT"] = 9
+    hdl.run_ghdl(TOP, MODULE, gen, hdl.rtl_sources(TOP), waves=hdl_waves,
+                 extra_env={CFG_ENV: json.dumps(cfg), "MS_PIXEL_PASS_N": "8"})
 
 
 @pytest.mark.ghdl

@@ -66,6 +66,10 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_cycles.py::test_worst_case_cycles[8]":
         "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
         "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_joint":
+        "test_tracker_v2_joint_fastsim (marker long: the joint core's GHDL netlist under Verilator on 160 real "
+        "frames of Girl, MotorRolling and Couple, bit-exact); this case is the RTL itself under GHDL on a rendered "
+        "scene (458 s)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test_fastsim":
         "test_tracker_v2_scale_test (the gated scale test's RTL bit-exact under GHDL, rendered scene with a "
         "size change); this case checks the netlist under Verilator on real frames, lost state included "

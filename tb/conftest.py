@@ -67,8 +67,8 @@ CI_EXTRA: dict[str, str] = {
         "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
         "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_joint":
-        "test_tracker_v2_joint_fastsim (marker long: the joint core's GHDL netlist under Verilator on 160 real "
-        "frames of Girl, MotorRolling and Couple, bit-exact); this case is the RTL itself under GHDL on a rendered "
+        "test_tracker_v2_joint_fastsim (marker long: the joint core's GHDL netlist under Verilator on 100 real "
+        "frames of Girl, MotorRolling and Deer, the lost state included, bit-exact); this case is the RTL itself under GHDL on a rendered "
         "scene (458 s)",
     "tb/test_realtime.py::test_realtime_v2_1080p60[joint]":
         "test_realtime_v2_1080p60[v2] (the colour core at 1080p60) and test_tracker_v2_joint_fastsim (the joint "

@@ -463,12 +463,16 @@ architecture rtl of ms_tracker_v2 is
   signal sc_spread    : unsigned(SPREAD_W - 1 downto 0);                    -- ms_scale's spread
   -- ms_scale_test_size(s8, d256, up) = (s8 (256 -+ d256) + 128) >> 8, saturated to SIZE_W bits (exact:
   -- a size of 2**SIZE_W - 1 already gives a window above MAX_WINDOW at D <= 16, asserted below)
-  function st_size(s8 : unsigned; up : std_logic) return unsigned is
+  -- in two registered steps (p_st_size): the product s8 f, f = 256 -+ d256, then the rounding and
+  -- saturation (st_round), so no multiplier output reaches a register through an adder in one clock
+  signal st_pw_lo, st_pw_hi, st_ph_lo, st_ph_hi : unsigned(SIZE_W + 9 downto 0) := (others => '0');
+  signal st_w8_lo, st_w8_hi, st_h8_lo, st_h8_hi : unsigned(SIZE_W - 1 downto 0) := (others => '0');
+  constant ST_F_LO : natural := 256 - SCALE_TEST_D256;
+  constant ST_F_HI : natural := 256 + SCALE_TEST_D256;
+  function st_round(prod : unsigned) return unsigned is
     variable p : unsigned(SIZE_W + 9 downto 0);
-    variable f : natural;
   begin
-    if up = '1' then f := 256 + SCALE_TEST_D256; else f := 256 - SCALE_TEST_D256; end if;
-    p := resize(s8 * to_unsigned(f, 10), SIZE_W + 10) + 128;
+    p := prod + 128;
     p := shift_right(p, 8);
     if p(SIZE_W + 9 downto SIZE_W) /= 0 then
       return to_unsigned(2 ** SIZE_W - 1, SIZE_W);
@@ -739,6 +743,25 @@ begin
   ---------------------------------------------------------------------------- Qw = ms_model_scale(Qn, K)
   -- one register stage between the model RAM's read data and the multiplier: T_QLOAD counts the
   -- results (ql_seen = N_BINS), so it takes one clock more per frame, nothing else changes
+  -- ms_scale_test_size of both test sizes, computed in every clock from w8, h8: the product registered,
+  -- then rounded and saturated (2 clocks).  w8, h8 change only between frames (init) and in T_RESIZE,
+  -- after the test, so at T_ST_SIZE these registers hold the sizes of this frame's w8, h8.
+  g_st_size : if ST_ON generate
+    p_st_size : process (clk)
+    begin
+      if rising_edge(clk) then
+        st_pw_lo <= resize(w8 * to_unsigned(ST_F_LO, 10), SIZE_W + 10);
+        st_pw_hi <= resize(w8 * to_unsigned(ST_F_HI, 10), SIZE_W + 10);
+        st_ph_lo <= resize(h8 * to_unsigned(ST_F_LO, 10), SIZE_W + 10);
+        st_ph_hi <= resize(h8 * to_unsigned(ST_F_HI, 10), SIZE_W + 10);
+        st_w8_lo <= st_round(st_pw_lo);
+        st_w8_hi <= st_round(st_pw_hi);
+        st_h8_lo <= st_round(st_ph_lo);
+        st_h8_hi <= st_round(st_ph_hi);
+      end if;
+    end process;
+  end generate;
+
   p_qn_r : process (clk)
   begin
     if rising_edge(clk) then
@@ -1413,8 +1436,13 @@ begin
         ------------------------------------------------------------ the gated scale test (ST_ON)
         when T_ST_SIZE =>                      -- ms_scale_test_size x 2; the final centre's window, region-relative
           if ST_ON then                        -- (no multiplier in the netlist without the test)
-            st_w8 <= st_size(w8, st_up);
-            st_h8 <= st_size(h8, st_up);
+            if st_up = '1' then
+              st_w8 <= st_w8_hi;
+              st_h8 <= st_h8_hi;
+            else
+              st_w8 <= st_w8_lo;
+              st_h8 <= st_h8_lo;
+            end if;
             st_rx <= rg_round(r_cx) - rg_s(reg_x);
             st_ry <= rg_round(r_cy) - rg_s(reg_y);
           end if;

@@ -164,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
             "flag's thresholds chosen again for it on this set (`loss_rho=0.69, loss_contrast=0.25`: in "
             "sample; leaving one sequence out gives about 0.54 / 0.83 recall at 0.063 / 0.070 false alarms, "
             "float / fixed).  It is the candidate for the next default (docs/results_v2_mean.md): the default "
-            "stays `mstrack-v2` until the joint core is placed and routed and the default is switched with core v2's tests (\"Path to adoption\").",
+            "stays `mstrack-v2` until the joint core's Fmax (112.65 MHz at grade 8) and the default switch with core v2's tests are done (\"Path to adoption\").",
             "* **Fusion does not pay on this set (paper preset).** In the run above, colour alone beats the fused "
             "tracker. The 16-bin gradient-magnitude histogram discriminates poorly (edge alone is the "
             "weakest mstrack variant): the background next to a target often has an edge histogram much "

@@ -103,7 +103,7 @@ eval: setup
 
 results: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval_float --quiet
-	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-joint,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
+	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
 	$(PY) tools/results_doc.py
 
 clean:

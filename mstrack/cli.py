@@ -447,22 +447,27 @@ def track_frames(tracker: Any, frames: Iterable[np.ndarray | None], box: Box, ou
 def resolve_tracker(tracker: str | None, preset: str | None) -> str:
     """Tracker name from ``--tracker`` and ``--preset`` (track, demo, bench).
 
-    No option: :data:`DEFAULT_TRACKER` (mstrack-v2).  ``--preset v2`` runs ``mstrack-v2`` (colour
-    only, so it takes no other ``--tracker``); ``--preset paper`` runs ``--tracker`` or
+    No option: :data:`DEFAULT_TRACKER` (mstrack-v2).  ``--preset v2`` runs ``mstrack-v2`` (or
+    ``--tracker mstrack-v2-colour``, tracker v2 on colour alone); ``--preset paper`` runs ``--tracker`` or
     :data:`PAPER_TRACKER` (mstrack-fused-flat, the paper's algorithm: the RTL core's).  An unknown
     name is refused with the list of known ones."""
     from .eval.evaluate import tracker_names
 
-    v2 = "mstrack-v2"
+    from .eval.evaluate import RENAMED
+
+    v2, v2s = "mstrack-v2", ("mstrack-v2", "mstrack-v2-colour")
+    if tracker in RENAMED:
+        raise ValueError(f"tracker {tracker!r} is now {RENAMED[tracker]!r}")
     if tracker is not None and tracker not in tracker_names():
         raise ValueError(f"unknown tracker {tracker!r}; known: {', '.join(tracker_names())}")
     if preset == "v2":
-        if tracker not in (None, v2):
-            raise ValueError(f"--preset v2 runs {v2}; leave out --tracker {tracker} (or use --preset paper)")
-        return v2
+        if tracker not in (None, *v2s):
+            raise ValueError(f"--preset v2 runs {' or '.join(v2s)}; leave out --tracker {tracker} "
+                             "(or use --preset paper)")
+        return tracker or v2
     if preset == "paper":
-        if tracker == v2:
-            raise ValueError(f"--tracker {v2} is the v2 preset; leave out --preset paper")
+        if tracker in v2s:
+            raise ValueError(f"--tracker {tracker} is the v2 preset; leave out --preset paper")
         return tracker or PAPER_TRACKER
     return tracker or DEFAULT_TRACKER
 

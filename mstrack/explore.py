@@ -184,9 +184,9 @@ def _base_params(tracker: str) -> tuple[TrackerParams, dict[str, Any]]:
         raise ValueError(f"explore runs mstrack trackers; unknown {tracker!r}; known: {', '.join(known)}")
     if tracker == "mstrack-v2":
         kw: dict[str, Any] = {"preset": "v2"}
-    elif tracker == "mstrack-v2-joint":
-        from .track.params import V2_JOINT
-        kw = {"preset": "v2", **V2_JOINT}
+    elif tracker == "mstrack-v2-colour":
+        from .track.params import V2_COLOUR
+        kw = {"preset": "v2", **V2_COLOUR}
     else:
         _, feat, ker = tracker.split("-")
         kw = {"preset": "paper", "features": canonical("features", feat), "kernel": canonical("kernel", ker)}

@@ -124,8 +124,8 @@ entity ms_tracker is
     CON_W          : natural := 18;
     LOSS_K         : natural := 1;
     REF_K          : natural := 6;
-    LOSS_RHO       : natural := 57672;
-    LOSS_CONTRAST  : integer := 12452;
+    LOSS_RHO       : natural := 45220;
+    LOSS_CONTRAST  : integer := 16384;
     CONF_LOST      : natural := 26214;           -- round(conf_lost 2**16)
     CONF_UNCERTAIN : natural := 32768;
     CONF_REACQUIRE : natural := 32768;
@@ -135,8 +135,8 @@ entity ms_tracker is
     SEARCH_ITER    : natural := 5;               -- iterations per start point while lost
     STEP16         : natural := 16;              -- search_step in 1/16
     MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
-    SCALE_TEST_D256: natural range 0 to 255 := 0; -- the gated scale test (experimental): round(256 scale_test); 0 = off
-    ORIENT_T       : integer range -1 to 2047 := -1 -- the joint colour x orientation bins (experimental): orient_T; -1 = off
+    SCALE_TEST_D256: natural range 0 to 255 := 13; -- PRESET 1: the gated scale test: round(256 scale_test); 0 = off (mstrack-v2-colour)
+    ORIENT_T       : integer range -1 to 2047 := 64 -- PRESET 1: the joint colour x orientation bins: orient_T; -1 = off (mstrack-v2-colour)
   );
   port (
     clk                  : in  std_logic;                                -- core and pixel clock
@@ -402,10 +402,6 @@ architecture rtl of ms_tracker is
         severity failure;
       return true;
     end if;
-    assert SCALE_TEST_D256 = 0 report "ms_tracker: SCALE_TEST_D256 = " & img(SCALE_TEST_D256)
-             & ": the gated scale test is core v2's (PRESET 1)" severity failure;
-    assert ORIENT_T = -1 report "ms_tracker: ORIENT_T = " & integer'image(ORIENT_T)
-             & ": the joint bins are core v2's (PRESET 1)" severity failure;
     assert LANES = 1 or (LANES >= 1 and 2 ** clog2(LANES) = LANES)
       report "ms_tracker: LANES = " & img(LANES) & " is not a power of two" severity failure;
     assert FEATURES <= 2 report "ms_tracker: FEATURES = " & img(FEATURES) & " (0 fused, 1 colour, 2 edge)"

@@ -20,7 +20,7 @@
 --   iterations in the same region, the best confidence wins; then for the winner ms_spread,
 --   ms_ring_share, ms_loss_filter x 2, ms_loss_flag, the search state and the reported status,
 --   ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
---   With SCALE_TEST_D256 > 0 (the gated scale test, experimental: FixedTrackerV2 with scale_test and
+--   With SCALE_TEST_D256 > 0 (the gated scale test, the default 13: FixedTrackerV2 with scale_test and
 --   scale_test_gate, _scale_verdict), when the scale branch is taken (SCALE_GAIN > 0, nt > 0), before
 --   ms_scale, for the sizes x(1 - d) then x(1 + d) (T_ST_SIZE .. T_ST_NEXT): ms_scale_test_size (a
 --   constant multiply, round half up), ms_window_size (the frame set-up's instances, inputs muxed),
@@ -31,8 +31,8 @@
 --   window tables, K, Q RAM and S are overwritten (nothing after T_DECIDE reads them: rho, share,
 --   spread, ring share, confidence and the loss flag are registered by then; the next frame rebuilds
 --   them); the window registers wd, hd, ex, ey, hi_x, hi_y likewise (set up again before the frame).
---   With ORIENT_T >= 0 (the joint colour x gradient-orientation bins, experimental: FixedTrackerV2
---   with orient_T = ORIENT_T, tracker mstrack-v2-joint with the gated scale test): a pixel's bin is
+--   With ORIENT_T >= 0 (the joint colour x gradient-orientation bins, the default 64: FixedTrackerV2
+--   with orient_T = ORIENT_T, tracker mstrack-v2 with the gated scale test): a pixel's bin is
 --   (colour, ms_orient_bin(ms_grey(frame), ORIENT_T)) = 9 colour + obin, 4,608 bins.  ms_frontend's
 --   ip_obin rides ms_decimate's edge path into a 4-bit orientation region RAM beside the colour one
 --   (same addresses, same latency: ram_obin); on the init frame ms_init_merge feeds ms_bg_model
@@ -144,8 +144,8 @@ entity ms_tracker_v2 is
     CON_W          : natural := 18;
     LOSS_K         : natural := 1;
     REF_K          : natural := 6;
-    LOSS_RHO       : natural := 57672;
-    LOSS_CONTRAST  : integer := 12452;
+    LOSS_RHO       : natural := 45220;
+    LOSS_CONTRAST  : integer := 16384;
     CONF_LOST      : natural := 26214;    -- round(conf_lost 2**16)
     CONF_UNCERTAIN : natural := 32768;
     CONF_REACQUIRE : natural := 32768;
@@ -155,17 +155,17 @@ entity ms_tracker_v2 is
     SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
     STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
     MARGIN_MAX     : natural := 255;      -- largest region margin (MARGIN + the search offset)
-    -- the gated scale test (experimental; mstrack.fixed.tracker_v2 _scale_verdict, scale_test with
-    -- scale_test_gate): d256 = round(256 scale_test); 0 = off (the core without it, bit for bit).
+    -- the gated scale test (mstrack.fixed.tracker_v2 _scale_verdict, scale_test with scale_test_gate):
+    -- d256 = round(256 scale_test), 13 = tracker v2's default 0.05; 0 = off (mstrack-v2-colour).
     -- Costs a 9-bit constant multiply per axis, a 2-input mux on the window-size inputs, the fit
     -- compares, 2 x 17-bit rho compares and one SPREAD_W compare (the gate); buys rho-checked scale
     -- updates at 2 x (tables + Qw load + one pass + rho) clocks more per tracking frame
-    SCALE_TEST_D256 : natural range 0 to 255 := 0;
-    -- the joint colour x gradient-orientation bins (experimental; FixedTrackerV2 with orient_T =
-    -- ORIENT_T, mstrack-v2-joint's 64): -1 = off (colour bins, the core without them, bit for bit);
+    SCALE_TEST_D256 : natural range 0 to 255 := 13;
+    -- the joint colour x gradient-orientation bins (FixedTrackerV2 with orient_T = ORIENT_T, the
+    -- default tracker v2's 64): -1 = off (colour bins alone: mstrack-v2-colour, bit for bit);
     -- >= 0: a pixel's bin is 9 colour + ms_orient_bin(grey, ORIENT_T) (4,608 bins: N_ORIENT 9 banks of
     -- the histogram, the bin pass, the model and T; a 4-bit orientation region RAM beside the colour one)
-    ORIENT_T        : integer range -1 to 2047 := -1
+    ORIENT_T        : integer range -1 to 2047 := 64
   );
   port (
     clk                  : in  std_logic;

@@ -71,7 +71,7 @@ CI_EXTRA: dict[str, str] = {
         "frames of Girl, MotorRolling and Deer, the lost state included, bit-exact); this case is the RTL itself under GHDL on a rendered "
         "scene (458 s)",
     "tb/test_realtime.py::test_realtime_v2_1080p60[joint]":
-        "test_realtime_v2_1080p60[v2] (the colour core at 1080p60) and test_tracker_v2_joint_fastsim (the joint "
+        "test_realtime_v2_1080p60[colour] (the colour core at 1080p60) and test_tracker_v2_joint_fastsim (the joint "
         "core's netlist, same build, bit-exact on real frames); this case: the joint core's latencies at 1080p60",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test_fastsim":
         "test_tracker_v2_scale_test (the gated scale test's RTL bit-exact under GHDL, rendered scene with a "

@@ -46,7 +46,7 @@ from mstrack.hw.cosim import (COMPARED_FIELDS, COMPARED_FIELDS_V2, CoreConfig, C
                               diff_fields, frame_words)
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import RESULT_FLAGS, STATUS_V2, unpack_result, unpack_result_v2
-from mstrack.track.params import TrackerParams
+from mstrack.track.params import V2_COLOUR, TrackerParams
 from mstrack.hw.regs import register_map
 
 from test_ms_tracker import SEQ_ROOT, lines_of
@@ -99,7 +99,9 @@ def load_job_frames(job: dict) -> tuple[list[np.ndarray], list[str | None], tupl
 
 def config_of(job: dict) -> CoreConfig | CoreConfigV2:
     if job.get("preset", 0):
-        return CoreConfigV2(TrackerParams(**{"preset": "v2", **job.get("tp", {})}), FixedParams(**job.get("fp", {})),
+        # tracker v2 on colour alone (V2_COLOUR; the register bank is the same for the joint bins)
+        return CoreConfigV2(TrackerParams(**{"preset": "v2", **V2_COLOUR, **job.get("tp", {})}),
+                            FixedParams(**job.get("fp", {})),
                             max_frame_w=job.get("max_frame_w", 1024))
     return CoreConfig(TrackerParams(**job.get("tp", {})), FixedParams(**job.get("fp", {})),
                       max_frame_w=job.get("max_frame_w", 1024))

@@ -108,6 +108,7 @@ CONFIG_CASES = {
     "big_window": dict(max_target=511, max_frame_width=8000, coord_bits=13, kernel="epanechnikov"),
     "l1_edge_ug934": dict(lanes=1, features="edge", max_target=15, margin=0, rgb_packing="ug934"),
     "v2": dict(preset="v2", max_frame_width=1920),        # PRESET 1: core v2 (ms_tracker_v2 elaborated too)
+    "v2_colour": dict(preset="v2", colour=True, max_frame_width=1920),   # mstrack-v2-colour: ORIENT_T -1
 }
 
 

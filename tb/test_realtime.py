@@ -151,13 +151,14 @@ V2_RT_START, V2_RT_FRAMES = 30, 10
 
 @pytest.mark.long
 @pytest.mark.verilator
-@pytest.mark.parametrize("variant", ["v2", "joint"])
+@pytest.mark.parametrize("variant", ["colour", "joint"])
 def test_realtime_v2_1080p60(variant):
     """Core v2 (ms_tracker with PRESET 1, LANES 4) at 1080p60 timing on real footage with a loss, a wide search and
     a re-acquisition: bit-exact (every field of result word v2), no input stall, every result before
     the next frame's first pixel.  The analytic worst case (largest window, max_iter, the search) is
-    the v2 cycle budget of docs/fixed_point.md ("Hardware cost of v2").  ``joint``: mstrack-v2-joint
-    (ORIENT_T 64, the gated scale test, its loss thresholds; `make test-extra`, tb/conftest.py CI_EXTRA)."""
+    the v2 cycle budget of docs/fixed_point.md ("Hardware cost of v2").  ``colour``: mstrack-v2-colour
+    (V2_COLOUR: ORIENT_T -1, no scale test); ``joint``: the default tracker v2, mstrack-v2 (ORIENT_T 64,
+    the gated scale test, its loss thresholds; `make test-extra`, tb/conftest.py CI_EXTRA)."""
     import cv2
     from mstrack.hw.cosim import COMPARED_FIELDS_V2, expected_results_v2
     from mstrack.io.data import load_sequence
@@ -168,17 +169,17 @@ def test_realtime_v2_1080p60(variant):
     frames = [cv2.resize(cv2.imread(str(f), cv2.IMREAD_COLOR), (HD_W, HD_H), interpolation=cv2.INTER_LINEAR)
               for f in s.img_files[V2_RT_START:V2_RT_START + V2_RT_FRAMES]]
     box = tuple(int(round(float(v) * 3)) for v in s.gt[V2_RT_START])
-    from mstrack.track.params import V2_JOINT
-    tp, fp = TrackerParams(preset="v2", **(V2_JOINT if variant == "joint" else {})), FixedParams()
+    from mstrack.track.params import V2_COLOUR, V2_JOINT
+    tp, fp = TrackerParams(preset="v2", **(V2_JOINT if variant == "joint" else V2_COLOUR)), FixedParams()
     exp = expected_results_v2(frames, box, tp, fp)
-    if variant == "v2":
+    if variant == "colour":
         assert any(e["searched"] == 8 for e in exp), "the clip must contain a wide-search frame (model)"
     run = fastsim.simulate(frames, box, tp, fp, lanes=DEFAULT_LANES, hblank=HBLANK, vblank=VBLANK, lead=VBLANK,
                            max_frame_w=HD_W, v2=True)
     mism = fastsim.compare(run.results, exp, COMPARED_FIELDS_V2)
     misses = _misses(run, BUDGET)
     stalls = [f["stall_cycles"] for f in run.frames]
-    _report(("realtime_v2_1080p60_lanes%d" if variant == "v2" else "realtime_v2_joint_1080p60_lanes%d") % DEFAULT_LANES, {
+    _report(("realtime_v2_1080p60_lanes%d" if variant == "colour" else "realtime_v2_joint_1080p60_lanes%d") % DEFAULT_LANES, {
         "source": f"MotorRolling {V2_RT_START}-{V2_RT_START + V2_RT_FRAMES - 1} x3", "frames": len(frames),
         "box": list(box), "lanes": DEFAULT_LANES, "budget_clocks": BUDGET, "latency_clocks": run.latencies,
         "worst_latency_clocks": max(run.latencies), "stall_cycles": stalls,

@@ -94,7 +94,7 @@ def test_bad_frame_while_lost_keeps_searching() -> None:
 
 
 @pytest.mark.parametrize("kw,what", [({"motion_gain": 0.5}, "motion_gain"),
-                                     ({"scale_test": 0.05}, "scale_test without scale_test_gate"),
+                                     ({"scale_test": 0.05, "scale_test_gate": False}, "scale_test without scale_test_gate"),
                                      ({"orient_T": 64, "motion_gain": 0.5}, "motion_gain")])
 def test_core_config_v2_refuses_options_without_rtl(kw, what):
     """The experimental v2 options without RTL (motion_gain; the ungated scale test) are in
@@ -108,11 +108,13 @@ def test_core_config_v2_refuses_options_without_rtl(kw, what):
 
 
 def test_core_config_v2_joint():
-    """mstrack-v2-joint has RTL (session 15): ORIENT_T = orient_T (64) beside SCALE_TEST_D256 13 and the
-    loss thresholds, for ms_tracker_v2 and ms_tracker (PRESET 1); every other generic as without it."""
+    """The default tracker v2 (the joint bins, RTL since session 15) has ORIENT_T = orient_T (64) beside
+    SCALE_TEST_D256 13 and the loss thresholds, for ms_tracker_v2 and ms_tracker (PRESET 1); every other
+    generic as without the joint bins."""
     from mstrack.fixed.formats import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import V2_JOINT, TrackerParams
+    assert TrackerParams(preset="v2") == TrackerParams(preset="v2", **V2_JOINT)   # the default
     j = CoreConfigV2(TrackerParams(preset="v2", **V2_JOINT), FixedParams()).generics()
     o = CoreConfigV2(TrackerParams(preset="v2", **{**V2_JOINT, "orient_T": 0}), FixedParams()).generics()
     assert j.pop("ORIENT_T") == 64 and o.pop("ORIENT_T") == -1 and j == o
@@ -122,14 +124,14 @@ def test_core_config_v2_joint():
 
 
 def test_core_config_v2_gated_scale_test():
-    """The gated scale test (mstrack-v2-joint's scale_test 0.05 + gate) has RTL: generic SCALE_TEST_D256 =
-    round(256 scale_test) = 13 of ms_tracker_v2 and of ms_tracker (PRESET 1 passes it on); off, it is 0,
-    the VHDL default, and every other generic is the same."""
+    """The gated scale test (the default scale_test 0.05 + gate) has RTL: generic SCALE_TEST_D256 =
+    round(256 scale_test) = 13 of ms_tracker_v2 and of ms_tracker (PRESET 1 passes it on), the VHDL
+    default; off (mstrack-v2-colour's), it is 0 and every other generic is the same."""
     from mstrack.fixed.formats import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import TrackerParams
-    on = CoreConfigV2(TrackerParams(preset="v2", scale_test=0.05, scale_test_gate=True), FixedParams())
-    off = CoreConfigV2(TrackerParams(preset="v2"), FixedParams())
+    on = CoreConfigV2(TrackerParams(preset="v2", orient_T=0), FixedParams())
+    off = CoreConfigV2(TrackerParams(preset="v2", orient_T=0, scale_test=0.0, scale_test_gate=False), FixedParams())
     g, g_off = on.generics(), off.generics()
     assert g.pop("SCALE_TEST_D256") == 13 and g_off.pop("SCALE_TEST_D256") == 0
     assert g == g_off

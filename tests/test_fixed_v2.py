@@ -19,7 +19,7 @@ from mstrack.fixed.blocks_v2 import (ONE, ms_bg_model, ms_box_size, ms_confidenc
                                      ms_spread,
                                      ms_target_stats, ms_window_size, rate_shift, sixteenths, TargetStats)
 from mstrack.track.float_v2 import FloatTrackerV2
-from mstrack.track.params import TrackerParams
+from mstrack.track.params import V2_COLOUR, TrackerParams
 
 SEQ_ROOT = Path(__file__).resolve().parents[2] / "shared" / "data" / "sequences"
 V2 = TrackerParams(preset="v2")
@@ -309,7 +309,9 @@ def _scene(n: int = 30):
 def test_fixed_v2_tracks_a_growing_target_like_float():
     frames, boxes = _scene()
     for model in ("float", "fixed"):
-        trk = Tracker(model=model, preset="v2")
+        # on colour alone, without the scale test: the default's gated scale test vetoes this growth
+        # (test_fixed_v2_joint_gate_tracks_like_float)
+        trk = Tracker(model=model, preset="v2", **V2_COLOUR)
         trk.init(frames[0], boxes[0])
         for f in frames[1:]:
             r = trk.update(f)
@@ -593,26 +595,36 @@ def test_fixed_v2_joint_gate_tracks_like_float():
         assert np.mean(iou(out[model], gt)) > 0.5, model
     assert np.max(np.abs(out["fixed"] - out["float"])[:, :2]) < 3.0
     with pytest.raises(ValueError):
-        Tracker(model="fixed", preset="v2", scale_test=0.05)
+        Tracker(model="fixed", preset="v2", scale_test=0.05, scale_test_gate=False)
     with pytest.raises(ValueError):
         Tracker(model="fixed", preset="v2", motion_gain=0.5)
 
 
-def test_registered_v2_joint_tracker_is_the_candidate():
-    """``mstrack-v2-joint`` (make results, mstrack eval / bench / explore) builds tracker v2 with the
-    candidate's options and loss thresholds in both models, and tracks the scene of
-    test_fixed_v2_joint_gate_tracks_like_float exactly as those options given by hand do."""
-    from mstrack.eval.evaluate import V2_JOINT, make_tracker
+def test_registered_v2_trackers():
+    """``mstrack-v2`` (make results, mstrack eval / bench / explore) builds the default tracker v2, the
+    joint tracker's options and loss thresholds (V2_JOINT), in both models, and tracks the scene of
+    test_fixed_v2_joint_gate_tracks_like_float exactly as those options given by hand do;
+    ``mstrack-v2-colour`` builds V2_COLOUR's (ORIENT_T 0, no scale test) and tracks differently; the
+    former name ``mstrack-v2-joint`` is refused with its new name."""
+    from mstrack.eval.evaluate import V2_COLOUR, V2_JOINT, make_tracker
     from mstrack.explore import _base_params
     frames, gt = _scene()
     frames = frames[:12]
     for model in ("float", "fixed"):
-        t = make_tracker("mstrack-v2-joint", model)
-        assert t.params == TrackerParams(preset="v2", **V2_JOINT), model
+        t = make_tracker("mstrack-v2", model)
+        assert t.params == TrackerParams(preset="v2", **V2_JOINT) == TrackerParams(preset="v2"), model
         ref = Tracker(model=model, preset="v2", orient_T=64, scale_test=0.05, scale_test_gate=True,
                       loss_rho=0.69, loss_contrast=0.25)
         got = [t.init(frames[0], tuple(gt[0]))] + [t.update(f) for f in frames[1:]]
         want = [ref.init(frames[0], tuple(gt[0]))] + [ref.update(f) for f in frames[1:]]
         assert got == want, model
-    tp, kw = _base_params("mstrack-v2-joint")
-    assert tp == TrackerParams(preset="v2", **V2_JOINT) and kw["orient_T"] == 64
+        c = make_tracker("mstrack-v2-colour", model)
+        assert c.params == TrackerParams(preset="v2", **V2_COLOUR) and c.params.orient_T == 0, model
+        colour = [c.init(frames[0], tuple(gt[0]))] + [c.update(f) for f in frames[1:]]
+        assert colour != got, model
+    with pytest.raises(ValueError, match="is now 'mstrack-v2'"):
+        make_tracker("mstrack-v2-joint")
+    tp, kw = _base_params("mstrack-v2")
+    assert tp == TrackerParams(preset="v2", **V2_JOINT) and tp.orient_T == 64
+    tp, kw = _base_params("mstrack-v2-colour")
+    assert tp == TrackerParams(preset="v2", **V2_COLOUR) and kw["orient_T"] == 0

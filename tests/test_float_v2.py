@@ -22,7 +22,7 @@ from mstrack import FrameError, Status, Tracker
 from mstrack.track import float_v2 as v2
 from mstrack.eval.agreement import shift_scene
 from mstrack.eval.metrics import iou
-from mstrack.track.params import TrackerParams
+from mstrack.track.params import V2_COLOUR, TrackerParams
 from mstrack.io.synthetic import render_scene
 
 SEQ_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "sequences"
@@ -371,12 +371,14 @@ def _scale_scene(seed, w0=40, h0=30, factor=1.6, n=121, width=320, height=240):
 @pytest.mark.parametrize("seed", SEEDS)
 @pytest.mark.parametrize("w0,h0,factor", [(40, 30, 1.6), (60, 45, 1 / 1.6)])
 def test_scale_followed(seed, w0, h0, factor):
-    """x1.6 (or /1.6) over 60 frames and back.  v2's box size follows it, lagging (gain 0.3, pulled
-    to the init size by reg 0.1); the paper preset keeps the init size.
+    """x1.6 (or /1.6) over 60 frames and back.  Tracker v2's box size follows it, lagging (gain 0.3,
+    pulled to the init size by reg 0.1); the paper preset keeps the init size.  This runs v2 on
+    colour alone without the scale test (mstrack-v2-colour): the default's gated scale test vetoes the
+    growth on this scene (test_scale_followed_default).
     Measured (seeds 0..2): size error max 0.20 (grow) / 0.18 (shrink); at the extreme v2's size is
     x1.28 / x0.73 of the init size; mean IoU v2 0.84 / 0.87, paper 0.53 / 0.64."""
     frames, gt = _scale_scene(seed, w0, h0, factor)
-    _, r2 = _run(frames, gt[0], preset="v2")
+    _, r2 = _run(frames, gt[0], preset="v2", **V2_COLOUR)
     _, rp = _run(frames, gt[0], preset="paper")
     b2, bp = _boxes(r2), _boxes(rp)
     size = lambda b: np.sqrt(b[:, 2] * b[:, 3])  # noqa: E731
@@ -394,6 +396,30 @@ def test_scale_followed(seed, w0, h0, factor):
     assert i2.mean() > 0.75 and i2.min() > 0.5, (i2.mean(), i2.min())
     assert i2.mean() > ip.mean() + 0.15, (i2.mean(), ip.mean())
     assert i2[55:66].mean() > ip[55:66].mean() + 0.2     # around the extreme size
+    assert all(r.ok for r in r2)
+
+
+@pytest.mark.parametrize("w0,h0,factor", [(40, 30, 1.6), (60, 45, 1 / 1.6)])
+def test_scale_followed_default(w0, h0, factor):
+    """The scene of test_scale_followed (seed 0) with the default tracker v2 (joint bins, the gated
+    scale test): it follows the shrinking as the colour tracker does (size error max 0.17), but the
+    gate vetoes most of the growth: on a uniform target whose padded window already holds it, rho at
+    x1.05 is not above rho at x1, so the spread's growth is not confirmed (size error max 0.36, the
+    box grows only about x1.06; the colour tracker's 0.20).  A known weakness of the default, kept
+    visible here; on the dev set the gate pays (docs/results_v2_mean.md)."""
+    frames, gt = _scale_scene(0, w0, h0, factor)
+    _, r2 = _run(frames, gt[0], preset="v2")
+    b2 = _boxes(r2)
+    size = lambda b: np.sqrt(b[:, 2] * b[:, 3])  # noqa: E731
+    err = np.abs(size(b2) / size(gt) - 1).max()
+    grow = size(b2)[60] / size(b2)[0]
+    i2 = iou(b2, gt)
+    if factor > 1:
+        assert 0.3 < err < 0.4 and grow < 1.1, (err, grow)   # vetoed (if this fails, the gate changed)
+        assert i2.mean() > 0.6, i2.mean()
+    else:
+        assert err < 0.2 and grow < 0.85, (err, grow)
+        assert i2.mean() > 0.75 and i2.min() > 0.5, (i2.mean(), i2.min())
     assert all(r.ok for r in r2)
 
 
@@ -627,6 +653,6 @@ def test_rescale_scale_test_options():
     assert rescale(size0, size0, spread_up, 1.0, shape, gate, 1.05) == grow
     assert rescale(size0, size0, spread_up, 1.0, shape, gate, 1.0) == size0
     assert rescale(size0, size0, spread_up, 1.0, shape, gate, 0.95) == size0
-    mix = TrackerParams(preset="v2", scale_test=0.05, scale_test_mix=0.5)
+    mix = TrackerParams(preset="v2", scale_test=0.05, scale_test_mix=0.5, scale_test_gate=False)
     w, _ = rescale(size0, size0, spread_up, 1.0, shape, mix, 0.95)
     assert w == pytest.approx(40.0 * (1.0 + 0.3 * (0.5 * 0.95 + 0.5 * 1.1 - 1.0)))

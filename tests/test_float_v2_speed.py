@@ -19,7 +19,7 @@ import pytest
 from mstrack.track import float_model as fm
 from mstrack.track import float_v2 as v2
 from mstrack.io.data import load_dataset
-from mstrack.track.params import TrackerParams
+from mstrack.track.params import V2_COLOUR, TrackerParams
 from mstrack.io.synthetic import make_scene
 from mstrack.track.types import Status
 
@@ -146,12 +146,16 @@ def test_moving_target(kernel):
 @needs_numba
 @pytest.mark.parametrize("kernel", KERNELS)
 def test_scale_change(kernel):
-    """The target grows from 20 to 50 px and shrinks back: the box follows (scale every frame)."""
+    """The target grows from 20 to 50 px and shrinks back: the two paths agree, and tracker v2 on
+    colour alone (V2_COLOUR) follows it (scale every frame); the default's gated scale test vetoes
+    the growth on this scene (tests/test_float_v2.py::test_scale_followed_default)."""
     sizes = [20 + i for i in range(30)] + [50 - i for i in range(25)]
     boxes = [(60 + 2 * i - s // 2, 90 - s // 2, s, s) for i, s in enumerate(sizes)]
-    res = _assert_identical(_render(200, 280, boxes, seed=1), boxes[0], kernel=kernel)
+    frames = _render(200, 280, boxes, seed=1)
+    res = _assert_identical(frames, boxes[0], kernel=kernel, **V2_COLOUR)
     widths = [r.box.w for r in res]
     assert max(widths) > 24 and widths[-1] < max(widths) - 1
+    _assert_identical(frames, boxes[0], kernel=kernel)
 
 
 @needs_numba
@@ -210,7 +214,7 @@ def test_shift_test_near_eps2_is_decided_in_python(monkeypatch):
     """s2 within rounding of eps2 goes back to Python (``dx ** 2`` is libm's pow, not dx * dx)."""
     boxes = [(50, 40, 37, 29), (53, 42, 37, 29)]
     frames = _render(150, 200, boxes, seed=7)
-    trk = v2.FloatTrackerV2(TrackerParams(preset="v2"), path="numpy")
+    trk = v2.FloatTrackerV2(TrackerParams(preset="v2", **V2_COLOUR), path="numpy")   # colour bins below
     trk.init(frames[0], boxes[0])
     w, h = trk._size
     hx, hy = 1.25 * w / 2.0, 1.25 * h / 2.0
@@ -231,7 +235,7 @@ def test_shift_test_near_eps2_is_decided_in_python(monkeypatch):
     trk._bufs = v2._nb_buffers_v2(hx, hy, 512)
     trk._cache = v2._bins_cache(*frames[1].shape[:2])
     for eps2 in (s2, float(np.nextafter(s2, np.inf))):  # go on, stop at c1
-        trk.params = TrackerParams(preset="v2", eps2=eps2)
+        trk.params = TrackerParams(preset="v2", eps2=eps2, **V2_COLOUR)
         want = trk._track(bins, start, hx, hy, 10)
         got = trk._track(frames[1], start, hx, hy, 10)
         assert got == want

@@ -39,16 +39,21 @@ def test_preset_v2_gives_core_v2_generics():
 
 
 def test_scale_test_choice():
-    """Preset v2's experimental gated scale test reaches SCALE_TEST_D256 (round(256 x), the generics of
-    CoreConfigV2 with scale_test + gate, the header says so); off it is 0, the VHDL default; the paper
-    preset, a step that rounds to 0 and one above 0.5 are refused with the reason."""
-    cfg = derive(CoreChoices(preset="v2", scale_test=0.05))
-    tp = TrackerParams(preset="v2", scale_test=0.05, scale_test_gate=True)
-    assert cfg.tp == tp and cfg.generics["SCALE_TEST_D256"] == 13
+    """Preset v2's gated scale test reaches SCALE_TEST_D256 (round(256 x), the generics of CoreConfigV2
+    with scale_test + gate, the header says so); left out it is the tracker's (mstrack-v2 0.05 -> 13, the
+    VHDL default; --colour 0); 0 turns it off; the paper preset, a step that rounds to 0 and one above
+    0.5 are refused with the reason."""
+    cfg = derive(CoreChoices(preset="v2", scale_test=0.1))
+    tp = TrackerParams(preset="v2", scale_test=0.1, scale_test_gate=True)
+    assert cfg.tp == tp and cfg.generics["SCALE_TEST_D256"] == 26
     assert {k: cfg.generics[k] for k in CoreConfigV2(tp, FixedParams()).tracker_generics()} == \
         CoreConfigV2(tp, FixedParams()).tracker_generics()
-    assert derive(CoreChoices(preset="v2")).generics["SCALE_TEST_D256"] == 0
-    assert "the gated scale test 0.05 (SCALE_TEST_D256 13" in render(cfg, "package")
+    assert derive(CoreChoices(preset="v2")).generics["SCALE_TEST_D256"] == 13
+    assert derive(CoreChoices(preset="v2", colour=True)).generics["SCALE_TEST_D256"] == 0
+    assert derive(CoreChoices(preset="v2", colour=True, scale_test=0.05)).generics["SCALE_TEST_D256"] == 13
+    off = derive(CoreChoices(preset="v2", scale_test=0.0))
+    assert off.generics["SCALE_TEST_D256"] == 0 and off.tp.scale_test == 0.0 and off.generics["ORIENT_T"] == 64
+    assert "SCALE_TEST_D256 26)" in render(cfg, "package")
     for bad, why in ((dict(scale_test=0.05), "core v2's"), (dict(preset="v2", scale_test=0.001), "d256 = 0"),
                      (dict(preset="v2", scale_test=0.7), "up to 0.5")):
         with pytest.raises(ConfigError, match=why):
@@ -56,24 +61,27 @@ def test_scale_test_choice():
     assert "SCALE_TEST_D256" not in derive(CoreChoices()).generics
 
 
-def test_joint_choice():
-    """Preset v2's experimental --joint builds mstrack-v2-joint: TrackerParams(preset="v2", **V2_JOINT),
-    ORIENT_T 64 and SCALE_TEST_D256 13 (CoreConfigV2's generics), the header says so; off, ORIENT_T is
-    -1 (the VHDL default, rendered as an integer constant); the paper preset and --joint with
-    --scale-test are refused with the reason."""
-    from mstrack.track.params import V2_JOINT
-    cfg = derive(CoreChoices(preset="v2", joint=True))
-    tp = TrackerParams(preset="v2", **V2_JOINT)
-    assert cfg.tp == tp and cfg.generics["ORIENT_T"] == 64 and cfg.generics["SCALE_TEST_D256"] == 13
+def test_colour_choice():
+    """Preset v2 builds the default tracker mstrack-v2 (the joint bins: ORIENT_T 64, SCALE_TEST_D256 13);
+    --colour builds mstrack-v2-colour: TrackerParams(preset="v2", **V2_COLOUR), ORIENT_T -1 (rendered as
+    an integer constant) and SCALE_TEST_D256 0 (CoreConfigV2's generics); the header names the tracker;
+    --colour with the paper preset is refused with the reason."""
+    from mstrack.track.params import V2_COLOUR, V2_JOINT
+    joint = derive(CoreChoices(preset="v2"))
+    assert joint.tp == TrackerParams(preset="v2", **V2_JOINT, max_window=joint.tp.max_window)
+    assert joint.generics["ORIENT_T"] == 64 and joint.generics["SCALE_TEST_D256"] == 13
+    cfg = derive(CoreChoices(preset="v2", colour=True))
+    tp = TrackerParams(preset="v2", **V2_COLOUR)
+    assert cfg.tp == tp and cfg.generics["ORIENT_T"] == -1 and cfg.generics["SCALE_TEST_D256"] == 0
     want = CoreConfigV2(tp, FixedParams()).tracker_generics()
     assert {k: cfg.generics[k] for k in want} == want
     text = render(cfg, "package")
-    assert "tracker mstrack-v2-joint (ORIENT_T 64" in text
-    assert re.search(r"constant C_ORIENT_T +: integer := 64;", text)
-    assert re.search(r"constant C_ORIENT_T +: integer := -1;", render(derive(CoreChoices(preset="v2")), "package"))
-    for bad, why in ((dict(joint=True), "core v2's"), (dict(preset="v2", joint=True, scale_test=0.05), "leave")):
-        with pytest.raises(ConfigError, match=why):
-            derive(CoreChoices(**bad))
+    assert "tracker mstrack-v2-colour (ORIENT_T -1" in text
+    assert re.search(r"constant C_ORIENT_T +: integer := -1;", text)
+    assert re.search(r"constant C_ORIENT_T +: integer := 64;", render(joint, "package"))
+    assert "tracker mstrack-v2 (ORIENT_T 64, SCALE_TEST_D256 13)" in render(joint, "package")
+    with pytest.raises(ConfigError, match="core v2 tracker"):
+        derive(CoreChoices(colour=True))
 
 
 def test_ppc_choice():
@@ -186,7 +194,8 @@ def test_cli_preset_v2_package(tmp_path):
     consts = dict(re.findall(r"^  constant C_(\w+) +: (?:natural|integer) := (-?\d+);$", text, re.M))
     assert list(consts) == entity_generics()
     assert consts["PRESET"] == "1" and consts["RESULT_W"] == "160" and consts["MAX_FRAME_W"] == "1920"
-    assert re.search(r"constant C_LOSS_CONTRAST +: integer := 12452;", text)
+    assert re.search(r"constant C_LOSS_CONTRAST +: integer := 16384;", text)   # 0.25, the joint tracker's
+    assert re.search(r"constant C_ORIENT_T +: integer := 64;", text)
     assert "preset v2 (PRESET 1)" in text and "result_layout_v2" in text
 
 

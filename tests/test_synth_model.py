@@ -184,25 +184,27 @@ def test_v2_config_has_v2_generics_and_wrapper():
     assert set(g) <= set(core)                 # every generic the flow sets exists on the wrapper
 
 
-def test_v2_joint_config_is_mstrack_v2_joint():
-    """Configuration "v2-joint": ms_tracker_v2 with the generics of tracker mstrack-v2-joint's parameters
-    (ORIENT_T 64, the gated scale test SCALE_TEST_D256 13), placed through ms_tracker_v2_pins, which
-    passes ORIENT_T (default -1 = off, the value configuration "v2" gives, so "v2" is unchanged)."""
+def test_v2_configs_are_the_v2_trackers():
+    """Configuration "v2": ms_tracker_v2 with the generics of tracker v2's default parameters (mstrack-v2:
+    ORIENT_T 64, the gated scale test SCALE_TEST_D256 13; the VHDL defaults of ms_tracker_v2_pins, which
+    nextpnr places); "v2-colour": those of mstrack-v2-colour (V2_COLOUR: ORIENT_T -1, SCALE_TEST_D256 0)."""
     import re
 
     from mstrack.fixed import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
-    from mstrack.track.params import TrackerParams
-    c = synth.CONFIGS["v2-joint"]
+    from mstrack.track.params import V2_COLOUR, TrackerParams
+    c = synth.CONFIGS["v2"]
     assert c.v2 and c.pins_top == "ms_tracker_v2_pins"
     g = c.generics()
     tp = TrackerParams(preset="v2", orient_T=64, scale_test=0.05, scale_test_gate=True, loss_rho=0.69,
                        loss_contrast=0.25)
     assert g == CoreConfigV2(tp, FixedParams()).generics()
     assert g["ORIENT_T"] == 64 and g["SCALE_TEST_D256"] == 13 and g["REGION_MAX"] == 256
-    assert synth.CONFIGS["v2"].generics()["ORIENT_T"] == -1          # off: the VHDL default
+    col = synth.CONFIGS["v2-colour"]
+    assert col.v2 and col.generics() == CoreConfigV2(TrackerParams(preset="v2", **V2_COLOUR), FixedParams()).generics()
+    assert col.generics()["ORIENT_T"] == -1 and col.generics()["SCALE_TEST_D256"] == 0
     body = synth.PINS_VHD_V2.read_text()
-    assert re.search(r"^\s+ORIENT_T\s*: integer range -1 to 2047 := -1", body, re.M)
+    assert re.search(r"^\s+ORIENT_T\s*: integer range -1 to 2047 := 64", body, re.M)
 
 
 def test_write_section_keeps_rows_of_other_configs(tmp_path):

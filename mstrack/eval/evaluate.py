@@ -40,7 +40,7 @@ from tqdm import tqdm
 from . import baselines
 from ..io.data import DataError, Sequence
 from .metrics import Scores, concat_scores, score, valid_gt
-from ..track.params import V2_JOINT  # mstrack-v2-joint's parameters (re-exported)
+from ..track.params import V2_COLOUR, V2_JOINT  # mstrack-v2-colour's; the defaults of mstrack-v2 (re-exported)
 from ..track.types import Box, Status
 
 CACHE_VERSION = 3
@@ -66,7 +66,7 @@ def _baseline(fn: Callable[[], Any]) -> Callable[[str], Any]:
 #: Tracker name -> factory ``f(model) -> tracker``.  Add entries here.
 TRACKERS: dict[str, Callable[[str], Any]] = {
     "mstrack-v2": _mstrack(None, "flat", "v2"),
-    "mstrack-v2-joint": _mstrack(None, "flat", "v2", **V2_JOINT),
+    "mstrack-v2-colour": _mstrack(None, "flat", "v2", **V2_COLOUR),
     "mstrack-fused-flat": _mstrack("fused", "flat"),
     "mstrack-colour-flat": _mstrack("colour", "flat"),
     "mstrack-edge-flat": _mstrack("edge", "flat"),
@@ -78,6 +78,11 @@ TRACKERS: dict[str, Callable[[str], Any]] = {
     "opencv-kcf": _baseline(baselines.kcf),
     "opencv-csrt": _baseline(baselines.csrt),
 }
+
+
+#: Former tracker names -> their names now (refused with the new name).  mstrack-v2-joint became the
+#: default v2 tracker mstrack-v2 in session 16; the colour-only tracker v2 is mstrack-v2-colour.
+RENAMED = {"mstrack-v2-joint": "mstrack-v2"}
 
 
 def tracker_names() -> list[str]:
@@ -100,6 +105,8 @@ def make_tracker(name: str, model: str = "float") -> Any:
     model : {"float", "fixed"}
         mstrack model (ignored by the OpenCV baselines).
     """
+    if name in RENAMED:
+        raise ValueError(f"tracker {name!r} is now {RENAMED[name]!r}")
     if name not in TRACKERS:
         raise ValueError(f"unknown tracker {name!r}; known: {', '.join(TRACKERS)}")
     if model not in MODELS:

@@ -337,9 +337,9 @@ class CoreConfigV2:
 
     def __post_init__(self) -> None:
         # the experimental option motion_gain is in the float model only: a generic for it would build
-        # a core that tracks differently from the model it names.  mstrack-v2-joint's options have RTL:
-        # the gated scale test (scale_test with scale_test_gate: generic SCALE_TEST_D256) and the joint
-        # bins (orient_T: generic ORIENT_T); the ungated scale test has no fixed model either.
+        # a core that tracks differently from the model it names.  The default tracker v2's options have
+        # RTL: the gated scale test (scale_test with scale_test_gate: generic SCALE_TEST_D256) and the
+        # joint bins (orient_T: generic ORIENT_T); the ungated scale test has no fixed model either.
         tp = self.tp
         rtl_less = [k for k, off in (("motion_gain", 0.0),) if getattr(tp, k) != off]
         if tp.scale_test != 0.0 and not tp.scale_test_gate:
@@ -383,9 +383,9 @@ class CoreConfigV2:
         g["ADDR_W"] = (rmax * stride - 1).bit_length()
         g["CENTRE_W"] = g["REGION_W"] + fp.centre_frac
         g["MAX_FRAME_W"] = self.max_frame_w
-        # the gated scale test (experimental; 0 = off, the default of ms_tracker / ms_tracker_v2)
+        # the gated scale test (0 = off: mstrack-v2-colour; the VHDL default 13 = mstrack-v2's 0.05)
         g["SCALE_TEST_D256"] = self.scale_test_d256()
-        # the joint colour x orientation bins (experimental; -1 = off, the VHDL default)
+        # the joint colour x orientation bins (-1 = off: mstrack-v2-colour; the VHDL default 64)
         if tp.orient_T > 0 and g["EDGE_BINS_LOG2"] != 4:
             raise ValueError("the joint bins carry the orientation on the 4-bit edge path: edge_bins_log2 must be 4")
         g["ORIENT_T"] = int(tp.orient_T) if tp.orient_T > 0 else -1

@@ -29,7 +29,7 @@ from typing import Any
 
 from ..fixed.formats import FixedParams
 from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
-from ..track.params import V2_JOINT, TrackerParams
+from ..track.params import V2_COLOUR, TrackerParams
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TRACKER_VHD = REPO_ROOT / "rtl" / "ms_tracker.vhd"
@@ -87,7 +87,7 @@ class CoreChoices:
     kernel : {"flat", "epanechnikov"}
         Preset v2: flat only.
     preset : {"paper", "v2"}
-        The tracker: generic PRESET 0 (the paper core) or 1 (core v2: colour only, flat kernel,
+        The tracker: generic PRESET 0 (the paper core) or 1 (core v2: tracker v2, flat kernel,
         PPC 1, result word v2 of 160 bits).
     margin : int
         MARGIN: search margin in px around the window (largest motion per frame followed).
@@ -97,14 +97,14 @@ class CoreChoices:
         Layout of s_axis_tdata (:data:`RGB_PACKINGS`).
     ppc : {1, 2, 4}
         PPC: pixels per clock of the video input (s_axis_tdata of 24 PPC bits); at most LANES.
-    joint : bool
-        Preset v2 only, experimental: tracker mstrack-v2-joint (mstrack.track.params.V2_JOINT: the
-        joint colour x gradient-orientation bins, orient_T 64 -> ORIENT_T; the gated scale test 0.05;
-        its loss thresholds); ``scale_test`` must then be left at 0.
-    scale_test : float
-        Preset v2 only, experimental: the gated scale test (TrackerParams scale_test with
-        scale_test_gate; mstrack-v2-joint's is 0.05), generic SCALE_TEST_D256 = round(256 scale_test);
-        0 (default) = off.
+    colour : bool
+        Preset v2 only: tracker mstrack-v2-colour (mstrack.track.params.V2_COLOUR: colour bins
+        alone, ORIENT_T -1; no scale test; its loss thresholds), a smaller and faster core than the
+        default mstrack-v2 (the joint colour x gradient-orientation bins, ORIENT_T 64).
+    scale_test : float or None
+        Preset v2 only: the gated scale test's relative size step (TrackerParams scale_test with
+        scale_test_gate), generic SCALE_TEST_D256 = round(256 scale_test); None (default): the
+        tracker's (mstrack-v2 0.05, mstrack-v2-colour 0 = off).
     """
 
     max_frame_width: int = 2048
@@ -117,8 +117,8 @@ class CoreChoices:
     coord_bits: int = FixedParams.coord_bits
     rgb_packing: str = "mstrack"
     ppc: int = 1
-    scale_test: float = 0.0
-    joint: bool = False
+    scale_test: float | None = None
+    colour: bool = False
 
 
 @dataclass(frozen=True)
@@ -167,17 +167,15 @@ def derive(c: CoreChoices) -> CoreConfiguration:
         if not V2_MIN_TARGET <= c.max_target <= V2_MAX_TARGET:
             raise ConfigError(f"largest window {c.max_target} px: core v2 windows are {V2_MIN_TARGET} .. "
                               f"{V2_MAX_TARGET} decimated px (larger targets are tracked on a decimated frame)")
-        if not 0 <= c.scale_test <= 0.5:
+        if c.scale_test is not None and not 0 <= c.scale_test <= 0.5:
             raise ConfigError(f"scale test {c.scale_test}: 0 (off) or a relative size step up to 0.5")
         if c.coord_bits != V2_COORD_BITS:
             raise ConfigError(f"COORD_W {c.coord_bits}: core v2 is built for COORD_W {V2_COORD_BITS} (frames up to "
                               "4095 px; result word v2 of 160 bits)")
-        if c.joint and c.scale_test:
-            raise ConfigError("--joint sets mstrack-v2-joint's scale test (0.05): leave --scale-test out")
-    elif c.scale_test:
+    elif c.scale_test is not None:
         raise ConfigError(f"scale test {c.scale_test}: the gated scale test is core v2's (--preset v2)")
-    elif c.joint:
-        raise ConfigError("the joint bins (mstrack-v2-joint) are core v2's (--preset v2)")
+    elif c.colour:
+        raise ConfigError("--colour (mstrack-v2-colour) is a core v2 tracker (--preset v2)")
     max_half = c.max_target // 2
     if max_half > MAX_HALF_LIMIT:
         raise ConfigError(f"largest target {c.max_target} px > {2 * MAX_HALF_LIMIT + 1} px, the largest window "
@@ -197,10 +195,10 @@ def derive(c: CoreChoices) -> CoreConfiguration:
                           f"more lanes than pixels in a region row")
     try:
         tp_kw: dict[str, Any] = {"max_window": 2 * max_half + 1} if v2 else {}
-        if c.scale_test:
+        if c.colour:
+            tp_kw.update(V2_COLOUR)
+        if v2 and c.scale_test is not None:
             tp_kw.update(scale_test=c.scale_test, scale_test_gate=True)
-        if c.joint:
-            tp_kw.update(V2_JOINT)
         tp = TrackerParams(features=features, kernel=c.kernel, preset=c.preset, **tp_kw)  # type: ignore[arg-type]
         fp = FixedParams(max_half=max_half, margin=c.margin, coord_bits=c.coord_bits)
     except ValueError as exc:  # the model's own checks (one line each)
@@ -249,10 +247,8 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
               f"  windows up to {2 * g['MAX_HALF'] + 1} decimated px (MAX_HALF {g['MAX_HALF']}; larger targets are "
               f"decimated), search margin {c.margin} decimated px;"),
              f"  LANES {c.lanes}, features {cfg.tp.features}, kernel {c.kernel}, preset {c.preset} (PRESET {g['PRESET']})"
-             + (f", the gated scale test {c.scale_test} (SCALE_TEST_D256 {g['SCALE_TEST_D256']}, experimental)"
-                if c.scale_test else "")
-             + (f", tracker mstrack-v2-joint (ORIENT_T {g['ORIENT_T']}, SCALE_TEST_D256 {g['SCALE_TEST_D256']}, "
-                "experimental)" if c.joint else "") + ";",
+             + (f", tracker {'mstrack-v2-colour' if c.colour else 'mstrack-v2'} (ORIENT_T {g['ORIENT_T']}, "
+                f"SCALE_TEST_D256 {g['SCALE_TEST_D256']})" if c.preset == "v2" else "") + ";",
              f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]}, {c.ppc} pixel(s) per clock (PPC);",
              f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout"
              f"{'_v2' if c.preset == 'v2' else ''})."]
@@ -296,7 +292,7 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
                    help="default: the preset's (paper fused, v2 colour, the only one v2 has)")
     p.add_argument("--kernel", choices=KERNELS, default=d.kernel)
     p.add_argument("--preset", default=d.preset,
-                   help="paper (PRESET 0, default) or v2 (PRESET 1: core v2, colour only, flat kernel, PPC 1, "
+                   help="paper (PRESET 0, default) or v2 (PRESET 1: core v2, tracker v2, flat kernel, PPC 1, "
                         "result word v2)")
     p.add_argument("--margin", type=int, default=d.margin, help=f"search margin in px (default {d.margin})")
     p.add_argument("--coord-bits", type=int, default=d.coord_bits,
@@ -306,11 +302,11 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ppc", type=int, choices=(1, 2, 4), default=d.ppc,
                    help="pixels per clock of the video input (PPC, <= LANES; default 1)")
     p.add_argument("--scale-test", type=float, default=d.scale_test,
-                   help="preset v2, experimental: the gated scale test's relative size step (SCALE_TEST_D256 = "
-                        "round(256 x); mstrack-v2-joint's 0.05; default 0 = off)")
-    p.add_argument("--joint", action="store_true",
-                   help="preset v2, experimental: tracker mstrack-v2-joint (the joint colour x orientation bins, "
-                        "ORIENT_T 64; the gated scale test 0.05; its loss thresholds)")
+                   help="preset v2: the gated scale test's relative size step (SCALE_TEST_D256 = round(256 x); "
+                        "0 = off; default: the tracker's, mstrack-v2 0.05, --colour 0)")
+    p.add_argument("--colour", action="store_true",
+                   help="preset v2: tracker mstrack-v2-colour (colour bins alone, ORIENT_T -1: a smaller, "
+                        "faster core than mstrack-v2's joint colour x orientation bins)")
     p.add_argument("--format", choices=FORMATS, default="package", help="output (default: VHDL package)")
     p.add_argument("--name", default="ms_tracker_config_pkg", help="package name (--format package)")
     p.add_argument("--out", help="output file (default: standard output)")
@@ -320,7 +316,7 @@ def run_config(args: argparse.Namespace) -> int:
     choices = CoreChoices(max_frame_width=args.max_frame_width, max_target=args.max_target, lanes=args.lanes,
                           features=args.features, kernel=args.kernel, preset=args.preset, margin=args.margin,
                           coord_bits=args.coord_bits, rgb_packing=args.rgb_packing, ppc=args.ppc,
-                          scale_test=args.scale_test, joint=args.joint)
+                          scale_test=args.scale_test, colour=args.colour)
     cfg = derive(choices)
     command = getattr(args, "command_line", None) or "mstrack hdl config"
     text = render(cfg, args.format, args.name, command)

@@ -45,7 +45,7 @@ from typing import Any, Callable, Iterable, Sequence
 
 from ..fixed.formats import FixedParams
 from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
-from ..track.params import TrackerParams
+from ..track.params import V2_COLOUR, TrackerParams
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 PERF_MD = REPO_ROOT / "docs" / "performance.md"
@@ -136,12 +136,13 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
     Config("epan", "default with the Epanechnikov kernel", tp={"kernel": "epanechnikov"}),
     Config("ppc4", "default with PPC 4 (4 pixels per clock, MAX_FRAME_W 3840: 2160p30 at 74.25 MHz)",
            max_frame_w=3840, ppc=4),
-    Config("v2", "core v2 (ms_tracker_v2, tracker preset v2, CoreConfigV2 generics: colour only, REGION_MAX 445, "
-                 "result word v2 of 160 bits)", core=TOP_V2),
-    Config("v2-joint", "core v2 with the joint colour x orientation bins of tracker mstrack-v2-joint (ORIENT_T 64: "
-                       "9 histogram / bin-pass banks, 4-bit orientation region RAM) and its gated scale test "
-                       "(SCALE_TEST_D256 13), loss_rho 0.69, loss_contrast 0.25", core=TOP_V2,
-           tp={"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}),
+    Config("v2", "core v2 (ms_tracker_v2, tracker mstrack-v2, CoreConfigV2 generics of preset v2's defaults: the "
+                 "joint colour x orientation bins, ORIENT_T 64: 9 histogram / bin-pass banks, 4-bit orientation "
+                 "region RAM; the gated scale test SCALE_TEST_D256 13; REGION_MAX 445, result word v2 of 160 bits)",
+           core=TOP_V2),
+    Config("v2-colour", "core v2 of tracker mstrack-v2-colour (mstrack.track.params.V2_COLOUR: colour bins alone, "
+                        "ORIENT_T -1, no scale test, loss_rho 0.88, loss_contrast 0.19; the default core v2 until "
+                        "session 15)", core=TOP_V2, tp=dict(V2_COLOUR)),
 )}
 
 

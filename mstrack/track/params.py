@@ -65,11 +65,18 @@ def check_param_types(obj: Any) -> None:
             object.__setattr__(obj, f.name, float(v))
 
 
-#: Tracker v2 with the joint colour x orientation histogram and the gated scale test, the loss
-#: flag's thresholds chosen for it (docs/results_v2_mean.md): tracker ``mstrack-v2-joint``,
-#: ``TrackerParams(preset="v2", **V2_JOINT)``; experimental, in the float and fixed models and in core
-#: v2 (generics ORIENT_T 64, SCALE_TEST_D256 13: mstrack.hw.cosim.CoreConfigV2).
+#: Tracker v2's defaults that make it the joint tracker (since session 16 the default v2 tracker,
+#: ``mstrack-v2``; before, the experimental ``mstrack-v2-joint``): the joint colour x gradient-
+#: orientation bins, the gated scale test and the loss flag's thresholds chosen for them
+#: (docs/results_v2_mean.md).  Core v2: generics ORIENT_T 64, SCALE_TEST_D256 13
+#: (mstrack.hw.cosim.CoreConfigV2).
 V2_JOINT = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
+
+#: Tracker v2 on colour alone (tracker ``mstrack-v2-colour``, the default v2 tracker until session 15):
+#: ``TrackerParams(preset="v2", **V2_COLOUR)``.  512 bins instead of 4608: a smaller, faster core
+#: (ORIENT_T -1, SCALE_TEST_D256 0), about twice the float reference's speed, and lower accuracy
+#: (docs/results.md).
+V2_COLOUR = {"orient_T": 0, "scale_test": 0.0, "scale_test_gate": False, "loss_rho": 0.88, "loss_contrast": 0.19}
 
 
 @dataclass(frozen=True)
@@ -101,8 +108,9 @@ class TrackerParams:
     preset : {"paper", "v2"}
         "paper": the paper's algorithm (fixed-size window, colour + edge
         fusion), bit for bit as before; "v2": tracker v2 (docs/algorithm.md,
-        "Tracker v2"; float model only for now).  ``features`` defaults to
-        "fused" for the paper and "colour" for v2.
+        "Tracker v2"; the joint colour x orientation bins by default,
+        :data:`V2_COLOUR` for colour alone).  ``features`` defaults to "fused"
+        for the paper and "colour" for v2 (the colour that the v2 bins join).
 
     The remaining fields are tracker v2's (ignored by the paper preset):
 
@@ -129,6 +137,7 @@ class TrackerParams:
         contrast = share in the box - share in the window's ring < loss_contrast,
         both smoothed by s <- s + loss_smooth (x - s) (1: no smoothing; a power
         of two for the fixed model) (docs/algorithm.md, "v2.7a Loss flag").
+        Defaults 0.69 / 0.25 (the joint tracker's); :data:`V2_COLOUR`'s 0.88 / 0.19.
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -142,18 +151,18 @@ class TrackerParams:
         (the step is set to 0 unless the frame's search state is ok)
         (docs/results_v2_mean.md).
     scale_test, scale_test_mix : float
-        Scale test by rho (experimental, off by default: 0): two more passes
+        Scale test by rho (default 0.05, gated; 0 = off, :data:`V2_COLOUR`): two more passes
         at the final centre with the window scaled by 1 -+ scale_test; the
         scale of the largest rho (1, 1 - scale_test or 1 + scale_test) is the
         rho estimate, and the size step uses scale_test_mix x it + (1 -
         scale_test_mix) x the spread estimate; scale_test_gate: instead, the
         spread estimate is kept only where the rho test moves the same way
-        (else no step) (docs/results_v2_mean.md).
+        (else no step; the default) (docs/results_v2_mean.md).
     orient_T : int
-        Joint colour x gradient-orientation bins (experimental, off by default:
-        0): bin = colour bin x 9 + octant of the 3x3 Sobel gradient of the grey
-        frame where |Gx| + |Gy| >= orient_T, 8 for flatter pixels (9 x 512
-        bins) (docs/results_v2_mean.md).
+        Joint colour x gradient-orientation bins (default 64; 0 = colour bins
+        only, :data:`V2_COLOUR`): bin = colour bin x 9 + octant of the 3x3 Sobel
+        gradient of the grey frame where |Gx| + |Gy| >= orient_T, 8 for flatter
+        pixels (9 x 512 bins) (docs/algorithm.md, docs/results_v2_mean.md).
     """
 
     features: Features = None  # type: ignore[assignment]  # resolved per preset
@@ -173,17 +182,17 @@ class TrackerParams:
     conf_lost: float = 0.4
     conf_uncertain: float = 0.5
     conf_reacquire: float = 0.5
-    loss_rho: float = 0.88
-    loss_contrast: float = 0.19
+    loss_rho: float = 0.69
+    loss_contrast: float = 0.25
     loss_smooth: float = 0.5
     ref_rate: float = 0.015625
     search_step: float = 1.0
     search_iter: int = 5
     motion_gain: float = 0.0
-    scale_test: float = 0.0
+    scale_test: float = 0.05
     scale_test_mix: float = 1.0
-    scale_test_gate: bool = False
-    orient_T: int = 0
+    scale_test_gate: bool = True
+    orient_T: int = 64
 
     def __post_init__(self) -> None:
         for name in ALIASES:

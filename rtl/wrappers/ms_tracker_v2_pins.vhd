@@ -81,8 +81,8 @@ entity ms_tracker_v2_pins is
     CON_W          : natural := 18;
     LOSS_K         : natural := 1;
     REF_K          : natural := 6;
-    LOSS_RHO       : natural := 57672;
-    LOSS_CONTRAST  : integer := 12452;
+    LOSS_RHO       : natural := 45220;
+    LOSS_CONTRAST  : integer := 16384;
     CONF_LOST      : natural := 26214;    -- round(conf_lost 2**16)
     CONF_UNCERTAIN : natural := 32768;
     CONF_REACQUIRE : natural := 32768;
@@ -92,8 +92,8 @@ entity ms_tracker_v2_pins is
     SEARCH_ITER    : natural := 5;        -- iterations per start point while lost
     STEP16         : natural := 16;       -- search_step in 1/16 (start points +- step x window)
     MARGIN_MAX     : natural := 255;      -- largest region margin (MARGIN + the search offset)
-    SCALE_TEST_D256 : natural range 0 to 255 := 0;  -- the gated scale test: round(256 scale_test); 0 = off
-    ORIENT_T        : integer range -1 to 2047 := -1  -- joint colour x orientation bins (mstrack-v2-joint: 64); -1 = off
+    SCALE_TEST_D256 : natural range 0 to 255 := 13;  -- the gated scale test: round(256 scale_test); 0 = off (mstrack-v2-colour)
+    ORIENT_T        : integer range -1 to 2047 := 64  -- joint colour x orientation bins: orient_T; -1 = off (mstrack-v2-colour)
   );
   port (
     clk           : in  std_logic;                      -- core clock

@@ -1194,12 +1194,11 @@ def v2_cycle_budget(lanes: int | None = None) -> list[dict[str, Any]]:
     bin passes for the CBWH model: min o, v and Q v, Qn).  Pass costs: :func:`pixel_pass_cycles`,
     :func:`bin_pass_cycles`, :func:`engine_cycles` of the paper core.
     """
-    from ..track.params import TrackerParams
     cfg = CONFIGS["default"]
     g = dict(cfg.generics())
     if lanes is not None:
         g["LANES"] = lanes
-    tp = TrackerParams(preset="v2")
+    tp = TrackerParams(preset="v2", **V2_COLOUR)  # the colour bins (the joint core's terms: docs/fixed_point.md)
     nc = 1 << (3 * tp.colour_bits)
     rows_scan = scan_kind() == "rows"
     out = []
@@ -1230,7 +1229,8 @@ def v2_budget_table(lanes: int | None = None) -> str:
     """Markdown table of :func:`v2_cycle_budget` against the 1080p60 blanking (99,000 clocks)."""
     g = CONFIGS["default"].generics()
     L = lanes or g["LANES"]
-    lines = [f"LANES = {L}, colour only (512 bins), default generics; 1080p60 vertical blanking = 99,000 "
+    lines = [f"LANES = {L}, tracker v2 on colour alone (mstrack-v2-colour, 512 bins), default generics; "
+             f"1080p60 vertical blanking = 99,000 "
              f"clocks at 148.5 MHz.  Per-frame v2 overhead (divisions, isqrt, confidence and loss blocks, kernel tables): "
              f"{v2_frame_overhead(g['MAX_HALF'], g['HALF_W'], g['KERNEL_BITS'] + 1)} clocks.", "",
              "| frame | pixel pass | worst clocks | vs 99,000 |", "|---|---:|---:|---|"]

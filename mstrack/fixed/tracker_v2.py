@@ -97,8 +97,8 @@ class FixedTrackerV2:
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
         if p.motion_gain > 0 or (p.scale_test > 0 and not p.scale_test_gate):
-            raise ValueError("the fixed-point v2 model has, of the experimental options, orient_T and the "
-                             "gated scale test only (motion_gain 0, scale_test_gate with scale_test)")
+            raise ValueError("the fixed-point v2 model has the gated scale test only (scale_test needs "
+                             "scale_test_gate) and no motion_gain (the float model's experimental option)")
         if p.max_window > 2 * self.fixed.max_half + 1:
             raise ValueError(f"max_window {p.max_window} > 2 max_half + 1 = {2 * self.fixed.max_half + 1}")
         self.widths = widths(p, self.fixed)
@@ -110,7 +110,7 @@ class FixedTrackerV2:
         c = ms_colour_bin(frame[::d, ::d], self.params.colour_bits)
         if self.params.orient_T <= 0:
             return c
-        # joint bins (experimental, off by default): Sobel on the full-resolution grey frame
+        # joint bins (the default, orient_T 64; 0 = colour bins): Sobel on the full-resolution grey frame
         return ms_joint_bin(c, ms_orient_bin(ms_grey(frame), self.params.orient_T)[::d, ::d])
 
     def _kernel(self, wd: int, hd: int) -> ms_kernel:
@@ -160,7 +160,7 @@ class FixedTrackerV2:
 
     def _scale_verdict(self, sub: np.ndarray, reg: Region, c8d: tuple[int, int], d: int,
                        rho: int, dims: tuple[int, int]) -> int:
-        """The scale test (experimental): rho of the windows of sizes x(1 -+ scale_test) at the
+        """The gated scale test (the default, scale_test 0.05): rho of the windows of sizes x(1 -+ scale_test) at the
         final centre (ms_scale_test_size, ms_window_size, kernel tables, model at that window, one
         pixel pass and one bin pass each); a window outside the captured region does not count."""
         p, fx = self.params, self.fixed
@@ -322,7 +322,7 @@ class FixedTrackerV2:
         spread = ms_spread(st)
         if p.scale_gain > 0 and st.nt > 0:
             sp = spread
-            if p.scale_test > 0 and p.scale_test_gate:  # experimental (off by default)
+            if p.scale_test > 0 and p.scale_test_gate:  # the default (V2_COLOUR: off)
                 sp = ms_scale_gate(spread, self.spread_ref,
                                    self._scale_verdict(sub, reg, c8d, d, rho, img.shape[:2]))
             s = ms_scale(sp, self.spread_ref, self.w8, self.w0_8, p)

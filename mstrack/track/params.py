@@ -70,13 +70,13 @@ def check_param_types(obj: Any) -> None:
 #: orientation bins, the gated scale test and the loss flag's thresholds chosen for them
 #: (docs/results_v2_mean.md).  Core v2: generics ORIENT_T 64, SCALE_TEST_D256 13
 #: (mstrack.hw.cosim.CoreConfigV2).
-V2_JOINT = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
+V2_JOINT: dict[str, Any] = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
 
 #: Tracker v2 on colour alone (tracker ``mstrack-v2-colour``, the default v2 tracker until session 15):
 #: ``TrackerParams(preset="v2", **V2_COLOUR)``.  512 bins instead of 4608: a smaller, faster core
 #: (ORIENT_T -1, SCALE_TEST_D256 0), about twice the float reference's speed, and lower accuracy
 #: (docs/results.md).
-V2_COLOUR = {"orient_T": 0, "scale_test": 0.0, "scale_test_gate": False, "loss_rho": 0.88, "loss_contrast": 0.19}
+V2_COLOUR: dict[str, Any] = {"orient_T": 0, "scale_test": 0.0, "scale_test_gate": False, "loss_rho": 0.88, "loss_contrast": 0.19}
 
 
 @dataclass(frozen=True)

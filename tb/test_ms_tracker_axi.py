@@ -517,7 +517,7 @@ def test_axi_real():
 # ----------------------------------------------------------------------------- core v2 (PRESET 1)
 @pytest.mark.long   # 2 min of GHDL: on make test's second core (CI time balance), not in the simulation half
 def test_axi_v2_synthetic():
-    """GHDL, core v2 (PRESET 1, default v2 generics, MAX_FRAME_W 1024), throttled, result stream: the
+    """GHDL, core v2 (PRESET 1, mstrack-v2-colour's generics, MAX_FRAME_W 1024), throttled, result stream: the
     pattern scene with two all-red frames gives init, ok, ok, uncertain (the second red frame), lost
     (grey frame), reacquired (wide search at D = 2), ok, a protocol error and a rejected init box;
     every register field of every result, the raw window, the stream word, STATUS.tracking,
@@ -527,7 +527,7 @@ def test_axi_v2_synthetic():
 
 
 def test_axi_v2_real():
-    """GHDL, core v2 (PRESET 1, default v2 generics): init + 2 tracked frames of a real sequence (Girl,
+    """GHDL, core v2 (PRESET 1, mstrack-v2-colour's generics): init + 2 tracked frames of a real sequence (Girl,
     128x96), results in registers only (RESULT_STREAM false)."""
     seq = SEQ_ROOT / "Girl"
     if not seq.is_dir():

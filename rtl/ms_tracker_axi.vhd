@@ -292,6 +292,12 @@ begin
   hw_in.CONFIG.preset.next_q          <= std_logic_vector(to_unsigned(PRESET, 2));
   hw_in.CONFIG.lanes.next_q           <= std_logic_vector(to_unsigned(LANES, 8));
   hw_in.CONFIG.max_half.next_q        <= std_logic_vector(to_unsigned(MAX_HALF, 16));
+  -- core v2's tracker variant (map minor 2): PRESET 0 has neither the joint bins nor the scale test
+  hw_in.CONFIG_V2.orient_on.next_q    <= '1' when PRESET /= 0 and ORIENT_T >= 0 else '0';
+  hw_in.CONFIG_V2.orient_t.next_q     <= std_logic_vector(to_unsigned(maximum(ORIENT_T, 0), 11))
+                                         when PRESET /= 0 and ORIENT_T >= 0 else (others => '0');
+  hw_in.CONFIG_V2.scale_test_d256.next_q <= std_logic_vector(to_unsigned(SCALE_TEST_D256, 8))
+                                            when PRESET /= 0 else (others => '0');
   hw_in.FORMAT.max_frame_w.next_q     <= std_logic_vector(to_unsigned(MAX_FRAME_W, 16));
   hw_in.FORMAT.centre_frac.next_q     <= std_logic_vector(to_unsigned(CF, 4));
   hw_in.FORMAT.rho_frac.next_q        <= std_logic_vector(to_unsigned(RHO_OUT_FRAC, 5));

@@ -102,6 +102,7 @@ architecture rtl of ms_tracker_regs is
         ERROR_COUNT : std_logic;
         REJECT_COUNT : std_logic;
         DROP_COUNT : std_logic;
+        CONFIG_V2 : std_logic;
         RES_HEAD : std_logic;
         RES_CX : std_logic;
         RES_CY : std_logic;
@@ -753,6 +754,9 @@ begin
         decoded_reg_strb.DROP_COUNT <= cpuif_req_masked and (cpuif_addr = 16#40#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#40#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#40#) and not cpuif_req_is_wr);
+        decoded_reg_strb.CONFIG_V2 <= cpuif_req_masked and (cpuif_addr = 16#44#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#44#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#44#) and not cpuif_req_is_wr);
         decoded_reg_strb.RES_HEAD <= cpuif_req_masked and (cpuif_addr = 16#50#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#50#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#50#) and not cpuif_req_is_wr);
@@ -1538,7 +1542,7 @@ begin
             readback_data_var(31 downto 0) := 32x"4D53544B";
         end if;
         if rd_mux_addr = 16#4# then
-            readback_data_var(7 downto 0) := 8x"1";
+            readback_data_var(7 downto 0) := 8x"2";
             readback_data_var(15 downto 8) := 8x"1";
             readback_data_var(19 downto 16) := hwif_in.VERSION.result_version.next_q;
             readback_data_var(31 downto 24) := hwif_in.VERSION.result_width.next_q;
@@ -1605,6 +1609,11 @@ begin
         end if;
         if rd_mux_addr = 16#40# then
             readback_data_var(31 downto 0) := field_storage.DROP_COUNT.count.value;
+        end if;
+        if rd_mux_addr = 16#44# then
+            readback_data_var(0) := hwif_in.CONFIG_V2.orient_on.next_q;
+            readback_data_var(18 downto 8) := hwif_in.CONFIG_V2.orient_t.next_q;
+            readback_data_var(31 downto 24) := hwif_in.CONFIG_V2.scale_test_d256.next_q;
         end if;
         if rd_mux_addr = 16#50# then
             readback_data_var(15 downto 0) := hwif_in.RES_HEAD.frame_count.next_q;

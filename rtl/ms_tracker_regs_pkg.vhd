@@ -172,6 +172,24 @@ package ms_tracker_regs_pkg is
         count : \ms_tracker_regs.DROP_COUNT.count_in_t\;
     end record;
 
+    type \ms_tracker_regs.CONFIG_V2.orient_on_in_t\ is record
+        next_q : std_logic;
+    end record;
+
+    type \ms_tracker_regs.CONFIG_V2.orient_t_in_t\ is record
+        next_q : std_logic_vector(10 downto 0);
+    end record;
+
+    type \ms_tracker_regs.CONFIG_V2.scale_test_d256_in_t\ is record
+        next_q : std_logic_vector(7 downto 0);
+    end record;
+
+    type \ms_tracker_regs.CONFIG_V2_in_t\ is record
+        orient_on : \ms_tracker_regs.CONFIG_V2.orient_on_in_t\;
+        orient_t : \ms_tracker_regs.CONFIG_V2.orient_t_in_t\;
+        scale_test_d256 : \ms_tracker_regs.CONFIG_V2.scale_test_d256_in_t\;
+    end record;
+
     type \ms_tracker_regs.RES_HEAD.frame_count_in_t\ is record
         next_q : std_logic_vector(15 downto 0);
     end record;
@@ -374,6 +392,7 @@ package ms_tracker_regs_pkg is
         ERROR_COUNT : \ms_tracker_regs.ERROR_COUNT_in_t\;
         REJECT_COUNT : \ms_tracker_regs.REJECT_COUNT_in_t\;
         DROP_COUNT : \ms_tracker_regs.DROP_COUNT_in_t\;
+        CONFIG_V2 : \ms_tracker_regs.CONFIG_V2_in_t\;
         RES_HEAD : \ms_tracker_regs.RES_HEAD_in_t\;
         RES_CX : \ms_tracker_regs.RES_CX_in_t\;
         RES_CY : \ms_tracker_regs.RES_CY_in_t\;

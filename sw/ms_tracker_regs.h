@@ -20,7 +20,7 @@ extern "C" {
 #define MS_TRACKER_REGS__VERSION__MAP_MINOR_bm 0xff
 #define MS_TRACKER_REGS__VERSION__MAP_MINOR_bp 0
 #define MS_TRACKER_REGS__VERSION__MAP_MINOR_bw 8
-#define MS_TRACKER_REGS__VERSION__MAP_MINOR_reset 0x1
+#define MS_TRACKER_REGS__VERSION__MAP_MINOR_reset 0x2
 #define MS_TRACKER_REGS__VERSION__MAP_MAJOR_bm 0xff00
 #define MS_TRACKER_REGS__VERSION__MAP_MAJOR_bp 8
 #define MS_TRACKER_REGS__VERSION__MAP_MAJOR_bw 8
@@ -195,6 +195,17 @@ extern "C" {
 #define MS_TRACKER_REGS__DROP_COUNT__COUNT_bw 32
 #define MS_TRACKER_REGS__DROP_COUNT__COUNT_reset 0x0
 
+// reg - ms_tracker_regs.CONFIG_V2
+#define MS_TRACKER_REGS__CONFIG_V2__ORIENT_ON_bm 0x1
+#define MS_TRACKER_REGS__CONFIG_V2__ORIENT_ON_bp 0
+#define MS_TRACKER_REGS__CONFIG_V2__ORIENT_ON_bw 1
+#define MS_TRACKER_REGS__CONFIG_V2__ORIENT_T_bm 0x7ff00
+#define MS_TRACKER_REGS__CONFIG_V2__ORIENT_T_bp 8
+#define MS_TRACKER_REGS__CONFIG_V2__ORIENT_T_bw 11
+#define MS_TRACKER_REGS__CONFIG_V2__SCALE_TEST_D256_bm 0xff000000
+#define MS_TRACKER_REGS__CONFIG_V2__SCALE_TEST_D256_bp 24
+#define MS_TRACKER_REGS__CONFIG_V2__SCALE_TEST_D256_bw 8
+
 // reg - ms_tracker_regs.RES_HEAD
 #define MS_TRACKER_REGS__RES_HEAD__FRAME_COUNT_bm 0xffff
 #define MS_TRACKER_REGS__RES_HEAD__FRAME_COUNT_bp 0
@@ -332,7 +343,8 @@ typedef struct __attribute__ ((__packed__)) {
     uint32_t ERROR_COUNT;
     uint32_t REJECT_COUNT;
     uint32_t DROP_COUNT;
-    uint8_t RESERVED_44_4f[0xc];
+    uint32_t CONFIG_V2;
+    uint8_t RESERVED_48_4f[0x8];
     uint32_t RES_HEAD;
     uint32_t RES_CX;
     uint32_t RES_CY;

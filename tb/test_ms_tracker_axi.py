@@ -12,7 +12,9 @@ the video, an AxiStreamSink the optional result stream.  Every result is predict
 exactly the frames the wrapper passes to the core; each is read back field by field from the
 RES_* registers, from the raw window RES_RAW0..4 and (RESULT_STREAM) from the stream, and compared.
 
-Covered: identification / configuration registers against the generics; bad accesses (unmapped
+Covered: identification / configuration registers against the generics (CONFIG_V2: core v2's
+ORIENT_T and SCALE_TEST_D256; the v2 jobs build the colour core, -1 / 0, and test_axi_v2_joint_config
+the joint core's registers after reset, 64 / 13, without video); bad accesses (unmapped
 address, write to read-only, read of write-only: SLVERR, nothing changes); the other preset's
 registers read 0; STATUS.tracking after every result;
 a frame while disabled (dropped whole, DROP_COUNT, no result); init by CMD.init (init_pending);
@@ -99,8 +101,10 @@ def load_job_frames(job: dict) -> tuple[list[np.ndarray], list[str | None], tupl
 
 def config_of(job: dict) -> CoreConfig | CoreConfigV2:
     if job.get("preset", 0):
-        # tracker v2 on colour alone (V2_COLOUR; the register bank is the same for the joint bins)
-        return CoreConfigV2(TrackerParams(**{"preset": "v2", **V2_COLOUR, **job.get("tp", {})}),
+        # tracker v2 on colour alone (V2_COLOUR, GHDL speed; the register bank is the same for the joint
+        # bins), or the joint tracker (job "joint": the default generics ORIENT_T 64, SCALE_TEST_D256 13)
+        colour = {} if job.get("joint") else V2_COLOUR
+        return CoreConfigV2(TrackerParams(**{"preset": "v2", **colour, **job.get("tp", {})}),
                             FixedParams(**job.get("fp", {})),
                             max_frame_w=job.get("max_frame_w", 1024))
     return CoreConfig(TrackerParams(**job.get("tp", {})), FixedParams(**job.get("fp", {})),
@@ -113,6 +117,16 @@ def top_generics(job: dict) -> dict[str, object]:
     g: dict[str, object] = dict(cfg.tracker_generics() if isinstance(cfg, CoreConfigV2) else cfg.generics())
     g["RESULT_STREAM"] = bool(job["result_stream"])
     return g
+
+
+def config_v2_of(g: dict[str, object], v2: bool) -> dict[str, int]:
+    """CONFIG_V2 (map minor 2) of a core built with generics g: core v2's ORIENT_T (orient_on 0 and
+    orient_t 0 for -1) and SCALE_TEST_D256; PRESET 0 reads 0 (its job passes neither generic, so the
+    wrapper's defaults 64 / 13 are in force and must not show)."""
+    if not v2:
+        return {"orient_on": 0, "orient_t": 0, "scale_test_d256": 0}
+    orient_t = int(g["ORIENT_T"])
+    return {"orient_on": int(orient_t >= 0), "orient_t": max(orient_t, 0), "scale_test_d256": int(g["SCALE_TEST_D256"])}
 
 
 def is_lost(r: dict[str, int], v2: bool) -> bool:
@@ -246,6 +260,40 @@ def feed_model(model: CoreModel, lines, fw: int, fh: int) -> None:
             model.beat(int(d), int(user[i] or 0), int(i == len(data) - 1), fw, fh)
 
 
+async def check_identification(tb: TB, check) -> None:
+    """ID, VERSION, CONFIG, CONFIG_V2 and FORMAT against the job's generics."""
+    g, v2 = tb.g, tb.v2
+    check("ID", await tb.rd("ID"), {"magic": 0x4D53544B})
+    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 2, "result_version": 2 if v2 else 1,
+                                              "result_width": g["RESULT_W"]})
+    check("CONFIG", await tb.rd("CONFIG"), {"preset": int(v2), "features": g["FEATURES"], "kernel_epan": g["KERNEL_EPAN"],
+                                            "result_stream": int(tb.job["result_stream"]), "lanes": g["LANES"],
+                                            "max_half": g["MAX_HALF"]})
+    check("CONFIG_V2", await tb.rd("CONFIG_V2"), config_v2_of(g, v2))
+    check("FORMAT", await tb.rd("FORMAT"), {"max_frame_w": tb.cfg.max_frame_w, "centre_frac": g["CF"],
+                                            "rho_frac": g["RHO_OUT_FRAC"], "alpha_frac": g["AF"]})
+
+
+@cocotb.test()
+async def config_axi(dut):
+    """Identification and configuration registers only, after reset (no video): a build whose
+    simulation is too slow for run_axi (the joint core v2 under GHDL) still shows its generics."""
+    job = json.loads(os.environ["MSTRACK_JOB"])
+    tb = TB(dut, job)
+    await tb.reset()
+    errors: list[str] = []
+
+    def check(what: str, got: dict, exp: dict) -> None:
+        d = diff_fields(got, exp, list(exp))
+        if d:
+            errors.append(f"{what}: " + "; ".join(d))
+
+    await check_identification(tb, check)
+    dut._log.warning("PRESET %d: CONFIG_V2 0x%08x; %d mismatches", int(tb.v2), (await tb.rd("CONFIG_V2"))["_raw"],
+                     len(errors))
+    assert not errors, "\n".join(errors)
+
+
 @cocotb.test()
 async def run_axi(dut):
     """Registers, interrupts and every result field against the model."""
@@ -268,28 +316,21 @@ async def run_axi(dut):
             errors.append(f"{what}: " + "; ".join(d))
 
     # -- identification, configuration, reset values
-    check("ID", await tb.rd("ID"), {"magic": 0x4D53544B})
-    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 1, "result_version": 2 if v2 else 1,
-                                              "result_width": g["RESULT_W"]})
-    check("CONFIG", await tb.rd("CONFIG"), {"preset": int(v2), "features": g["FEATURES"], "kernel_epan": g["KERNEL_EPAN"],
-                                            "result_stream": int(job["result_stream"]), "lanes": g["LANES"],
-                                            "max_half": g["MAX_HALF"]})
-    check("FORMAT", await tb.rd("FORMAT"), {"max_frame_w": tb.cfg.max_frame_w, "centre_frac": g["CF"],
-                                            "rho_frac": g["RHO_OUT_FRAC"], "alpha_frac": g["AF"]})
+    await check_identification(tb, check)
     for name in ("CTRL", "INT_STATUS", "INT_ENABLE", "RESULT_COUNT", "DROP_COUNT", "RES_HEAD", "RES_CX", *V2_ONLY):
         v = await tb.rd(name)
         if v["_raw"]:
             errors.append(f"{name} after reset: 0x{v['_raw']:08x}")
 
     # -- bad accesses: SLVERR, data 0, no effect
-    for addr in (0x044, 0x04C, 0x094, 0x0FC, 0xFFC):
+    for addr in (0x048, 0x04C, 0x094, 0x0FC, 0xFFC):
         v, resp = await tb.read_at(addr)
         if resp != AxiResp.SLVERR or v:
             errors.append(f"read of unmapped 0x{addr:03x}: {resp} 0x{v:08x}")
     v, resp = await tb.read_at(REGS["CMD"].offset)
     if resp != AxiResp.SLVERR:
         errors.append(f"read of write-only CMD: {resp}")
-    for name in ("ID", "CONFIG", "STATUS", "RESULT_COUNT", "RES_CX"):
+    for name in ("ID", "CONFIG", "CONFIG_V2", "STATUS", "RESULT_COUNT", "RES_CX"):
         before = (await tb.rd(name))["_raw"]
         resp = await tb.write_at(REGS[name].offset, 0xFFFFFFFF)
         after = (await tb.rd(name))["_raw"]
@@ -438,12 +479,12 @@ async def run_axi(dut):
 SMALL = {"fp": {"max_half": 15, "margin": 8}}
 
 
-def _run(job: dict, build_name: str, verilator: bool = False) -> None:
+def _run(job: dict, build_name: str, verilator: bool = False, testcase: str = "run_axi") -> None:
     from mstrack.hw.hdl import run_ghdl, run_verilator
     g = top_generics(job)
     runner = run_verilator if verilator else run_ghdl
     runner("ms_tracker_axi", "test_ms_tracker_axi", generics=g, build_name=build_name,
-           extra_env={"MSTRACK_JOB": json.dumps(job)})
+           extra_env={"MSTRACK_JOB": json.dumps(job)}, testcase=testcase)
 
 
 @pytest.mark.parametrize("variant", ["stream", "throttled", "no_stream"])
@@ -476,7 +517,7 @@ def test_axi_real():
 # ----------------------------------------------------------------------------- core v2 (PRESET 1)
 @pytest.mark.long   # 2 min of GHDL: on make test's second core (CI time balance), not in the simulation half
 def test_axi_v2_synthetic():
-    """GHDL, core v2 (PRESET 1, default v2 generics, MAX_FRAME_W 1024), throttled, result stream: the
+    """GHDL, core v2 (PRESET 1, mstrack-v2-colour's generics, MAX_FRAME_W 1024), throttled, result stream: the
     pattern scene with two all-red frames gives init, ok, ok, uncertain (the second red frame), lost
     (grey frame), reacquired (wide search at D = 2), ok, a protocol error and a rejected init box;
     every register field of every result, the raw window, the stream word, STATUS.tracking,
@@ -486,7 +527,7 @@ def test_axi_v2_synthetic():
 
 
 def test_axi_v2_real():
-    """GHDL, core v2 (PRESET 1, default v2 generics): init + 2 tracked frames of a real sequence (Girl,
+    """GHDL, core v2 (PRESET 1, mstrack-v2-colour's generics): init + 2 tracked frames of a real sequence (Girl,
     128x96), results in registers only (RESULT_STREAM false)."""
     seq = SEQ_ROOT / "Girl"
     if not seq.is_dir():
@@ -496,6 +537,16 @@ def test_axi_v2_real():
     box = round_box(*[float(v) for v in load_sequence(seq).gt[0]])
     job = {"preset": 1, "scene": "real", "seq": str(seq), "n": 3, "box": list(box), "result_stream": False}
     _run(job, "ms_tracker_axi_v2_real")
+
+
+def test_axi_v2_joint_config():
+    """GHDL, the joint core v2 (PRESET 1, ms_tracker's default generics ORIENT_T 64, SCALE_TEST_D256 13:
+    tracker mstrack-v2): the identification and configuration registers after reset, CONFIG_V2
+    orient_on 1, orient_t 64, scale_test_d256 13 (the other v2 jobs build the colour core, which reads
+    0 there).  No video: the joint core's simulation is 5x slower under GHDL."""
+    job = {"preset": 1, "joint": True, "result_stream": True}
+    assert config_v2_of(top_generics(job), True) == {"orient_on": 1, "orient_t": 64, "scale_test_d256": 13}
+    _run(job, "ms_tracker_axi_v2_joint", testcase="config_axi")
 
 
 @pytest.mark.verilator

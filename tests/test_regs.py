@@ -32,7 +32,7 @@ def test_register_map():
     assert m["RES_HEAD"].offset < m["RES_CX"].offset
     v2_space = range(0x70, 0x80)
     assert [r.name for r in m.values() if r.offset in v2_space] == ["RES_W8", "RES_H8", "RES_CONF", "RES_STATE"]
-    assert m["VERSION"].fields["map_minor"].reset == 1 and m["VERSION"].fields["map_major"].reset == 1
+    assert m["VERSION"].fields["map_minor"].reset == 2 and m["VERSION"].fields["map_major"].reset == 1
     raw = [m[f"RES_RAW{i}"].offset for i in range(5)]
     assert raw == list(range(raw[0], raw[0] + 20, 4))
     assert 5 * 32 >= max(result_width(), result_width_v2())
@@ -45,6 +45,30 @@ def test_register_map():
         assert bits < 1 << 32
     # the interrupt bits the wrapper sets and the flags they follow
     assert set(m["INT_STATUS"].fields) == set(m["INT_ENABLE"].fields) == {"result", "lost", "error", "reacquired"}
+
+
+def test_config_v2_holds_the_tracker_generics():
+    """CONFIG_V2 (map minor 2): read-only, between the counters and RES_HEAD; its fields hold ORIENT_T
+    (0 .. 2047, ms_tracker_axi's range; -1 is orient_on 0) and SCALE_TEST_D256 (0 .. 255), and the
+    values of both trackers v2 (mstrack-v2: 64 / 13, mstrack-v2-colour: -1 / 0) as the wrapper drives them."""
+    from mstrack.fixed import FixedParams
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import V2_COLOUR, TrackerParams
+    m = regs.register_map()
+    r = m["CONFIG_V2"]
+    assert m["DROP_COUNT"].offset < r.offset < m["RES_HEAD"].offset
+    assert r.readable and not r.writable
+    assert {n: f.width for n, f in r.fields.items()} == {"orient_on": 1, "orient_t": 11, "scale_test_d256": 8}
+    text = (regs.REPO / "rtl" / "ms_tracker_axi.vhd").read_text()
+    assert re.search(r"ORIENT_T\s*:\s*integer range -1 to 2047", text)
+    assert re.search(r"SCALE_TEST_D256\s*:\s*natural range 0 to 255", text)
+    seen = {}
+    for name, tp in (("joint", TrackerParams(preset="v2")), ("colour", TrackerParams(preset="v2", **V2_COLOUR))):
+        g = CoreConfigV2(tp, FixedParams()).tracker_generics()
+        on = int(g["ORIENT_T"] >= 0)
+        seen[name] = r.encode(orient_on=on, orient_t=g["ORIENT_T"] if on else 0, scale_test_d256=g["SCALE_TEST_D256"])
+    assert r.decode(seen["joint"]) == {"orient_on": 1, "orient_t": 64, "scale_test_d256": 13}
+    assert seen["colour"] == 0
 
 
 def test_register_fields_hold_result_fields():

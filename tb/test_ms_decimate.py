@@ -49,7 +49,7 @@ from mstrack.fixed.blocks import Region, ms_edge_bin, ms_grey, ms_sobel, round_b
 from mstrack.fixed.blocks_v2 import PAD_FRAC, SIZE_FRAC, ms_orient_bin, sixteenths
 from mstrack.fixed.formats import FixedParams
 from mstrack.fixed.tracker_v2 import FixedTrackerV2
-from mstrack.track.params import TrackerParams
+from mstrack.track.params import V2_COLOUR, TrackerParams
 
 from test_ms_frontend import ERR_SHORT_LINE, TB, frame_beats, random_frame
 
@@ -139,7 +139,8 @@ def job_cases(job: dict, g: dict) -> list[Case]:
     out: list[Case] = []
     orient_t = int(g.get("ORIENT_T", -1))
     for src in job["sources"]:
-        tp = TrackerParams(preset="v2", colour_bits=int(g["COLOUR_BITS"]), max_window=src["max_window"])
+        # colour bins (V2_COLOUR) unless the job's generics have ORIENT_T: then the model's joint bins
+        tp = TrackerParams(preset="v2", **V2_COLOUR, colour_bits=int(g["COLOUR_BITS"]), max_window=src["max_window"])
         tp_model = tp.with_(orient_T=orient_t) if orient_t > 0 else tp  # corner cases: colour bins
         if "seq" in src:
             from mstrack.io.data import load_sequence

@@ -296,13 +296,13 @@ def test_joint_bins_kernel_equals_whole_frame(T):
         trk = v2.FloatTrackerV2(TrackerParams(preset="v2", orient_T=T), path="numpy")
         whole = trk._bins(frame, d)
         h, w = whole.shape
-        cache, rows = v2._bins_cache(h, w)
+        cache, rows, grey = v2._bins_cache(*frame.shape[:2], True)
         src = frame[::d, ::d]
         for x0, x1, y0, y1 in ((3, 40, 2, 11), (0, 4, 0, 6), (w - 9, w - 1, h - 4, h - 1), (1, 50, 5, 30),
                                (w // 3, w // 2, h // 4, h - 2), (0, w - 1, 0, h - 1)):  # inclusive
             x0, x1, y0, y1 = min(x0, w - 1), min(x1, w - 1), min(y0, h - 1), min(y1, h - 1)
-            v2._nb_bins(src, 3, cache, rows, x0, x1, y0, y1, frame, d, T)
-        assert np.array_equal(cache, whole), d
+            v2._nb_bins(src, 3, cache, rows, grey, x0, x1, y0, y1, frame, d, T)
+        assert np.array_equal(cache[:h, :w], whole), d
     # features_v2.sobel's float32 order is cv2.Sobel's on frames whose width is a multiple of 8
     from mstrack.track.features import grey_area
     from mstrack.track.features_v2 import sobel

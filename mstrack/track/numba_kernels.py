@@ -37,6 +37,18 @@ def _jit(fn):
         return _numba_njit(nogil=True, error_model="numpy")(fn)
 
 
+def _jit_inline(fn):
+    """:func:`_jit` for a small helper that numba inlines into its callers (in its IR, before LLVM):
+    no call and no reference counting of the arrays passed, which for helpers called per row or
+    per pixel costs more than their work."""
+    if _numba_njit is None:
+        return fn
+    try:
+        return _numba_njit(cache=True, nogil=True, error_model="numpy", inline="always")(fn)
+    except RuntimeError:
+        return _numba_njit(nogil=True, error_model="numpy", inline="always")(fn)
+
+
 _PW_BLOCK = 128            # numpy's PW_BLOCKSIZE (numpy/_core/src/umath/loops_utils.h.src)
 _SHIFT2_BAND = 1e-9        # |dx*dx + dy*dy - eps2| <= band * eps2: Python decides the shift test
 

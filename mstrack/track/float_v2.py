@@ -337,47 +337,43 @@ _SPARSE_BINS = 1024
 
 
 @_jit
-def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, B, X, Y, h, ax, cnt, U, mark):
+def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, lists, B, X, Y, h, ax, cnt, U, mark):
     """numba_kernels._nb_scan on the bins image ``bins`` (the bins cache), for many bins: the same
-    pixels, B, X, Y and histogram h (the same sums in the same order), without clearing h and the
-    count tables first: they must be zero (as :func:`_nb_pass` leaves them).  The touched bins,
-    in order of first appearance, go to U (mark[u] = 1); h is set for them only.  Returns (n, nu)."""
+    pixels, B, X, Y (``lists``; else not written) and histogram h (the same sums in the same order),
+    without clearing h and the count tables first: they must be zero (as :func:`_nb_pass` leaves
+    them).  The touched bins go to U (mark[u] = 1); h is set for them only.  Returns (n, nu).
+
+    (uint64 indices and no views: numba then neither checks for negative indices nor reference-
+    counts a view per row.)"""
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     nx = x1 - x0 + 1
     jc = _nb_columns(cx, hx, x0, nx, ax)
-    mask = cnt.shape[0] - 1
-    n = 0
+    mask = np.uint64(cnt.shape[0] - 1)
+    n = nu = 0
     for y in range(y0, y1 + 1):
         t = (y - cy) / hy
         by = t * t
         ja, m = _nb_run(ax, jc, nx, by)
         if m == 0:
             continue
-        xa = x0 + ja
-        b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
-        row = bins[y, xa:xa + m]
+        xa, yu = x0 + ja, np.uint64(y)
         for k in range(m):
-            b[k] = row[k]
-            xs[k] = xa + k
-            ys[k] = y
-        if flat:
-            for k in range(m):
-                cnt[(n + k) & mask, b[k]] += 1
-        else:
-            axr = ax[ja:ja + m]
-            for k in range(m):
-                h[b[k]] += 1.0 - (axr[k] + by)
+            i, x = np.uint64(n + k), np.uint64(xa + k)
+            u = np.uint64(bins[yu, x])
+            if lists:
+                B[i], X[i], Y[i] = u, xa + k, y
+            if mark[u] == 0:
+                mark[u] = 1
+                U[np.uint64(nu)] = u
+                nu += 1
+            if flat:  # integer counts in interleaved tables (no store-to-load chain on runs of one bin)
+                cnt[i & mask, u] += 1
+            else:  # bincount's sequential sum
+                h[u] += 1.0 - (ax[np.uint64(ja + k)] + by)
         n += m
-    nu = 0
-    for k in range(n):
-        u = B[k]
-        if mark[u] == 0:
-            mark[u] = 1
-            U[nu] = u
-            nu += 1
     if flat:
         for i in range(nu):
-            u = U[i]
+            u = np.uint64(U[i])
             c = 0
             for r in range(cnt.shape[0]):
                 c += cnt[r, u]
@@ -400,7 +396,7 @@ def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y
         n = nu = 0
     else:
         _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T)
-        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, B, X, Y, h, ax, cnt, U, mark)
+        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, True, B, X, Y, h, ax, cnt, U, mark)
     # _nb_normalise: p = h / total, roots sqrt(p q) (in wb), rho their pairwise sum over all bins
     total = float(n) if flat else _nb_sum(h, nb)
     for i in range(nu):
@@ -457,23 +453,24 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
     (B, X, Y, ax of that window): (nt, st2, n_in, nt_in).
 
     d2 = ax + by as the scan found the pixels (row-major, each row's pixels one run
-    of consecutive columns); td = t[b] d2 per pixel, st2 its pairwise sum."""
+    of consecutive columns); td = t[b] d2 per pixel, st2 its pairwise sum.  (uint64
+    indices, no views: see :func:`_nb_scan_sparse`.)"""
     x0 = max(0, math.ceil(cx - hx))
     nt = n_in = nt_in = 0
     i = 0
     while i < n:
-        y = Y[i]
+        y = Y[np.uint64(i)]
         v = (y - cy) / hy
         by = v * v
+        xa = X[np.uint64(i)] - x0
         j = i + 1
-        while j < n and Y[j] == y:
+        while j < n and Y[np.uint64(j)] == y:
             j += 1
-        xa = X[i] - x0
-        axr, b, tdr = ax[xa:xa + j - i], B[i:j], td[i:j]
         for k in range(j - i):
-            d2 = axr[k] + by
-            tv = t[b[k]]
-            tdr[k] = tv * d2
+            ik = np.uint64(i + k)
+            d2 = ax[np.uint64(xa + k)] + by
+            tv = t[np.uint64(B[ik])]
+            td[ik] = tv * d2
             inner = d2 < inner2
             target = tv != 0.0
             n_in += inner  # (no branches: t is as often 0 as 1)
@@ -495,48 +492,20 @@ def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q,
 
 
 @_jit
-def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, fbuf, ax, cnt, ubuf):
+def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, ibuf, fbuf, ax, cnt, ubuf):
     """rho of :func:`_nb_pass_sparse` at (cx, cy) on bins already in ``bins`` (the cache), for many
-    bins, without the pixel lists: the same window pixels (the scan's runs), the same histogram
-    (counts; or bincount's sequential sums in row-major order), p and sqrt(p q) on the touched bins
-    and their pairwise sum over all bins; h, p, the roots, counts and marks cleared again after."""
+    bins, without the pixel lists (:func:`_nb_scan_sparse` without ``lists``): the same window
+    pixels, the same histogram (counts; or bincount's sequential sums in row-major order), p and
+    sqrt(p q) on the touched bins and their pairwise sum over all bins; h, p, the roots, counts and
+    marks cleared again after."""
     nb = q.shape[0]
     h, p, tmp = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     U, mark = ubuf[0], ubuf[1]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     n = nu = 0
     if x1 >= x0 and y1 >= y0:
-        nx = x1 - x0 + 1
-        jc = _nb_columns(cx, hx, x0, nx, ax)
-        mask = cnt.shape[0] - 1
-        for y in range(y0, y1 + 1):
-            t = (y - cy) / hy
-            by = t * t
-            ja, m = _nb_run(ax, jc, nx, by)
-            if m == 0:
-                continue
-            row = bins[y, x0 + ja:x0 + ja + m]
-            for k in range(m):
-                u = row[k]
-                if mark[u] == 0:
-                    mark[u] = 1
-                    U[nu] = u
-                    nu += 1
-            if flat:
-                for k in range(m):
-                    cnt[(n + k) & mask, row[k]] += 1
-            else:
-                axr = ax[ja:ja + m]
-                for k in range(m):
-                    h[row[k]] += 1.0 - (axr[k] + by)
-            n += m
-        if flat:
-            for i in range(nu):
-                u = U[i]
-                c = 0
-                for r in range(cnt.shape[0]):
-                    c += cnt[r, u]
-                h[u] = float(c)
+        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, False, ibuf[0], ibuf[1], ibuf[2], h, ax,
+                                cnt, U, mark)
     total = float(n) if flat else _nb_sum(h, nb)
     for i in range(nu):
         u = U[i]
@@ -560,7 +529,7 @@ def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fb
         bx0, bx1, by0, by1 = _nb_box(cx, cy, hx, hy, width, height)
         if bx1 >= bx0 and by1 >= by0:
             _nb_bins(frame, bits, cache, rows, grey, bx0, bx1, by0, by1, full, d, T)
-        return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, fbuf, ax[0], cnt, ubuf)
+        return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, ibuf, fbuf, ax[0], cnt, ubuf)
     return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
                     cnt, ubuf, cache, rows, grey, full, d, T)[1]
 

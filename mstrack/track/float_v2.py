@@ -213,7 +213,7 @@ def _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T):
     rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
     to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
     if T > 0:
-        _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T)
+        _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, _NO_AX, 0, 0.0, 0.0)
         return
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
     for y in range(y0, y1 + 1):
@@ -236,11 +236,31 @@ def _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T):
 
 
 @_jit
-def _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T):
+def _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax, full, d, T):
+    """:func:`_nb_bins` for the window at (cx, cy): joint bins (T > 0) of its pixels only (each row's
+    run of inside pixels, as the scan finds them: ``ax`` gets the window's column terms, see
+    float_model's ``_nb_columns``, ``_nb_run``), the other bins of its box."""
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
+    if x1 < x0 or y1 < y0:
+        return
+    if T > 0:
+        jc = _nb_columns(cx, hx, x0, x1 - x0 + 1, ax)
+        _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, ax, jc, cy, hy)
+    else:
+        _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T)
+
+
+_NO_AX = np.zeros(1)  # (_nb_bins_joint's ax for a box: not read)
+
+
+@_jit
+def _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, ax, jc, cy, hy):
     """:func:`_nb_bins` with joint bins: colour x 9 + the orientation bin of frame pixel (d y, d x)
     of ``full`` (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``: the colour bin
     (:func:`_nb_colour`), the orientation bin (:func:`_nb_octant`) of the greys around the pixel
-    (:func:`_nb_grey`); 8 on the frame's 1-px border.
+    (:func:`_nb_grey`); 8 on the frame's 1-px border.  hy > 0: in each row [y0, y1] only the run
+    of pixels inside the window at (., cy) of column terms ``ax`` (from x0; least at jc), the
+    pixels the scan reads (a box has a fifth more); hy = 0: the box [x0, x1] x [y0, y1].
 
     D <= 2: the greys come from the frame's grey cache ``grey``, each computed once per frame
     (at D 1 and 2 neighbouring pixels share greys): rows[2, R], rows[3, R] are frame row R's
@@ -255,15 +275,22 @@ def _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T):
     H, W = full.shape[0], full.shape[1]
     tf = float(T)
     one = np.uint64(1)
+    xl, xr, nx = x0, x1, x1 - x0 + 1  # the row's pixels [xl, xr]
     for y in range(y0, y1 + 1):
+        if hy > 0:  # the window's run in this row
+            v = (y - cy) / hy
+            ja, m = _nb_run(ax, jc, nx, v * v)
+            if m == 0:
+                continue
+            xl, xr = x0 + ja, x0 + ja + m - 1
         lo, hi = rows[0, y], rows[1, y]
-        if lo <= x0 and x1 < hi:
+        if lo <= xl and xr < hi:
             continue
         if lo >= hi:  # nothing yet in this row
-            a, b = x0, x1 + 1
-            lo, hi = x0, x0
+            a, b = xl, xr + 1
+            lo, hi = xl, xl
         else:
-            a, b = min(x0, lo), max(x1 + 1, hi)
+            a, b = min(xl, lo), max(xr + 1, hi)
         rows[0, y], rows[1, y] = a, b
         yu, Y = np.uint64(y), d * y
         for run in range(2):  # the new runs [a, lo) and [hi, b)
@@ -325,10 +352,10 @@ def _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T):
                                                grey[r2, l], grey[r2, x], grey[r2, r], tf)
             else:
                 for X in range(xa, xb):
-                    m = np.uint64(2 * X)
-                    l, r = m - one, m + one
-                    cache[yu, np.uint64(X)] += _nb_octant(grey[r0, l], grey[r0, m], grey[r0, r], grey[r1, l],
-                                                          grey[r1, r], grey[r2, l], grey[r2, m], grey[r2, r], tf)
+                    c = np.uint64(2 * X)
+                    l, r = c - one, c + one
+                    cache[yu, np.uint64(X)] += _nb_octant(grey[r0, l], grey[r0, c], grey[r0, r], grey[r1, l],
+                                                          grey[r1, r], grey[r2, l], grey[r2, c], grey[r2, r], tf)
 
 
 #: More bins than this (the joint colour x orientation bins, 4608): :func:`_nb_pass` works on the bins
@@ -395,7 +422,7 @@ def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y
     if x1 < x0 or y1 < y0:  # no pixel in the box
         n = nu = 0
     else:
-        _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T)
+        _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax, full, d, T)
         n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, True, B, X, Y, h, ax, cnt, U, mark)
     # _nb_normalise: p = h / total, roots sqrt(p q) (in wb), rho their pairwise sum over all bins
     total = float(n) if flat else _nb_sum(h, nb)
@@ -526,9 +553,7 @@ def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fb
                    full, d, T):
     """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_rho_sparse`)."""
     if q.shape[0] > _SPARSE_BINS:
-        bx0, bx1, by0, by1 = _nb_box(cx, cy, hx, hy, width, height)
-        if bx1 >= bx0 and by1 >= by0:
-            _nb_bins(frame, bits, cache, rows, grey, bx0, bx1, by0, by1, full, d, T)
+        _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax[0], full, d, T)
         return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, ibuf, fbuf, ax[0], cnt, ubuf)
     return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
                     cnt, ubuf, cache, rows, grey, full, d, T)[1]

@@ -49,6 +49,39 @@ def _jit_inline(fn):
         return _numba_njit(nogil=True, error_model="numpy", inline="always")(fn)
 
 
+if _numba_njit is not None:
+    from llvmlite import ir as _ir
+    from numba import types as _types
+    from numba.core import cgutils as _cgutils
+    from numba.extending import intrinsic as _intrinsic
+
+    @_intrinsic
+    def _prefetch(typingctx, a, i, j):
+        """Prefetch a[i, j, 0] (an (H, W, C) array; i, j >= 0) into the caches for reading: LLVM's
+        prefetch hint, no load (no fault, nothing to wait for).  The kernels read each new frame's
+        pixels once, from memory: a hint a few rows ahead lets those misses overlap the work."""
+        def codegen(context, builder, sig, args):
+            aryty = sig.args[0]
+            ary = context.make_array(aryty)(context, builder, args[0])
+            inds = [context.cast(builder, v, t, _types.intp) for v, t in zip(args[1:], sig.args[1:])]
+            inds.append(context.get_constant(_types.intp, 0))
+            ptr = _cgutils.get_item_pointer2(context, builder, data=ary.data,
+                                             shape=_cgutils.unpack_tuple(builder, ary.shape),
+                                             strides=_cgutils.unpack_tuple(builder, ary.strides),
+                                             layout=aryty.layout, inds=inds, wraparound=False)
+            i32, ptrty = _ir.IntType(32), _ir.PointerType()
+            fn = _cgutils.get_or_insert_function(builder.module, _ir.FunctionType(
+                _ir.VoidType(), [ptrty, i32, i32, i32]), "llvm.prefetch.p0")
+            # read, high locality, data cache
+            builder.call(fn, [builder.bitcast(ptr, ptrty), _ir.Constant(i32, 0), _ir.Constant(i32, 3),
+                              _ir.Constant(i32, 1)])
+            return context.get_dummy_value()
+        return _types.void(a, i, j), codegen
+else:  # pragma: no cover - numba is a declared dependency
+    def _prefetch(a, i, j):
+        """(no numba: nothing to prefetch)"""
+
+
 _PW_BLOCK = 128            # numpy's PW_BLOCKSIZE (numpy/_core/src/umath/loops_utils.h.src)
 _SHIFT2_BAND = 1e-9        # |dx*dx + dy*dy - eps2| <= band * eps2: Python decides the shift test
 

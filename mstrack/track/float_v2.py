@@ -163,7 +163,7 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
 # With orient_T > 0 the kernels bin joint colour x orientation bins lazily too (_nb_bins_joint, the
 # Sobel in features_v2.sobel's float32 order on greys computed once per frame in a grey cache), and
 # with more than _SPARSE_BINS bins a pass runs its per-bin steps on the bins its pixels touch
-# (_nb_pass_sparse, _nb_rho_sparse), the same numbers.
+# (_nb_pass_sparse), the same numbers.
 
 @_jit
 def _nb_box(cx, cy, hx, hy, width, height):
@@ -375,18 +375,19 @@ _SPARSE_BINS = 1024
 
 
 @_jit
-def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, lists, B, X, Y, h, ax, cnt, U, mark):
+def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, lists, B, X, Y, h, ax, cnt, U):
     """numba_kernels._nb_scan on the bins image ``bins`` (the bins cache), for many bins: the same
     pixels, B, X, Y (``lists``; else not written) and histogram h (the same sums in the same order),
-    without clearing h and the count tables first: they must be zero (as :func:`_nb_pass` leaves
-    them).  The touched bins go to U (mark[u] = 1); h is set for them only.  Returns (n, nu).
+    without clearing h and the counts cnt[0] first: they must be zero (as :func:`_nb_pass_sparse`
+    leaves them).  The touched bins go to U (a bin is new where its count, or h, is still 0: every
+    pixel adds 1, or 1 - d2 > 0); h is set for them only.  Returns (n, nu).
 
-    (uint64 indices and no views: numba then neither checks for negative indices nor reference-
-    counts a view per row.)"""
+    (One count table: with many bins runs of one bin are short.  uint64 indices and no views:
+    numba then neither checks for negative indices nor reference-counts a view per row.)"""
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     nx = x1 - x0 + 1
     jc = _nb_columns(cx, hx, x0, nx, ax)
-    mask = np.uint64(cnt.shape[0] - 1)
+    c1 = cnt[0]
     n = nu = 0
     for y in range(y0, y1 + 1):
         t = (y - cy) / hy
@@ -400,60 +401,63 @@ def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, lists, B, X, Y, h
             u = np.uint64(bins[yu, x])
             if lists:
                 B[i], X[i], Y[i] = u, xa + k, y
-            if mark[u] == 0:
-                mark[u] = 1
-                U[np.uint64(nu)] = u
-                nu += 1
-            if flat:  # integer counts in interleaved tables (no store-to-load chain on runs of one bin)
-                cnt[i & mask, u] += 1
+            if flat:  # integer counts
+                c = c1[u]
+                if c == 0:
+                    U[np.uint64(nu)] = u
+                    nu += 1
+                c1[u] = c + 1
             else:  # bincount's sequential sum
-                h[u] += 1.0 - (ax[np.uint64(ja + k)] + by)
+                hu = h[u]
+                if hu == 0.0:
+                    U[np.uint64(nu)] = u
+                    nu += 1
+                h[u] = hu + (1.0 - (ax[np.uint64(ja + k)] + by))
         n += m
     if flat:
         for i in range(nu):
             u = np.uint64(U[i])
-            c = 0
-            for r in range(cnt.shape[0]):
-                c += cnt[r, u]
-            h[u] = float(c)
+            h[u] = float(c1[u])
     return n, nu
 
 
 @_jit
 def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
                     cache, rows, grey, full, d, T, rho_only):
-    """:func:`_nb_pass` for many bins: the same numbers; the per-bin steps run on the touched bins
-    (h, p, the roots and the weights are 0 elsewhere, bit for bit what the dense steps give), and
-    h, p, wb, the count tables and the marks are cleared again for them at the end.  rho_only:
-    no weights (sw, swx, swy returned 0)."""
+    """:func:`_nb_pass` for many bins: the same numbers.  The per-bin steps run on the bins the
+    window's pixels touch (U, :func:`_nb_scan_sparse`) and only where q > 0 (elsewhere the root
+    sqrt(p q) and the weight sqrt(q / p) are 0, p is not used): p = h / total, the root in p's row
+    (rho: their pairwise sum over all bins), the weight in h's (after h's sum).  h, p and the counts
+    are 0 elsewhere, bit for bit what the dense steps give, and are cleared again for the touched
+    bins at the end.  rho_only: no pixel lists, no weights (sw, swx, swy returned 0)."""
     nb = q.shape[0]
-    h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
-    U, mark = ubuf[0], ubuf[1]
+    h, p = fbuf[0, :nb], fbuf[1, :nb]
+    U = ubuf[0]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box
         n = nu = 0
     else:
         _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax, full, d, T)
-        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, True, B, X, Y, h, ax, cnt, U, mark)
-    # _nb_normalise: p = h / total, roots sqrt(p q) (in wb), rho their pairwise sum over all bins
+        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, not rho_only, B, X, Y, h, ax, cnt, U)
     total = float(n) if flat else _nb_sum(h, nb)
     for i in range(nu):
-        u = U[i]
-        p[u] = h[u] / total if total > 0 else h[u]
-        wb[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
-    rho = _nb_sum(wb, nb)
+        u = np.uint64(U[i])
+        qu = q[u]
+        if qu != 0.0:
+            pu = h[u] / total if total > 0 else h[u]
+            p[u] = math.sqrt(pu * qu)
+            h[u] = math.sqrt(qu / pu) if pu > 0 else 0.0
+        else:
+            h[u] = 0.0
+    rho = _nb_sum(p, nb)
     sw = swx = swy = 0.0
     if not rho_only:
-        for i in range(nu):
-            u = U[i]
-            wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
-        sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+        sw, swx, swy = _nb_sum3(h, B, X, Y, n)
+    c1 = cnt[0]
     for i in range(nu):
-        u = U[i]
-        h[u] = p[u] = wb[u] = 0.0
-        mark[u] = 0
-        for r in range(cnt.shape[0]):
-            cnt[r, u] = 0
+        u = np.uint64(U[i])
+        h[u] = p[u] = 0.0
+        c1[u] = 0
     return n, rho, sw, swx, swy
 
 
@@ -530,42 +534,13 @@ def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q,
 
 
 @_jit
-def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, ibuf, fbuf, ax, cnt, ubuf):
-    """rho of :func:`_nb_pass_sparse` at (cx, cy) on bins already in ``bins`` (the cache), for many
-    bins, without the pixel lists (:func:`_nb_scan_sparse` without ``lists``): the same window
-    pixels, the same histogram (counts; or bincount's sequential sums in row-major order), p and
-    sqrt(p q) on the touched bins and their pairwise sum over all bins; h, p, the roots, counts and
-    marks cleared again after."""
-    nb = q.shape[0]
-    h, p, tmp = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
-    U, mark = ubuf[0], ubuf[1]
-    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
-    n = nu = 0
-    if x1 >= x0 and y1 >= y0:
-        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, False, ibuf[0], ibuf[1], ibuf[2], h, ax,
-                                cnt, U, mark)
-    total = float(n) if flat else _nb_sum(h, nb)
-    for i in range(nu):
-        u = U[i]
-        p[u] = h[u] / total if total > 0 else h[u]
-        tmp[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
-    rho = _nb_sum(tmp, nb)
-    for i in range(nu):
-        u = U[i]
-        h[u] = p[u] = tmp[u] = 0.0
-        mark[u] = 0
-        for r in range(cnt.shape[0]):
-            cnt[r, u] = 0
-    return rho
-
-
-@_jit
 def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, grey,
                    full, d, T):
-    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_rho_sparse`)."""
+    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_pass_sparse` without the
+    pixel lists and the weights)."""
     if q.shape[0] > _SPARSE_BINS:
-        _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax[0], full, d, T)
-        return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, ibuf, fbuf, ax[0], cnt, ubuf)
+        return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2],
+                               fbuf, ax[0], cnt, ubuf, cache, rows, grey, full, d, T, True)[1]
     return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
                     cnt, ubuf, cache, rows, grey, full, d, T)[1]
 
@@ -624,14 +599,14 @@ def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
     int32 bins and coordinates of two windows (6, box px); float64 histogram,
     normalised histogram, weights (3, bins); d2 column terms of two windows
     (2, box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins);
-    float64 t d2 (box px); int32 touched bins and their marks (2, bins).  The
-    histogram rows, the counts and the marks start at zero: with more than
-    _SPARSE_BINS bins :func:`_nb_pass_sparse` relies on it (and leaves them so).
+    float64 t d2 (box px); int32 touched bins (1, bins).  The histogram rows and
+    the counts start at zero: with more than _SPARSE_BINS bins
+    :func:`_nb_pass_sparse` relies on it (and leaves them so).
     """
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
     return (np.empty((6, box_w * box_h), np.int32), np.zeros((3, n_bins)), np.empty((2, box_w)),
             np.zeros((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h),
-            np.zeros((2, n_bins), np.int32))
+            np.zeros((1, n_bins), np.int32))
 
 
 def _bins_cache(height: int, width: int, joint: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

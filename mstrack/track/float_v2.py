@@ -286,10 +286,10 @@ def _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, a
             if m == 0:
                 continue
             xl, xr = x0 + ja, x0 + ja + m - 1
-        # the frame rows of the next _PF_ROWS rows not binned yet (their columns as this row's): into
+        # the frame rows of the next _PF_ROWS rows whose bins lack some of this row's columns: into
         # the caches while this row is worked on (a new frame is read from memory)
         while yf <= min(y + _PF_ROWS, y1):
-            if rows[0, yf] >= rows[1, yf]:
+            if not (rows[0, yf] <= xl and xr < rows[1, yf]):
                 for R in range(max(d * yf - 1, 0), min(d * yf + 2, H)):
                     for X in range(max(d * xl - 1, 0), min(d * xr + 2, W), 21):  # 64 bytes apart
                         _prefetch(full, np.uint64(R), np.uint64(X))

@@ -37,7 +37,8 @@ import numpy as np
 from . import float_model as _fm
 from .features import _GREY_W, colour_bins
 from .frames import check_frame, clip_box
-from .numba_kernels import _SHIFT2_BAND, _jit, _jit_inline, _nb_columns, _prefetch, _nb_normalise, _nb_run, _nb_scan, _nb_sum, _nb_sum3
+from .numba_kernels import (_SHIFT2_BAND, _jit, _jit_inline, _nb_columns, _nb_normalise, _nb_run, _nb_scan, _nb_sum,
+                            _nb_sum3, _prefetch)
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -534,8 +535,8 @@ def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q,
 
 
 @_jit
-def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, grey,
-                   full, d, T):
+def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows,
+                   grey, full, d, T):
     """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_pass_sparse` without the
     pixel lists and the weights)."""
     if q.shape[0] > _SPARSE_BINS:

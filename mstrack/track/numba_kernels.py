@@ -194,8 +194,10 @@ def _nb_leaf3(wb, B, X, Y, lo, n):
             s2 += w * Y[i]
         return s0, s1, s2
     i = b
-    w0, w1, w2, w3 = wb[np.uint64(B[i])], wb[np.uint64(B[i + _U1])], wb[np.uint64(B[i + _U2])], wb[np.uint64(B[i + _U3])]
-    w4, w5, w6, w7 = wb[np.uint64(B[i + _U4])], wb[np.uint64(B[i + _U5])], wb[np.uint64(B[i + _U6])], wb[np.uint64(B[i + _U7])]
+    w0, w1 = wb[np.uint64(B[i])], wb[np.uint64(B[i + _U1])]
+    w2, w3 = wb[np.uint64(B[i + _U2])], wb[np.uint64(B[i + _U3])]
+    w4, w5 = wb[np.uint64(B[i + _U4])], wb[np.uint64(B[i + _U5])]
+    w6, w7 = wb[np.uint64(B[i + _U6])], wb[np.uint64(B[i + _U7])]
     a0, a1, a2, a3, a4, a5, a6, a7 = w0, w1, w2, w3, w4, w5, w6, w7
     b0, b1, b2, b3 = w0 * X[i], w1 * X[i + _U1], w2 * X[i + _U2], w3 * X[i + _U3]
     b4, b5, b6, b7 = w4 * X[i + _U4], w5 * X[i + _U5], w6 * X[i + _U6], w7 * X[i + _U7]
@@ -204,8 +206,10 @@ def _nb_leaf3(wb, B, X, Y, lo, n):
     end = n - n % 8
     for k in range(8, end, 8):
         i = b + np.uint64(k)
-        w0, w1, w2, w3 = wb[np.uint64(B[i])], wb[np.uint64(B[i + _U1])], wb[np.uint64(B[i + _U2])], wb[np.uint64(B[i + _U3])]
-        w4, w5, w6, w7 = wb[np.uint64(B[i + _U4])], wb[np.uint64(B[i + _U5])], wb[np.uint64(B[i + _U6])], wb[np.uint64(B[i + _U7])]
+        w0, w1 = wb[np.uint64(B[i])], wb[np.uint64(B[i + _U1])]
+        w2, w3 = wb[np.uint64(B[i + _U2])], wb[np.uint64(B[i + _U3])]
+        w4, w5 = wb[np.uint64(B[i + _U4])], wb[np.uint64(B[i + _U5])]
+        w6, w7 = wb[np.uint64(B[i + _U6])], wb[np.uint64(B[i + _U7])]
         a0 += w0
         a1 += w1
         a2 += w2

@@ -265,6 +265,67 @@ def test_real_sequences_identical_joint_gate(real_sequences):
         _assert_identical(frames, box, orient_T=64, scale_test=0.05, scale_test_gate=True)
 
 
+def _assert_fields_identical(frames, box, **params):
+    """Both paths, every TrackResult field compared by itself (box, centre, rho, iterations, status,
+    confidence and each entry of ``extra``), frame by frame."""
+    from dataclasses import fields
+    want = _run("numpy", frames, box, **params)
+    got = _run("numba", frames, box, **params)
+    assert len(got) == len(want)
+    for i, (g, w) in enumerate(zip(got, want)):
+        for f in fields(w):
+            gv, wv = getattr(g, f.name), getattr(w, f.name)
+            if f.name == "extra":
+                assert gv.keys() == wv.keys(), f"frame {i}: extra keys"
+                for k in wv:
+                    assert gv[k] == wv[k], f"frame {i}: extra[{k!r}] numba {gv[k]!r} != numpy {wv[k]!r}"
+            else:
+                assert gv == wv, f"frame {i}: {f.name} numba {gv!r} != numpy {wv!r}"
+        assert g == w
+    return want
+
+
+@needs_numba
+@pytest.mark.parametrize("kernel", KERNELS)
+def test_joint_synthetic_all_decimations(kernel):
+    """The joint tracker (V2_JOINT, the candidate default) on synthetic scenes that need D 1, 2 and 4
+    and a lost target (the wide search at 2 D): the joint bins' three paths (D 1, D 2 with the grey
+    cache, D > 2 straight-line), the prefetch and the many-bins passes, both paths field by field."""
+    from mstrack.track.params import V2_JOINT
+    boxes = [(80 + 2 * i, 70 + (i % 7), 36, 30) for i in range(30)]
+    res = _assert_fields_identical(_render(220, 320, boxes, seed=4, occluded=range(12, 18)), boxes[0],
+                                   kernel=kernel, **V2_JOINT)
+    assert any(r.extra.get("searched") for r in res)
+    boxes = [(40 + 4 * i, 30 + 2 * i, 150 + 2 * i, 120 + i) for i in range(12)]
+    res = _assert_fields_identical(_render(300, 480, boxes, seed=8), boxes[0], kernel=kernel, **V2_JOINT)
+    assert {r.extra["decimation"] for r in res[1:]} == {2}
+    boxes = [(60 + 3 * i, 40 + i, 300 + 4 * i, 260 + 3 * i) for i in range(8)]
+    res = _assert_fields_identical(_render(420, 640, boxes, seed=2), boxes[0], kernel=kernel, **V2_JOINT)
+    assert {r.extra["decimation"] for r in res[1:]} == {4}
+
+
+@pytest.fixture(scope="module")
+def real_joint_clips():
+    """Real clips that take the joint tracker through D 1, 2 and 4 (MotorRolling: D 2 and its lost
+    search at D 4; Deer: large D 1 windows; Girl: a 128 x 96 frame)."""
+    if not SEQ_ROOT.is_dir():
+        pytest.skip(f"real sequences not found at {SEQ_ROOT} (the synthetic joint test runs without them)")
+    seqs = {s.name: s for s in load_dataset(SEQ_ROOT)}
+    names = [n for n in ("MotorRolling", "Deer", "Girl") if n in seqs]
+    if not names:
+        pytest.skip(f"none of MotorRolling, Deer, Girl in {SEQ_ROOT}")
+    return {n: ([seqs[n].frame(i) for i in range(min(len(seqs[n]), 60))], seqs[n].init_box()) for n in names}
+
+
+@needs_numba
+def test_real_joint_fields_identical(real_joint_clips):
+    """V2_JOINT (orient_T 64, gated scale test, its loss thresholds) on real frames: numba and numpy
+    give every TrackResult field equal, frame by frame."""
+    from mstrack.track.params import V2_JOINT
+    for name, (frames, box) in real_joint_clips.items():
+        _assert_fields_identical(frames, box, **V2_JOINT)
+
+
 # ----------------------------------------------------------------------------- path selection
 def test_unknown_path_rejected():
     with pytest.raises(ValueError):
@@ -300,13 +361,13 @@ def test_joint_bins_kernel_equals_whole_frame(T):
         trk = v2.FloatTrackerV2(TrackerParams(preset="v2", orient_T=T), path="numpy")
         whole = trk._bins(frame, d)
         h, w = whole.shape
-        cache, rows = v2._bins_cache(h, w)
+        cache, rows, grey = v2._bins_cache(*frame.shape[:2], True)
         src = frame[::d, ::d]
         for x0, x1, y0, y1 in ((3, 40, 2, 11), (0, 4, 0, 6), (w - 9, w - 1, h - 4, h - 1), (1, 50, 5, 30),
                                (w // 3, w // 2, h // 4, h - 2), (0, w - 1, 0, h - 1)):  # inclusive
             x0, x1, y0, y1 = min(x0, w - 1), min(x1, w - 1), min(y0, h - 1), min(y1, h - 1)
-            v2._nb_bins(src, 3, cache, rows, x0, x1, y0, y1, frame, d, T)
-        assert np.array_equal(cache, whole), d
+            v2._nb_bins(src, 3, cache, rows, grey, x0, x1, y0, y1, frame, d, T)
+        assert np.array_equal(cache[:h, :w], whole), d
     # features_v2.sobel's float32 order is cv2.Sobel's on frames whose width is a multiple of 8
     from mstrack.track.features import grey_area
     from mstrack.track.features_v2 import sobel

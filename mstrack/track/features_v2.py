@@ -98,7 +98,7 @@ def sobel(frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gx, Gy (float32) of the 3x3 Sobel on the float32 grey image; 0 on the 1-px frame border.
 
     Element-wise float32 operations in a fixed order (so the numba kernel,
-    float_v2._nb_orient_run, computes the same values pixel by pixel):
+    float_v2._nb_joint_run, computes the same values pixel by pixel):
     Gx = (d[y-1] + d[y+1]) + 2 d[y] with d = g[x+1] - g[x-1] (the row difference), and
     Gy = s[y+1] - s[y-1] with s = (g[x-1] + g[x+1]) + 2 g[x] (the row smoothing).  This is
     cv2.Sobel(grey, CV_32F, ksize=3)'s order in its vector loop: equal to it bit for bit on

@@ -37,7 +37,8 @@ import numpy as np
 from . import float_model as _fm
 from .features import _GREY_W, colour_bins
 from .frames import check_frame, clip_box
-from .numba_kernels import _SHIFT2_BAND, _jit, _nb_columns, _nb_normalise, _nb_run, _nb_scan, _nb_sum, _nb_sum3
+from .numba_kernels import (_SHIFT2_BAND, _jit, _jit_inline, _nb_columns, _nb_normalise, _nb_run, _nb_scan, _nb_sum,
+                            _nb_sum3, _prefetch)
 from .params import TrackerParams
 from .types import Box, Status, TrackResult, box_centre_index, box_from_centre_index
 
@@ -161,8 +162,9 @@ def window_pass(bins: np.ndarray, n_bins: int, q: np.ndarray, t: np.ndarray, c: 
 # float operation of the loop, s2 = dx ** 2 + dy ** 2 (libm pow), is left to Python when s2 is
 # within rounding of eps2.  init() and everything per frame run the same Python for both paths.
 # With orient_T > 0 the kernels bin joint colour x orientation bins lazily too (_nb_bins_joint, the
-# Sobel in features_v2.sobel's float32 order), and with more than _SPARSE_BINS bins a pass runs its per-bin steps on the
-# bins its pixels touch (_nb_pass_sparse, _nb_rho_sparse), the same numbers.
+# Sobel in features_v2.sobel's float32 order on greys computed once per frame in a grey cache), and
+# with more than _SPARSE_BINS bins a pass runs its per-bin steps on the bins its pixels touch
+# (_nb_pass_sparse), the same numbers.
 
 @_jit
 def _nb_box(cx, cy, hx, hy, width, height):
@@ -177,67 +179,42 @@ _LB, _LG, _LR = (np.arange(256, dtype=np.float32) * w for w in _GREY_W)
 _TWO = np.float32(2.0)
 
 
-@_jit
-def _nb_orient_run(full, d, T, y, a, b, row, g, gk):
-    """row[x] = row[x] x 9 + the orientation bin of frame pixel (d y, d x) for x in [a, b)
-    (:func:`~mstrack.track.features_v2.orientation_bins` of :func:`~mstrack.track.features_v2.sobel`'s
-    Gx, Gy, the same float32 operations in the same order; 8 on the frame's 1-px border): the grey
-    of frame rows d y - 1 .. d y + 1 over the run's columns (+-1; D > 2: the 3 around each pixel's)
-    into g (float32), then Gx, Gy of each pixel from it.
+@_jit_inline
+def _nb_colour(r, g, b, s, s1, s2):
+    """The colour bin (:func:`colour_bins`) of one pixel's R, G, B (uint8); s = 8 - bits, s1 = bits,
+    s2 = 2 bits (uint32)."""
+    return ((np.uint32(r) >> s) << s2) | ((np.uint32(g) >> s) << s1) | (np.uint32(b) >> s)
 
-    g holds frame row R in g[R % 3]; gk[0, R % 3] = R and gk[1:3, R % 3] = the run [a', b') it
-    was computed for (-1: none): a row already there for a run containing [a, b) is reused."""
-    if b <= a:
-        return
-    H, W = full.shape[0], full.shape[1]
-    Y = d * y
-    if Y == 0 or Y == H - 1:
-        for x in range(a, b):
-            row[x] = row[x] * 9 + 8
-        return
-    c0, c1 = max(d * a - 1, 0), min(d * (b - 1) + 1, W - 1)
-    for r in range(3):
-        R = Y - 1 + r
-        k = R % 3
-        if gk[0, k] == R and gk[1, k] <= a and b <= gk[2, k]:
-            continue
-        gk[0, k], gk[1, k], gk[2, k] = R, a, b
-        px, gr = full[R], g[k]
-        if d <= 2:  # every column of the run
-            for X in range(c0, c1 + 1):
-                gr[X] = (_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]]
-        else:  # the 3 columns around each pixel's
-            for x in range(a, b):
-                for X in range(max(d * x - 1, 0), min(d * x + 1, W - 1) + 1):
-                    gr[X] = (_LB[px[X, 0]] + _LG[px[X, 1]]) + _LR[px[X, 2]]
-    g0, g1, g2 = g[(Y - 1) % 3], g[Y % 3], g[(Y + 1) % 3]
-    tf = float(T)
-    xa, xb = a, b  # the pixels off the frame's left / right column
-    if d * a == 0:
-        row[a] = row[a] * 9 + 8
-        xa = a + 1
-    if d * (b - 1) == W - 1 and xb > xa:
-        row[b - 1] = row[b - 1] * 9 + 8
-        xb = b - 1
-    for x in range(xa, xb):  # (no branches: the flat test is as often true as not)
-        X = d * x
-        gx = ((g0[X + 1] - g0[X - 1]) + (g2[X + 1] - g2[X - 1])) + (g1[X + 1] - g1[X - 1]) * _TWO
-        gy = ((g2[X - 1] + g2[X + 1]) + g2[X] * _TWO) - ((g0[X - 1] + g0[X + 1]) + g0[X] * _TWO)
-        ax, ay = abs(gx), abs(gy)
-        o = 4 * np.int32(gx < 0) + 2 * np.int32(gy < 0) + np.int32(ay > ax)
-        o += np.int32(ax + ay < tf) * (8 - o)
-        row[x] = row[x] * 9 + o
+
+@_jit_inline
+def _nb_grey(b, g, r):
+    """The grey of one pixel's B, G, R (uint8): :func:`~mstrack.track.features.grey_area`'s
+    (B wb + G wg) + R wr in float32 (the products from the _LB, _LG, _LR tables)."""
+    return (_LB[b] + _LG[g]) + _LR[r]
+
+
+@_jit_inline
+def _nb_octant(l0, m0, r0, l1, r1, l2, m2, r2, tf):
+    """The orientation bin of a pixel from the greys of its 3 x 3 neighbourhood (rows 0 .. 2, left,
+    middle, right; the centre is not used): :func:`~mstrack.track.features_v2.sobel`'s float32 Gx,
+    Gy in its order, then :func:`~mstrack.track.features_v2.orientation_bins` (no branches: the flat
+    test is as often true as not)."""
+    gx = ((r0 - l0) + (r2 - l2)) + (r1 - l1) * _TWO
+    gy = ((l2 + r2) + m2 * _TWO) - ((l0 + r0) + m0 * _TWO)
+    ax, ay = abs(gx), abs(gy)
+    o = 4 * np.int32(gx < 0) + 2 * np.int32(gy < 0) + np.int32(ay > ax)
+    return o + np.int32(ax + ay < tf) * (8 - o)
 
 
 @_jit
-def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
+def _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T):
     """Colour bins (:func:`colour_bins`) of ``frame``'s [y0, y1] x [x0, x1] into ``cache``, once;
     T > 0: joint bins (:func:`_nb_bins_joint`).
 
     rows[0, y], rows[1, y]: the computed columns [lo, hi) of row y (one run, grown
     to the union; lo >= hi: none yet).  The bins never depend on what was asked before."""
     if T > 0:
-        _nb_bins_joint(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
+        _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, _NO_AX, 0, 0.0, 0.0)
         return
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
     for y in range(y0, y1 + 1):
@@ -260,33 +237,137 @@ def _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
 
 
 @_jit
-def _nb_bins_joint(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T):
+def _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax, full, d, T):
+    """:func:`_nb_bins` for the window at (cx, cy): joint bins (T > 0) of its pixels only (each row's
+    run of inside pixels, as the scan finds them: ``ax`` gets the window's column terms, see
+    float_model's ``_nb_columns``, ``_nb_run``), the other bins of its box."""
+    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
+    if x1 < x0 or y1 < y0:
+        return
+    if T > 0:
+        jc = _nb_columns(cx, hx, x0, x1 - x0 + 1, ax)
+        _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, ax, jc, cy, hy)
+    else:
+        _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T)
+
+
+#: _nb_bins_joint prefetches the frame rows of the next rows this far ahead (1: measured best on the dev set)
+_PF_ROWS = 1
+_NO_AX = np.zeros(1)  # (_nb_bins_joint's ax for a box: not read)
+
+
+@_jit
+def _nb_bins_joint(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T, ax, jc, cy, hy):
     """:func:`_nb_bins` with joint bins: colour x 9 + the orientation bin of frame pixel (d y, d x)
-    of ``full`` (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``
-    (:func:`_nb_orient_run` for each new run of a row)."""
+    of ``full`` (``frame`` = ``full[::d, ::d]``), as ``FloatTrackerV2._bins``: the colour bin
+    (:func:`_nb_colour`), the orientation bin (:func:`_nb_octant`) of the greys around the pixel
+    (:func:`_nb_grey`); 8 on the frame's 1-px border.  hy > 0: in each row [y0, y1] only the run
+    of pixels inside the window at (., cy) of column terms ``ax`` (from x0; least at jc), the
+    pixels the scan reads (a box has a fifth more); hy = 0: the box [x0, x1] x [y0, y1].
+
+    D <= 2: the greys come from the frame's grey cache ``grey``, each computed once per frame
+    (at D 1 and 2 neighbouring pixels share greys): rows[2, R], rows[3, R] are frame row R's
+    computed columns [lo, hi) (one run, grown to the union as the bins' runs); the loops for D 1
+    and 2 are separate (a constant stride).  D > 2: no two pixels share a grey; each pixel's 8
+    greys (the Sobel does not use the centre's) are computed in straight-line code.
+
+    One function without array-passing helpers and with uint64 indices (ints known to be >= 0):
+    numba then neither reference-counts arrays nor checks for negative indices per row or pixel,
+    which for the short runs a moved window adds to each row cost more than the bins."""
     s, s1, s2 = np.uint32(8 - bits), np.uint32(bits), np.uint32(2 * bits)
-    # the grey of three frame rows (one row of decimated pixels' 3 x 3 neighbourhoods)
-    g = np.empty((3, full.shape[1]), np.float32)
-    gk = np.full((3, 3), -1, np.int64)  # which frame row / run each row of g holds (_nb_orient_run)
+    H, W = full.shape[0], full.shape[1]
+    tf = float(T)
+    one = np.uint64(1)
+    xl, xr, nx = x0, x1, x1 - x0 + 1  # the row's pixels [xl, xr]
+    yf = y0  # rows before yf: prefetched
     for y in range(y0, y1 + 1):
+        if hy > 0:  # the window's run in this row
+            v = (y - cy) / hy
+            ja, m = _nb_run(ax, jc, nx, v * v)
+            if m == 0:
+                continue
+            xl, xr = x0 + ja, x0 + ja + m - 1
+        # the frame rows of the next _PF_ROWS rows whose bins lack some of this row's columns: into
+        # the caches while this row is worked on (a new frame is read from memory)
+        while yf <= min(y + _PF_ROWS, y1):
+            if not (rows[0, yf] <= xl and xr < rows[1, yf]):
+                for R in range(max(d * yf - 1, 0), min(d * yf + 2, H)):
+                    for X in range(max(d * xl - 1, 0), min(d * xr + 2, W), 21):  # 64 bytes apart
+                        _prefetch(full, np.uint64(R), np.uint64(X))
+            yf += 1
         lo, hi = rows[0, y], rows[1, y]
-        if lo <= x0 and x1 < hi:
+        if lo <= xl and xr < hi:
             continue
         if lo >= hi:  # nothing yet in this row
-            a, b = x0, x1 + 1
-            lo, hi = x0, x0
+            a, b = xl, xr + 1
+            lo, hi = xl, xl
         else:
-            a, b = min(x0, lo), max(x1 + 1, hi)
-        px, row = frame[y], cache[y]
-        for x in range(a, lo):
-            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
-                      | (np.uint32(px[x, 0]) >> s))
-        for x in range(hi, b):
-            row[x] = (((np.uint32(px[x, 2]) >> s) << s2) | ((np.uint32(px[x, 1]) >> s) << s1)
-                      | (np.uint32(px[x, 0]) >> s))
-        _nb_orient_run(full, d, T, y, a, lo, row, g, gk)
-        _nb_orient_run(full, d, T, y, hi, b, row, g, gk)
+            a, b = min(xl, lo), max(xr + 1, hi)
         rows[0, y], rows[1, y] = a, b
+        yu, Y = np.uint64(y), d * y
+        for run in range(2):  # the new runs [a, lo) and [hi, b)
+            xa, xb = (a, lo) if run == 0 else (hi, b)
+            if xb <= xa:
+                continue
+            for X in range(xa, xb):
+                x = np.uint64(X)
+                cache[yu, x] = 9 * _nb_colour(frame[yu, x, 2], frame[yu, x, 1], frame[yu, x, 0], s, s1, s2)
+            if Y == 0 or Y == H - 1:
+                for X in range(xa, xb):
+                    cache[yu, np.uint64(X)] += 8
+                continue
+            if xa == 0:  # the frame's left / right column
+                cache[yu, 0] += 8
+                xa = 1
+            if d * (xb - 1) == W - 1 and xb > xa:
+                cache[yu, np.uint64(xb - 1)] += 8
+                xb -= 1
+            if xb <= xa:
+                continue
+            r0, r1, r2 = np.uint64(Y - 1), np.uint64(Y), np.uint64(Y + 1)
+            if d > 2:
+                for X in range(xa, xb):
+                    x = np.uint64(d * X)
+                    l, r = x - one, x + one
+                    o = _nb_octant(
+                        _nb_grey(full[r0, l, 0], full[r0, l, 1], full[r0, l, 2]),
+                        _nb_grey(full[r0, x, 0], full[r0, x, 1], full[r0, x, 2]),
+                        _nb_grey(full[r0, r, 0], full[r0, r, 1], full[r0, r, 2]),
+                        _nb_grey(full[r1, l, 0], full[r1, l, 1], full[r1, l, 2]),
+                        _nb_grey(full[r1, r, 0], full[r1, r, 1], full[r1, r, 2]),
+                        _nb_grey(full[r2, l, 0], full[r2, l, 1], full[r2, l, 2]),
+                        _nb_grey(full[r2, x, 0], full[r2, x, 1], full[r2, x, 2]),
+                        _nb_grey(full[r2, r, 0], full[r2, r, 1], full[r2, r, 2]), tf)
+                    cache[yu, np.uint64(X)] += o
+                continue
+            c0, c1 = d * xa - 1, d * (xb - 1) + 2  # frame columns [c0, c1): X - 1 .. X + 1 of every pixel
+            for R in range(Y - 1, Y + 2):  # their greys, once per frame
+                glo, ghi = rows[2, R], rows[3, R]
+                if glo <= c0 and c1 <= ghi:
+                    continue
+                if glo >= ghi:  # nothing yet in this row
+                    glo = ghi = c0
+                ga, gb = min(c0, glo), max(c1, ghi)
+                ru = np.uint64(R)
+                for X in range(ga, glo):
+                    x = np.uint64(X)
+                    grey[ru, x] = _nb_grey(full[ru, x, 0], full[ru, x, 1], full[ru, x, 2])
+                for X in range(ghi, gb):
+                    x = np.uint64(X)
+                    grey[ru, x] = _nb_grey(full[ru, x, 0], full[ru, x, 1], full[ru, x, 2])
+                rows[2, R], rows[3, R] = ga, gb
+            if d == 1:
+                for X in range(xa, xb):
+                    x = np.uint64(X)
+                    l, r = x - one, x + one
+                    cache[yu, x] += _nb_octant(grey[r0, l], grey[r0, x], grey[r0, r], grey[r1, l], grey[r1, r],
+                                               grey[r2, l], grey[r2, x], grey[r2, r], tf)
+            else:
+                for X in range(xa, xb):
+                    c = np.uint64(2 * X)
+                    l, r = c - one, c + one
+                    cache[yu, np.uint64(X)] += _nb_octant(grey[r0, l], grey[r0, c], grey[r0, r], grey[r1, l],
+                                                          grey[r1, r], grey[r2, l], grey[r2, c], grey[r2, r], tf)
 
 
 #: More bins than this (the joint colour x orientation bins, 4608): :func:`_nb_pass` works on the bins
@@ -295,94 +376,94 @@ _SPARSE_BINS = 1024
 
 
 @_jit
-def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, B, X, Y, h, ax, cnt, U, mark):
+def _nb_scan_sparse(cx, cy, hx, hy, width, height, bins, flat, lists, B, X, Y, h, ax, cnt, U):
     """numba_kernels._nb_scan on the bins image ``bins`` (the bins cache), for many bins: the same
-    pixels, B, X, Y and histogram h (the same sums in the same order), without clearing h and the
-    count tables first: they must be zero (as :func:`_nb_pass` leaves them).  The touched bins,
-    in order of first appearance, go to U (mark[u] = 1); h is set for them only.  Returns (n, nu)."""
+    pixels, B, X, Y (``lists``; else not written) and histogram h (the same sums in the same order),
+    without clearing h and the counts cnt[0] first: they must be zero (as :func:`_nb_pass_sparse`
+    leaves them).  The touched bins go to U (a bin is new where its count, or h, is still 0: every
+    pixel adds 1, or 1 - d2 > 0); h is set for them only.  Returns (n, nu).
+
+    (One count table: with many bins runs of one bin are short.  uint64 indices and no views:
+    numba then neither checks for negative indices nor reference-counts a view per row.)"""
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     nx = x1 - x0 + 1
     jc = _nb_columns(cx, hx, x0, nx, ax)
-    mask = cnt.shape[0] - 1
-    n = 0
+    c1 = cnt[0]
+    n = nu = 0
     for y in range(y0, y1 + 1):
         t = (y - cy) / hy
         by = t * t
         ja, m = _nb_run(ax, jc, nx, by)
         if m == 0:
             continue
-        xa = x0 + ja
-        b, xs, ys = B[n:n + m], X[n:n + m], Y[n:n + m]
-        row = bins[y, xa:xa + m]
+        xa, yu = x0 + ja, np.uint64(y)
         for k in range(m):
-            b[k] = row[k]
-            xs[k] = xa + k
-            ys[k] = y
-        if flat:
-            for k in range(m):
-                cnt[(n + k) & mask, b[k]] += 1
-        else:
-            axr = ax[ja:ja + m]
-            for k in range(m):
-                h[b[k]] += 1.0 - (axr[k] + by)
+            i, x = np.uint64(n + k), np.uint64(xa + k)
+            u = np.uint64(bins[yu, x])
+            if lists:
+                B[i], X[i], Y[i] = u, xa + k, y
+            if flat:  # integer counts
+                c = c1[u]
+                if c == 0:
+                    U[np.uint64(nu)] = u
+                    nu += 1
+                c1[u] = c + 1
+            else:  # bincount's sequential sum
+                hu = h[u]
+                if hu == 0.0:
+                    U[np.uint64(nu)] = u
+                    nu += 1
+                h[u] = hu + (1.0 - (ax[np.uint64(ja + k)] + by))
         n += m
-    nu = 0
-    for k in range(n):
-        u = B[k]
-        if mark[u] == 0:
-            mark[u] = 1
-            U[nu] = u
-            nu += 1
     if flat:
         for i in range(nu):
-            u = U[i]
-            c = 0
-            for r in range(cnt.shape[0]):
-                c += cnt[r, u]
-            h[u] = float(c)
+            u = np.uint64(U[i])
+            h[u] = float(c1[u])
     return n, nu
 
 
 @_jit
 def _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
-                    cache, rows, full, d, T, rho_only):
-    """:func:`_nb_pass` for many bins: the same numbers; the per-bin steps run on the touched bins
-    (h, p, the roots and the weights are 0 elsewhere, bit for bit what the dense steps give), and
-    h, p, wb, the count tables and the marks are cleared again for them at the end.  rho_only:
-    no weights (sw, swx, swy returned 0)."""
+                    cache, rows, grey, full, d, T, rho_only):
+    """:func:`_nb_pass` for many bins: the same numbers.  The per-bin steps run on the bins the
+    window's pixels touch (U, :func:`_nb_scan_sparse`) and only where q > 0 (elsewhere the root
+    sqrt(p q) and the weight sqrt(q / p) are 0, p is not used): p = h / total, the root in p's row
+    (rho: their pairwise sum over all bins), the weight in h's (after h's sum).  h, p and the counts
+    are 0 elsewhere, bit for bit what the dense steps give, and are cleared again for the touched
+    bins at the end.  rho_only: no pixel lists, no weights (sw, swx, swy returned 0)."""
     nb = q.shape[0]
-    h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
-    U, mark = ubuf[0], ubuf[1]
+    h, p = fbuf[0, :nb], fbuf[1, :nb]
+    U = ubuf[0]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box
         n = nu = 0
     else:
-        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
-        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, B, X, Y, h, ax, cnt, U, mark)
-    # _nb_normalise: p = h / total, roots sqrt(p q) (in wb), rho their pairwise sum over all bins
+        _nb_bins_window(frame, bits, cache, rows, grey, cx, cy, hx, hy, width, height, ax, full, d, T)
+        n, nu = _nb_scan_sparse(cx, cy, hx, hy, width, height, cache, flat, not rho_only, B, X, Y, h, ax, cnt, U)
     total = float(n) if flat else _nb_sum(h, nb)
     for i in range(nu):
-        u = U[i]
-        p[u] = h[u] / total if total > 0 else h[u]
-        wb[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
-    rho = _nb_sum(wb, nb)
+        u = np.uint64(U[i])
+        qu = q[u]
+        if qu != 0.0:
+            pu = h[u] / total if total > 0 else h[u]
+            p[u] = math.sqrt(pu * qu)
+            h[u] = math.sqrt(qu / pu) if pu > 0 else 0.0
+        else:
+            h[u] = 0.0
+    rho = _nb_sum(p, nb)
     sw = swx = swy = 0.0
     if not rho_only:
-        for i in range(nu):
-            u = U[i]
-            wb[u] = math.sqrt(q[u] / p[u]) if p[u] > 0 else 0.0
-        sw, swx, swy = _nb_sum3(wb, B, X, Y, n)
+        sw, swx, swy = _nb_sum3(h, B, X, Y, n)
+    c1 = cnt[0]
     for i in range(nu):
-        u = U[i]
-        h[u] = p[u] = wb[u] = 0.0
-        mark[u] = 0
-        for r in range(cnt.shape[0]):
-            cnt[r, u] = 0
+        u = np.uint64(U[i])
+        h[u] = p[u] = 0.0
+        c1[u] = 0
     return n, rho, sw, swx, swy
 
 
 @_jit
-def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf, cache, rows,
+def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf, cache, rows, grey,
              full, d, T):
     """The mean-shift part of :func:`window_pass` at (cx, cy): (n, rho, sw, swx, swy).
 
@@ -393,14 +474,14 @@ def _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf,
     nb = q.shape[0]
     if nb > _SPARSE_BINS:
         return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, B, X, Y, fbuf, ax, cnt, ubuf,
-                               cache, rows, full, d, T, False)
+                               cache, rows, grey, full, d, T, False)
     h, p, wb = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
     x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
     if x1 < x0 or y1 < y0:  # no pixel in the box (_nb_scan needs one column)
         h[:] = 0.0
         n = 0
     else:
-        _nb_bins(frame, bits, cache, rows, x0, x1, y0, y1, full, d, T)
+        _nb_bins(frame, bits, cache, rows, grey, x0, x1, y0, y1, full, d, T)
         n = _nb_scan(cx, cy, hx, hy, width, height, frame, 0, cache, 0, 0, flat, B, X, Y, h, ax, cnt[:, :nb])
     rho = _nb_normalise(h, q, n, flat, p, wb)  # wb: rho's temporary
     for u in range(nb):
@@ -415,23 +496,24 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
     (B, X, Y, ax of that window): (nt, st2, n_in, nt_in).
 
     d2 = ax + by as the scan found the pixels (row-major, each row's pixels one run
-    of consecutive columns); td = t[b] d2 per pixel, st2 its pairwise sum."""
+    of consecutive columns); td = t[b] d2 per pixel, st2 its pairwise sum.  (uint64
+    indices, no views: see :func:`_nb_scan_sparse`.)"""
     x0 = max(0, math.ceil(cx - hx))
     nt = n_in = nt_in = 0
     i = 0
     while i < n:
-        y = Y[i]
+        y = Y[np.uint64(i)]
         v = (y - cy) / hy
         by = v * v
+        xa = X[np.uint64(i)] - x0
         j = i + 1
-        while j < n and Y[j] == y:
+        while j < n and Y[np.uint64(j)] == y:
             j += 1
-        xa = X[i] - x0
-        axr, b, tdr = ax[xa:xa + j - i], B[i:j], td[i:j]
         for k in range(j - i):
-            d2 = axr[k] + by
-            tv = t[b[k]]
-            tdr[k] = tv * d2
+            ik = np.uint64(i + k)
+            d2 = ax[np.uint64(xa + k)] + by
+            tv = t[np.uint64(B[ik])]
+            td[ik] = tv * d2
             inner = d2 < inner2
             target = tv != 0.0
             n_in += inner  # (no branches: t is as often 0 as 1)
@@ -443,99 +525,40 @@ def _nb_stats(n, B, X, Y, ax, cx, cy, hx, hy, t, inner2, td):
 
 @_jit
 def _nb_window_pass(frame, bits, cx, cy, hx, hy, width, height, inner2, flat, q, t,
-                    ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, full, d, T):
+                    ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, grey, full, d, T):
     """:func:`window_pass` at (cx, cy) on the colour bins of ``frame`` (an (H, W, 3) uint8 view,
     the decimated frame): (rho, sw, swx, swy, nt, st2, n_in, nt_in, n).  Buffers: :func:`_nb_buffers_v2`."""
     n, rho, sw, swx, swy = _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1],
-                                    ibuf[2], fbuf, ax[0], cnt, ubuf, cache, rows, full, d, T)
+                                    ibuf[2], fbuf, ax[0], cnt, ubuf, cache, rows, grey, full, d, T)
     nt, st2, n_in, nt_in = _nb_stats(n, ibuf[0], ibuf[1], ibuf[2], ax[0], cx, cy, hx, hy, t, inner2, td)
     return rho, sw, swx, swy, nt, st2, n_in, nt_in, n
 
 
 @_jit
-def _nb_rho_sparse(cx, cy, hx, hy, width, height, bins, flat, q, fbuf, ax, cnt, ubuf):
-    """rho of :func:`_nb_pass_sparse` at (cx, cy) on bins already in ``bins`` (the cache), for many
-    bins, without the pixel lists: the same window pixels (the scan's runs), the same histogram
-    (counts; or bincount's sequential sums in row-major order), p and sqrt(p q) on the touched bins
-    and their pairwise sum over all bins; h, p, the roots, counts and marks cleared again after."""
-    nb = q.shape[0]
-    h, p, tmp = fbuf[0, :nb], fbuf[1, :nb], fbuf[2, :nb]
-    U, mark = ubuf[0], ubuf[1]
-    x0, x1, y0, y1 = _nb_box(cx, cy, hx, hy, width, height)
-    n = nu = 0
-    if x1 >= x0 and y1 >= y0:
-        nx = x1 - x0 + 1
-        jc = _nb_columns(cx, hx, x0, nx, ax)
-        mask = cnt.shape[0] - 1
-        for y in range(y0, y1 + 1):
-            t = (y - cy) / hy
-            by = t * t
-            ja, m = _nb_run(ax, jc, nx, by)
-            if m == 0:
-                continue
-            row = bins[y, x0 + ja:x0 + ja + m]
-            for k in range(m):
-                u = row[k]
-                if mark[u] == 0:
-                    mark[u] = 1
-                    U[nu] = u
-                    nu += 1
-            if flat:
-                for k in range(m):
-                    cnt[(n + k) & mask, row[k]] += 1
-            else:
-                axr = ax[ja:ja + m]
-                for k in range(m):
-                    h[row[k]] += 1.0 - (axr[k] + by)
-            n += m
-        if flat:
-            for i in range(nu):
-                u = U[i]
-                c = 0
-                for r in range(cnt.shape[0]):
-                    c += cnt[r, u]
-                h[u] = float(c)
-    total = float(n) if flat else _nb_sum(h, nb)
-    for i in range(nu):
-        u = U[i]
-        p[u] = h[u] / total if total > 0 else h[u]
-        tmp[u] = math.sqrt(p[u] * q[u]) if q[u] != 0.0 else 0.0
-    rho = _nb_sum(tmp, nb)
-    for i in range(nu):
-        u = U[i]
-        h[u] = p[u] = tmp[u] = 0.0
-        mark[u] = 0
-        for r in range(cnt.shape[0]):
-            cnt[r, u] = 0
-    return rho
-
-
-@_jit
 def _nb_window_rho(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf, cache, rows,
-                   full, d, T):
-    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_rho_sparse`)."""
+                   grey, full, d, T):
+    """rho of :func:`_nb_window_pass` at (cx, cy) (many bins: :func:`_nb_pass_sparse` without the
+    pixel lists and the weights)."""
     if q.shape[0] > _SPARSE_BINS:
-        bx0, bx1, by0, by1 = _nb_box(cx, cy, hx, hy, width, height)
-        if bx1 >= bx0 and by1 >= by0:
-            _nb_bins(frame, bits, cache, rows, bx0, bx1, by0, by1, full, d, T)
-        return _nb_rho_sparse(cx, cy, hx, hy, width, height, cache, flat, q, fbuf, ax[0], cnt, ubuf)
+        return _nb_pass_sparse(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2],
+                               fbuf, ax[0], cnt, ubuf, cache, rows, grey, full, d, T, True)[1]
     return _nb_pass(frame, bits, cx, cy, hx, hy, width, height, flat, q, ibuf[0], ibuf[1], ibuf[2], fbuf, ax[0],
-                    cnt, ubuf, cache, rows, full, d, T)[1]
+                    cnt, ubuf, cache, rows, grey, full, d, T)[1]
 
 
 @_jit
 def _nb_window_rho2(frame, bits, cx, cy, hx1, hy1, hx2, hy2, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
-                    cache, rows, full, d, T):
+                    cache, rows, grey, full, d, T):
     """:func:`_nb_window_rho` at (cx, cy) for two window sizes (the scale test's), one call."""
     return (_nb_window_rho(frame, bits, cx, cy, hx1, hy1, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
-                           cache, rows, full, d, T),
+                           cache, rows, grey, full, d, T),
             _nb_window_rho(frame, bits, cx, cy, hx2, hy2, width, height, flat, q, ibuf, fbuf, ax, cnt, td, ubuf,
-                           cache, rows, full, d, T))
+                           cache, rows, grey, full, d, T))
 
 
 @_jit
 def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, t, max_iter, eps2,
-              ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, full, d, T):
+              ibuf, fbuf, ax, cnt, td, ubuf, cache, rows, grey, full, d, T):
     """FloatTrackerV2._track's mean shift from (sx, sy) after ``it0`` iterations.
 
     Returns (code, it, c0x, c0y, c1x, c1y, pass): code 0 a stop at c0 after ``it``
@@ -549,7 +572,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
     c0x = min(max(sx, 0.0), width - 1.0)
     c0y = min(max(sy, 0.0), height - 1.0)
     n0, rho0, sw0, swx0, swy0 = _nb_pass(frame, bits, c0x, c0y, hx, hy, width, height, flat, q, B0, X0, Y0, fbuf,
-                                         ax0, cnt, ubuf, cache, rows, full, d, T)
+                                         ax0, cnt, ubuf, cache, rows, grey, full, d, T)
     it = it0
     for it in range(it0 + 1, max_iter + 1):
         if sw0 <= 0:
@@ -557,7 +580,7 @@ def _nb_track(frame, bits, sx, sy, it0, hx, hy, width, height, inner2, flat, q, 
         c1x = min(max(swx0 / sw0, 0.0), width - 1.0)
         c1y = min(max(swy0 / sw0, 0.0), height - 1.0)
         n1, rho1, sw1, swx1, swy1 = _nb_pass(frame, bits, c1x, c1y, hx, hy, width, height, flat, q, B1, X1, Y1,
-                                             fbuf, ax1, cnt, ubuf, cache, rows, full, d, T)
+                                             fbuf, ax1, cnt, ubuf, cache, rows, grey, full, d, T)
         if rho1 < rho0:
             break
         s2 = (c1x - c0x) * (c1x - c0x) + (c1y - c0y) * (c1y - c0y)
@@ -577,20 +600,26 @@ def _nb_buffers_v2(hx: float, hy: float, n_bins: int) -> tuple[np.ndarray, ...]:
     int32 bins and coordinates of two windows (6, box px); float64 histogram,
     normalised histogram, weights (3, bins); d2 column terms of two windows
     (2, box width); int32 counts (4 interleaved tables, 1 beyond 2**16 bins);
-    float64 t d2 (box px); int32 touched bins and their marks (2, bins).  The
-    histogram rows, the counts and the marks start at zero: with more than
-    _SPARSE_BINS bins :func:`_nb_pass_sparse` relies on it (and leaves them so).
+    float64 t d2 (box px); int32 touched bins (1, bins).  The histogram rows and
+    the counts start at zero: with more than _SPARSE_BINS bins
+    :func:`_nb_pass_sparse` relies on it (and leaves them so).
     """
     box_w, box_h = int(2.0 * hx) + 2, int(2.0 * hy) + 2
     return (np.empty((6, box_w * box_h), np.int32), np.zeros((3, n_bins)), np.empty((2, box_w)),
             np.zeros((4 if n_bins <= 1 << 16 else 1, n_bins), np.int32), np.empty(box_w * box_h),
-            np.zeros((2, n_bins), np.int32))
+            np.zeros((1, n_bins), np.int32))
 
 
-def _bins_cache(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
-    """An empty bins cache of :func:`_nb_bins` for a height x width image: (bins, rows)."""
-    rows = np.zeros((2, height), np.int32)
-    return np.empty((height, width), np.int32), rows
+def _bins_cache(height: int, width: int, joint: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """An empty bins cache of :func:`_nb_bins` for a height x width frame: (bins, rows, grey).
+
+    bins: the (decimated) image's bins in its top-left part; rows[0:2]: each bins row's computed
+    columns; rows[2:4] and grey (``joint``: float32, the frame's size; else 1 x 1, unused): each
+    frame row's computed grey columns and the greys (:func:`_nb_grey_row`).  Zeroing ``rows``
+    empties both caches (a new frame)."""
+    rows = np.zeros((4, height), np.int32)
+    grey = np.empty((height, width) if joint else (1, 1), np.float32)
+    return np.empty((height, width), np.int32), rows, grey
 
 
 def _buffers_fit(bufs: tuple[np.ndarray, ...], hx: float, hy: float, n_bins: int) -> bool:
@@ -765,7 +794,7 @@ class FloatTrackerV2:
         self.path = path
         self._shape: tuple[int, int] | None = None
         self._bufs: tuple[np.ndarray, ...] | None = None
-        self._cache: tuple[np.ndarray, np.ndarray] | None = None
+        self._cache: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._use_numba = False
 
     def active_path(self) -> str:
@@ -939,9 +968,9 @@ class FloatTrackerV2:
             if self._bufs is None or not _buffers_fit(self._bufs, hx, hy, p.n_bins_v2):
                 self._bufs = _nb_buffers_v2(1.25 * hx, 1.25 * hy, p.n_bins_v2)  # room to grow
             if self._cache is None:
-                self._cache = _bins_cache(*self._shape)  # (the decimated image uses its top-left part)
+                self._cache = _bins_cache(*self._shape, p.orient_T > 0)  # (the decimated image: its top-left part)
             else:
-                self._cache[1][:] = 0  # a new frame: no bins yet
+                self._cache[1][:] = 0  # a new frame: no bins, no greys yet
             # joint bins (orient_T > 0): the kernel adds each binned pixel's orientation from the frame
             self._src = (frame, d, int(p.orient_T))
         elif p.orient_T > 0:

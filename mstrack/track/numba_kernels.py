@@ -37,6 +37,51 @@ def _jit(fn):
         return _numba_njit(nogil=True, error_model="numpy")(fn)
 
 
+def _jit_inline(fn):
+    """:func:`_jit` for a small helper that numba inlines into its callers (in its IR, before LLVM):
+    no call and no reference counting of the arrays passed, which for helpers called per row or
+    per pixel costs more than their work."""
+    if _numba_njit is None:
+        return fn
+    try:
+        return _numba_njit(cache=True, nogil=True, error_model="numpy", inline="always")(fn)
+    except RuntimeError:
+        return _numba_njit(nogil=True, error_model="numpy", inline="always")(fn)
+
+
+if _numba_njit is not None:
+    from llvmlite import ir as _ir
+    from numba import types as _types
+    from numba.core import cgutils as _cgutils
+    from numba.extending import intrinsic as _intrinsic
+
+    @_intrinsic
+    def _prefetch(typingctx, a, i, j):
+        """Prefetch a[i, j, 0] (an (H, W, C) array; i, j >= 0) into the caches for reading: LLVM's
+        prefetch hint, no load (no fault, nothing to wait for).  The kernels read each new frame's
+        pixels once, from memory: a hint a few rows ahead lets those misses overlap the work."""
+        def codegen(context, builder, sig, args):
+            aryty = sig.args[0]
+            ary = context.make_array(aryty)(context, builder, args[0])
+            inds = [context.cast(builder, v, t, _types.intp) for v, t in zip(args[1:], sig.args[1:])]
+            inds.append(context.get_constant(_types.intp, 0))
+            ptr = _cgutils.get_item_pointer2(context, builder, data=ary.data,
+                                             shape=_cgutils.unpack_tuple(builder, ary.shape),
+                                             strides=_cgutils.unpack_tuple(builder, ary.strides),
+                                             layout=aryty.layout, inds=inds, wraparound=False)
+            i32, ptrty = _ir.IntType(32), _ir.PointerType()
+            fn = _cgutils.get_or_insert_function(builder.module, _ir.FunctionType(
+                _ir.VoidType(), [ptrty, i32, i32, i32]), "llvm.prefetch.p0")
+            # read, high locality, data cache
+            builder.call(fn, [builder.bitcast(ptr, ptrty), _ir.Constant(i32, 0), _ir.Constant(i32, 3),
+                              _ir.Constant(i32, 1)])
+            return context.get_dummy_value()
+        return _types.void(a, i, j), codegen
+else:  # pragma: no cover - numba is a declared dependency
+    def _prefetch(a, i, j):
+        """(no numba: nothing to prefetch)"""
+
+
 _PW_BLOCK = 128            # numpy's PW_BLOCKSIZE (numpy/_core/src/umath/loops_utils.h.src)
 _SHIFT2_BAND = 1e-9        # |dx*dx + dy*dy - eps2| <= band * eps2: Python decides the shift test
 
@@ -64,32 +109,36 @@ def _nb_edge_bins(gx, gy, r0, c0, shift, top, out):
             row[j] = min(top, np.int32(abs(a[j]) + abs(b[j])) >> shift)
 
 
+# The sums index with uint64 (ints known to be >= 0): numba then skips its negative-index
+# wraparound on every access, which also lets LLVM vectorise the leaves' 8 accumulators.
+_U1, _U2, _U3, _U4, _U5, _U6, _U7 = (np.uint64(k) for k in range(1, 8))
+
+
 @_jit
 def _nb_leaf(a, lo, n):
     """numpy's pairwise-sum leaf over a[lo:lo+n] (n <= 128): 8 accumulators, then the rest."""
+    b = np.uint64(lo)
     if n < 8:
         res = 0.0
-        for i in range(lo, lo + n):
-            res += a[i]
+        for k in range(n):
+            res += a[b + np.uint64(k)]
         return res
-    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
-    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
-    i = lo + 8
-    end = lo + n - n % 8
-    while i < end:
+    r0, r1, r2, r3 = a[b], a[b + _U1], a[b + _U2], a[b + _U3]
+    r4, r5, r6, r7 = a[b + _U4], a[b + _U5], a[b + _U6], a[b + _U7]
+    end = n - n % 8
+    for k in range(8, end, 8):
+        i = b + np.uint64(k)
         r0 += a[i]
-        r1 += a[i + 1]
-        r2 += a[i + 2]
-        r3 += a[i + 3]
-        r4 += a[i + 4]
-        r5 += a[i + 5]
-        r6 += a[i + 6]
-        r7 += a[i + 7]
-        i += 8
+        r1 += a[i + _U1]
+        r2 += a[i + _U2]
+        r3 += a[i + _U3]
+        r4 += a[i + _U4]
+        r5 += a[i + _U5]
+        r6 += a[i + _U6]
+        r7 += a[i + _U7]
     res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-    while i < lo + n:
-        res += a[i]
-        i += 1
+    for k in range(end, n):
+        res += a[b + np.uint64(k)]
     return res
 
 
@@ -98,16 +147,17 @@ def _nb_sum(a, n):
     """numpy's ``a[:n].sum()`` bit for bit: 0 + pairwise sum.
 
     numpy halves a block (rounded down to a multiple of 8) until it is at most
-    128 long; the recursion runs here on an explicit stack.
+    128 long; the recursion runs here on an explicit stack (one allocation;
+    numba's on-disk cache does not take recursive functions well).
     """
     if n <= _PW_BLOCK:
         return 0.0 + _nb_leaf(a, 0, n)
-    lo_s, n_s, st_s = np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
+    stk = np.empty((3, 64), np.int64)  # lo, n, state (0: left half next, 1: right half next, 2: add)
     vals = np.empty(64)
     sp, vp = 1, 0
-    lo_s[0], n_s[0], st_s[0] = 0, n, 0
+    stk[0, 0], stk[1, 0], stk[2, 0] = 0, n, 0
     while sp > 0:
-        lo, m = lo_s[sp - 1], n_s[sp - 1]
+        lo, m, st = stk[0, sp - 1], stk[1, sp - 1], stk[2, sp - 1]
         if m <= _PW_BLOCK:
             vals[vp] = _nb_leaf(a, lo, m)
             vp += 1
@@ -115,15 +165,15 @@ def _nb_sum(a, n):
             continue
         half = m // 2
         half -= half % 8
-        if st_s[sp - 1] == 0:      # left half
-            st_s[sp - 1] = 1
-            lo_s[sp], n_s[sp], st_s[sp] = lo, half, 0
+        if st == 0:      # left half
+            stk[2, sp - 1] = 1
+            stk[0, sp], stk[1, sp], stk[2, sp] = lo, half, 0
             sp += 1
-        elif st_s[sp - 1] == 1:    # right half
-            st_s[sp - 1] = 2
-            lo_s[sp], n_s[sp], st_s[sp] = lo + half, m - half, 0
+        elif st == 1:    # right half
+            stk[2, sp - 1] = 2
+            stk[0, sp], stk[1, sp], stk[2, sp] = lo + half, m - half, 0
             sp += 1
-        else:                      # left + right
+        else:            # left + right
             vals[vp - 2] = vals[vp - 2] + vals[vp - 1]
             vp -= 1
             sp -= 1
@@ -133,26 +183,33 @@ def _nb_sum(a, n):
 @_jit
 def _nb_leaf3(wb, B, X, Y, lo, n):
     """Three pairwise leaves at once: w = wb[B], sums of w, w * X and w * Y over [lo, lo+n)."""
-    B, X, Y = B[lo:lo + n], X[lo:lo + n], Y[lo:lo + n]  # indices from 0: no negative-index checks
+    b = np.uint64(lo)
     if n < 8:
         s0 = s1 = s2 = 0.0
-        for i in range(n):
-            w = wb[B[i]]
+        for k in range(n):
+            i = b + np.uint64(k)
+            w = wb[np.uint64(B[i])]
             s0 += w
             s1 += w * X[i]
             s2 += w * Y[i]
         return s0, s1, s2
-    w0, w1, w2, w3 = wb[B[0]], wb[B[1]], wb[B[2]], wb[B[3]]
-    w4, w5, w6, w7 = wb[B[4]], wb[B[5]], wb[B[6]], wb[B[7]]
+    i = b
+    w0, w1 = wb[np.uint64(B[i])], wb[np.uint64(B[i + _U1])]
+    w2, w3 = wb[np.uint64(B[i + _U2])], wb[np.uint64(B[i + _U3])]
+    w4, w5 = wb[np.uint64(B[i + _U4])], wb[np.uint64(B[i + _U5])]
+    w6, w7 = wb[np.uint64(B[i + _U6])], wb[np.uint64(B[i + _U7])]
     a0, a1, a2, a3, a4, a5, a6, a7 = w0, w1, w2, w3, w4, w5, w6, w7
-    b0, b1, b2, b3 = w0 * X[0], w1 * X[1], w2 * X[2], w3 * X[3]
-    b4, b5, b6, b7 = w4 * X[4], w5 * X[5], w6 * X[6], w7 * X[7]
-    c0, c1, c2, c3 = w0 * Y[0], w1 * Y[1], w2 * Y[2], w3 * Y[3]
-    c4, c5, c6, c7 = w4 * Y[4], w5 * Y[5], w6 * Y[6], w7 * Y[7]
+    b0, b1, b2, b3 = w0 * X[i], w1 * X[i + _U1], w2 * X[i + _U2], w3 * X[i + _U3]
+    b4, b5, b6, b7 = w4 * X[i + _U4], w5 * X[i + _U5], w6 * X[i + _U6], w7 * X[i + _U7]
+    c0, c1, c2, c3 = w0 * Y[i], w1 * Y[i + _U1], w2 * Y[i + _U2], w3 * Y[i + _U3]
+    c4, c5, c6, c7 = w4 * Y[i + _U4], w5 * Y[i + _U5], w6 * Y[i + _U6], w7 * Y[i + _U7]
     end = n - n % 8
-    for i in range(8, end, 8):
-        w0, w1, w2, w3 = wb[B[i]], wb[B[i + 1]], wb[B[i + 2]], wb[B[i + 3]]
-        w4, w5, w6, w7 = wb[B[i + 4]], wb[B[i + 5]], wb[B[i + 6]], wb[B[i + 7]]
+    for k in range(8, end, 8):
+        i = b + np.uint64(k)
+        w0, w1 = wb[np.uint64(B[i])], wb[np.uint64(B[i + _U1])]
+        w2, w3 = wb[np.uint64(B[i + _U2])], wb[np.uint64(B[i + _U3])]
+        w4, w5 = wb[np.uint64(B[i + _U4])], wb[np.uint64(B[i + _U5])]
+        w6, w7 = wb[np.uint64(B[i + _U6])], wb[np.uint64(B[i + _U7])]
         a0 += w0
         a1 += w1
         a2 += w2
@@ -162,26 +219,27 @@ def _nb_leaf3(wb, B, X, Y, lo, n):
         a6 += w6
         a7 += w7
         b0 += w0 * X[i]
-        b1 += w1 * X[i + 1]
-        b2 += w2 * X[i + 2]
-        b3 += w3 * X[i + 3]
-        b4 += w4 * X[i + 4]
-        b5 += w5 * X[i + 5]
-        b6 += w6 * X[i + 6]
-        b7 += w7 * X[i + 7]
+        b1 += w1 * X[i + _U1]
+        b2 += w2 * X[i + _U2]
+        b3 += w3 * X[i + _U3]
+        b4 += w4 * X[i + _U4]
+        b5 += w5 * X[i + _U5]
+        b6 += w6 * X[i + _U6]
+        b7 += w7 * X[i + _U7]
         c0 += w0 * Y[i]
-        c1 += w1 * Y[i + 1]
-        c2 += w2 * Y[i + 2]
-        c3 += w3 * Y[i + 3]
-        c4 += w4 * Y[i + 4]
-        c5 += w5 * Y[i + 5]
-        c6 += w6 * Y[i + 6]
-        c7 += w7 * Y[i + 7]
+        c1 += w1 * Y[i + _U1]
+        c2 += w2 * Y[i + _U2]
+        c3 += w3 * Y[i + _U3]
+        c4 += w4 * Y[i + _U4]
+        c5 += w5 * Y[i + _U5]
+        c6 += w6 * Y[i + _U6]
+        c7 += w7 * Y[i + _U7]
     s0 = ((a0 + a1) + (a2 + a3)) + ((a4 + a5) + (a6 + a7))
     s1 = ((b0 + b1) + (b2 + b3)) + ((b4 + b5) + (b6 + b7))
     s2 = ((c0 + c1) + (c2 + c3)) + ((c4 + c5) + (c6 + c7))
-    for i in range(end, n):
-        w = wb[B[i]]
+    for k in range(end, n):
+        i = b + np.uint64(k)
+        w = wb[np.uint64(B[i])]
         s0 += w
         s1 += w * X[i]
         s2 += w * Y[i]
@@ -190,38 +248,39 @@ def _nb_leaf3(wb, B, X, Y, lo, n):
 
 @_jit
 def _nb_sum3(wb, B, X, Y, n):
-    """numpy's ``w.sum(), (w * xs).sum(), (w * ys).sum()`` with w = wb[B], bit for bit (one pass)."""
+    """numpy's ``w.sum(), (w * xs).sum(), (w * ys).sum()`` with w = wb[B], bit for bit (one pass;
+    :func:`_nb_sum`'s explicit stack)."""
     if n <= _PW_BLOCK:
         s0, s1, s2 = _nb_leaf3(wb, B, X, Y, 0, n)
         return 0.0 + s0, 0.0 + s1, 0.0 + s2
-    lo_s, n_s, st_s = np.empty(64, np.int64), np.empty(64, np.int64), np.empty(64, np.int64)
-    v0, v1, v2 = np.empty(64), np.empty(64), np.empty(64)
+    stk = np.empty((3, 64), np.int64)
+    v = np.empty((3, 64))
     sp, vp = 1, 0
-    lo_s[0], n_s[0], st_s[0] = 0, n, 0
+    stk[0, 0], stk[1, 0], stk[2, 0] = 0, n, 0
     while sp > 0:
-        lo, m = lo_s[sp - 1], n_s[sp - 1]
+        lo, m, st = stk[0, sp - 1], stk[1, sp - 1], stk[2, sp - 1]
         if m <= _PW_BLOCK:
-            v0[vp], v1[vp], v2[vp] = _nb_leaf3(wb, B, X, Y, lo, m)
+            v[0, vp], v[1, vp], v[2, vp] = _nb_leaf3(wb, B, X, Y, lo, m)
             vp += 1
             sp -= 1
             continue
         half = m // 2
         half -= half % 8
-        if st_s[sp - 1] == 0:
-            st_s[sp - 1] = 1
-            lo_s[sp], n_s[sp], st_s[sp] = lo, half, 0
+        if st == 0:
+            stk[2, sp - 1] = 1
+            stk[0, sp], stk[1, sp], stk[2, sp] = lo, half, 0
             sp += 1
-        elif st_s[sp - 1] == 1:
-            st_s[sp - 1] = 2
-            lo_s[sp], n_s[sp], st_s[sp] = lo + half, m - half, 0
+        elif st == 1:
+            stk[2, sp - 1] = 2
+            stk[0, sp], stk[1, sp], stk[2, sp] = lo + half, m - half, 0
             sp += 1
         else:
-            v0[vp - 2] = v0[vp - 2] + v0[vp - 1]
-            v1[vp - 2] = v1[vp - 2] + v1[vp - 1]
-            v2[vp - 2] = v2[vp - 2] + v2[vp - 1]
+            v[0, vp - 2] = v[0, vp - 2] + v[0, vp - 1]
+            v[1, vp - 2] = v[1, vp - 2] + v[1, vp - 1]
+            v[2, vp - 2] = v[2, vp - 2] + v[2, vp - 1]
             vp -= 1
             sp -= 1
-    return 0.0 + v0[0], 0.0 + v1[0], 0.0 + v2[0]
+    return 0.0 + v[0, 0], 0.0 + v[1, 0], 0.0 + v[2, 0]
 
 
 @_jit

@@ -374,10 +374,11 @@ def real_cases(g: dict) -> list[dict]:
     from mstrack.fixed.blocks import ms_box_clip, ms_colour_bin, ms_round_centre, round_box
     from mstrack.fixed.blocks_v2 import SIZE_FRAC, ms_box_size, ms_decimation, sixteenths
     from mstrack.fixed.tracker_v2 import FixedTrackerV2
-    from mstrack.track.params import TrackerParams
+    from mstrack.track.params import V2_COLOUR, TrackerParams
 
     colour_bits = int(g["BIN_W"]) // 3
-    tp = TrackerParams(preset="v2", colour_bits=colour_bits)
+    # the colour tracker (V2_COLOUR): tracker v2's default learns on the joint bins (real_cases_joint)
+    tp = TrackerParams(preset="v2", colour_bits=colour_bits, **V2_COLOUR)
     out = []
     for name in REAL_SEQS:
         seq = load_sequence(SEQ_ROOT / name)

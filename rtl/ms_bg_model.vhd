@@ -44,7 +44,7 @@
 -- 2**HALF_W x HALF_W and the Q delay memory (LUT RAM).
 -- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
 -- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz (measured
--- before the count RAM became an ms_ram_sdp with RD_LAT 3: now 3 DP16KD and about 100 FF more).
+-- before the count RAM became an ms_ram_sdp with RD_LAT 3: now 3 DP16KD; not re-measured).
 --
 -- Latency (tb/test_ms_bg_model.py measures both):
 --   start -> counting : the kernel-table set-up of (wb, hb) (flat ms_kernel_tables: at most

@@ -33,30 +33,35 @@
 -- the model sees (the decimated frame frame[::D, ::D], coordinates in decimated px) exactly once.
 -- Counting: stage A registers |dx|, |dy|; stage B the XR look-up (registered) and the rectangle
 -- tests; stage C the box / ring flags; then a read-modify-write of the count RAM word
--- {T | Q | O} at the pixel's bin with the forwarding of ms_histogram (any sequence of bins, runs
--- of one bin included, counts exactly).
+-- {T | Q | O} at the pixel's bin (read latency 3, written one clock after the increment) with
+-- forwarding from the 4 pixels before (any sequence of bins, runs of one bin included, counts
+-- exactly).
 --
--- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W) (1 DP16KD at the defaults, 512 x 32; 9 at
--- N_ORIENT 9), model RAM N_ORIENT banks of N_BINS x 18 {T | Qn} (1 DP16KD per bank), XR table
+-- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W), an ms_ram_sdp with RD_LAT 3 (on ECP5
+-- DP16KD x18 tiles with their output register and a registered row multiplexer: 2 DP16KD at the
+-- defaults, 512 x 32; 10 at N_ORIENT 9, 5 rows of 1,024; before, the inferred RAM read without the
+-- output register was core v2's critical path), model RAM N_ORIENT banks of N_BINS x 18 {T | Qn} (1 DP16KD per bank), XR table
 -- 2**HALF_W x HALF_W and the Q delay memory (LUT RAM).
 -- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
--- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz.
+-- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz (measured
+-- before the count RAM became an ms_ram_sdp with RD_LAT 3: now 3 DP16KD; not re-measured).
 --
 -- Latency (tb/test_ms_bg_model.py measures both):
 --   start -> counting : the kernel-table set-up of (wb, hb) (flat ms_kernel_tables: at most
 --                       215 clocks at HALF_W = 6) + 2 clocks, exactly; pixels before `counting` are
 --                       ignored (the top starts the block when the init box is taken, between
 --                       frames, so this costs nothing on the stream).
---   px_last -> done   : LAT_DONE = 3 N + 61 clocks at the default widths, N = N_ORIENT N_BINS:
---                       drain 6, pass 1 N + 3, pass 2 N + 30 (read 2, T products M(Q_W) = 4, T 1,
---                       divider 18, v Q M(9) = 4, end 1), pass 3 N + 22 (read 2, divider 18,
+--   px_last -> done   : LAT_DONE = 3 N + 65 clocks at the default widths, N = N_ORIENT N_BINS:
+--                       drain 7, pass 1 N + 4, pass 2 N + 31 (read 3, T products M(Q_W) = 4, T 1,
+--                       divider 18, v Q M(9) = 4, end 1), pass 3 N + 23 (read 3, divider 18,
 --                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
---                       ms_mult_r4 latency (constant LAT_DONE).  1,597 clocks at N = 512
---                       against the 3 x 517 = 1,551 of the v2 budget (python -m mstrack.hw.synth
---                       --v2-budget: init frame 5,800 clocks, so 5,846 with this block).
---                       N_ORIENT 9 (N = 4,608): 13,885 clocks (passes 1 / 2 / 3: 4,611 / 4,638 /
---                       4,630, drain 6), on the init frame only: the init frame's estimate becomes
---                       about 18,100 of the 99,000 clocks of 1080p60 blanking.
+--                       ms_mult_r4 latency (constant LAT_DONE; the count RAM's read latency 3
+--                       costs 4 clocks against the 3 N + 61 of a 2-clock read).  1,601 clocks at
+--                       N = 512 against the 3 x 517 = 1,551 of the v2 budget (python -m
+--                       mstrack.hw.synth --v2-budget: init frame 5,800 clocks, so 5,850 with this
+--                       block).  N_ORIENT 9 (N = 4,608): 13,889 clocks (passes 1 / 2 / 3: 4,612 /
+--                       4,639 / 4,631, drain 7), on the init frame only: the init frame's estimate
+--                       becomes about 18,100 of the 99,000 clocks of 1080p60 blanking.
 -- Throughput: one pixel per clock while counting; one model per init.
 -- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high
 --             until `done` (one-clock pulse); n_box, n_ring, o_min, qv_sum are stable from done
@@ -131,7 +136,6 @@ architecture rtl of ms_bg_model is
   constant OB_W    : natural := clog2(N_ORIENT) * boolean'pos(N_ORIENT > 1);  -- bank bits of an address
   constant AW      : natural := BIN_W + OB_W;                -- joint address {obin, colour}
   constant NJ      : natural := N_ORIENT * N_BINS;           -- joint bins: count RAM depth, clocks per pass
-  constant GUARD   : boolean := NJ < 2 ** AW;                -- addresses >= NJ exist (N_ORIENT not 2**k)
   constant BG_FRAC : natural := 8;                 -- v in Q.8 (blocks_v2.BG_FRAC)
   constant QN_FRAC : natural := 16;                -- Qn in Q.16 (blocks_v2.QN_BITS)
   constant QN_W    : natural := QN_FRAC + 1;       -- Qn bits (<= 2**16)
@@ -144,7 +148,8 @@ architecture rtl of ms_bg_model is
   constant DD_W    : natural := max(TOT_W, O_W);                      -- divider divisor
   constant G_W     : natural := max(COORD_W, RING_W + HALF_W + 1) + 1; -- ring extents
   constant P_W     : natural := Q_W + O_W;         -- T products
-  constant DRAIN   : natural := 6;                 -- px_last -> S_P1 (the last count is in the RAM)
+  constant RD_LAT  : natural := 3;                 -- count RAM read latency (ms_ram_sdp: ECP5 OUTREG)
+  constant DRAIN   : natural := RD_LAT + 4;        -- px_last -> S_P1 (the last count is in the RAM)
   constant DVT_W  : natural := 3;                 -- divider tag [last | qz | T]
   constant QD_W   : natural := clog2(QN_W + 2);   -- Q delay memory address (holds > divider latency)
   constant MTT_W  : natural := Q_W + O_W + 1;    -- T product tag [last | O | Q]
@@ -155,9 +160,9 @@ architecture rtl of ms_bg_model is
     return 1 + max(1, clog2((a_w + 1) / 2));
   end function;
   -- px_last -> done (documentation; the test measures it): drain, pass 1, pass 2, pass 3
-  constant LAT_DONE : natural := DRAIN + (NJ + 3)
-                                 + (NJ + 2 + mult_lat(Q_W) + 1 + (QN_W + 1) + mult_lat(V_W) + 1)
-                                 + (NJ + 2 + (QN_W + 1) + 2);
+  constant LAT_DONE : natural := DRAIN + (NJ + RD_LAT + 1)
+                                 + (NJ + RD_LAT + mult_lat(Q_W) + 1 + (QN_W + 1) + mult_lat(V_W) + 1)
+                                 + (NJ + RD_LAT + (QN_W + 1) + 2);
 
   type state_t is (S_CLEAR, S_IDLE, S_SETUP, S_COUNT, S_DRAIN, S_P1, S_P2, S_P3, S_DONE);
   signal state : state_t := S_CLEAR;
@@ -194,23 +199,21 @@ architecture rtl of ms_bg_model is
   signal no_r           : unsigned(O_W - 1 downto 0) := (others => '0');
 
   -- count RAM and its read-modify-write pipeline (ms_histogram's scheme, one lane)
-  type cnt_ram_t is array (0 to NJ - 1) of std_logic_vector(CW - 1 downto 0);
-  signal cram           : cnt_ram_t := (others => (others => '0'));
   signal rd_addr        : unsigned(AW - 1 downto 0);
-  signal rd_raw, rd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
-  signal s1_acc, s1_box, s2_acc, s2_box : std_logic := '0';
-  signal s1_b, s2_b     : unsigned(AW - 1 downto 0) := (others => '0');
+  signal rd_word        : std_logic_vector(CW - 1 downto 0);     -- RAM read data, RD_LAT clocks after rd_addr
+  signal s1_acc, s1_box, s2_acc, s2_box, s3_acc, s3_box : std_logic := '0';
+  signal s1_b, s2_b, s3_b : unsigned(AW - 1 downto 0) := (others => '0');
   signal old_w, new_w   : std_logic_vector(CW - 1 downto 0);
   signal wq_we, wq2_we  : std_logic := '0';
   signal wq_b, wq2_b    : unsigned(AW - 1 downto 0) := (others => '0');
-  signal wq_word, wq2_word, fwd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
-  signal h1, h2, h3, fwd_hit : std_logic := '0';
+  signal wq_word, wq2_word, wq3_word, fwd_word : std_logic_vector(CW - 1 downto 0) := (others => '0');
+  signal h1, h2, h3, h4, fwd_hit : std_logic := '0';
 
   -- passes: issue side and read stages
   signal iss_en         : std_logic := '0';
   signal iss_addr       : unsigned(AW - 1 downto 0) := (others => '0');
-  signal r1_v, r2_v, r1_last, r2_last : std_logic := '0';
-  signal r1_u, r2_u     : unsigned(AW - 1 downto 0) := (others => '0');
+  signal r1_v, r2_v, r3_v, r1_last, r2_last, r3_last : std_logic := '0';
+  signal r1_u, r2_u, r3_u : unsigned(AW - 1 downto 0) := (others => '0');
   signal pass_we        : std_logic;                        -- count RAM write of a pass
   signal pass_wa        : unsigned(AW - 1 downto 0);
   signal pass_wd        : std_logic_vector(CW - 1 downto 0);
@@ -445,7 +448,7 @@ begin
     variable w : std_logic_vector(CW - 1 downto 0);
   begin
     w := old_w;
-    if s2_box = '1' then
+    if s3_box = '1' then
       w(O_W + Q_W - 1 downto O_W) := std_logic_vector(unsigned(old_w(O_W + Q_W - 1 downto O_W)) + 1);
     else
       w(O_W - 1 downto 0) := std_logic_vector(unsigned(old_w(O_W - 1 downto 0)) + 1);
@@ -453,23 +456,14 @@ begin
     new_w <= w;
   end process;
 
-  p_ram : process (clk)
-  begin
-    if rising_edge(clk) then
-      if wq_we = '1' then
-        cram(to_integer(wq_b)) <= wq_word;
-      end if;
-      -- a read/write collision's data is never used (forwarded: h3)
-      if wq_we = '1' and wq_b = rd_addr then
-        rd_raw <= (others => 'X');
-      elsif GUARD and rd_addr >= NJ then                 -- junk address of an idle pixel slot
-        rd_raw <= (others => 'X');
-      else
-        rd_raw <= cram(to_integer(rd_addr));
-      end if;
-      rd_word <= rd_raw;                                 -- the RAM's output register
-    end if;
-  end process;
+  -- the count RAM: ms_ram_sdp, read latency RD_LAT (on ECP5 DP16KD with its output register and
+  -- a registered row multiplexer); written from the write register wq (write at the next edge).
+  -- A read of the word written at the same edge (DP16KD collision: undefined; `inferred`: the old
+  -- word) or of a junk address >= NJ (idle pixel slot: the output holds) is never used (h4).
+  u_cram : entity work.ms_ram_sdp
+    generic map (DEPTH => NJ, DATA_W => CW, ADDR_W => AW, RD_LAT => RD_LAT, WR_LAT => 0)
+    port map (clk => clk, we => wq_we, waddr => wq_b, wdata => wq_word, raddr => rd_addr,
+              rdata => rd_word);
 
   p_fw : process (clk)
   begin
@@ -480,6 +474,9 @@ begin
       s2_acc <= s1_acc;
       s2_box <= s1_box;
       s2_b   <= s1_b;
+      s3_acc <= s2_acc;
+      s3_box <= s2_box;
+      s3_b   <= s2_b;
       -- RAM write register: reset clear, else a pass write, else the count
       if state = S_CLEAR then
         wq_we   <= '1';
@@ -490,29 +487,37 @@ begin
         wq_b    <= pass_wa;
         wq_word <= pass_wd;
       else
-        wq_we   <= s2_acc;
-        wq_b    <= s2_b;
+        wq_we   <= s3_acc;
+        wq_b    <= s3_b;
         wq_word <= new_w;
       end if;
       wq2_we   <= wq_we;
       wq2_b    <= wq_b;
       wq2_word <= wq_word;
-      -- the read at this edge misses the writes of this edge (wq), of the next (stage 2) and of
-      -- the one after (stage 1): the newest one to the same bin is forwarded into stage 2
-      h1 <= s1_acc and to_sl(s1_b = rd_addr);
-      h2 <= s2_acc and to_sl(s2_b = rd_addr);
-      h3 <= wq_we and to_sl(wq_b = rd_addr);
-      fwd_hit <= h1 or h2 or h3;
+      wq3_word <= wq2_word;
+      -- a read at edge e (rd_word in stage 3, after edge e + RD_LAT - 1) misses the writes of
+      -- the 4 pixels read at e - 1 .. e - 4 (their writes at e + 3 .. e, the RAM written from wq
+      -- one edge after the word leaves stage 3): at edge e + 1 (the read's bin in s1_b) compare
+      -- with them (s2, s3, wq, wq2), at edge e + 2 forward the newest one's word into stage 3
+      -- (then new_w, wq_word, wq2_word, wq3_word)
+      h1 <= s2_acc and to_sl(s2_b = s1_b);
+      h2 <= s3_acc and to_sl(s3_b = s1_b);
+      h3 <= wq_we and to_sl(wq_b = s1_b);
+      h4 <= wq2_we and to_sl(wq2_b = s1_b);
+      fwd_hit <= h1 or h2 or h3 or h4;
       if h1 = '1' then
         fwd_word <= new_w;
       elsif h2 = '1' then
         fwd_word <= wq_word;
-      else
+      elsif h3 = '1' then
         fwd_word <= wq2_word;
+      else
+        fwd_word <= wq3_word;
       end if;
       if rst = '1' then
         s1_acc <= '0';
         s2_acc <= '0';
+        s3_acc <= '0';
       end if;
     end if;
   end process;
@@ -535,17 +540,21 @@ begin
           iss_addr <= iss_addr + 1;
         end if;
       end if;
-      -- read stages: r1 = RAM read register, r2 = rd_word
+      -- read stages r1 .. r3 (RD_LAT = 3): r3 beside rd_word
       r1_v    <= iss_en;
       r1_u    <= iss_addr;
       r1_last <= iss_en and to_sl(iss_addr = NJ - 1);
       r2_v    <= r1_v;
       r2_u    <= r1_u;
       r2_last <= r1_last;
+      r3_v    <= r2_v;
+      r3_u    <= r2_u;
+      r3_last <= r2_last;
       if rst = '1' then
         iss_en <= '0';
         r1_v   <= '0';
         r2_v   <= '0';
+        r3_v   <= '0';
       end if;
     end if;
   end process;
@@ -560,7 +569,7 @@ begin
       if state = S_DRAIN then
         omin <= (others => '1');
         tot  <= (others => '0');
-      elsif state = S_P1 and r2_v = '1' then
+      elsif state = S_P1 and r3_v = '1' then
         if w_o /= 0 and w_o < omin then
           omin <= w_o;
         end if;
@@ -572,8 +581,8 @@ begin
   end process;
 
   -- pass 2 stage 1: T products Q no and nq O
-  mt_in_v   <= r2_v when state = S_P2 else '0';
-  mt_tag_in <= r2_last & std_logic_vector(w_o) & std_logic_vector(w_q);
+  mt_in_v   <= r3_v when state = S_P2 else '0';
+  mt_tag_in <= r3_last & std_logic_vector(w_o) & std_logic_vector(w_q);
   u_mt1 : entity work.ms_mult_r4
     generic map (A_W => Q_W, B_W => O_W, B_SIGNED => false, P_W => P_W, TAG_W => MTT_W)
     port map (clk => clk, rst => rst, in_valid => mt_in_v, in_a => w_q, in_b => std_logic_vector(no_r),
@@ -605,12 +614,12 @@ begin
   end process;
 
   -- the divider: pass 2 floor(o* 2**8 / O), pass 3 floor(qv 2**16 / tot)
-  dv_in_v   <= t_v when state = S_P2 else r2_v when state = S_P3 else '0';
+  dv_in_v   <= t_v when state = S_P2 else r3_v when state = S_P3 else '0';
   dv_n      <= shift_left(resize(omin, DN_W), BG_FRAC) when state = S_P2
                else shift_left(resize(unsigned(rd_word(QV_W - 1 downto 0)), DN_W), QN_FRAC);
   dv_d      <= resize(t_o, DD_W) when state = S_P2 else resize(tot, DD_W);
   dv_tag_in <= (t_last & '0' & t_t) when state = S_P2
-               else (r2_last & to_sl(unsigned(rd_word(QV_W - 1 downto 0)) = 0) & rd_word(CW - 1));
+               else (r3_last & to_sl(unsigned(rd_word(QV_W - 1 downto 0)) = 0) & rd_word(CW - 1));
 
   -- results leave the divider in bin order: counters give their bin; in pass 2 Q waits beside
   -- the divider in a small delay memory (written at the divider input, read at its output)
@@ -654,14 +663,14 @@ begin
   p_pw : process (all)
   begin
     pass_we <= '0';
-    pass_wa <= r2_u;
+    pass_wa <= r3_u;
     pass_wd <= (others => '0');
     if state = S_P2 and mv_v = '1' then
       pass_we <= '1';
       pass_wa <= unsigned(mv_tag(AW - 1 downto 0));
       pass_wd(CW - 1) <= mv_tag(AW);
       pass_wd(QV_W - 1 downto 0) <= mv_p;
-    elsif state = S_P3 and r2_v = '1' then
+    elsif state = S_P3 and r3_v = '1' then
       pass_we <= '1';
     end if;
   end process;
@@ -671,7 +680,7 @@ begin
   begin
     if rising_edge(clk) then
       pass_end <= '0';
-      if state = S_P1 and r2_v = '1' and r2_last = '1' then
+      if state = S_P1 and r3_v = '1' and r3_last = '1' then
         pass_end <= '1';
       elsif state = S_P2 and mv_v = '1' and mv_tag(MVT_W - 1) = '1' then
         pass_end <= '1';

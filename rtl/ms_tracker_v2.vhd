@@ -41,7 +41,7 @@
 --   (m_qn_all -> the engine's q_ext_all_*) and writes ms_target_stats' 512 x 9 T words (m_t_all)
 --   beside it; ms_meanshift, ms_pixel_pass, ms_histogram, ms_bin_pass and ms_target_stats run with
 --   N_ORIENT 9 (9 banks per colour address, a pass still walks 512 addresses).  Cost in clocks: the
---   init frame's ms_bg_model passes walk 4,608 joint bins (13,885 clocks instead of 1,597), the bin
+--   init frame's ms_bg_model passes walk 4,608 joint bins (13,889 clocks instead of 1,601), the bin
 --   pass + 4 clocks (its adder tree); everything else as with colour bins.
 -- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
 -- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
@@ -65,7 +65,7 @@
 -- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
 -- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 -- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
--- shifts with their confidence; on the init frame ms_bg_model's 3 N_BINS + 61 clocks first.
+-- shifts with their confidence; on the init frame ms_bg_model's 3 N_BINS + 65 clocks first.
 -- With the gated scale test (SCALE_TEST_D256 > 0), on frames that scale: 2 x (about 8 clocks of size,
 -- window size and fit test + the kernel tables + the Qw load (N_BINS + 6) + one pixel pass and one
 -- bin pass + ms_fusion's rho), a window that does not fit skipping all but the first 8; measured

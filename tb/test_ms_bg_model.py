@@ -11,7 +11,7 @@ tot = 0, even sizes, the largest box; real cases: the init frame of real sequenc
 geometry of FixedTrackerV2.init (checked against the tracker's own model).  Full speed and with
 random input gaps, with a `start` pulse while busy (ignored); an init frame abandoned half way
 by a reset, then a model from scratch.  The clocks from the last pixel to `done` must equal LAT_DONE of the header
-(3 N_BINS + 61 at the default widths), models follow each other without reset (pass 3 clears the counts).
+(3 N_BINS + 65 at the default widths), models follow each other without reset (pass 3 clears the counts).
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_bg_model.py``.
 """
@@ -49,11 +49,11 @@ def n_orient(g: dict) -> int:
 
 
 def lat_done(g: dict) -> int:
-    """px_last -> done of rtl/ms_bg_model.vhd (header: LAT_DONE; 3 N + 61 at the defaults, N =
-    N_ORIENT 2**BIN_W joint bins): drain 6, pass 1 N + 3, pass 2 N + 2 + M(Q_W) + 1 + 18 + M(9) + 1,
-    pass 3 N + 2 + 18 + 2."""
+    """px_last -> done of rtl/ms_bg_model.vhd (header: LAT_DONE; 3 N + 65 at the defaults, N =
+    N_ORIENT 2**BIN_W joint bins; count RAM read latency 3): drain 7, pass 1 N + 4, pass 2 N + 3 + M(Q_W)
+    + 1 + 18 + M(9) + 1, pass 3 N + 3 + 18 + 2."""
     n = n_orient(g) << int(g["BIN_W"])
-    return 6 + (n + 3) + (n + 2 + mult_lat(int(g["Q_W"])) + 1 + 18 + mult_lat(9) + 1) + (n + 2 + 18 + 2)
+    return 7 + (n + 4) + (n + 3 + mult_lat(int(g["Q_W"])) + 1 + 18 + mult_lat(9) + 1) + (n + 3 + 18 + 2)
 
 
 def _counts(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: int, n_bins: int):

@@ -67,12 +67,16 @@ CI_EXTRA: dict[str, str] = {
         "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
         "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_joint":
-        "test_tracker_v2_joint_fastsim (marker long: the joint core's GHDL netlist under Verilator on 100 real "
-        "frames of Girl, MotorRolling and Deer, the lost state included, bit-exact); this case is the RTL itself under GHDL on a rendered "
+        "test_tracker_v2_fastsim_long (marker long: the default joint core's GHDL netlist under Verilator on 1,545 "
+        "real frames, losses and re-acquisitions included, bit-exact); this case is the RTL itself under GHDL on a rendered "
         "scene (458 s)",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_joint_fastsim":
+        "test_tracker_v2_fastsim_long (the same build, the default joint core, on 1,545 real frames: the whole of "
+        "Girl, MotorRolling and Deer among them); this case adds input gaps and back-pressure on MotorRolling and "
+        "checks that the expected results differ from the colour core's",
     "tb/test_realtime.py::test_realtime_v2_1080p60[joint]":
-        "test_realtime_v2_1080p60[colour] (the colour core at 1080p60) and test_tracker_v2_joint_fastsim (the joint "
-        "core's netlist, same build, bit-exact on real frames); this case: the joint core's latencies at 1080p60",
+        "test_realtime_v2_1080p60[colour] (the colour core at 1080p60) and test_tracker_v2_fastsim_long (the joint "
+        "core's netlist, same build, bit-exact on 1,545 real frames); this case: the joint core's latencies at 1080p60",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test_fastsim":
         "test_tracker_v2_scale_test (the gated scale test's RTL bit-exact under GHDL, rendered scene with a "
         "size change); this case checks the netlist under Verilator on real frames, lost state included "

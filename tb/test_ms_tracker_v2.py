@@ -363,7 +363,7 @@ def test_tracker_v2_scale_test_fastsim(name, n):
     from mstrack.fixed import FixedParams
     from mstrack.hw import fastsim
     frames, box = _real_clip(name, 0, n)
-    tp = TrackerParams(preset="v2", **SCALE_TP)
+    tp = TrackerParams(preset="v2", **{**V2_COLOUR, **SCALE_TP})   # the gated test on the colour bins
     tests, gates = scale_test_trace(frames, box, tp)
     exp = expected_results_v2(frames, box, tp)
     assert any(gates) and not all(gates)
@@ -422,7 +422,8 @@ LONG_RUNS = [("Girl", 500, 0, 0), ("Couple", 140, 20, 30), ("Crossing", 120, 0, 
 @pytest.mark.verilator
 @pytest.mark.parametrize("name,n,pin,pout", LONG_RUNS, ids=[r[0] for r in LONG_RUNS])
 def test_tracker_v2_fastsim_long(name, n, pin, pout):
-    """Verilator: whole real sequences through core v2 (ms_tracker, PRESET 1; 1,545 frames), bit-exact, frames back to
-    back (the core back-pressures while it tracks).  Marker ``long``: `make test` runs it on the
-    second core after the netlist build (`make test-synth-only`)."""
+    """Verilator: whole real sequences through core v2 with its default generics (ms_tracker, PRESET 1:
+    the joint core, ORIENT_T 64, SCALE_TEST_D256 13, tracker mstrack-v2; 1,545 frames), bit-exact,
+    frames back to back (the core back-pressures while it tracks).  Marker ``long``: `make test` runs
+    it on the second core after the netlist build (`make test-synth-only`)."""
     _fastsim_real(name, 0, n, pin, pout)

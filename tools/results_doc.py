@@ -238,7 +238,7 @@ def main(argv: list[str] | None = None) -> int:
             "docs/results_v2_mean.md).  It is the best tracker here in both layers and meets issue 10's "
             "targets above.  RTL: core v2 (`ms_tracker` PRESET 1, `mstrack hdl config --preset v2`), "
             "bit-exact with the fixed model in simulation; placed and routed on the LFE5U-85F it fits "
-            "(156 of 208 DP16KD) at 112.65 MHz (grade 8), below the 148.5 MHz of 1080p60 at one pixel per "
+            "(157 of 208 DP16KD) at 114.82 MHz (grade 8, seed 1), below the 148.5 MHz of 1080p60 at one pixel per "
             "clock (docs/performance.md).",
             "* **mstrack-v2-colour** (`mstrack.track.params.V2_COLOUR`, the default until session 15; "
             "`mstrack hdl config --preset v2 --colour`: ORIENT_T -1) is tracker v2 on the 512 colour bins "

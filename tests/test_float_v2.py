@@ -613,9 +613,49 @@ def test_never_nan(kernel, scene):
 
 # ============================================================================ real data
 #: Overall frame-weighted OTB AUC (frame 0 included) of v2 float over the 10 sequences of
-#: ../shared/data/sequences; measured 2026-11-23: v2 0.551, paper float fused/flat 0.366 (same
-#: run; 8 .. 15 s for both on 2 shared cores).  Floor 0.50.
+#: ../shared/data/sequences; measured 2026-11-23: v2 0.551 (the colour tracker, then the default),
+#: since session 16 (the joint default) 0.564; paper float fused/flat 0.366 (same run; 8 .. 15 s
+#: for both on 2 shared cores).  Floor 0.50.
 V2_AUC_FLOOR = 0.50
+#: OpenCV CSRT on the same set (docs/results.md, `make results`): overall AUC 0.452, mean over
+#: sequences 0.562 (CSRT is not bit-reproducible across runs here, so the targets are fixed numbers)
+CSRT_AUC, CSRT_MEAN = 0.452, 0.562
+
+
+@pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (CI has them)")
+def test_real_sequences_issue10_targets():
+    """Issue 10's accuracy and loss targets for the default tracker v2 (mstrack-v2), float and fixed
+    model, as docs/results.md's targets table computes them: fixed overall AUC >= 0.46 and >= CSRT's,
+    fixed mean over sequences >= CSRT's, fixed within 0.01 AUC of float, and the loss flag (frames
+    after the init frame with valid ground truth) at recall >= 0.6 with false alarms <= 0.05 in both
+    models.  Measured (session 16): AUC 0.564 / 0.570, mean 0.587 / 0.572, loss 0.63 at 0.048 /
+    0.81 at 0.049 (float / fixed; the loss thresholds were chosen on this set).  Both models are
+    deterministic (no BLAS), so the figures repeat bit for bit."""
+    from mstrack.eval.evaluate import aggregate, make_tracker, run_sequence
+    from mstrack.eval.metrics import iou, loss_detection, valid_gt
+    from mstrack.io.data import load_dataset
+
+    seqs = load_dataset(SEQ_ROOT)
+    runs = {m: {s.name: run_sequence(make_tracker("mstrack-v2", m), s, label=m, model=m) for s in seqs}
+            for m in ("float", "fixed")}
+    ev = aggregate(runs, seqs)
+    assert not ev.failed
+    auc = {m: ev.overall[m].auc for m in runs}
+    mean = {m: float(np.mean([ev.per_sequence[m][n].auc for n in ev.sequences])) for m in runs}
+    assert auc["fixed"] >= max(0.46, CSRT_AUC), auc
+    assert mean["fixed"] >= CSRT_MEAN, mean
+    assert abs(auc["fixed"] - auc["float"]) <= 0.01, auc
+    for m, per in runs.items():
+        ious, oks = [], []
+        for seq in seqs:
+            run = per[seq.name]
+            gt = seq.gt[:run.n_frames]
+            v = valid_gt(gt)
+            v[0] = False   # the init frame says nothing about loss detection
+            ious.append(iou(run.boxes, gt)[v])
+            oks.append(run.ok[v])
+        ld = loss_detection(np.concatenate(ious), np.concatenate(oks))
+        assert ld.recall >= 0.6 and ld.false_alarm <= 0.05, (m, ld)
 
 
 @pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (CI has them)")

@@ -12,6 +12,8 @@ Public API::
     trk = mstrack.Tracker(preset="paper")         # the paper's colour + edge fusion (the RTL core)
     trk = mstrack.Tracker(model="fixed")          # the bit-accurate fixed-point model
 
+    mstrack.__version__                           # the package version ("0.2.0")
+
     tracker = mstrack.TrackerMeanShift.create()   # OpenCV's tracker API (cv2.TrackerCSRT drop-in)
     tracker.init(frame, rect); ok, rect = tracker.update(frame)
 
@@ -27,13 +29,16 @@ if TYPE_CHECKING:  # for type checkers; at run time they are imported lazily by 
 
 _RESULT_API = ("RESULT_FLAGS", "result_layout", "result_width", "pack_result", "unpack_result",
                "STATUS_V2", "result_layout_v2", "result_width_v2", "pack_result_v2", "unpack_result_v2")
-__all__ = ["Box", "FeatureResult", "Status", "TrackResult", "Tracker", "TrackerMeanShift", "TrackerParams",
+__all__ = ["__version__", "Box", "FeatureResult", "Status", "TrackResult", "Tracker", "TrackerMeanShift", "TrackerParams",
            "FrameError", *_RESULT_API]
 
 _LAZY = ("Tracker", "TrackerMeanShift", "TrackerParams", "FrameError")
 
 
 def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
+    if name == "__version__":
+        from .versions import package_version
+        return package_version()
     if name in _LAZY:
         from .track import tracker
         return getattr(tracker, name)

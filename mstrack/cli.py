@@ -808,9 +808,24 @@ EXTENSIONS: list[str] = [
 ]
 
 
+class _VersionAction(argparse.Action):
+    """``mstrack --version``: the package version, then one line of tool versions."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
+                 option_string: str | None = None) -> None:
+        from .versions import package_version, tools_line
+        print(f"mstrack {package_version()}")
+        print(tools_line())
+        parser.exit()
+
+
 def build_parser(extensions: list[str] | None = None) -> argparse.ArgumentParser:
     """The argument parser with built-in commands and the :data:`EXTENSIONS`."""
-    parser = argparse.ArgumentParser(prog="mstrack", description="Mean-shift colour + edge fusion tracker tools.")
+    parser = argparse.ArgumentParser(
+        prog="mstrack", description="mstrack: mean-shift object tracking, from the float reference to the FPGA core: "
+                                    "track, evaluate, benchmark, co-simulate and synthesise.")
+    parser.add_argument("--version", action=_VersionAction, nargs=0,
+                        help="print the package version and the versions of the tools it uses, then exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for register in BUILTIN_COMMANDS.values():
         register(sub)

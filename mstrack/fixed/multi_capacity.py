@@ -151,12 +151,14 @@ class TargetDemand:
 @dataclass(frozen=True)
 class FramePlan:
     """:func:`plan_frame`: ids tracked and held on the frame, the admitted jobs' clocks and the
-    budget they were checked against (the smallest slack among them)."""
+    budget they were checked against (the smallest slack among them); ``jobs``: the admitted jobs
+    (what :func:`check_add` takes, with the adds taken since)."""
 
     tracked: tuple[int, ...]
     held: tuple[int, ...]
     clocks: int
     budget: int
+    jobs: tuple[TargetDemand, ...] = ()
 
 
 # ----------------------------------------------------------------------------- job clocks
@@ -338,7 +340,8 @@ def plan_frame(demands: Sequence[TargetDemand], cfg: MultiCoreConfig = MultiCore
         else:
             held.append(dm.target_id)
     budget = min((j.slack(cfg.timing) for j in admitted), default=cfg.timing.frame_clocks)
-    return FramePlan(tuple(j.target_id for j in admitted), tuple(held), sum(j.clocks for j in admitted), budget)
+    return FramePlan(tuple(j.target_id for j in admitted), tuple(held), sum(j.clocks for j in admitted), budget,
+                     tuple(admitted))
 
 
 def check_add(admitted: Sequence[TargetDemand], n_live: int, new: TargetDemand,

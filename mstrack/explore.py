@@ -858,12 +858,52 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--no-plot", action="store_true", help="no PNG")
     ap.add_argument("--check", action="store_true",
                     help="only print the estimate against the measured configurations (no DATASET run)")
+    ap.add_argument("--multi", action="store_true",
+                    help="only print the multi-target core's cost model for MAX_TARGETS = --targets (cycles per "
+                         "frame, DP16KD, LUT4 / FF, what fits the LFE5U-85F; docs/multi_target_core.md; no DATASET run)")
+    ap.add_argument("--targets", default=",".join(str(n) for n in (1, 2, 4, 8, 10, 16)), metavar="N1,N2,...",
+                    help="with --multi: the MAX_TARGETS values (1..16; default 1,2,4,8,10,16)")
+    ap.add_argument("--write", action="store_true",
+                    help="with --multi: regenerate the tables of docs/multi_target_core.md")
+    ap.add_argument("--yosys-check", action="store_true",
+                    help="with --multi: synthesise the region-slot pool and model RAM at several N with yosys "
+                         "synth_ecp5 (cached, seconds each) and print them against the model")
+
+
+def _targets(text: str) -> list[int]:
+    try:
+        ns = [int(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise ValueError(f"--targets wants comma-separated integers in 1..16, got {text!r}") from None
+    if not ns or any(not 1 <= n <= 16 for n in ns):
+        raise ValueError(f"--targets wants comma-separated integers in 1..16, got {text!r}")
+    return ns
+
+
+def run_multi(args: argparse.Namespace) -> int:
+    """``mstrack explore --multi``: the multi-target core's cost model (mstrack.hw.multi_core)."""
+    from .hw import multi_core
+    ns = _targets(args.targets)
+    if args.yosys_check:
+        for r in multi_core.yosys_check():
+            print(r)
+        return 0
+    if args.write:
+        doc = multi_core.DOC
+        doc.write_text(multi_core.render_doc(doc.read_text()))
+        print(f"wrote {doc}", file=sys.stderr)
+    print(multi_core.markdown(ns))
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
     if args.check:
         print(check_markdown())
         return 0
+    if args.multi or args.write or args.yosys_check:
+        if not args.multi:
+            raise ValueError("--write and --yosys-check go with --multi")
+        return run_multi(args)
     from .cli import _csv_list, check_out_dir
     from .io.data import load_dataset
     if not args.dataset:

@@ -386,8 +386,10 @@ def cmd_bench_mot(args: argparse.Namespace) -> int:
               "upd/s = target updates per second: the time in update() of the multi-tracker (mstrack: one "
               "`mstrack.MultiTracker`; CamShift: one OpenCV CamShift per target, the OpenCV tutorial's) over "
               "the number of target updates, on frames preloaded in memory; each ground-truth target is added on "
-              "its first frame and removed after its last, as `mstrack eval` does (init excluded).  A benchmark, "
-              "not a timed test.", "",
+              "its first frame and removed after its last, as `mstrack eval` does (init excluded).  Each CamShift "
+              "converts the whole frame to HSV and back-projects it on every update (OpenCV's tutorial recipe, "
+              "mstrack/eval/baselines.py), so its cost grows with the frame; mstrack's with the target's search "
+              "region.  A benchmark, not a timed test.", "",
               "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
         md += ["| " + " | ".join(r) + " |" for r in rows]
         doc.parent.mkdir(parents=True, exist_ok=True)

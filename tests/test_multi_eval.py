@@ -133,7 +133,8 @@ def test_eval_cli_report_and_cache(mot_root, tmp_path, capsys, monkeypatch):
 
 def test_refused_adds_are_reported(mot_root, tmp_path):
     seq = load_mot_sequence(mot_root / "syn-a")
-    ev = em.evaluate_mot([seq], ["mstrack-v2"], tmp_path, make=lambda n, m: em.make_multi(n, m, Capacity(max_targets=2)))
+    two = Capacity(max_targets=2)
+    ev = em.evaluate_mot([seq], ["mstrack-v2"], tmp_path, make=lambda n, m: em.make_multi(n, m, two))
     run = ev.runs["mstrack-v2"]["syn-a"]
     assert sorted(run.targets) == [1, 2] and list(run.refused) == [3] and "MAX_TARGETS" in run.refused[3]
     assert "## Refused adds" in em.report_markdown_mot(ev)

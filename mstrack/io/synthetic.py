@@ -239,7 +239,8 @@ def make_multi_scene(n_frames: int = 60, width: int = 320, height: int = 240, n_
         yy, xx = np.mgrid[0:th, 0:tw]
         cell = max(4, min(tw, th) // 6)
         check = ((yy // cell + xx // cell) % 2).astype(bool)
-        tex = tex - np.where(check[..., None], np.array((30, 40, 210), np.float32), np.array((40, 200, 230), np.float32))
+        red, yellow = np.array((30, 40, 210), np.float32), np.array((40, 200, 230), np.float32)
+        tex = tex - np.where(check[..., None], red, yellow)  # target_texture's colours -> this target's
         tex += np.where(check[..., None], np.array(c0, np.float32), np.array(c1, np.float32))
         texs.append(np.clip(tex, 0, 255))
         mx, my = (width - tw) / 2.0, (height - th) / 2.0

@@ -103,7 +103,8 @@ class Capacity:
     buffers: int = 1
 
     def __post_init__(self) -> None:
-        if isinstance(self.max_targets, bool) or not isinstance(self.max_targets, int) or not 1 <= self.max_targets <= 1024:
+        m = self.max_targets
+        if isinstance(m, bool) or not isinstance(m, int) or not 1 <= m <= 1024:
             raise ValueError(f"max_targets must be an integer in 1..1024, got {self.max_targets!r}")
         if self.region_words is not None and (isinstance(self.region_words, bool)
                                               or not isinstance(self.region_words, int) or self.region_words < 1):
@@ -150,9 +151,10 @@ class Capacity:
         if self.region_words is not None:
             need = self.buffers * (sum(live_words) + new_words)
             if need > self.region_words:
+                terms = " + ".join(str(v) for v in live_words + [new_words])
                 raise CapacityError("REGION_WORDS", f"the {n} targets' regions need {need:,} words "
-                                                    f"({self.buffers} x ({' + '.join(str(v) for v in live_words + [new_words])})), "
-                                                    f"the region memory has {self.region_words:,}")
+                                                    f"({self.buffers} x ({terms})), the region memory has "
+                                                    f"{self.region_words:,}")
 
 
 class MultiTracker:

@@ -2,6 +2,7 @@
 VENV    ?= .venv
 PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
+MULTI_DATASET ?= ../shared/data/multi
 ARGS    ?=
 
 # Compiled bytecode goes to build/pycache.  The machines may set PYTHONDONTWRITEBYTECODE; then every
@@ -105,6 +106,16 @@ results: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval_float --quiet
 	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
 	$(PY) tools/results_doc.py
+	$(MAKE) --no-print-directory results-multi
+
+.PHONY: results-multi
+# the multi-target section (docs/results_multi.md, linked from docs/results.md): mstrack-v2 float and fixed,
+# OpenCV CSRT and KCF (one per target) on the MOT sequences; it reads the speed benchmark docs/bench_multi.md
+# (`mstrack bench $(MULTI_DATASET) --model float --frames 1000 --write-docs`, not run here: timings)
+results-multi: setup
+	$(VENV)/bin/mstrack eval $(MULTI_DATASET) --trackers mstrack-v2,opencv-csrt,opencv-kcf --out out/eval_multi_float --quiet
+	$(VENV)/bin/mstrack eval $(MULTI_DATASET) --model fixed --trackers mstrack-v2 --out out/eval_multi_fixed --quiet
+	$(PY) tools/results_multi_doc.py
 
 clean:
 	rm -rf out build .pytest_cache sim_build* results.xml *.egg-info

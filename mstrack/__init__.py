@@ -17,6 +17,12 @@ Public API::
     tracker = mstrack.TrackerMeanShift.create()   # OpenCV's tracker API (cv2.TrackerCSRT drop-in)
     tracker.init(frame, rect); ok, rect = tracker.update(frame)
 
+    mt = mstrack.MultiTracker()                   # several targets (docs/multi.md)
+    tid = mt.add(frame, (x, y, w, h))             # -> target id (lowest free slot); mt.last[tid]: init result
+    results = mt.update(next_frame)               # one TrackResult per live target, .target_id set
+    mt.remove(tid)
+    multi = mstrack.MultiTrackerMeanShift.create()  # cv2.legacy.MultiTracker's API
+
 The core's result word (v1 and v2): ``mstrack.unpack_result(word)``, ``result_layout()``, ...
 (re-exported from :mod:`mstrack.fixed`; docs/integration.md, "Result word").
 """
@@ -25,12 +31,14 @@ from typing import TYPE_CHECKING
 from .track.types import Box, FeatureResult, Status, TrackResult
 
 if TYPE_CHECKING:  # for type checkers; at run time they are imported lazily by __getattr__
+    from .track.multi import Capacity, CapacityError, MultiTracker, MultiTrackerMeanShift
     from .track.tracker import FrameError, Tracker, TrackerMeanShift, TrackerParams
 
 _RESULT_API = ("RESULT_FLAGS", "result_layout", "result_width", "pack_result", "unpack_result",
                "STATUS_V2", "result_layout_v2", "result_width_v2", "pack_result_v2", "unpack_result_v2")
-__all__ = ["__version__", "Box", "FeatureResult", "Status", "TrackResult", "Tracker", "TrackerMeanShift", "TrackerParams",
-           "FrameError", *_RESULT_API]
+_MULTI = ("MultiTracker", "MultiTrackerMeanShift", "Capacity", "CapacityError")
+__all__ = ["__version__", "Box", "FeatureResult", "Status", "TrackResult", "Tracker", "TrackerMeanShift",
+           "TrackerParams", "FrameError", *_MULTI, *_RESULT_API]
 
 _LAZY = ("Tracker", "TrackerMeanShift", "TrackerParams", "FrameError")
 
@@ -42,6 +50,9 @@ def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
     if name in _LAZY:
         from .track import tracker
         return getattr(tracker, name)
+    if name in _MULTI:
+        from .track import multi
+        return getattr(multi, name)
     if name in _RESULT_API:
         from .fixed import vhdl_pkg
         return getattr(vhdl_pkg, name)
@@ -49,4 +60,4 @@ def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
 
 
 def __dir__() -> list[str]:
-    return sorted([*globals(), *_LAZY])
+    return sorted([*globals(), *_LAZY, *_MULTI])

@@ -496,6 +496,11 @@ def _add_preset_options(p: argparse.ArgumentParser) -> None:
 def _cmd_eval(args: argparse.Namespace) -> int:
     from .eval.evaluate import evaluate, tracker_names
     from .eval.report import write_report
+    from .io.mot import is_mot_dataset
+
+    if is_mot_dataset(args.dataset):  # MOT format (gt.txt): the multi-object evaluation (docs/multi.md)
+        from .multicli import cmd_eval_mot
+        return cmd_eval_mot(args)
 
     names = _csv_list(args.trackers) or tracker_names()
     unknown = [n for n in names if n not in tracker_names()]
@@ -520,8 +525,10 @@ def _cmd_eval(args: argparse.Namespace) -> int:
 
 def register_eval(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("eval", help="OTB one-pass evaluation of trackers on a dataset folder",
-                       description="Run trackers over every sequence of DATASET_DIR (OPE) and write a report.")
-    p.add_argument("dataset", metavar="DATASET_DIR", help="folder of OTB/VOT sequence folders")
+                       description="Run trackers over every sequence of DATASET_DIR (OPE) and write a report. "
+                                   "A MOT folder (gt.txt) gets the multi-object evaluation (docs/multi.md).")
+    p.add_argument("dataset", metavar="DATASET_DIR", help="folder of OTB/VOT sequence folders, or a MOT "
+                                                           "sequence folder (gt.txt, img/) or a folder of them")
     p.add_argument("--trackers", help="comma-separated tracker names (default: all registered)")
     p.add_argument("--model", choices=("float", "fixed"), default="float", help=MODEL_HELP)
     p.add_argument("--out", default="out/eval", help="report folder (default out/eval)")
@@ -544,9 +551,14 @@ def register_eval(sub: argparse._SubParsersAction) -> None:
 
 def _cmd_track(args: argparse.Namespace) -> int:
     from .eval.evaluate import make_tracker
+    from .io.mot import is_mot_dir
 
+    boxes = list(args.box or [])
+    if len(boxes) > 1 or args.init is not None or (not boxes and is_mot_dir(args.source)):
+        from .multicli import cmd_track_multi  # several targets (docs/multi.md)
+        return cmd_track_multi(args, boxes, args.init)
     src = VideoSource(args.source)
-    box = args.box
+    box = boxes[0] if boxes else None
     gt = None
     if src.sequence is not None:
         gt = src.sequence.gt
@@ -572,13 +584,19 @@ def _cmd_track(args: argparse.Namespace) -> int:
 
 
 def register_track(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("track", help="track a target in a video, image folder or sequence folder",
-                       description="Track one target and write results.csv, results.json and an overlay video.")
-    p.add_argument("source", metavar="SOURCE", help="video file, image folder or OTB/VOT sequence folder")
-    p.add_argument("--box", type=_parse_box, metavar="X,Y,W,H",
+    p = sub.add_parser("track", help="track one or several targets in a video, image folder or sequence folder",
+                       description="Track one target and write results.csv, results.json and an overlay video; "
+                                   "with several --box or --init: several targets, results.csv in MOT format "
+                                   "(docs/multi.md).")
+    p.add_argument("source", metavar="SOURCE", help="video file, image folder, OTB/VOT sequence folder or MOT "
+                                                   "sequence folder (gt.txt: its targets by default)")
+    p.add_argument("--box", type=_parse_box, metavar="X,Y,W,H", action="append",
                    help="initial box, 0-based pixels, e.g. --box -5,10,20,20 (default: frame 0 ground truth); "
                         "a box outside the frame is clipped, one larger than the model's window shrunk, "
-                        "with a warning")
+                        "with a warning.  Repeat it for several targets (ids 1, 2, ... in order)")
+    p.add_argument("--init", metavar="GT_TXT",
+                   help="a MOT file (frame,id,x,y,w,h,...; 1-based): each id is added on its first frame with "
+                        "its box there (id = its MOT id) and tracked to the end")
     p.add_argument("--model", choices=("float", "fixed"), default="float", help=MODEL_HELP)
     _add_preset_options(p)
     p.add_argument("--out", help="output folder (default out/track/<source name>)")
@@ -629,6 +647,11 @@ def parse_variant(text: str) -> dict[str, Any]:
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     from .eval.evaluate import make_tracker, run_label
+    from .io.mot import is_mot_dataset
+
+    if args.dataset and is_mot_dataset(args.dataset):  # per-target speed of the MultiTracker (docs/multi.md)
+        from .multicli import cmd_bench_mot
+        return cmd_bench_mot(args)
 
     models = ["float", "fixed"] if args.model == "both" else [args.model]
     variants: list[tuple[str, dict[str, Any]]] = [("", {})]
@@ -697,7 +720,9 @@ def register_bench(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="speed of mstrack vs OpenCV CamShift",
                        description="fps of the mstrack tracker(s) and of OpenCV CamShift on the same frames. "
                                    "Without DATASET_DIR: a synthetic 640x360 scene with a 64x64 target.")
-    p.add_argument("dataset", metavar="DATASET_DIR", nargs="?", help="folder of sequences (optional)")
+    p.add_argument("dataset", metavar="DATASET_DIR", nargs="?",
+                   help="folder of sequences (optional); a MOT folder (gt.txt): target updates per second of "
+                        "the MultiTracker against one CamShift per target (--write-docs: docs/bench_multi.md)")
     p.add_argument("--sequences", help="comma-separated sequence names (default: all)")
     p.add_argument("--model", choices=("float", "fixed", "both"), default="both",
                    help="float reference, fixed-point model, or both (default)")
@@ -765,6 +790,16 @@ def _cmd_demo(args: argparse.Namespace) -> int:
                             "mean_confidence": float(np.nanmean(conf)) if np.isfinite(conf).any() else None}
         print(f"[demo] {vt.name}, {len(rows)} frames from box {Box.of(args.box).as_tuple()}: status {st}, "
               f"{_fmt(info['fps'], 1)} fps -> {info['video']}")
+    # (c) several targets at once: a generated scene with four targets (docs/multi.md)
+    if args.multi_frames > 0:
+        from .multicli import demo_multi
+        m = demo_multi(name, args.model, out / "multi", args.multi_frames)
+        summary["multi"] = m
+        mot = m["mot"] or {}
+        print(f"[demo] multi-target scene, {m['frames']} frames, {m['targets']} targets (two enter / leave "
+              f"mid-scene), {label}: mean AUC {m['mean_auc']:.3f}"
+              + (f", HOTA {mot['HOTA']:.3f}, MOTA {mot['MOTA']:.3f}, IDF1 {mot['IDF1']:.3f}" if mot else "")
+              + f", {_fmt(m['fps'], 1)} target updates/s -> {m['video']}")
     out.mkdir(parents=True, exist_ok=True)
     (out / "summary.json").write_text(json.dumps(summary, indent=1, default=lambda v: None) + "\n")
     print(f"[demo] results in {out}/ (summary.json, */results.csv, */overlay video)")
@@ -772,13 +807,16 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def register_demo(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("demo", help="run the tracker on a synthetic scene and OpenCV's vtest.avi",
+    p = sub.add_parser("demo", help="run the tracker on a synthetic scene, OpenCV's vtest.avi and a "
+                                    "multi-target scene",
                        description="Default job: needs no dataset. Writes overlays and results to --out.")
     p.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
     p.add_argument("--model", choices=("float", "fixed"), default="float", help=MODEL_HELP)
     _add_preset_options(p)
     p.add_argument("--frames", type=int, default=200, help="vtest.avi frames to track (default 200)")
     p.add_argument("--synthetic-frames", type=int, default=120, help="synthetic scene length (default 120)")
+    p.add_argument("--multi-frames", type=int, default=60,
+                   help="length of the multi-target scene (four targets; default 60, 0: skip it)")
     p.add_argument("--video", help="video to use instead of vtest.avi (then also give --box)")
     p.add_argument("--box", type=_parse_box, default=Box(*VTEST_BOX),
                    help="init box x,y,w,h for the video (default: a person in vtest.avi)")

@@ -197,6 +197,15 @@ def targets_section(totals: dict) -> list[str]:
     return out + [""]
 
 
+#: The link to the multi-target results (tools/results_multi_doc.py writes docs/results_multi.md).
+MULTI_SECTION = ["## Several targets (MOT sequences)", "",
+                 "Multi-target tracking (`mstrack.MultiTracker`, docs/multi.md) on the two MOT sequences of "
+                 "`../shared/data/multi`: float and fixed mstrack-v2 against OpenCV CSRT and KCF, per target, per "
+                 "sequence and overall (AUC, P@20, HOTA, MOTA, IDF1, ID switches, the loss table), and the "
+                 "per-target update speed of the float MultiTracker against CamShift's: "
+                 "[results_multi.md](results_multi.md) (`make results-multi`, part of `make results`).", ""]
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = [] if argv is None else argv
     out = ["# Results on real video", "",
@@ -228,6 +237,7 @@ def main(argv: list[str] | None = None) -> int:
         out += targets_section(totals)
     except KeyError as exc:  # a run without the trackers the targets name
         out += [f"(issue 10's targets: no run of {exc} in the reports; run `make results`)", ""]
+    out += MULTI_SECTION
     out += ["## Reading the numbers", "",
             "* **Tracker v2** (`preset=\"v2\"`, tracker `mstrack-v2`, the default since session 16; "
             "docs/algorithm.md \"Tracker v2\", fixed-point model docs/fixed_point.md \"Tracker v2\") is "

@@ -37,7 +37,13 @@ APT_PACKAGES=(opencv-doc ghdl ghdl-llvm ccache yosys)
 # regs       : PeakRDL (SystemRDL compiler, regblock-vhdl, c-header, markdown) for `make regs`
 # test       : pytest, mypy (tests/test_typing.py)
 # dist       : dask[distributed] (mstrack eval --scheduler: a Dask cluster, docs/distributed.md)
-PIP_EXTRAS=(hdl hdltools test regs dist)
+# mot        : scipy, tabulate, motmetrics (the MOT metrics of mstrack eval on MOT folders, docs/multi.md)
+PIP_EXTRAS=(hdl hdltools test regs dist mot)
+# === EXTENSION POINT: packages installed with --no-deps ======================
+# trackeval  : TrackEval (HOTA / CLEAR / Identity, docs/multi.md): its metadata requires opencv-python,
+#              which would overwrite opencv-contrib-python-headless's cv2 (no CSRT / KCF); its metrics
+#              need only numpy and scipy (extra mot).  Pinned by requirements.lock like the rest.
+PIP_NODEPS=(trackeval)
 
 log() { printf 'setup: %s\n' "$*"; }
 
@@ -101,15 +107,24 @@ else
     lock_note="pinned by requirements.lock"
     want=$( { cat pyproject.toml requirements.lock; echo "extras=$extras"; } | sha256sum | cut -d' ' -f1)
 fi
+want=$( { echo "$want"; echo "nodeps=${PIP_NODEPS[*]}"; } | sha256sum | cut -d' ' -f1)
 have=$(cat "$VENV/.stamp" 2>/dev/null || true)
 if [ "$want" != "$have" ] || ! "$VENV/bin/python" -c 'import mstrack, cv2, numpy, matplotlib, tqdm, pytest' 2>/dev/null \
-   || [ ! -x "$VENV/bin/mstrack" ]; then
+   || [ ! -x "$VENV/bin/mstrack" ] \
+   || ! "$VENV/bin/python" -c 'import importlib.util as u, sys; sys.exit(any(u.find_spec(m) is None for m in sys.argv[1:]))' "${PIP_NODEPS[@]}"; then
     log "pip install -e .[$extras] ($lock_note)"
     if [ -n "${SETUP_LATEST:-}" ]; then
         "$VENV/bin/python" -m pip install -q --disable-pip-version-check --upgrade --upgrade-strategy eager -e ".[$extras]"
     else
         PIP_CONSTRAINT="$PWD/requirements.lock" \
             "$VENV/bin/python" -m pip install -q --disable-pip-version-check -e ".[$extras]"
+    fi
+    log "pip install --no-deps ${PIP_NODEPS[*]} ($lock_note)"
+    if [ -n "${SETUP_LATEST:-}" ]; then
+        "$VENV/bin/python" -m pip install -q --disable-pip-version-check --upgrade --no-deps "${PIP_NODEPS[@]}"
+    else
+        PIP_CONSTRAINT="$PWD/requirements.lock" \
+            "$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps "${PIP_NODEPS[@]}"
     fi
     echo "$want" > "$VENV/.stamp"
 fi

@@ -181,3 +181,105 @@ def write_otb_sequence(frames: np.ndarray, gt: np.ndarray, folder: str | Path,
             "frames": int(len(frames)), "source": "mstrack.io.synthetic.make_scene"}
     (d / "meta.json").write_text(json.dumps(meta, indent=1) + "\n")
     return d
+
+
+#: Colour pairs (BGR) of the checkerboard targets of :func:`make_multi_scene`: red / yellow (the
+#: target of :func:`make_scene`), magenta / white, orange / black, purple / pink, then again.
+MULTI_COLOURS = (((30, 40, 210), (40, 200, 230)), ((200, 40, 200), (235, 235, 235)),
+                 ((20, 120, 240), (25, 25, 25)), ((140, 30, 110), (180, 150, 250)))
+
+
+def make_multi_scene(n_frames: int = 60, width: int = 320, height: int = 240, n_targets: int = 4, seed: int = 0,
+                     spans: list[tuple[int, int]] | None = None, sizes: list[tuple[int, int]] | None = None,
+                     noise: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+    """A scene with several targets (ground truth known), for multi-target tracking.
+
+    Each target is a checkerboard of its own colour pair (:data:`MULTI_COLOURS`) moving on its own
+    smooth Lissajous path (at most about 3 px/frame) over the background of :func:`make_scene`;
+    targets drawn later (higher id) pass in front of earlier ones where they cross.
+
+    Parameters
+    ----------
+    n_frames, width, height : int
+        Frames and frame size (at least 64 x 64).
+    n_targets : int
+        Targets, ids 1 .. n_targets.
+    seed : int
+        Random seed; the same arguments give identical output.
+    spans : list of (first, end), optional
+        Per target, the frames it is in the scene: ``first <= frame < end`` (default: the whole
+        scene for every target); a target appears (enters) and disappears at these frames.
+    sizes : list of (w, h), optional
+        Per target size in pixels (default: squares of side ``min(40, min(width, height) // 5)``
+        minus 4 px per id, so they differ).
+    noise : float
+        Standard deviation of the per-frame sensor noise.
+
+    Returns
+    -------
+    frames : ndarray, shape (N, height, width, 3), uint8 BGR
+    rows : ndarray, shape (M, 6), float64
+        Ground truth ``(frame, id, x, y, w, h)``, frame 0-based, boxes 0-based integer-valued, sorted
+        by frame then id (the layout of :attr:`mstrack.io.mot.MotSequence.rows`).
+    """
+    if n_frames < 1 or width < 64 or height < 64 or n_targets < 1:
+        raise ValueError("need n_frames >= 1, n_targets >= 1 and a frame of at least 64 x 64")
+    rng = np.random.default_rng(seed)
+    bg = background_texture(rng, width, height)
+    side = min(40, min(width, height) // 5)
+    sizes = sizes or [(max(12, side - 4 * (i % 4)), max(12, side + 8 - 4 * (i % 3))) for i in range(n_targets)]
+    spans = spans or [(0, n_frames)] * n_targets
+    if len(sizes) != n_targets or len(spans) != n_targets:
+        raise ValueError("sizes and spans need one entry per target")
+    t = np.arange(n_frames, dtype=np.float64)
+    paths, texs = [], []
+    for i, (tw, th) in enumerate(sizes):
+        tex = target_texture(rng, tw, th)
+        c0, c1 = MULTI_COLOURS[i % len(MULTI_COLOURS)]
+        yy, xx = np.mgrid[0:th, 0:tw]
+        cell = max(4, min(tw, th) // 6)
+        check = ((yy // cell + xx // cell) % 2).astype(bool)
+        red, yellow = np.array((30, 40, 210), np.float32), np.array((40, 200, 230), np.float32)
+        tex = tex - np.where(check[..., None], red, yellow)  # target_texture's colours -> this target's
+        tex += np.where(check[..., None], np.array(c0, np.float32), np.array(c1, np.float32))
+        texs.append(np.clip(tex, 0, 255))
+        mx, my = (width - tw) / 2.0, (height - th) / 2.0
+        ax, ay = 0.85 * mx, 0.85 * my
+        px, py = rng.uniform(0, 2 * np.pi, 2)
+        wx = min(3.0 / max(ax, 1.0), 2 * np.pi / rng.uniform(60, 110))
+        wy = min(2.5 / max(ay, 1.0), 2 * np.pi / rng.uniform(50, 90))
+        paths.append((np.round(mx + ax * np.sin(wx * t + px)).astype(int),
+                      np.round(my + ay * np.sin(wy * t + py)).astype(int)))
+    frames = np.empty((n_frames, height, width, 3), np.uint8)
+    rows = []
+    for k in range(n_frames):
+        f = bg.copy()
+        for i, ((tw, th), (xs, ys), (first, end)) in enumerate(zip(sizes, paths, spans)):
+            if first <= k < end:
+                f[ys[k]:ys[k] + th, xs[k]:xs[k] + tw] = texs[i]
+                rows.append((k, i + 1, xs[k], ys[k], tw, th))
+        f += rng.normal(0.0, noise, f.shape).astype(np.float32)
+        frames[k] = np.clip(f, 0, 255).astype(np.uint8)
+    return frames, np.asarray(rows, dtype=np.float64).reshape(-1, 6)
+
+
+def write_mot_sequence(frames: np.ndarray, rows: np.ndarray, folder: str | Path, name: str | None = None,
+                       fps: float | None = None) -> Path:
+    """Write frames and ground-truth rows ``(frame, id, x, y, w, h)`` (0-based, as
+    :func:`make_multi_scene` returns them) as a MOTChallenge-format folder: ``img/000001.jpg ...``,
+    ``gt.txt`` (1-based frames and x, y) and ``meta.json``.  Returns the folder."""
+    from .mot import write_mot_gt
+    d = Path(folder)
+    (d / "img").mkdir(parents=True, exist_ok=True)
+    for i, f in enumerate(frames, start=1):
+        if not cv2.imwrite(str(d / "img" / f"{i:06d}.jpg"), f, [cv2.IMWRITE_JPEG_QUALITY, 95]):
+            raise OSError(f"cannot write {d / 'img' / f'{i:06d}.jpg'}")
+    write_mot_gt(d / "gt.txt", rows)
+    h, w = frames.shape[1:3]
+    meta: dict[str, object] = {"name": name or d.name, "format": "mot", "width": int(w), "height": int(h),
+                               "frames": int(len(frames)), "targets": int(len(np.unique(np.asarray(rows)[:, 1]))),
+                               "source": "mstrack.io.synthetic.make_multi_scene"}
+    if fps is not None:
+        meta["fps"] = float(fps)
+    (d / "meta.json").write_text(json.dumps(meta, indent=1) + "\n")
+    return d

@@ -153,6 +153,9 @@ class TrackResult:
         and always reports 1.0.
     extra : dict
         Model-specific detail (the fixed model puts its raw integers here).
+    target_id : int or None
+        The target's id in a :class:`mstrack.MultiTracker` (its slot, 0 .. max_targets - 1); None
+        for a single :class:`mstrack.Tracker`.
 
     ``ok`` (property) is True when the box can be trusted (status ok, init, clipped or
     reacquired): the ``ok`` of OpenCV's ``(ok, rect) = tracker.update(frame)``.
@@ -170,6 +173,7 @@ class TrackResult:
     message: str = ""
     confidence: float = 1.0
     extra: dict[str, Any] = field(default_factory=dict)
+    target_id: int | None = None
 
     @property
     def ok(self) -> bool:

@@ -2,9 +2,9 @@
 
 Usage::
 
-    python tools/loss_study.py dump [SEQ_ROOT]     # runs float + fixed v2, writes out/loss_study/*.npz
-    python tools/loss_study.py search [SEQ_ROOT]   # float v2 with the wide search started by the flag
-    python tools/loss_study.py report              # -> docs/results_loss.md, docs/results/loss_*.png
+    python studies/loss_study.py dump [SEQ_ROOT]     # runs float + fixed v2, writes out/loss_study/*.npz
+    python studies/loss_study.py search [SEQ_ROOT]   # float v2 with the wide search started by the flag
+    python studies/loss_study.py report              # -> docs/results_loss.md, docs/results/loss_*.png
 
 ``dump`` runs the v2 tracker as it is (``preset="v2"``) on every sequence and keeps, per
 frame after the init frame: IoU with the ground truth (NaN where invalid), status, confidence,
@@ -444,9 +444,9 @@ def main_report() -> None:
           "(IoU = 0) with `TrackResult.ok` false; *false alarms* = share of on-target frames (IoU >= 0.5) "
           "with `ok` false.  Target: recall >= 0.6 at false alarms <= 0.05.  The rule adopted is in "
           "docs/algorithm.md, \"v2.7a Loss flag\"; this page is the evidence.", "",
-          "Commands: `python tools/loss_study.py dump` (runs float and fixed v2 and keeps the per-frame "
-          "signals in out/loss_study/), `python tools/loss_study.py search` (float v2 with the search "
-          "started by the flag), `python tools/loss_study.py report` (this page and its plots).  The search "
+          "Commands: `python studies/loss_study.py dump` (runs float and fixed v2 and keeps the per-frame "
+          "signals in out/loss_study/), `python studies/loss_study.py search` (float v2 with the search "
+          "started by the flag), `python studies/loss_study.py report` (this page and its plots).  The search "
           "state of v2 does not depend on the flag, so the boxes, and every signal below, are those of "
           "the v2 runs of docs/results.md.  Session 6 measured two more cues (a ceiling on rho, a "
           "grey-template check): docs/results_loss_cues.md.", ""]
@@ -555,7 +555,7 @@ def main_report() -> None:
     sp = OUT / "search.json"
     if sp.exists():
         res = json.loads(sp.read_text())
-        L += ["* Search state from the flag (float, `python tools/loss_study.py search`): the wide search of "
+        L += ["* Search state from the flag (float, `python studies/loss_study.py search`): the wide search of "
               "v2.7 started by the loss flag instead of the confidence.", "",
               "| search started by | AUC | mean AUC over sequences | recall | false alarms |", "|---|---:|---:|---:|---:|"]
         for k, v in res.items():
@@ -567,8 +567,8 @@ def main_report() -> None:
     L += ["## Rules tried, session 5", "",
           "Issue 10 item 4 (target recall >= 0.6 at false alarms <= 0.05, float and fixed, in and out of sample) "
           "is not met by the adopted rule.  Session 5 measured the cheap alternatives below on the same dumped "
-          "signals (`python tools/loss_study.py report` recomputes this table; the rules are `tried_rules()` in "
-          "tools/loss_study.py).  rs = rho_s / rho0 and con = contrast_s are the adopted filters' values (rate "
+          "signals (`python studies/loss_study.py report` recomputes this table; the rules are `tried_rules()` in "
+          "studies/loss_study.py).  rs = rho_s / rho0 and con = contrast_s are the adopted filters' values (rate "
           "1/2); share = 0 flags in every rule.  Per rule: its grid size; per model, thresholds chosen on that "
           "model (max recall with false alarms <= 0.05): in sample and leave one sequence out; then one set of "
           "thresholds for both models (the highest lower recall, both false-alarm rates <= 0.05, as the defaults "

@@ -2,8 +2,8 @@
 
 Usage::
 
-    python tools/loss_cues.py dump [SEQ_ROOT]   # runs float + fixed v2, writes out/loss_cues/{float,fixed}.json
-    python tools/loss_cues.py report            # -> docs/results_loss_cues.md
+    python studies/loss_cues.py dump [SEQ_ROOT]   # runs float + fixed v2, writes out/loss_cues/{float,fixed}.json
+    python studies/loss_cues.py report            # -> docs/results_loss_cues.md
 
 Per frame after the init frame (the v2 defaults; the flag does not steer the tracker, so the
 boxes are those of docs/results.md): IoU, the adopted flag's inputs rs = rho_s / rho0 and
@@ -155,8 +155,8 @@ def main_report() -> None:
          "the session-5 search).  This page measures two cues the session-5 search did not have: a **ceiling** on "
          "rho (rs = rho_s / rho0 > h: the window matches the model clearly better than the init box did) and a "
          f"**template** check (NCC of the box's grey image at {N_T} x {N_T} px against the init box's, smoothed "
-         "with rate 1/2, below c).  Commands: `python tools/loss_cues.py dump` (float and fixed v2, default "
-         "parameters, about 4 min), `python tools/loss_cues.py report` (this page).", "",
+         "with rate 1/2, below c).  Commands: `python studies/loss_cues.py dump` (float and fixed v2, default "
+         "parameters, about 4 min), `python studies/loss_cues.py report` (this page).", "",
          f"Grid: a {GA[0]:.2f} .. {GA[-1]:.2f}, b {GB[0]:.2f} .. {GB[-1]:.2f} (steps 0.01), h {GH[0]:.2f} .. "
          f"{GH[-2]:.2f} (0.01) or off, c {GC[0]:.2f} .. {GC[-2]:.2f} (0.02) or off.  One set of thresholds for "
          "both models (the highest lower recall, both false-alarm rates <= 0.05); leave one sequence out: the "

@@ -426,7 +426,7 @@ def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
 def test_v2_loss_flag_on_the_dev_set():
     """Loss signal floors, both models, whole dev set (docs/results_loss.md): recall (off-target
     frames, IoU = 0, not ok) and false alarms (IoU >= 0.5, not ok).  Measured 2026-11-23: float
-    0.556 / 0.041, fixed 0.581 / 0.048 (issue target 0.6 / 0.05: recall not reached)."""
+    0.556 / 0.041, fixed 0.581 / 0.048 (target 0.6 / 0.05: recall not reached)."""
     from mstrack.io.data import load_dataset
     from mstrack.eval.metrics import iou, loss_detection, valid_gt
 

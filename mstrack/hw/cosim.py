@@ -346,7 +346,7 @@ class CoreConfigV2:
             rtl_less.append("scale_test without scale_test_gate")
         if rtl_less:
             raise ValueError(f"core v2 has no RTL yet for {', '.join(rtl_less)} (float and fixed models only; "
-                             "docs/results_v2_mean.md \"Path to adoption\")")
+                             "docs/results_v2_mean.md)")
 
     def generics(self) -> dict[str, int]:
         from ..fixed.blocks_v2 import q16, sixteenths

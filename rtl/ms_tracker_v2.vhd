@@ -1,4 +1,4 @@
--- ms_tracker_v2: the sequencer of core v2 (issue 11): tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2)
+-- ms_tracker_v2: the sequencer of core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2)
 -- bit for bit, on the ports and stream behaviour of ms_tracker, with result word v2.
 --
 -- Computes, per video frame (docs/blocks/ms_tracker_v2.md, docs/architecture.md "Core v2"):

@@ -1,4 +1,4 @@
-"""Tracker v2: edge feature and fusion variants, measured (issue 10, item 5).
+"""Tracker v2: edge feature and fusion variants, measured (docs/results_v2_features.md).
 
 Runs tracker v2 variants (mstrack/track/features_v2.py) over every sequence of a
 dataset, one-pass (OPE), and scores them exactly as ``mstrack eval`` does

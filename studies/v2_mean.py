@@ -1,4 +1,4 @@
-"""Issue 10, last accuracy target: mean AUC over the dev sequences of tracker v2 variants.
+"""The mean-AUC target: mean AUC over the dev sequences of tracker v2 variants.
 
 Every variant runs on every sequence with the same parameters (no per-sequence choice), one
 pass (OPE), scored as ``mstrack eval`` (mstrack.eval.evaluate.run_sequence + aggregate).  Prints the

@@ -365,7 +365,7 @@ def test_lost_window_at_doubled_decimation_is_half():
 @pytest.mark.parametrize("scene", ["lost_at_d4", "lost_at_d16", "tall_lost_at_d16"])
 def test_region_max_v2_bounds_the_fixed_model_regions(scene, monkeypatch):
     """Every region the fixed model captures, while tracking and while lost, fits core v2's region RAM
-    (REGION_MAX = region_max_v2 rounded up to LANES: 256 at the defaults, 445 before session 12); the
+    (REGION_MAX = region_max_v2 rounded up to LANES: 256 at the defaults); the
     lost region at D = 4 reaches past the tracking region's 191, so the lost-state bound is exercised."""
     from mstrack.fixed import FixedParams
     from mstrack.fixed import tracker_v2 as tv2

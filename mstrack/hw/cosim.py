@@ -276,7 +276,7 @@ class CoreModel:
             self._frame(done)
 
 
-# ----------------------------------------------------------------------------- core v2 (issue 11)
+# ----------------------------------------------------------------------------- core v2
 #: fields of result word v2 compared frame by frame (mstrack.fixed.vhdl_pkg.result_layout_v2)
 COMPARED_FIELDS_V2 = ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "stop", "decim_log2",
                       "searched", "flags", "err_code", "frame_count")

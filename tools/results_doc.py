@@ -28,7 +28,7 @@ def command(md: str) -> str:
 def tools(md: str) -> str:
     """The report's "Tools: ..." line (mstrack.versions.tools_line), which names what produced it."""
     return next((line for line in md.splitlines() if line.startswith("Tools:")),
-                "Tools: not recorded in this report (made before `mstrack eval` recorded them).")
+                "Tools: not recorded in this report.")
 
 
 LOSS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-colour", "float"),

@@ -1,4 +1,4 @@
-"""Versions of the tools behind a generated figure (issue 9: every generated table names them).
+"""Versions of the tools behind a generated figure (every generated table names them).
 
 :func:`tool_versions` returns ``{label: version}`` for the Python packages (numpy, OpenCV, numba,
 cocotb) and the HDL tools (GHDL, Verilator, yosys, nextpnr-ecp5); a tool that is missing gives

@@ -1,4 +1,4 @@
--- ms_tracker_v2: the sequencer of core v2 (issue 11): tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2)
+-- ms_tracker_v2: the sequencer of core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2)
 -- bit for bit, on the ports and stream behaviour of ms_tracker, with result word v2.
 --
 -- Computes, per video frame (docs/blocks/ms_tracker_v2.md, docs/architecture.md "Core v2"):
@@ -71,7 +71,7 @@
 -- bin pass + ms_fusion's rho), a window that does not fit skipping all but the first 8; measured
 -- on the first tracking frame (LANES 4, 512 bins): 3,462 clocks more (Girl, 128x96), 3,607
 -- (Couple), 5,041 (MotorRolling, D = 2); at MAX_WINDOW 127 about 2 x 4,800 (estimated, not measured).
--- Measured: docs/blocks/ms_tracker_v2.md (tools/v2_latency.py).  Throughput: 1 pixel per clock while a frame streams;
+-- Measured: docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).  Throughput: 1 pixel per clock while a frame streams;
 -- the input is closed from a frame's last pixel until its result is in the FIFO (as ms_tracker).
 -- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1).
 library ieee;

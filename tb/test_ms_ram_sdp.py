@@ -116,8 +116,8 @@ CASES = [
     pytest.param({"DEPTH": 18336, "DATA_W": 2, "ADDR_W": 15, "RD_LAT": 4}, id="x2_deep"),
     pytest.param({"DEPTH": 1500, "DATA_W": 25, "ADDR_W": 11, "RD_LAT": 3}, id="x18_wide"),
     # core v2's colour bank (REGION_MAX 256, STRIDE 64: 8 rows of x9) at RD_LAT 4: the row
-    # multiplexer in two registered levels; its bank before session 12 (REGION_MAX 445, STRIDE 112:
-    # 25 rows, 5 groups of 5 rows); 7 rows: groups of 3, 3 and 1
+    # multiplexer in two registered levels; a bank of REGION_MAX 445, STRIDE 112
+    # (25 rows, 5 groups of 5 rows); 7 rows: groups of 3, 3 and 1
     pytest.param({"DEPTH": 16384, "DATA_W": 9, "ADDR_W": 14, "RD_LAT": 4, "WR_LAT": 1}, id="v2_colour_bank"),
     pytest.param({"DEPTH": 49840, "DATA_W": 9, "ADDR_W": 16, "RD_LAT": 4, "WR_LAT": 1}, id="rows25"),
     pytest.param({"DEPTH": 14000, "DATA_W": 9, "ADDR_W": 14, "RD_LAT": 5}, id="two_level_7rows"),

@@ -409,7 +409,7 @@ def test_tracker_v2_joint_fastsim(name, n, pin, pout):
         assert any(e["searched"] > 0 for e in exp) and any(e["status"] == 3 for e in exp)
 
 
-#: the long run (issue 11: >= 1,500 real frames): whole sequences, 1,545 frames in all (name, frames,
+#: the long run (>= 1,500 real frames): whole sequences, 1,545 frames in all (name, frames,
 #: input-gap %, result back-pressure %): MotorRolling is 640x360 (D = 2), Deer 704x400 (lost at D = 4),
 #: Girl 128x96; Couple and Deer are streamed with random input gaps and result back-pressure; losses
 #: and re-acquisitions on Couple (46-48), Crossing, Deer, Subway (docs/blocks/ms_tracker_v2.md)

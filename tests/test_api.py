@@ -1,4 +1,4 @@
-"""The public API with OpenCV habits (issue 14, item 1): Box as a 4-tuple and an OpenCV rect,
+"""The public API with OpenCV habits: Box as a 4-tuple and an OpenCV rect,
 TrackResult.ok / .confidence, TrackerMeanShift in a loop written for cv2 trackers, parameter
 aliases, the default tracker."""
 import dataclasses
@@ -62,7 +62,7 @@ def test_trackresult_ok_confidence_and_box(scene):
     trk = Tracker()
     r0 = trk.init(frames[0], gt[0])
     r1 = trk.update(frames[1])
-    x, y, w, h = r1.box                          # the issue's failing line
+    x, y, w, h = r1.box                          # the OpenCV habit: unpack the box
     assert r0.ok and r1.ok and r1.status in (Status.OK, Status.REACQUIRED)
     assert 0.0 <= r1.confidence <= 1.0
     d = r1.to_dict()

@@ -189,7 +189,7 @@ def test_data_reader_errors(tmp_path):
         data.load_sequence(tmp_path / "missing")
 
 
-# ----------------------------------------------------------------------------- issue 9: boxes and parameters
+# ----------------------------------------------------------------------------- boxes and parameters
 @pytest.mark.parametrize("box", ["5599", b"5599", bytearray(b"5599"), {1.0, 2.0, 30.0, 40.0},
                                  {"x": 1, "y": 2, "w": 3, "h": 4}, (True, 10, 20, 20), ("10", "10", "20", "20"),
                                  (10, 10, 20, None), iter((10, 10, 20, 20))])

@@ -1,4 +1,4 @@
-"""Issue 9, "Bad input": clear one-line errors, nothing lost (CLI, data readers, eval harness).
+"""Bad input: clear one-line errors, nothing lost (CLI, data readers, eval harness).
 
 Each case was reproduced on main first; the test asserts the message and that files written
 earlier are still there.  Tiny synthetic data (mstrack.io.synthetic)."""

@@ -1,4 +1,4 @@
-"""The command line as a vision engineer meets it (issue 14, item 2): one test per item."""
+"""The command line as a vision engineer meets it: one test per usability point."""
 import csv
 import io
 import json

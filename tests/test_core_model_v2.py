@@ -108,7 +108,7 @@ def test_core_config_v2_refuses_options_without_rtl(kw, what):
 
 
 def test_core_config_v2_joint():
-    """The default tracker v2 (the joint bins, RTL since session 15) has ORIENT_T = orient_T (64) beside
+    """The default tracker v2 (the joint bins) has ORIENT_T = orient_T (64) beside
     SCALE_TEST_D256 13 and the loss thresholds, for ms_tracker_v2 and ms_tracker (PRESET 1); every other
     generic as without the joint bins."""
     from mstrack.fixed.formats import FixedParams

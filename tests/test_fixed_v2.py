@@ -365,7 +365,7 @@ def test_lost_window_at_doubled_decimation_is_half():
 @pytest.mark.parametrize("scene", ["lost_at_d4", "lost_at_d16", "tall_lost_at_d16"])
 def test_region_max_v2_bounds_the_fixed_model_regions(scene, monkeypatch):
     """Every region the fixed model captures, while tracking and while lost, fits core v2's region RAM
-    (REGION_MAX = region_max_v2 rounded up to LANES: 256 at the defaults, 445 before session 12); the
+    (REGION_MAX = region_max_v2 rounded up to LANES: 256 at the defaults); the
     lost region at D = 4 reaches past the tracking region's 191, so the lost-state bound is exercised."""
     from mstrack.fixed import FixedParams
     from mstrack.fixed import tracker_v2 as tv2
@@ -426,7 +426,7 @@ def test_fixed_v2_within_001_auc_of_float_v2_on_the_dev_set():
 def test_v2_loss_flag_on_the_dev_set():
     """Loss signal floors, both models, whole dev set (docs/results_loss.md): recall (off-target
     frames, IoU = 0, not ok) and false alarms (IoU >= 0.5, not ok).  Measured 2026-11-23: float
-    0.556 / 0.041, fixed 0.581 / 0.048 (issue target 0.6 / 0.05: recall not reached)."""
+    0.556 / 0.041, fixed 0.581 / 0.048 (target 0.6 / 0.05: recall not reached)."""
     from mstrack.io.data import load_dataset
     from mstrack.eval.metrics import iou, loss_detection, valid_gt
 

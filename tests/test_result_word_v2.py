@@ -1,4 +1,4 @@
-"""Result word v2 (issue 11, item 2): layout, packing and decoding of tracker v2's results.
+"""Result word v2: layout, packing and decoding of tracker v2's results.
 
 The layout is the specification core v2 is built against: every field of every frame of the
 fixed-point model v2 must fit its width and decode back to the same integers.

@@ -107,7 +107,7 @@ def test_tables_from_a_summary():
     json.dumps(s)
 
 
-# ----------------------------------------------------------------------------- Lattice Nexus (issue 13 item 3)
+# ----------------------------------------------------------------------------- Lattice Nexus
 def test_nexus_counts_classify_cells():
     from mstrack.hw import hdl
     cells = {"LUT4": 10, "WIDEFN9": 2, "FD1P3IX": 7, "FD1P3JX": 1, "FD1P3DX": 2, "CCU2": 5, "DP16K": 1,
@@ -151,7 +151,7 @@ def test_nexus_table_row():
     assert row.endswith("yes: 28 % / 38 % / 52 % / 0 % |")
 
 
-# ----------------------------------------------------------------------------- core v2 (issue 11 item 5)
+# ----------------------------------------------------------------------------- core v2
 def test_v2_config_has_v2_generics_and_wrapper():
     """Configuration "v2": ms_tracker_v2 with CoreConfigV2's generics, placed through ms_tracker_v2_pins,
     whose generics are exactly ms_tracker_v2's (every one passed through); the paper configurations unchanged."""

@@ -1,4 +1,4 @@
-"""Issue 9: every generator that writes figures names the tool versions (mstrack.versions)."""
+"""Every generator that writes figures names the tool versions (mstrack.versions)."""
 from __future__ import annotations
 
 import importlib.util

@@ -28,7 +28,7 @@ def command(md: str) -> str:
 def tools(md: str) -> str:
     """The report's "Tools: ..." line (mstrack.versions.tools_line), which names what produced it."""
     return next((line for line in md.splitlines() if line.startswith("Tools:")),
-                "Tools: not recorded in this report (made before `mstrack eval` recorded them).")
+                "Tools: not recorded in this report.")
 
 
 LOSS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-colour", "float"),
@@ -37,7 +37,7 @@ LOSS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-
 
 
 def loss_section(seq_root: Path, totals: dict | None = None) -> list[str]:
-    """Issue 10's loss signal: per tracker, off-target frames (IoU = 0) flagged not ok (recall) and
+    """The loss signal: per tracker, off-target frames (IoU = 0) flagged not ok (recall) and
     on-target frames (IoU >= 0.5) flagged not ok (false alarms), from the cached runs; and the
     confidence-vs-IoU plot of v2 (docs/results/v2_confidence.png).  ``totals``: filled with each
     run label's overall loss detection (for :func:`targets_section`)."""
@@ -76,7 +76,7 @@ def loss_section(seq_root: Path, totals: dict | None = None) -> list[str]:
         ld = loss_detection(np.concatenate(ious), np.concatenate(oks))
         totals[label] = ld
         rows.append(f"| {label} | {ld.off} | {ld.recall:.2f} | {ld.on} | {ld.false_alarm:.3f} |")
-    out = ["## Loss detection (issue 10)", "",
+    out = ["## Loss detection", "",
            "Per frame, frames with valid ground truth after the init frame: *recall* = share of "
            "off-target frames (IoU = 0) whose result is not `ok`; *false alarms* = share of on-target "
            "frames (IoU >= 0.5) whose result is not `ok` (`TrackResult.ok`: status ok, init, clipped or "
@@ -145,7 +145,7 @@ def _bench_all(path: Path, column: str) -> tuple[str, str]:
 
 
 def targets_section(totals: dict) -> list[str]:
-    """Issue 10's targets for the default tracker v2 (mstrack-v2), each with its figure and whether it
+    """The targets for the default tracker v2 (mstrack-v2), each with its figure and whether it
     is met, from the two reports (docs/results/*/report.json), the loss table and docs/bench*.md."""
     import json
 
@@ -187,7 +187,7 @@ def targets_section(totals: dict) -> list[str]:
     ok = fps not in ("-", "") and float(fps) >= 200
     rows.append(("fixed v2 >= 200 frames/s at 640x360, 64x64 target (docs/bench_synthetic.md)",
                  f"{fps} fps ({date})", yes(ok)))
-    out = ["## Issue 10's targets (default tracker v2, `mstrack-v2`)", "",
+    out = ["## Targets (default tracker v2, `mstrack-v2`)", "",
            "From the runs above (AUC: frame-weighted overall, or the plain mean of the per-sequence AUCs), "
            "the loss table, and the speed benchmarks in docs/bench.md and docs/bench_synthetic.md (their "
            "dates in brackets).  Parameters are chosen once for the whole set; the loss thresholds were "
@@ -236,21 +236,21 @@ def main(argv: list[str] | None = None) -> int:
     try:
         out += targets_section(totals)
     except KeyError as exc:  # a run without the trackers the targets name
-        out += [f"(issue 10's targets: no run of {exc} in the reports; run `make results`)", ""]
+        out += [f"(targets: no run of {exc} in the reports; run `make results`)", ""]
     out += MULTI_SECTION
     out += ["## Reading the numbers", "",
-            "* **Tracker v2** (`preset=\"v2\"`, tracker `mstrack-v2`, the default since session 16; "
+            "* **Tracker v2** (`preset=\"v2\"`, tracker `mstrack-v2`, the default; "
             "docs/algorithm.md \"Tracker v2\", fixed-point model docs/fixed_point.md \"Tracker v2\") is "
             "the background-weighted tracker with scale, decimation, confidence, a loss flag and a wide "
             "search, on the joint colour x gradient-orientation histogram (`orient_T=64`: 512 colour bins x "
             "9 orientation bins) with the gated scale test (`scale_test=0.05, scale_test_gate=True`) and the "
             "loss flag's thresholds chosen for it on this set (`loss_rho=0.69, loss_contrast=0.25`; "
-            "docs/results_v2_mean.md).  It is the best tracker here in both layers and meets issue 10's "
+            "docs/results_v2_mean.md).  It is the best tracker here in both layers and meets the "
             "targets above.  RTL: core v2 (`ms_tracker` PRESET 1, `mstrack hdl config --preset v2`), "
             "bit-exact with the fixed model in simulation; placed and routed on the LFE5U-85F it fits "
             "(157 of 208 DP16KD) at 114.82 MHz (grade 8, seed 1), below the 148.5 MHz of 1080p60 at one pixel per "
             "clock (docs/performance.md).",
-            "* **mstrack-v2-colour** (`mstrack.track.params.V2_COLOUR`, the default until session 15; "
+            "* **mstrack-v2-colour** (`mstrack.track.params.V2_COLOUR`; "
             "`mstrack hdl config --preset v2 --colour`: ORIENT_T -1) is tracker v2 on the 512 colour bins "
             "alone, without the scale test: lower AUC and mean over sequences (0.527, below CSRT's), a "
             "weaker loss flag, but twice the float speed and a smaller, faster core (133.96 MHz).  It "

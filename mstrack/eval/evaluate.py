@@ -80,8 +80,8 @@ TRACKERS: dict[str, Callable[[str], Any]] = {
 }
 
 
-#: Former tracker names -> their names now (refused with the new name).  mstrack-v2-joint became the
-#: default v2 tracker mstrack-v2 in session 16; the colour-only tracker v2 is mstrack-v2-colour.
+#: Tracker names that are refused, with the name to use instead: mstrack-v2-joint is the default v2
+#: tracker mstrack-v2; the colour-only tracker v2 is mstrack-v2-colour.
 RENAMED = {"mstrack-v2-joint": "mstrack-v2"}
 
 

@@ -202,7 +202,7 @@ def concat_scores(parts: list[Scores]) -> Scores:
 
 @dataclass
 class LossDetection:
-    """How well a tracker's ``ok`` flag tells when it is off the target (issue 10's loss signal).
+    """How well a tracker's ``ok`` flag tells when it is off the target (the loss signal).
 
     off: frames with IoU = 0 (off the target); recall: share of them with ok False.
     on: frames with IoU >= 0.5 (on the target); false_alarm: share of them with ok False.

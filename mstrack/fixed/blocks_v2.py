@@ -251,7 +251,7 @@ def ms_resize(s8: int, s: int, frame_size: int) -> int:
 
 # ----------------------------------------------------------------------------- joint bins, gated scale test
 # docs/results_v2_mean.md: joint colour x orientation bins and the gated scale test, tracker v2's
-# defaults since session 16 (TrackerParams.orient_T, scale_test, scale_test_gate; docs/fixed_point.md
+# defaults (TrackerParams.orient_T, scale_test, scale_test_gate; docs/fixed_point.md
 # "The joint bins and the gated scale test").
 ORIENT_FLAT = 8  # the orientation bin of pixels with |Gx| + |Gy| < T (and of the frame's 1-px border)
 

@@ -224,7 +224,7 @@ def unpack_result(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
 
 
 # ----------------------------------------------------------------------------- result word v2
-# Core v2 (issue 11) carries tracker v2's result: the box size follows the target, the status is
+# Core v2 carries tracker v2's result: the box size follows the target, the status is
 # one of STATUS_V2 and the confidence is a Q1.16 number.  The model side (this layout, packing
 # FixedTrackerV2's raw integers, decoding) exists before the RTL so that core v2 is built against
 # it; docs/architecture.md ("Result word v2") lists it.

@@ -276,7 +276,7 @@ class CoreModel:
             self._frame(done)
 
 
-# ----------------------------------------------------------------------------- core v2 (issue 11)
+# ----------------------------------------------------------------------------- core v2
 #: fields of result word v2 compared frame by frame (mstrack.fixed.vhdl_pkg.result_layout_v2)
 COMPARED_FIELDS_V2 = ("cx", "cy", "w8", "h8", "rho", "confidence", "status", "iter", "stop", "decim_log2",
                       "searched", "flags", "err_code", "frame_count")
@@ -346,7 +346,7 @@ class CoreConfigV2:
             rtl_less.append("scale_test without scale_test_gate")
         if rtl_less:
             raise ValueError(f"core v2 has no RTL yet for {', '.join(rtl_less)} (float and fixed models only; "
-                             "docs/results_v2_mean.md \"Path to adoption\")")
+                             "docs/results_v2_mean.md)")
 
     def generics(self) -> dict[str, int]:
         from ..fixed.blocks_v2 import q16, sixteenths

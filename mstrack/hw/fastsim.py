@@ -143,7 +143,7 @@ class FastsimRun:
 # ----------------------------------------------------------------------------- build
 @contextlib.contextmanager
 def _lock(path: Path) -> Iterator[None]:
-    """Exclusive lock between processes (parallel pytest workers, other sessions)."""
+    """Exclusive lock between processes (parallel pytest workers, other users of the build folder)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w") as f:
         fcntl.flock(f, fcntl.LOCK_EX)

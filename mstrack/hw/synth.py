@@ -52,7 +52,7 @@ PERF_MD = REPO_ROOT / "docs" / "performance.md"
 SYNTH_DIR = REPO_ROOT / "build" / "synth"
 PINS_TOP = "ms_tracker_pins"
 PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_pins.vhd"
-#: core v2 (issue 11): its top and its pin wrapper (a sibling of ms_tracker_pins for the 160-bit result word v2)
+#: core v2: its top and its pin wrapper (a sibling of ms_tracker_pins for the 160-bit result word v2)
 TOP_V2 = "ms_tracker_v2"
 PINS_TOP_V2 = "ms_tracker_v2_pins"
 PINS_VHD_V2 = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_v2_pins.vhd"
@@ -60,14 +60,14 @@ PINS_VHD_V2 = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_v2_pins.vhd"
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
 #: ECP5 speed grades nextpnr-ecp5 models (LFE5U-85F-6 / -7 / -8, -8 the fastest); SPEED: the grade of
-#: `mstrack synth` unless --speed (nextpnr's default, the grade of every ECP5 figure before session 11);
-#: CI_SPEED: the grade of the CI netlist build (tb/test_synth.py), the part that takes 1080p60 (issue 13)
+#: `mstrack synth` unless --speed (nextpnr's default, the slowest grade);
+#: CI_SPEED: the grade of the CI netlist build (tb/test_synth.py), the part that takes the 1080p60 pixel clock
 SPEEDS = (6, 7, 8)
 SPEED = 6
 CI_SPEED = 8
-#: nextpnr-ecp5 options of every ECP5 run: the HeAP placer's timing weight 50 (default 10).  Session 11,
-#: the default core (RTL 6a86ef8), seeds 1 / 2 / 3: grade 6 110.1 / 118.1 / 114.9 -> 119.5 / 119.4 / 121.0 MHz,
-#: grade 8 151.3 / 146.0 / 150.7 -> 152.7 / 154.8 / 159.8 MHz (docs/performance.md "nextpnr options")
+#: nextpnr-ecp5 options of every ECP5 run: the HeAP placer's timing weight 50 (default 10): on the default
+#: core it gave a higher Fmax than nextpnr's defaults at every seed of grades 6 and 8 (docs/performance.md
+#: "nextpnr options")
 NEXTPNR_ECP5_OPTS = ("--placer-heap-timingweight", "50")
 FREQ_MHZ = 150.0
 TARGET_FMAX_MHZ = 148.5            # 1080p60 pixel clock
@@ -141,8 +141,7 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
                  "region RAM; the gated scale test SCALE_TEST_D256 13; REGION_MAX 445, result word v2 of 160 bits)",
            core=TOP_V2),
     Config("v2-colour", "core v2 of tracker mstrack-v2-colour (mstrack.track.params.V2_COLOUR: colour bins alone, "
-                        "ORIENT_T -1, no scale test, loss_rho 0.88, loss_contrast 0.19; the default core v2 until "
-                        "session 15)", core=TOP_V2, tp=dict(V2_COLOUR)),
+                        "ORIENT_T -1, no scale test, loss_rho 0.88, loss_contrast 0.19)", core=TOP_V2, tp=dict(V2_COLOUR)),
 )}
 
 
@@ -1180,7 +1179,7 @@ def kernel_tables_clocks(max_half: int = 63, half_w: int = 6, kval_w: int = 9) -
 
 
 def v2_frame_overhead(max_half: int = 63, half_w: int = 6, kval_w: int = 9) -> int:
-    """Clocks per frame that v2 adds to the paper's engine (estimate for core v2, issue 11)."""
+    """Clocks per frame that v2 adds to the paper's engine (the estimate of core v2's cost before its RTL)."""
     return (sum(q + 2 for q in V2_DIVISIONS_Q) + sum(V2_BLOCK_CLOCKS.values()) + V2_ISQRT
             + kernel_tables_clocks(max_half, half_w, kval_w))
 

@@ -1,6 +1,6 @@
-"""Experimental feature and fusion variants of tracker v2 (issue 10, item 5).
+"""Experimental feature and fusion variants of tracker v2 (docs/results_v2_features.md).
 
-Used by ``tools/v2_features.py`` to measure, on the dev sequences, whether an
+Used by ``studies/v2_features.py`` to measure, on the dev sequences, whether an
 edge feature helps tracker v2 (:mod:`mstrack.track.float_v2`) and how to fuse it.
 Nothing here changes :class:`~mstrack.track.float_v2.FloatTrackerV2`; the pieces
 it is built from (:func:`~mstrack.track.float_v2.window_pixels`,

@@ -65,14 +65,13 @@ def check_param_types(obj: Any) -> None:
             object.__setattr__(obj, f.name, float(v))
 
 
-#: Tracker v2's defaults that make it the joint tracker (since session 16 the default v2 tracker,
-#: ``mstrack-v2``; before, the experimental ``mstrack-v2-joint``): the joint colour x gradient-
+#: Tracker v2's defaults that make it the joint tracker (the default v2 tracker, ``mstrack-v2``): the joint colour x gradient-
 #: orientation bins, the gated scale test and the loss flag's thresholds chosen for them
 #: (docs/results_v2_mean.md).  Core v2: generics ORIENT_T 64, SCALE_TEST_D256 13
 #: (mstrack.hw.cosim.CoreConfigV2).
 V2_JOINT: dict[str, Any] = {"orient_T": 64, "scale_test": 0.05, "scale_test_gate": True, "loss_rho": 0.69, "loss_contrast": 0.25}
 
-#: Tracker v2 on colour alone (tracker ``mstrack-v2-colour``, the default v2 tracker until session 15):
+#: Tracker v2 on colour alone (tracker ``mstrack-v2-colour``):
 #: ``TrackerParams(preset="v2", **V2_COLOUR)``.  512 bins instead of 4608: a smaller, faster core
 #: (ORIENT_T -1, SCALE_TEST_D256 0), about twice the float reference's speed, and lower accuracy
 #: (docs/results.md).

@@ -2,7 +2,7 @@
 tracker's centres but the ground-truth size ("oracle size"), precision at 20 px, the median size
 ratio box / truth and the truth's growth first -> last frame.
 
-Usage: PYTHONPATH=. python tools/v2_oracle_size.py
+Usage: PYTHONPATH=. python studies/v2_oracle_size.py
 """
 import numpy as np
 from mstrack import Tracker

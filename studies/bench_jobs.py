@@ -1,6 +1,6 @@
 """Time ``mstrack eval --jobs N`` against one process on a dataset and write docs/bench_jobs.md.
 
-    python tools/bench_jobs.py [DATASET_DIR] [--jobs 1,2] [--trackers a,b] [--scheduler] [--out build/bench_jobs]
+    python studies/bench_jobs.py [DATASET_DIR] [--jobs 1,2] [--trackers a,b] [--scheduler] [--out build/bench_jobs]
 
 Each run is a fresh evaluation (``--force``: nothing from the cache) into its own folder, one after
 the other; then the reports are compared without their timings (fps): they must be identical.
@@ -71,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     except ImportError:
         dask_v = ""
     md = ["# Parallel evaluation: `mstrack eval --jobs N`", "",
-          f"Command: `python tools/bench_jobs.py {' '.join(shlex.quote(a) for a in (argv or sys.argv[1:]))}`".rstrip()
+          f"Command: `python studies/bench_jobs.py {' '.join(shlex.quote(a) for a in (argv or sys.argv[1:]))}`".rstrip()
           + f" (DATASET = `{os.path.relpath(args.dataset, REPO)}`: {len(ev['sequences'])} sequences, "
           f"{n_frames} frames; trackers: {', '.join(ev['trackers'])}).", "",
           f"Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M UTC}; machine: {platform.machine()}, "

@@ -1,6 +1,6 @@
 """Measure simulator speed (cycles/s) on the toy tb/flow_example.vhd.
 
-    .venv/bin/python tools/hdl/bench_example.py [LINES]
+    .venv/bin/python studies/bench_example.py [LINES]
 
 Runs the cocotb ``throughput`` test (LINES x 256 pixels, one pixel per clock)
 with GHDL mcode, GHDL llvm (if installed) and Verilator, and prints the
@@ -14,7 +14,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from mstrack.hw import hdl  # noqa: E402
 

@@ -1,9 +1,9 @@
-"""Issue 10, loss signal, session 6: two more cues for the loss flag, measured (not adopted).
+"""Loss signal: two more cues for the loss flag, measured (not adopted).
 
 Usage::
 
-    python tools/loss_cues.py dump [SEQ_ROOT]   # runs float + fixed v2, writes out/loss_cues/{float,fixed}.json
-    python tools/loss_cues.py report            # -> docs/results_loss_cues.md
+    python studies/loss_cues.py dump [SEQ_ROOT]   # runs float + fixed v2, writes out/loss_cues/{float,fixed}.json
+    python studies/loss_cues.py report            # -> docs/results_loss_cues.md
 
 Per frame after the init frame (the v2 defaults; the flag does not steer the tracker, so the
 boxes are those of docs/results.md): IoU, the adopted flag's inputs rs = rho_s / rho0 and
@@ -146,17 +146,17 @@ def main_report() -> None:
     h_off = (ih == len(GH) - 1)[None, None, :, None]
     c_off = (ic == len(GC) - 1)[None, None, None, :]
     full = np.ones(shape, dtype=bool)
-    rules = [("session-5 rule: share = 0 or (rs < a and con < b)", full & h_off & c_off),
+    rules = [("adopted rule: share = 0 or (rs < a and con < b)", full & h_off & c_off),
              ("+ ceiling: or rs > h", full & c_off),
              ("+ template: or ncc_s < c", full & h_off),
              ("+ ceiling + template", full)]
-    L = ["# Loss flag: two more cues (session 6, measured, not adopted)", "",
-         "Issue 10 asks for recall >= 0.6 at false alarms <= 0.05 (docs/results_loss.md has the adopted rule and "
-         "the session-5 search).  This page measures two cues the session-5 search did not have: a **ceiling** on "
+    L = ["# Loss flag: two more cues (measured, not adopted)", "",
+         "The target is recall >= 0.6 at false alarms <= 0.05 (docs/results_loss.md has the adopted rule and "
+         "the rules tried).  This page measures two cues those rules do not have: a **ceiling** on "
          "rho (rs = rho_s / rho0 > h: the window matches the model clearly better than the init box did) and a "
          f"**template** check (NCC of the box's grey image at {N_T} x {N_T} px against the init box's, smoothed "
-         "with rate 1/2, below c).  Commands: `python tools/loss_cues.py dump` (float and fixed v2, default "
-         "parameters, about 4 min), `python tools/loss_cues.py report` (this page).", "",
+         "with rate 1/2, below c).  Commands: `python studies/loss_cues.py dump` (float and fixed v2, default "
+         "parameters, about 4 min), `python studies/loss_cues.py report` (this page).", "",
          f"Grid: a {GA[0]:.2f} .. {GA[-1]:.2f}, b {GB[0]:.2f} .. {GB[-1]:.2f} (steps 0.01), h {GH[0]:.2f} .. "
          f"{GH[-2]:.2f} (0.01) or off, c {GC[0]:.2f} .. {GC[-2]:.2f} (0.02) or off.  One set of thresholds for "
          "both models (the highest lower recall, both false-alarm rates <= 0.05); leave one sequence out: the "
@@ -202,9 +202,8 @@ def main_report() -> None:
           "recall barely moves.  It would be a new v2 step in all three layers: a 16 x 16 cell sum of the box's "
           "grey values (one more pass over the window pixels in the region RAM, which holds colour bins only, so "
           "the grey would come from the bins), a 256-entry template RAM per target and one NCC (256 "
-          "multiply-adds, a square root and a division) per frame.  Not adopted this session: it does not bring "
-          "the fixed model (the hardware) to the target, and it would move the specification while core v2 is "
-          "being built to it.  It is the next candidate if the float model's loss signal matters more than the "
+          "multiply-adds, a square root and a division) per frame.  Not adopted: it does not bring "
+          "the fixed model (the hardware) to the target, and it would move the specification of core v2.  It is the next candidate if the float model's loss signal matters more than the "
           "hardware's.",
           "* With both cues both models pass 0.6 in sample, but the gain of the fixed model is the ceiling's, with "
           "the failure above.", "", tools_line(), ""]

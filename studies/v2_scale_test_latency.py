@@ -1,6 +1,6 @@
 """Per-frame latency of core v2 (ms_tracker_v2) with and without the gated scale test, Verilator fast path.
 
-Usage: PYTHONPATH=. python tools/v2_scale_test_latency.py Girl:40 MotorRolling:40 Couple:40
+Usage: PYTHONPATH=. python studies/v2_scale_test_latency.py Girl:40 MotorRolling:40 Couple:40
 (name:frames from the start of /work/shared/data/sequences/<name>, init box = ground truth of
 frame 0, LANES = 4, MAX_FRAME_W 1024, top ms_tracker_v2; scale_test 0.05 + scale_test_gate, i.e.
 generic SCALE_TEST_D256 13, against the default v2 parameters).  Both runs are checked bit-exact

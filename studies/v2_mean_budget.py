@@ -9,7 +9,7 @@ The joint histogram has 512 x 9 = 4608 bins: every bin pass (one per mean-shift 
 A bin pass with B banks (the histogram and model RAMs split by orientation bin, B datapaths
 walking the addresses in parallel, partial sums added) walks 4608 / B addresses: rows "4608 / B".
 
-Usage: PYTHONPATH=. python tools/v2_mean_budget.py
+Usage: PYTHONPATH=. python studies/v2_mean_budget.py
 """
 from __future__ import annotations
 

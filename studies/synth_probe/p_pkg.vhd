@@ -1,4 +1,4 @@
--- shared package for the GHDL --synth construct probes (tools/hdl/synth_probe)
+-- shared package for the GHDL --synth construct probes (studies/synth_probe)
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;

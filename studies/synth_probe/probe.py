@@ -1,6 +1,6 @@
 """Which VHDL-2008 constructs does `ghdl --synth` (GHDL 2.0, Debian) accept?
 
-    .venv/bin/python tools/hdl/synth_probe/probe.py
+    .venv/bin/python studies/synth_probe/probe.py
 
 For each probe entity: GHDL analysis+elaboration for simulation (mcode),
 `ghdl --synth --out=verilog` (through mstrack.hw.hdl.ghdl_to_verilog), then Yosys
@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[2]))
+sys.path.insert(0, str(HERE.parents[1]))
 
 from mstrack.hw import hdl  # noqa: E402
 

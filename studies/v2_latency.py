@@ -1,6 +1,6 @@
 """Per-frame latency of core v2 (ms_tracker_v2) on real sequences, Verilator fast path.
 
-Usage: PYTHONPATH=. python tools/v2_latency.py Girl:40 MotorRolling:30 Couple:60 ...
+Usage: PYTHONPATH=. python studies/v2_latency.py Girl:40 MotorRolling:30 Couple:60 ...
 (name:frames from the start of /work/shared/data/sequences/<name>, init box = ground truth of
 frame 0, LANES = 4, default v2 generics, frames back to back).  Prints the init frame's latency
 (last pixel -> result, clocks), the tracking frames' max / mean and the searched (lost-state)

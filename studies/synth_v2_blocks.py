@@ -5,7 +5,7 @@
 Generics: the v2 defaults (``TrackerParams(preset="v2")``, ``FixedParams()``), as core v2 will
 map them.  Prints a Markdown table (the docs/blocks/ pages quote it).
 
-Run: ``PYTHONPATH=. .venv/bin/python tools/synth_v2_blocks.py [block ...]``.
+Run: ``PYTHONPATH=. .venv/bin/python studies/synth_v2_blocks.py [block ...]``.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tracker v2: edge feature and fusion variants, measured (issue 10, item 5).
+"""Tracker v2: edge feature and fusion variants, measured (docs/results_v2_features.md).
 
 Runs tracker v2 variants (mstrack/track/features_v2.py) over every sequence of a
 dataset, one-pass (OPE), and scores them exactly as ``mstrack eval`` does
@@ -11,8 +11,8 @@ MultiFeatureV2 with the colour feature alone gives the same boxes on every
 frame (so the variants differ from the baseline only in what they add).
 Parameters are the same on every sequence.
 
-    .venv/bin/python tools/v2_features.py [--data DIR] [--jobs 2] [--md OUT.md]
-    .venv/bin/python tools/v2_features.py --robust [--md OUT.md]
+    .venv/bin/python studies/v2_features.py [--data DIR] [--jobs 2] [--md OUT.md]
+    .venv/bin/python studies/v2_features.py --robust [--md OUT.md]
 
 ``--robust``: the shortlisted variants (ROBUST) again under 8 perturbed
 starts, OTB-style: TRE (start at frames n//3 and 2n//3 of every sequence,

@@ -1,10 +1,10 @@
-"""Issue 10, loss signal: per-frame signals of tracker v2 (float and fixed) against the IoU.
+"""Loss signal: per-frame signals of tracker v2 (float and fixed) against the IoU.
 
 Usage::
 
-    python tools/loss_study.py dump [SEQ_ROOT]     # runs float + fixed v2, writes out/loss_study/*.npz
-    python tools/loss_study.py search [SEQ_ROOT]   # float v2 with the wide search started by the flag
-    python tools/loss_study.py report              # -> docs/results_loss.md, docs/results/loss_*.png
+    python studies/loss_study.py dump [SEQ_ROOT]     # runs float + fixed v2, writes out/loss_study/*.npz
+    python studies/loss_study.py search [SEQ_ROOT]   # float v2 with the wide search started by the flag
+    python studies/loss_study.py report              # -> docs/results_loss.md, docs/results/loss_*.png
 
 ``dump`` runs the v2 tracker as it is (``preset="v2"``) on every sequence and keeps, per
 frame after the init frame: IoU with the ground truth (NaN where invalid), status, confidence,
@@ -295,7 +295,7 @@ def latch_study(seqs: list[dict]) -> tuple[tuple, tuple[float, float], tuple[flo
     return LATCH_GRID[j], rate(C[j]), rate(loo)
 
 
-# ----------------------------------------------------------------------------- session 5: rules tried
+# ----------------------------------------------------------------------------- rules tried
 def _hyst(rs: np.ndarray, con: np.ndarray, z: np.ndarray, a: float, b: float, ha: float, hb: float) -> np.ndarray:
     """Hysteresis: enter on rs < a and con < b; stay while rs < a + ha and con < b + hb (z: share = 0)."""
     out = np.zeros(len(rs), bool)
@@ -329,7 +329,7 @@ def _running_max(x: np.ndarray, x0: float, k: int) -> np.ndarray:
 
 def tried_signals(model: str) -> list[dict]:
     """Per sequence: the adopted filters' values (rs = rho_s / rho0, con_s), share = 0, and the extra
-    signals the session-5 rules use (all re-computed in float from the dumped raw values)."""
+    signals the tried rules use (all re-computed in float from the dumped raw values)."""
     out = []
     for name, d in load(model).items():
         share = d["nt_in"] / np.maximum(d["n_in"], 1)
@@ -351,7 +351,7 @@ GC2 = np.round(np.arange(0.30, 1.001, 0.02), 2)
 
 
 def tried_rules() -> list[tuple[str, object, list[tuple]]]:
-    """(description, rule(q, *g) -> flags, grid) of every rule measured in session 5."""
+    """(description, rule(q, *g) -> flags, grid) of every rule tried."""
     import itertools as it
     P2, P3 = list(it.product(GA, GB)), list(it.product(GA2, GB2, GC2))
     base = lambda q, a, b: q["z"] | ((q["rs"] < a) & (q["con"] < b))  # noqa: E731
@@ -439,16 +439,16 @@ def main_report() -> None:
     from mstrack.track.params import TrackerParams
     p = TrackerParams(preset="v2")
     L: list[str] = []
-    L += ["# Loss signal of tracker v2 (issue 10)", "",
+    L += ["# Loss signal of tracker v2", "",
           "Per frame after the init frame, on the 10 dev sequences: *recall* = share of off-target frames "
           "(IoU = 0) with `TrackResult.ok` false; *false alarms* = share of on-target frames (IoU >= 0.5) "
           "with `ok` false.  Target: recall >= 0.6 at false alarms <= 0.05.  The rule adopted is in "
           "docs/algorithm.md, \"v2.7a Loss flag\"; this page is the evidence.", "",
-          "Commands: `python tools/loss_study.py dump` (runs float and fixed v2 and keeps the per-frame "
-          "signals in out/loss_study/), `python tools/loss_study.py search` (float v2 with the search "
-          "started by the flag), `python tools/loss_study.py report` (this page and its plots).  The search "
+          "Commands: `python studies/loss_study.py dump` (runs float and fixed v2 and keeps the per-frame "
+          "signals in out/loss_study/), `python studies/loss_study.py search` (float v2 with the search "
+          "started by the flag), `python studies/loss_study.py report` (this page and its plots).  The search "
           "state of v2 does not depend on the flag, so the boxes, and every signal below, are those of "
-          "the v2 runs of docs/results.md.  Session 6 measured two more cues (a ceiling on rho, a "
+          "the v2 runs of docs/results.md.  Two more cues (a ceiling on rho, a "
           "grey-template check): docs/results_loss_cues.md.", ""]
     models = ("float", "fixed")
     S = {m: sequences(m) for m in models}
@@ -537,7 +537,7 @@ def main_report() -> None:
           "with false alarms <= 0.05 (in sample): recall.", "", "| signal | float | fixed |", "|---|---:|---:|"]
     for k in S["float"][0]["sig"]:
         L.append(f"| {k} | {single_best(S['float'], k)[0]:.3f} | {single_best(S['fixed'], k)[0]:.3f} |")
-    L += ["", "The last four rows were added in session 5 (recall near 0.1 at the bound, where a signal unrelated to the loss gives 0.05; the mean-shift loop reaches max_iter on fewer than 1 % of the on- and of the off-target frames).  The references of the confidence (rho_ref, share_ref) follow the drift: on MotorRolling and "
+    L += ["", "The last four rows give recall near 0.1 at the bound (where a signal unrelated to the loss gives 0.05; the mean-shift loop reaches max_iter on fewer than 1 % of the on- and of the off-target frames).  The references of the confidence (rho_ref, share_ref) follow the drift: on MotorRolling and "
           "Girl the tracker stays `ok` for tens of frames while it slides off the target, so by the time it is "
           "off, rho / rho_ref is near 1 again.  rho against its init value does not drift, but alone it flags "
           "the on-target frames of Crossing and bag_vot (appearance change).  The contrast alone flags Suv, "
@@ -555,7 +555,7 @@ def main_report() -> None:
     sp = OUT / "search.json"
     if sp.exists():
         res = json.loads(sp.read_text())
-        L += ["* Search state from the flag (float, `python tools/loss_study.py search`): the wide search of "
+        L += ["* Search state from the flag (float, `python studies/loss_study.py search`): the wide search of "
               "v2.7 started by the loss flag instead of the confidence.", "",
               "| search started by | AUC | mean AUC over sequences | recall | false alarms |", "|---|---:|---:|---:|---:|"]
         for k, v in res.items():
@@ -563,12 +563,12 @@ def main_report() -> None:
         L += ["", "  (AUC here over the frames after the init frame.)  The wide search, started on frames where the "
               "target has drifted but is still partly in the window, jumps to background: the confidence "
               "stays the search trigger.", ""]
-    # session 5
-    L += ["## Rules tried, session 5", "",
-          "Issue 10 item 4 (target recall >= 0.6 at false alarms <= 0.05, float and fixed, in and out of sample) "
-          "is not met by the adopted rule.  Session 5 measured the cheap alternatives below on the same dumped "
-          "signals (`python tools/loss_study.py report` recomputes this table; the rules are `tried_rules()` in "
-          "tools/loss_study.py).  rs = rho_s / rho0 and con = contrast_s are the adopted filters' values (rate "
+    # rules tried
+    L += ["## Rules tried", "",
+          "The target (recall >= 0.6 at false alarms <= 0.05, float and fixed, in and out of sample) "
+          "is not met by the adopted rule.  The cheap alternatives below were measured on the same dumped "
+          "signals (`python studies/loss_study.py report` recomputes this table; the rules are `tried_rules()` in "
+          "studies/loss_study.py).  rs = rho_s / rho0 and con = contrast_s are the adopted filters' values (rate "
           "1/2); share = 0 flags in every rule.  Per rule: its grid size; per model, thresholds chosen on that "
           "model (max recall with false alarms <= 0.05): in sample and leave one sequence out; then one set of "
           "thresholds for both models (the highest lower recall, both false-alarm rates <= 0.05, as the defaults "

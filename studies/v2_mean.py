@@ -1,20 +1,20 @@
-"""Issue 10, last accuracy target: mean AUC over the dev sequences of tracker v2 variants.
+"""The mean-AUC target: mean AUC over the dev sequences of tracker v2 variants.
 
 Every variant runs on every sequence with the same parameters (no per-sequence choice), one
 pass (OPE), scored as ``mstrack eval`` (mstrack.eval.evaluate.run_sequence + aggregate).  Prints the
 overall (frame-weighted) AUC, the mean of the per-sequence AUCs, the per-sequence AUCs and the
 wins / losses against the default v2 on the sequences (docs/results_v2_mean.md).
 
-    PYTHONPATH=. python tools/v2_mean.py [--data DIR] [--jobs 2] [--only LABEL ...] [--md OUT.md]
-    PYTHONPATH=. python tools/v2_mean.py --robust LABEL ...
-    PYTHONPATH=. python tools/v2_mean.py --loss-grid LABEL ...
+    PYTHONPATH=. python studies/v2_mean.py [--data DIR] [--jobs 2] [--only LABEL ...] [--md OUT.md]
+    PYTHONPATH=. python studies/v2_mean.py --robust LABEL ...
+    PYTHONPATH=. python studies/v2_mean.py --loss-grid LABEL ...
 
 ``--loss-grid``: for FloatTrackerV2 variants, the loss flag's thresholds (loss_rho, loss_contrast)
 chosen again on a 0.01 grid as docs/algorithm.md v2.7a does (the highest recall with false alarms
 <= 0.05, in sample; the boxes do not depend on the flag, so this re-scores one run exactly).
 
 ``--robust``: the given variants and the baseline under the 8 perturbed starts of
-tools/v2_features.py (TRE at n//3 and 2n//3, SRE shifts +-10 % and scales 0.9 / 1.1): overall
+studies/v2_features.py (TRE at n//3 and 2n//3, SRE shifts +-10 % and scales 0.9 / 1.1): overall
 AUC and mean over sequences per start, over all 9 starts, and wins on the 8 perturbed starts.
 """
 from __future__ import annotations
@@ -154,7 +154,7 @@ def robust(a, labels: list[str]) -> str:
 
 
 def loss_figures(runs: dict, seqs) -> tuple[float, float]:
-    """The loss flag on the frames after init (as tools/loss_study.py scores it, with the default
+    """The loss flag on the frames after init (as studies/loss_study.py scores it, with the default
     thresholds; MultiFeatureV2 reports the search state instead): recall = share of off-target
     frames (IoU = 0) not ok, false alarms = share of on-target frames (IoU >= 0.5) not ok."""
     from mstrack.eval.metrics import iou, valid_gt

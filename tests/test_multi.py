@@ -149,7 +149,8 @@ def test_capacity_rule_max_targets(scene):
         mt.remove(5)
         assert mt.add(frames[0], (100, 100, 20, 20)) == 5
     front = MultiTrackerMeanShift.create(capacity=MultiCoreConfig(max_targets=1))
-    assert front.add(None, frames[0], (10, 20, 12, 14)) is True and front.add(None, frames[0], (50, 20, 12, 14)) is False
+    assert front.add(None, frames[0], (10, 20, 12, 14)) is True
+    assert front.add(None, frames[0], (50, 20, 12, 14)) is False and len(front.getObjects()) == 1
 
 
 #: A raster for the 240 x 180 scene whose frame holds two of its targets' init jobs but not their

@@ -179,7 +179,7 @@ class MultiTracker:
             if fh > cap.timing.active_lines or fw > cap.timing.line_clocks:
                 raise ValueError(f"frame {fw}x{fh} is larger than the capacity's video timing "
                                  f"({cap.timing.active_lines} active lines of {cap.timing.line_clocks} clocks)")
-            new = init_demand(box, fw, fh, tid, self.params, self.fixed, cap.costs)  # ValueError for a bad box
+            new = init_demand(Box.of(box), fw, fh, tid, self.params, self.fixed, cap.costs)  # ValueError: bad box
             code = check_add(jobs, len(self._trackers), new, cap)
             if code != ADD_OK:
                 budget = min(j.slack(cap.timing) for j in [*jobs, new])
@@ -260,7 +260,8 @@ class MultiTrackerMeanShift:
     def create(cls, params: TrackerParams | None = None, model: Model = "float",
                capacity: Any = None) -> "MultiTrackerMeanShift":
         """A new multi-tracker, as ``cv2.legacy.MultiTracker.create()``; ``params`` (default tracker v2)
-        and ``model`` apply to every target."""
+        and ``model`` apply to every target; ``capacity``: an ``mstrack.MultiCoreConfig``, as
+        :class:`MultiTracker`'s."""
         return cls(params, model, capacity)
 
     @property

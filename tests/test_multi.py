@@ -215,6 +215,25 @@ def test_capacity_rule_cycles_holds_a_live_target(scene):
         assert got.target_id == a1 and "err_code" not in got.extra
 
 
+def test_capacity_arguments_and_who_applies_the_cycle_rule(scene):
+    """capacity must be a MultiCoreConfig; the cycle rule is the fixed tracker v2's only (the float
+    model and the fixed paper preset take every add the slots allow, on the raster that refuses one)."""
+    frames, gt = scene
+    b = gt[gt[:, 0] == 0][:, 2:6]
+    with pytest.raises(TypeError, match="MultiCoreConfig"):
+        MultiTracker(capacity=4)
+    with pytest.raises(ValueError, match="1..16"):
+        MultiCoreConfig(max_targets=17)
+    with pytest.raises(TypeError):
+        MultiTracker(model="float", margin=3)   # FixedParams field on the float model
+    assert MultiTracker(model="fixed", margin=16).fixed.margin == 16
+    assert [MultiTracker(model=m, preset=p).cycle_rule for m, p in
+            (("fixed", "v2"), ("float", "v2"), ("fixed", "paper"))] == [True, False, False]
+    paper = MultiTracker(model="fixed", preset="paper", capacity=SMALL)
+    assert [paper.add(frames[0], box) for box in b] == [0, 1, 2]
+    assert len(paper.update(frames[1])) == 3 and paper.plan is None
+
+
 def test_opencv_style_front_end(scene):
     """mstrack.MultiTrackerMeanShift in a loop written for cv2.legacy.MultiTracker."""
     frames, gt = scene

@@ -22,6 +22,7 @@ Public API::
     results = mt.update(next_frame)               # one TrackResult per live target, .target_id set
     mt.remove(tid)
     multi = mstrack.MultiTrackerMeanShift.create()  # cv2.legacy.MultiTracker's API
+    mt = mstrack.MultiTracker(model="fixed", capacity=mstrack.MultiCoreConfig(max_targets=4))  # the core's rule
 
 The core's result word (v1 and v2): ``mstrack.unpack_result(word)``, ``result_layout()``, ...
 (re-exported from :mod:`mstrack.fixed`; docs/integration.md, "Result word").
@@ -31,14 +32,16 @@ from typing import TYPE_CHECKING
 from .track.types import Box, FeatureResult, Status, TrackResult
 
 if TYPE_CHECKING:  # for type checkers; at run time they are imported lazily by __getattr__
-    from .track.multi import Capacity, CapacityError, MultiTracker, MultiTrackerMeanShift
+    from .fixed.multi_capacity import MultiCoreConfig, VideoTiming
+    from .track.multi import CapacityError, MultiTracker, MultiTrackerMeanShift
     from .track.tracker import FrameError, Tracker, TrackerMeanShift, TrackerParams
 
 _RESULT_API = ("RESULT_FLAGS", "result_layout", "result_width", "pack_result", "unpack_result",
                "STATUS_V2", "result_layout_v2", "result_width_v2", "pack_result_v2", "unpack_result_v2")
-_MULTI = ("MultiTracker", "MultiTrackerMeanShift", "Capacity", "CapacityError")
+_MULTI = ("MultiTracker", "MultiTrackerMeanShift", "CapacityError")
+_CAPACITY = ("MultiCoreConfig", "VideoTiming")  # the multi-target core's configuration (docs/multi.md)
 __all__ = ["__version__", "Box", "FeatureResult", "Status", "TrackResult", "Tracker", "TrackerMeanShift",
-           "TrackerParams", "FrameError", *_MULTI, *_RESULT_API]
+           "TrackerParams", "FrameError", *_MULTI, *_CAPACITY, *_RESULT_API]
 
 _LAZY = ("Tracker", "TrackerMeanShift", "TrackerParams", "FrameError")
 
@@ -53,6 +56,9 @@ def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
     if name in _MULTI:
         from .track import multi
         return getattr(multi, name)
+    if name in _CAPACITY:
+        from .fixed import multi_capacity
+        return getattr(multi_capacity, name)
     if name in _RESULT_API:
         from .fixed import vhdl_pkg
         return getattr(vhdl_pkg, name)
@@ -60,4 +66,4 @@ def __getattr__(name: str) -> object:  # lazy: keep `import mstrack` light
 
 
 def __dir__() -> list[str]:
-    return sorted([*globals(), *_LAZY, *_MULTI])
+    return sorted([*globals(), *_LAZY, *_MULTI, *_CAPACITY])

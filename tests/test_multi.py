@@ -1,7 +1,9 @@
 """mstrack.MultiTracker and MultiTrackerMeanShift (docs/multi.md): every target's results equal, field by
 field and frame by frame, those of a single Tracker run on the same frames from the same box (float
 exactly, fixed bit for bit), on a generated scene with targets entering and leaving and on a real MOT
-clip; the capacity rule (Capacity) refuses adds when slots or region memory would be exceeded."""
+clip, where the core's capacity suffices; where it does not, the fixed model applies the core's capacity
+rule (mstrack.fixed.multi_capacity): adds refused for slots (ADD_FULL) or cycles (ADD_CYCLES), live targets
+held for a frame (status error, err_code 6) and then continuing bit for bit."""
 from dataclasses import fields, replace
 from pathlib import Path
 
@@ -9,9 +11,12 @@ import numpy as np
 import pytest
 
 import mstrack
-from mstrack import Capacity, CapacityError, FrameError, MultiTracker, MultiTrackerMeanShift, Tracker, TrackResult
+from mstrack import (CapacityError, FrameError, MultiCoreConfig, MultiTracker, MultiTrackerMeanShift, Status, Tracker,
+                     TrackResult, VideoTiming)
+from mstrack.fixed.multi_capacity import (ADD_CYCLES, ADD_FULL, ERR_CAPACITY, check_add, init_demand, plan_frame,
+                                          target_demand)
+from mstrack.fixed.vhdl_pkg import RESULT_FLAGS, pack_result_v2, result_fields_v2, unpack_result_v2
 from mstrack.io.synthetic import make_multi_scene
-from mstrack.track.multi import MAX_TARGETS, REGION_RAM_WORDS
 
 MOT_ROOT = Path(__file__).resolve().parents[2] / "shared" / "data" / "multi"
 
@@ -52,6 +57,7 @@ def _check_against_single(frames, gt_rows, model, **params):
         for k in [k for k in slot if last[k] < i]:
             mt.remove(slot.pop(k))
         by_slot = {r.target_id: r for r in mt.update(frames[i])}
+        assert mt.plan is None or mt.plan.held == ()   # the default capacity suffices here
         assert sorted(by_slot) == mt.targets == sorted(slot.values())
         for k, s in slot.items():
             got[k].append(by_slot[s])
@@ -127,67 +133,105 @@ def test_bad_frames_and_sizes_change_nothing(scene):
 
 
 def test_capacity_rule_max_targets(scene):
-    """The default rule: 16 slots; the 17th add is refused with code MAX_TARGETS, nothing changes,
-    and a remove makes room again."""
+    """Both models: 16 slots by default; the 17th add is refused with ADD_FULL, nothing changes, and a
+    remove makes room again."""
     frames, _ = scene
-    mt = MultiTracker(model="fixed")
-    assert mt.capacity == Capacity() and Capacity().max_targets == MAX_TARGETS == 16
-    for k in range(16):
-        assert mt.add(frames[0], (10 + 12 * (k % 8), 20 + 60 * (k // 8), 12, 14)) == k
-    with pytest.raises(CapacityError) as e:
-        mt.add(frames[0], (100, 100, 20, 20))
-    assert e.value.code == "MAX_TARGETS" and "16 slots" in str(e.value)
-    assert mt.targets == list(range(16))
-    mt.remove(5)
-    assert mt.add(frames[0], (100, 100, 20, 20)) == 5
+    for model in ("fixed", "float"):
+        mt = MultiTracker(model=model)
+        assert mt.capacity == MultiCoreConfig() and mt.capacity.max_targets == 16
+        for k in range(16):
+            assert mt.add(frames[0], (10 + 12 * (k % 8), 20 + 60 * (k // 8), 12, 14)) == k
+        before = dict(mt.last)
+        with pytest.raises(CapacityError) as e:
+            mt.add(frames[0], (100, 100, 20, 20))
+        assert (e.value.code, e.value.add_code) == ("ADD_FULL", ADD_FULL) and "16 slots" in str(e.value)
+        assert mt.targets == list(range(16)) and mt.last == before
+        mt.remove(5)
+        assert mt.add(frames[0], (100, 100, 20, 20)) == 5
+    front = MultiTrackerMeanShift.create(capacity=MultiCoreConfig(max_targets=1))
+    assert front.add(None, frames[0], (10, 20, 12, 14)) is True
+    assert front.add(None, frames[0], (50, 20, 12, 14)) is False and len(front.getObjects()) == 1
 
 
-def test_capacity_rule_region_memory(scene):
-    """A region memory of three worst-case regions: the fourth add is refused with REGION_WORDS; with
-    double-buffered regions (buffers=2) the second already is."""
+#: A raster for the 240 x 180 scene whose frame holds two of its targets' init jobs but not their
+#: tracking jobs (the figures are read from the rule's own functions in the tests).
+SMALL = MultiCoreConfig(timing=VideoTiming(active_lines=180, frame_lines=200, line_clocks=800))
+
+
+def test_capacity_rule_cycles_refuses_an_add(scene):
+    """Fixed tracker v2: an add whose init job breaks the frame's cycle rule is refused with ADD_CYCLES
+    (check_add on the jobs admitted on that frame) and changes nothing; the float model applies
+    max_targets only."""
     frames, gt = scene
     b = gt[gt[:, 0] == 0][:, 2:6]
-    cap = Capacity(region_words=3 * REGION_RAM_WORDS)
-    words = cap.target_words(MultiTracker().params, MultiTracker().fixed, frames[0].shape)
-    # 240 x 180 frame: columns 191 (tracking at D = 1: 127 + 2 x 32 + 1; lost at D = 2 the decimated frame
-    # is 120 wide), rows 178 (S - 2)
-    assert words == 191 * 178
-    mt = MultiTracker(capacity=Capacity(region_words=3 * words))
-    for k in range(3):
-        mt.add(frames[0], b[k % len(b)])
-    assert mt.region_words() == 3 * words
+    jobs = [init_demand(b[k], 240, 180, k) for k in range(3)]
+    assert check_add(jobs[:1], 1, jobs[1], SMALL) == 0 and check_add(jobs[:2], 2, jobs[2], SMALL) == ADD_CYCLES
+    mt = MultiTracker(model="fixed", capacity=SMALL)
+    assert [mt.add(frames[0], b[0]), mt.add(frames[0], b[1])] == [0, 1]
+    before = dict(mt.last)
     with pytest.raises(CapacityError) as e:
-        mt.add(frames[0], b[0])
-    assert e.value.code == "REGION_WORDS" and mt.targets == [0, 1, 2]
-    mt2 = MultiTracker(capacity=Capacity(region_words=3 * words, buffers=2))
-    mt2.add(frames[0], b[0])
-    with pytest.raises(CapacityError, match="REGION_WORDS"):
-        mt2.add(frames[0], b[1])
-    front = MultiTrackerMeanShift.create(capacity=Capacity(max_targets=1))
-    assert front.add(None, frames[0], b[0]) is True and front.add(None, frames[0], b[1]) is False
+        mt.add(frames[0], b[2])
+    assert (e.value.code, e.value.add_code) == ("ADD_CYCLES", ADD_CYCLES) and "clocks" in str(e.value)
+    assert mt.targets == [0, 1] and mt.last == before
+    # the default raster holds all three; so does the float model on the small one
+    assert MultiTracker(model="fixed").add(frames[0], b[0]) == 0
+    fl = MultiTracker(model="float", capacity=SMALL)
+    assert [fl.add(frames[0], box) for box in b] == [0, 1, 2] and fl.update(frames[1])[1].ok
+    # an add on a frame with no target live is on a new frame: only its own job counts
+    mt.remove(0)
+    mt.remove(1)
+    assert mt.add(frames[1], b[2]) == 0
+    with pytest.raises(ValueError, match="video timing"):
+        MultiTracker(model="fixed", capacity=SMALL).add(np.zeros((200, 240, 3), np.uint8), (10, 10, 20, 20))
 
 
-@pytest.mark.parametrize("size", [640, 1920, 2048])
-def test_target_words_is_region_max_v2(size):
-    """Capacity.target_words of tracker v2 in a square frame is the square of core v2's region bound
-    (mstrack.hw.cosim.region_max_v2), whose REGION_MAX 256 sizes the region RAM."""
-    from mstrack.fixed import FixedParams
-    from mstrack.hw.cosim import region_max_v2
-    tp = MultiTracker().params
-    n = region_max_v2(tp, FixedParams(), size)
-    assert Capacity().target_words(tp, FixedParams(), (size, size, 3)) == n * n
-    assert n * n <= REGION_RAM_WORDS
+def test_capacity_rule_cycles_holds_a_live_target(scene):
+    """Fixed tracker v2: two targets whose tracking jobs do not fit one frame (their init jobs did):
+    the newer is held on frame 1 (plan_frame: oldest first), its result status error, err_code 6, its
+    box unchanged, and its result word says so; once the older is removed it continues, bit for bit,
+    as a single Tracker that skipped frame 1.  The older is tracked as a single Tracker throughout."""
+    frames, gt = scene
+    b = gt[gt[:, 0] == 0][:, 2:6]
+    mt = MultiTracker(model="fixed", capacity=SMALL)
+    a0, a1 = mt.add(frames[0], b[0]), mt.add(frames[0], b[1])
+    singles = [Tracker(model="fixed") for _ in range(2)]
+    inits = [singles[k].init(frames[0], b[k]) for k in range(2)]
+    want = plan_frame([target_demand(s.impl, k) for k, s in enumerate(singles)], SMALL)
+    assert want.tracked == (0,) and want.held == (1,)
+    r = {x.target_id: x for x in mt.update(frames[1])}
+    assert mt.plan == want
+    _assert_same(r[a0], singles[0].update(frames[1]), "older target, frame 1")
+    held = r[a1]
+    assert held.status == Status.ERROR and not held.ok and held.extra["err_code"] == ERR_CAPACITY == 6
+    assert held.box == inits[1].box and held.centre == inits[1].centre and mt.last[a1] is held
+    word = unpack_result_v2(pack_result_v2(result_fields_v2(held.extra)))
+    assert word["status"] == 6 and word["flag_error"] == 1 and word["err_code"] == 6
+    assert word["flags"] == 1 << RESULT_FLAGS.index("error")
+    mt.remove(a0)
+    for i in range(2, 8):
+        (got,) = mt.update(frames[i])
+        assert mt.plan.held == ()
+        _assert_same(got, singles[1].update(frames[i]), f"held target, frame {i}")
+        assert got.target_id == a1 and "err_code" not in got.extra
 
 
-def test_capacity_arguments():
-    for bad in (dict(max_targets=0), dict(region_words=0), dict(buffers=3), dict(max_targets=True)):
-        with pytest.raises(ValueError):
-            Capacity(**bad)
-    with pytest.raises(TypeError):
+def test_capacity_arguments_and_who_applies_the_cycle_rule(scene):
+    """capacity must be a MultiCoreConfig; the cycle rule is the fixed tracker v2's only (the float
+    model and the fixed paper preset take every add the slots allow, on the raster that refuses one)."""
+    frames, gt = scene
+    b = gt[gt[:, 0] == 0][:, 2:6]
+    with pytest.raises(TypeError, match="MultiCoreConfig"):
         MultiTracker(capacity=4)
+    with pytest.raises(ValueError, match="1..16"):
+        MultiCoreConfig(max_targets=17)
     with pytest.raises(TypeError):
         MultiTracker(model="float", margin=3)   # FixedParams field on the float model
     assert MultiTracker(model="fixed", margin=16).fixed.margin == 16
+    assert [MultiTracker(model=m, preset=p).cycle_rule for m, p in
+            (("fixed", "v2"), ("float", "v2"), ("fixed", "paper"))] == [True, False, False]
+    paper = MultiTracker(model="fixed", preset="paper", capacity=SMALL)
+    assert [paper.add(frames[0], box) for box in b] == [0, 1, 2]
+    assert len(paper.update(frames[1])) == 3 and paper.plan is None
 
 
 def test_opencv_style_front_end(scene):

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 import pytest
 
-from mstrack import Capacity, cli
+from mstrack import MultiCoreConfig, cli
 from mstrack.eval import multi as em
 from mstrack.io.mot import load_mot_sequence, parse_mot_gt
 from mstrack.io.synthetic import make_multi_scene, write_mot_sequence, write_video
@@ -133,10 +133,10 @@ def test_eval_cli_report_and_cache(mot_root, tmp_path, capsys, monkeypatch):
 
 def test_refused_adds_are_reported(mot_root, tmp_path):
     seq = load_mot_sequence(mot_root / "syn-a")
-    two = Capacity(max_targets=2)
+    two = MultiCoreConfig(max_targets=2)
     ev = em.evaluate_mot([seq], ["mstrack-v2"], tmp_path, make=lambda n, m: em.make_multi(n, m, two))
     run = ev.runs["mstrack-v2"]["syn-a"]
-    assert sorted(run.targets) == [1, 2] and list(run.refused) == [3] and "MAX_TARGETS" in run.refused[3]
+    assert sorted(run.targets) == [1, 2] and list(run.refused) == [3] and "ADD_FULL" in run.refused[3]
     assert "## Refused adds" in em.report_markdown_mot(ev)
 
 

@@ -97,7 +97,8 @@ class _Multi:
 
 def make_multi(name: str, model: str = "float", capacity: Any = None) -> Any:
     """The harness of tracker ``name``: a :class:`mstrack.MultiTracker` with the registered tracker's
-    parameters for the mstrack trackers, :class:`PerTarget` of the registered factory otherwise."""
+    parameters for the mstrack trackers (``capacity``: its :class:`mstrack.MultiCoreConfig`, default
+    the MultiTracker's), :class:`PerTarget` of the registered factory otherwise."""
     if uses_model(name):
         from ..track.multi import MultiTracker
         trk = make_tracker(name, model)  # the registered tracker's parameters (default FixedParams)

@@ -14,7 +14,11 @@ rule the core applies, as integers, so the fixed-point MultiTracker applies it b
   on that frame: state unchanged, result word status 6 error with ``err_code``
   :data:`ERR_CAPACITY`);
 * :func:`check_add`: whether an add is taken (:data:`ADD_OK`) or refused (:data:`ADD_FULL`,
-  :data:`ADD_CYCLES`).
+  :data:`ADD_CYCLES`);
+* :func:`held_result`: the result of a held target.
+
+``mstrack.MultiTracker(model="fixed")`` applies the rule on every ``add`` and ``update``
+(docs/multi.md, "The capacity rule").
 
 The rule (a sufficient condition for every deadline of a frame, whatever the order the engine
 takes the jobs in, as long as it never idles while a job waits): the jobs admitted on a frame
@@ -36,16 +40,18 @@ from typing import Literal, Sequence
 import numpy as np
 
 from ..track.params import TrackerParams
-from ..track.types import Box
+from ..track.types import Box, Status, TrackResult
 from .blocks import Region, ms_box_clip, ms_kernel, ms_region, ms_round_centre, round_box
 from .blocks_v2 import (MAX_DECIMATION, ms_box_size, ms_decimation, ms_window_size, q16, sixteenths)
 from .formats import FixedParams
-from .tracker_v2 import FixedTrackerV2
+from .tracker_v2 import STATUS_CODES_V2, FixedTrackerV2
 
 #: :func:`check_add` results.  ADD_FULL: ``MAX_TARGETS`` targets are live; ADD_CYCLES: the new
 #: target's init job with this frame's admitted jobs breaks the cycle rule.
 ADD_OK, ADD_FULL, ADD_CYCLES = 0, 1, 2
 ADD_CODES = {ADD_OK: "ok", ADD_FULL: "full", ADD_CYCLES: "cycles"}
+#: The constants' names, by value (what ``mstrack.CapacityError.code`` says).
+ADD_NAMES = {ADD_OK: "ADD_OK", ADD_FULL: "ADD_FULL", ADD_CYCLES: "ADD_CYCLES"}
 #: ``err_code`` of the result word of a held target (status 6 error; codes 0..5 are the stream
 #: faults of rtl/ms_stream_pkg.vhd).
 ERR_CAPACITY = 6
@@ -356,3 +362,19 @@ def check_add(admitted: Sequence[TargetDemand], n_live: int, new: TargetDemand,
     if not _fits([*admitted, new], cfg.timing):
         return ADD_CYCLES
     return ADD_OK
+
+
+def held_result(trk: FixedTrackerV2, demand: TargetDemand) -> TrackResult:
+    """The result of a live target held on a frame (:func:`plan_frame`): status error (result word
+    status 6, flag ``error``, ``err_code`` :data:`ERR_CAPACITY`) with the target's current centre and
+    size; rho, confidence and iterations 0, ``decimation`` that of the job it was not given.  The
+    tracker is not touched: its next frame continues from the same state."""
+    if trk._shape is None:
+        raise ValueError("held_result needs an initialised tracker (init() first)")
+    cf = trk.fixed.centre_frac
+    raw = {"cx": trk.c8[0], "cy": trk.c8[1], "w8": trk.w8, "h8": trk.h8, "rho": 0, "confidence": 0,
+           "status": STATUS_CODES_V2[Status.ERROR], "iter": 0, "decimation": demand.d, "err_code": ERR_CAPACITY}
+    return TrackResult(box=trk._box(), centre=(trk.c8[0] / (1 << cf), trk.c8[1] / (1 << cf)), rho_c=0.0,
+                       rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=0, iter_e=0, status=Status.ERROR,
+                       message=f"held: the frame's cycle budget is taken (err_code {ERR_CAPACITY})",
+                       confidence=0.0, extra=raw)

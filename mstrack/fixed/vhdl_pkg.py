@@ -297,18 +297,21 @@ def unpack_result_v2(word: int, g: dict[str, int] | None = None) -> dict[str, in
 def result_fields_v2(extra: dict[str, int], frame_count: int = 0) -> dict[str, int]:
     """The result word v2 fields of one frame of FixedTrackerV2 (``TrackResult.extra``).
 
-    Flags follow the status (init, clipped, lost); a model frame has no stream error.
+    Flags follow the status (init, clipped, lost, error); a model frame has no stream error, so
+    ``err_code`` is ``extra["err_code"]`` when the status is error (a target the multi-target core
+    held, :func:`mstrack.fixed.multi_capacity.held_result`) and 0 otherwise.
     """
     status = STATUS_V2[int(extra["status"])]
     d = int(extra["decimation"])
     flags = 0
-    for name in ("init", "clipped", "lost"):
+    for name in ("init", "clipped", "lost", "error"):
         if status == name:
             flags |= 1 << RESULT_FLAGS.index(name)
     return {"cx": int(extra["cx"]), "cy": int(extra["cy"]), "w8": int(extra["w8"]), "h8": int(extra["h8"]),
             "rho": int(extra["rho"]), "confidence": int(extra["confidence"]), "status": int(extra["status"]),
             "iter": int(extra["iter"]), "stop": int(extra.get("stop", 0)), "decim_log2": d.bit_length() - 1,
-            "searched": int(extra.get("searched", 0)), "flags": flags, "err_code": 0,
+            "searched": int(extra.get("searched", 0)), "flags": flags,
+            "err_code": int(extra.get("err_code", 0)) if status == "error" else 0,
             "frame_count": frame_count & ((1 << FRAME_COUNT_W) - 1)}
 
 

@@ -2,8 +2,9 @@
 
 The executable specification of a multi-target core: each target is tracked exactly as a single
 :class:`~mstrack.track.tracker.Tracker` tracks it (float) or bit for bit (fixed model) -- the
-targets share the frame, never their state (region, model Q / T, search state) -- and admission
-follows one capacity rule, :class:`Capacity`, in one place.
+targets share the frame, never their state (region, model Q / T, search state) -- as long as the
+core's capacity suffices; where it does not, the fixed model applies the core's capacity rule
+(:mod:`mstrack.fixed.multi_capacity`, docs/multi_target_core.md "Capacity rule").
 
 Target ids
 ----------
@@ -18,29 +19,30 @@ Frames
 As OpenCV's ``cv2.legacy.MultiTracker``: ``add(frame, box)`` initialises the new target on ``frame``
 (its first result, status init or clipped, is ``last[target_id]``); ``update(frame)`` processes a *new*
 frame for every live target, the targets added before it.  All targets share one frame size (that
-of the first target added while none was live).
+of the first target added while none was live).  An add is on the frame of the last ``update``
+(the adds since it included); when no target is live it starts a new frame.
 
-The capacity rule (:class:`Capacity`)
--------------------------------------
-An add is refused with :class:`CapacityError` (``code`` ``"MAX_TARGETS"`` or ``"REGION_WORDS"``)
-and changes nothing when, with the new target,
+The capacity rule
+-----------------
+``capacity``: a :class:`mstrack.fixed.multi_capacity.MultiCoreConfig` (``max_targets``, the video
+``timing``, the engine's pass ``costs``; default 16 targets, 1080p60 at 148.5 MHz, LANES 4).
 
-* the live targets would exceed ``max_targets`` (default 16), or
-* the region memory they hold would exceed ``region_words``: each target holds
-  ``buffers`` x :meth:`Capacity.target_words` words (one per decimated pixel of its worst-case
-  search region in this frame size; default budget 16 x 65,536 words = sixteen of core v2's
-  REGION_MAX 256 x 256 region RAMs).
+* Both models: an add when ``max_targets`` targets are live is refused (:class:`CapacityError`,
+  code ``"ADD_FULL"``).
+* The fixed model of tracker v2 (the core the multi-target design extends) also applies the cycle
+  rule: an add whose init job does not fit the frame's admitted jobs is refused (code
+  ``"ADD_CYCLES"``, :func:`~mstrack.fixed.multi_capacity.check_add`), and on ``update`` a live
+  target whose job does not fit is *held* for that frame
+  (:func:`~mstrack.fixed.multi_capacity.plan_frame`, oldest target first): its tracker is not
+  updated and its result has status error, ``extra["err_code"]`` 6
+  (:func:`~mstrack.fixed.multi_capacity.held_result`).
+* The float model and the fixed paper preset apply ``max_targets`` only: clocks are a property of
+  the hardware, whose cycle model is core v2's.
 
-Both models apply the same rule, so float and fixed accept the same adds.  Clocks are not a
-refusal reason in this model: with the pipelined schedule (the mean shift of frame t while frame
-t + 1 streams in, one frame of 2,475,000 clocks at 1080p60) 16 worst-case targets fit (81,279 clocks
-each, docs/architecture.md "Per-target state, and N targets"), so ``max_targets`` binds first.
-The rule is written down in docs/multi.md; docs/architecture.md "Multi-target core" is where the
-hardware's choice is made -- align :class:`Capacity` with it there.
+docs/multi.md, "The capacity rule", is where the rule is written down for users.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -49,112 +51,38 @@ from .frames import FrameError, check_frame
 from .params import TrackerParams
 from .types import Box, TrackResult
 
-__all__ = ["MultiTracker", "MultiTrackerMeanShift", "Capacity", "CapacityError", "MAX_TARGETS",
-           "REGION_RAM_WORDS"]
-
-#: Default number of target slots (the generic MAX_TARGETS of a multi-target core: 1..16).
-MAX_TARGETS = 16
-#: Words of core v2's region RAM today (REGION_MAX 256 x 256 decimated pixels, docs/architecture.md
-#: "Region RAM"): one target's worst case in any frame up to 2048 px wide.
-REGION_RAM_WORDS = 256 * 256
+__all__ = ["MultiTracker", "MultiTrackerMeanShift", "CapacityError"]
 
 Model = Literal["float", "fixed"]
 BoxLike = Box | tuple[float, float, float, float] | list[float] | np.ndarray
 
 
 class CapacityError(RuntimeError):
-    """An add the capacity rule refuses (:class:`Capacity`); nothing was changed.
+    """An add the capacity rule refuses; nothing was changed.
 
     Attributes
     ----------
     code : str
-        ``"MAX_TARGETS"`` (no free target slot) or ``"REGION_WORDS"`` (the region memory would be
-        exceeded): the error code a core's add command would return.
+        ``"ADD_FULL"`` (``max_targets`` targets live) or ``"ADD_CYCLES"`` (the new target's init job
+        does not fit the frame's cycle budget): the names of
+        :mod:`mstrack.fixed.multi_capacity`'s constants.
+    add_code : int
+        The value the core's add command returns (``ADD_FULL`` 1, ``ADD_CYCLES`` 2).
     """
 
-    def __init__(self, code: str, message: str) -> None:
+    def __init__(self, code: str, add_code: int, message: str) -> None:
         self.code = code
+        self.add_code = add_code
         super().__init__(f"{code}: {message}")
 
 
-@dataclass(frozen=True)
-class Capacity:
-    """The multi-target core's capacity rule: when an add is refused (the one place it is written).
-
-    Parameters
-    ----------
-    max_targets : int
-        Target slots (the generic MAX_TARGETS, 1..16; default 16).
-    region_words : int or None
-        Region memory shared by the live targets, in words (one word per decimated pixel of a
-        search region; default 16 x :data:`REGION_RAM_WORDS`); None: no memory limit.
-    buffers : int
-        Regions per target: 1 when a target's region is captured and used in the same blanking
-        (core v2 today), 2 for double-buffered regions (the pipelined schedule: frame t's region is
-        searched while frame t + 1's is captured).
-
-    The rule (:meth:`check`): refuse the add (:class:`CapacityError`) if the live targets plus the
-    new one would be more than ``max_targets``, or would hold more than ``region_words`` words, each
-    target holding ``buffers * target_words(...)``.
-    """
-
-    max_targets: int = MAX_TARGETS
-    region_words: int | None = MAX_TARGETS * REGION_RAM_WORDS
-    buffers: int = 1
-
-    def __post_init__(self) -> None:
-        m = self.max_targets
-        if isinstance(m, bool) or not isinstance(m, int) or not 1 <= m <= 1024:
-            raise ValueError(f"max_targets must be an integer in 1..1024, got {self.max_targets!r}")
-        if self.region_words is not None and (isinstance(self.region_words, bool)
-                                              or not isinstance(self.region_words, int) or self.region_words < 1):
-            raise ValueError(f"region_words must be a positive integer or None, got {self.region_words!r}")
-        if self.buffers not in (1, 2):
-            raise ValueError(f"buffers must be 1 or 2, got {self.buffers!r}")
-
-    def target_words(self, params: TrackerParams, fixed: Any, frame_shape: tuple[int, ...]) -> int:
-        """Region words one target may need in frames of ``frame_shape`` (H, W, ...): columns x rows
-        of its worst-case search region, decimated pixels (what a region RAM slot must hold for it).
-
-        Tracker v2 (docs/fixed_point.md "Search region", ``mstrack.hw.cosim.region_max_v2`` per
-        axis): ms_region's n = min(2e + 2m + 1, S - 2), S the decimated frame size, over tracking
-        (any window up to 2 max_half + 1 at D = 1, margin MARGIN), lost at D = 2 (half the largest
-        window, margin + search offset) and lost at 2 x the largest decimation.  The paper
-        preset: window 2 max_half + 1 + 2 MARGIN, at most S - 2.  ``fixed``: the
-        :class:`mstrack.fixed.FixedParams` (margin, max_half; the hardware's defaults for the
-        float model)."""
-        h, w = int(frame_shape[0]), int(frame_shape[1])
-        win = 2 * fixed.max_half + 1
-        if params.preset != "v2":
-            return min(win + 2 * fixed.margin, w - 2) * min(win + 2 * fixed.margin, h - 2)
-        from ..fixed.blocks_v2 import MAX_DECIMATION, sixteenths
-        step16 = sixteenths(params.search_step, "search_step")
-        half = min((params.max_window + 1) // 2, win)
-
-        def n(size: int, wd: int, lost: bool, d: int) -> int:
-            e = (wd - 1) >> 1
-            m = min(fixed.margin + ((step16 * wd) >> 4), 255) if lost else fixed.margin
-            return min(2 * e + 2 * m + 1, ((size - 1) // d + 1) - 2)
-
-        def axis(size: int) -> int:
-            return max(n(size, win, False, 1), n(size, half, True, 2), n(size, win, True, 2 * MAX_DECIMATION))
-
-        return axis(w) * axis(h)
-
-    def check(self, live_words: list[int], new_words: int) -> None:
-        """Raise :class:`CapacityError` if a target needing ``new_words`` region words (one buffer) may
-        not join live targets holding ``live_words`` (one entry per live target, one buffer each)."""
-        n = len(live_words) + 1
-        if n > self.max_targets:
-            raise CapacityError("MAX_TARGETS", f"{len(live_words)} targets live, the core has "
-                                               f"{self.max_targets} slots (remove one first)")
-        if self.region_words is not None:
-            need = self.buffers * (sum(live_words) + new_words)
-            if need > self.region_words:
-                terms = " + ".join(str(v) for v in live_words + [new_words])
-                raise CapacityError("REGION_WORDS", f"the {n} targets' regions need {need:,} words "
-                                                    f"({self.buffers} x ({terms})), the region memory has "
-                                                    f"{self.region_words:,}")
+def _default_capacity(capacity: Any) -> Any:
+    from ..fixed.multi_capacity import MultiCoreConfig
+    if capacity is None:
+        return MultiCoreConfig()
+    if not isinstance(capacity, MultiCoreConfig):
+        raise TypeError(f"capacity must be an mstrack.MultiCoreConfig, got {type(capacity).__name__}")
+    return capacity
 
 
 class MultiTracker:
@@ -166,8 +94,10 @@ class MultiTracker:
         As :class:`mstrack.Tracker`.
     params : TrackerParams, optional
         Algorithm parameters of every target (default tracker v2).
-    capacity : Capacity, optional
-        The capacity rule (default ``Capacity()``: 16 slots, 16 x 65,536 region words).
+    capacity : MultiCoreConfig, optional
+        The multi-target core's configuration the capacity rule reads (``mstrack.MultiCoreConfig``:
+        ``max_targets``, ``timing``, ``costs``; default 16 targets, 1080p60).  The float model and
+        the fixed paper preset use its ``max_targets`` only (module docstring).
     **kwargs
         :class:`TrackerParams` (and, for ``model="fixed"``, FixedParams) fields, as :class:`mstrack.Tracker`.
 
@@ -182,26 +112,30 @@ class MultiTracker:
     """
 
     def __init__(self, model: Model = "float", params: TrackerParams | None = None,
-                 capacity: Capacity | None = None, **kwargs: Any) -> None:
+                 capacity: Any = None, **kwargs: Any) -> None:
         from .tracker import Tracker
-        if capacity is not None and not isinstance(capacity, Capacity):
-            raise TypeError(f"capacity must be a Capacity, got {type(capacity).__name__}")
+        self.capacity: Any = _default_capacity(capacity)
         probe = Tracker(model=model, params=params, **kwargs)  # checks model and parameters now
         own = TrackerParams.field_names()
         self._rest = {k: v for k, v in kwargs.items() if k not in own}  # FixedParams fields (model fixed)
         self.model: Model = model
         self.params: TrackerParams = probe.params
-        self.capacity: Capacity = capacity or Capacity()
         fixed = getattr(probe.impl, "fixed", None)
         if fixed is None:
             from ..fixed import FixedParams
             fixed = FixedParams()
         self.fixed = fixed
+        #: True when the cycle rule applies (the fixed model of tracker v2).
+        self.cycle_rule: bool = model == "fixed" and self.params.preset == "v2"
         self._trackers: dict[int, Any] = {}
-        self._words: dict[int, int] = {}
+        self._order: list[int] = []     # live ids, oldest first (the rule's priority)
+        self._jobs: list[Any] = []      # the current frame's admitted jobs (TargetDemand)
         self._shape: tuple[int, int] | None = None
         #: Last result per live target id (its init result right after :meth:`add`).
         self.last: dict[int, TrackResult] = {}
+        #: The last update's :class:`~mstrack.fixed.multi_capacity.FramePlan` (fixed tracker v2;
+        #: None otherwise or before the first update).
+        self.plan: Any = None
 
     # ------------------------------------------------------------------ targets
     @property
@@ -227,48 +161,77 @@ class MultiTracker:
 
         Its init result is :attr:`last` ``[id]`` (with ``target_id`` set).  Raises
         :class:`CapacityError` when the capacity rule refuses the add, :class:`FrameError` for a bad
-        frame or one whose size differs from the live targets', ValueError for a bad box; nothing
-        changes then.
+        frame or one whose size differs from the live targets', ValueError for a bad box or a frame
+        larger than the capacity's video timing; nothing changes then.
         """
         from .tracker import Tracker
         frame = check_frame(frame, self._shape) if self._trackers else check_frame(frame)
-        words = self.capacity.target_words(self.params, self.fixed, frame.shape)
-        self.capacity.check([self._words[i] for i in self.targets], words)
-        tid = next(i for i in range(self.capacity.max_targets) if i not in self._trackers)
+        cap = self.capacity
+        if len(self._trackers) >= cap.max_targets:
+            raise CapacityError("ADD_FULL", 1, f"{len(self._trackers)} targets live, the core has "
+                                               f"{cap.max_targets} slots (remove one first)")
+        tid = next(i for i in range(cap.max_targets) if i not in self._trackers)
+        jobs = self._jobs if self._trackers else []  # with no target live, a new frame
+        new = None
+        if self.cycle_rule:
+            from ..fixed.multi_capacity import ADD_NAMES, ADD_OK, check_add, init_demand
+            fh, fw = frame.shape[:2]
+            if fh > cap.timing.active_lines or fw > cap.timing.line_clocks:
+                raise ValueError(f"frame {fw}x{fh} is larger than the capacity's video timing "
+                                 f"({cap.timing.active_lines} active lines of {cap.timing.line_clocks} clocks)")
+            new = init_demand(Box.of(box), fw, fh, tid, self.params, self.fixed, cap.costs)  # ValueError: bad box
+            code = check_add(jobs, len(self._trackers), new, cap)
+            if code != ADD_OK:
+                budget = min(j.slack(cap.timing) for j in [*jobs, new])
+                raise CapacityError(ADD_NAMES[code], code, f"the init job ({new.clocks:,} clocks) with the "
+                                    f"frame's {len(jobs)} admitted jobs ({sum(j.clocks for j in jobs):,} clocks) "
+                                    f"exceeds the smallest slack, {budget:,} clocks")
         trk = Tracker(model=self.model, params=self.params, **self._rest)
         res = trk.init(frame, box)  # raises before anything is changed
         res.target_id = tid
         if not self._trackers:
             self._shape = (frame.shape[0], frame.shape[1])
-        self._trackers[tid], self._words[tid], self.last[tid] = trk, words, res
+        self._jobs = [*jobs, new] if new is not None else jobs
+        self._trackers[tid], self.last[tid] = trk, res
+        self._order.append(tid)
         return tid
 
     def remove(self, target_id: int) -> None:
         """Remove a live target; its slot (id) is free for the next :meth:`add`."""
         self._check_id(target_id)
-        del self._trackers[target_id], self._words[target_id], self.last[target_id]
+        del self._trackers[target_id], self.last[target_id]
+        self._order.remove(target_id)
 
     def update(self, frame: np.ndarray) -> list[TrackResult]:
         """Track every live target into ``frame`` (ndarray (H, W, 3) uint8 BGR, the targets' frame size).
 
         Returns one :class:`TrackResult` per live target, in ascending ``target_id`` order; each is
-        what that target's own :class:`mstrack.Tracker` returns.  A bad frame raises
-        :class:`FrameError` before any target is updated (all keep their state).
+        what that target's own :class:`mstrack.Tracker` returns, except for a target the capacity rule
+        holds on this frame (fixed tracker v2): status error, ``extra["err_code"]`` 6, its tracker
+        not updated.  A bad frame raises :class:`FrameError` before any target is updated (all keep
+        their state).
         """
         if not self._trackers:
             return []
         frame = check_frame(frame, self._shape)
+        held: dict[int, Any] = {}
+        if self.cycle_rule:
+            from ..fixed.multi_capacity import plan_frame, target_demand
+            jobs = [target_demand(self._trackers[t].impl, t, costs=self.capacity.costs) for t in self._order]
+            self.plan = plan_frame(jobs, self.capacity)
+            self._jobs = list(self.plan.jobs)
+            held = {j.target_id: j for j in jobs if j.target_id in self.plan.held}
         out = []
         for tid in self.targets:
-            res = self._trackers[tid].update(frame)
+            if tid in held:
+                from ..fixed.multi_capacity import held_result
+                res = held_result(self._trackers[tid].impl, held[tid])
+            else:
+                res = self._trackers[tid].update(frame)
             res.target_id = tid
             self.last[tid] = res
             out.append(res)
         return out
-
-    def region_words(self) -> int:
-        """Region memory the live targets hold, in words (as the capacity rule counts it)."""
-        return self.capacity.buffers * sum(self._words.values())
 
 
 class MultiTrackerMeanShift:
@@ -287,7 +250,7 @@ class MultiTrackerMeanShift:
     """
 
     def __init__(self, params: TrackerParams | None = None, model: Model = "float",
-                 capacity: Capacity | None = None) -> None:
+                 capacity: Any = None) -> None:
         from .tracker import DEFAULT_PRESET
         self.multi = MultiTracker(model=model, params=params if params is not None
                                   else TrackerParams(preset=DEFAULT_PRESET), capacity=capacity)
@@ -295,9 +258,10 @@ class MultiTrackerMeanShift:
 
     @classmethod
     def create(cls, params: TrackerParams | None = None, model: Model = "float",
-               capacity: Capacity | None = None) -> "MultiTrackerMeanShift":
+               capacity: Any = None) -> "MultiTrackerMeanShift":
         """A new multi-tracker, as ``cv2.legacy.MultiTracker.create()``; ``params`` (default tracker v2)
-        and ``model`` apply to every target."""
+        and ``model`` apply to every target; ``capacity``: an ``mstrack.MultiCoreConfig``, as
+        :class:`MultiTracker`'s."""
         return cls(params, model, capacity)
 
     @property

@@ -141,7 +141,7 @@ class FixedTrackerV2:
         if sub is None:
             sub = self._capture(img, reg)
         tp = p.with_(max_iter=max_iter)
-        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_bins_v2, self.widths.shift_q)
+        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_bins_v2, self.widths.shift_q, q_frac=fx.model_frac)
         win = (ms_round_centre(r.c8[0], cf) - reg.x, ms_round_centre(r.c8[1], cf) - reg.y)
         st = ms_target_stats(sub, self.model.T, win, ker, fx.kernel_bits, self.pad16)
         return r.c8, r.S, r.iterations, r.stop, st
@@ -179,7 +179,7 @@ class FixedTrackerV2:
                 rhos.append(None)
                 continue
             hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
-            S = ms_bin_pass(ms_model_scale(self.model.Qn, ker.K), hist, fx).S
+            S = ms_bin_pass(ms_model_scale(self.model.Qn, ker.K, fx.model_frac), hist, fx, fx.model_frac).S
             rhos.append(ms_rho_out(S, ker.K, fx))
         return ms_scale_test(rho, rhos[0], rhos[1])
 
@@ -220,10 +220,10 @@ class FixedTrackerV2:
         # keep the box inside the decimated interior
         cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
-        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2)
+        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2, fx.bg_frac)
         wd, hd = self._geometry(d, bins.shape)
         ker = self._kernel(wd, hd)
-        Qw = ms_model_scale(self.model.Qn, ker.K)
+        Qw = ms_model_scale(self.model.Qn, ker.K, fx.model_frac)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one pass at the init centre (no iteration) gives the references
         if p.orient_T > 0:
@@ -256,7 +256,7 @@ class FixedTrackerV2:
         win = (ms_round_centre(c8[0], cf), ms_round_centre(c8[1], cf))
         sub = self._capture(img, reg)
         hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
-        S = ms_bin_pass(Qw, hist, fx).S
+        S = ms_bin_pass(Qw, hist, fx, fx.model_frac).S
         st = ms_target_stats(sub, self.model.T, (win[0] - reg.x, win[1] - reg.y), ker, fx.kernel_bits, self.pad16)
         return c8, S, 0, "shift", st
 
@@ -272,7 +272,7 @@ class FixedTrackerV2:
         img = frame[::d, ::d]
         wd, hd = self._geometry(d, img.shape[:2])
         ker = self._kernel(wd, hd)
-        Qw = ms_model_scale(self.model.Qn, ker.K)
+        Qw = ms_model_scale(self.model.Qn, ker.K, fx.model_frac)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost
         ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4

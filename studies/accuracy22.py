@@ -1,0 +1,307 @@
+"""Tracker v2 on the 22 sequences (dev + validation): accuracy, float/fixed stability, loss flag.
+
+Usage::
+
+    python studies/accuracy22.py run [--tag T] [--set k=v ...]   # float + fixed v2 -> out/acc22/<T>/
+    python studies/accuracy22.py report [--tag T]                # tables of one run (stdout)
+    python studies/accuracy22.py diverge [--tag T]               # first float/fixed divergence per sequence
+    python studies/accuracy22.py loss [--tag T]                  # loss thresholds: in sample and LOSO
+
+``run`` keeps, per sequence and model, the boxes, centres, the loss flag's smoothed signals
+(rho_s, contrast_s, rho0, share) and the per-frame decimation / search state / size, so that the
+other commands need no tracking.  The loss flag does not steer the tracker (the search state
+comes from the confidence), so its thresholds are re-scored from the kept signals: float in
+float arithmetic, fixed with the integer comparison of ms_loss_flag (the same decision).
+Sequences: ../shared/data/sequences (dev, 10) and ../shared/data/validation (12).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from mstrack.eval.metrics import centre_error, iou, score, valid_gt  # noqa: E402
+from mstrack.fixed.blocks_v2 import q16  # noqa: E402
+from mstrack.io.data import load_dataset  # noqa: E402
+from mstrack.track.tracker import Tracker  # noqa: E402
+from mstrack.track.types import Status  # noqa: E402
+
+DATA = ROOT.parent / "shared" / "data"
+SETS = {"dev": DATA / "sequences", "validation": DATA / "validation"}
+OUT = ROOT / "out" / "acc22"
+MODELS = ("float", "fixed")
+FA_MAX = 0.05
+
+
+def sequences() -> list[tuple[str, object]]:
+    out = []
+    for set_name, root in SETS.items():
+        if not root.is_dir():
+            raise SystemExit(f"{root} not found (needs ../shared/data)")
+        out += [(set_name, s) for s in load_dataset(root)]
+    return out
+
+
+def parse_sets(items: list[str]) -> dict:
+    kw = {}
+    for it in items:
+        k, v = it.split("=", 1)
+        kw[k] = json.loads(v.lower()) if v.lower() in ("true", "false") else (int(v) if v.lstrip("-").isdigit() else float(v))
+    return kw
+
+
+def run_one(seq, model: str, kw: dict) -> dict:
+    trk = Tracker(model=model, preset="v2", **kw)
+    n = len(seq)
+    boxes = np.zeros((n, 4))
+    cen = np.zeros((n, 2))
+    ok = np.ones(n, bool)
+    sig = {k: np.zeros(n) for k in ("rho", "rho_s", "con_s", "share", "dec", "state", "w", "h", "iter", "conf")}
+    one = 65536.0 if model == "fixed" else 1.0
+    res = trk.init(seq.frame(0), seq.init_box())
+    rho0 = res.extra["rho"] if model == "fixed" else res.rho_c
+    boxes[0] = res.box.as_tuple()
+    cen[0] = res.centre
+    for i in range(1, n):
+        r = trk.update(seq.frame(i))
+        boxes[i] = r.box.as_tuple()
+        cen[i] = r.centre
+        ok[i] = r.ok
+        e = r.extra
+        sig["rho"][i] = e["rho"] if model == "fixed" else r.rho_c
+        sig["rho_s"][i] = e["rho_s"]
+        sig["con_s"][i] = e["contrast_s"]
+        sig["share"][i] = e["share"]
+        sig["dec"][i] = e["decimation"]
+        st = e["state"]
+        sig["state"][i] = st if isinstance(st, (int, np.integer)) else {"ok": 0, "uncertain": 1, "lost": 2, "reacquired": 3}.get(st, 9)
+        sig["w"][i], sig["h"][i] = r.box.w, r.box.h
+        sig["iter"][i] = r.iter_c
+        sig["conf"][i] = r.confidence
+    return {"boxes": boxes, "centre": cen, "ok": ok, "rho0": np.array(rho0), "one": np.array(one), **sig}
+
+
+def main_run(tag: str, kw: dict, models: tuple[str, ...]) -> None:
+    d = OUT / tag
+    d.mkdir(parents=True, exist_ok=True)
+    (d / "params.json").write_text(json.dumps(kw))
+    for set_name, seq in sequences():
+        for model in models:
+            f = d / f"{model}_{seq.name}.npz"
+            if f.is_file():
+                continue
+            np.savez(f, set=set_name, **run_one(seq, model, kw))
+        print(tag, seq.name, flush=True)
+
+
+def load(tag: str, model: str) -> dict[str, tuple[str, dict, np.ndarray]]:
+    """name -> (set, arrays, gt)."""
+    out = {}
+    for set_name, seq in sequences():
+        f = OUT / tag / f"{model}_{seq.name}.npz"
+        if not f.is_file():
+            continue
+        z = dict(np.load(f))
+        out[seq.name] = (set_name, z, np.asarray(seq.gt[:len(z["boxes"])], dtype=np.float64))
+    return out
+
+
+def seq_scores(runs: dict) -> dict[str, tuple[str, float, float, np.ndarray, np.ndarray]]:
+    """name -> (set, AUC, P@20, ious, errors) on valid-GT frames."""
+    out = {}
+    for name, (set_name, z, gt) in runs.items():
+        s = score(z["boxes"], gt)
+        out[name] = (set_name, s.auc, s.precision20, s.ious, s.errors)
+    return out
+
+
+def summary(sc: dict, which: str) -> tuple[float, float, float, float, int]:
+    """(frame-weighted AUC, P@20, mean AUC over sequences, mean P@20 over sequences, n seqs)."""
+    from mstrack.eval.metrics import score_frames
+    part = [v for v in sc.values() if which == "all" or v[0] == which]
+    if not part:
+        return (float("nan"),) * 4 + (0,)  # type: ignore[return-value]
+    s = score_frames(np.concatenate([p[3] for p in part]), np.concatenate([p[4] for p in part]))
+    return s.auc, s.precision20, float(np.mean([p[1] for p in part])), float(np.mean([p[2] for p in part])), len(part)
+
+
+# ----------------------------------------------------------------------------- loss flag
+def loss_arrays(runs: dict, model: str) -> dict[str, dict[str, np.ndarray]]:
+    """Per sequence, frames after init with valid GT: iou, rho_s / rho0 parts, con_s, share."""
+    out = {}
+    for name, (_, z, gt) in runs.items():
+        v = valid_gt(gt)
+        v[0] = False
+        out[name] = {"iou": iou(z["boxes"], gt)[v], "rho_s": z["rho_s"][v], "con_s": z["con_s"][v],
+                     "share": z["share"][v], "rho0": float(z["rho0"]), "ok": z["ok"][v]}
+    return out
+
+
+def flag(a: dict, lr: float, lc: float, model: str) -> np.ndarray:
+    if model == "fixed":
+        rs = a["rho_s"].astype(np.int64)
+        return (a["share"] == 0) | (rs == 0) | ((rs << 16) < q16(lr) * int(a["rho0"])) & (a["con_s"] < q16(lc))
+    return (a["share"] == 0) | (a["rho_s"] == 0) | ((a["rho_s"] < lr * a["rho0"]) & (a["con_s"] < lc))
+
+
+RHO_GRID = np.round(np.arange(0.50, 1.001, 0.01), 2)
+CON_GRID = np.round(np.arange(0.00, 0.401, 0.01), 2)
+
+
+def counts(arr: dict, names: list[str], lr: float, lc: float, model: str) -> tuple[int, int, int, int]:
+    offf = off = onf = on = 0
+    for n in names:
+        a = arr[n]
+        f = flag(a, lr, lc, model)
+        o, g = a["iou"] == 0, a["iou"] >= 0.5
+        offf += int((f & o).sum())
+        off += int(o.sum())
+        onf += int((f & g).sum())
+        on += int(g.sum())
+    return offf, off, onf, on
+
+
+def table(arr: dict, names: list[str], model: str) -> np.ndarray:
+    """(rho, con) grid -> (offf, off, onf, on) per sequence summed over names."""
+    t = np.zeros((len(RHO_GRID), len(CON_GRID), 4), np.int64)
+    for i, lr in enumerate(RHO_GRID):
+        for j, lc in enumerate(CON_GRID):
+            t[i, j] = counts(arr, names, lr, lc, model)
+    return t
+
+
+def choose(t: np.ndarray) -> tuple[int, int]:
+    """Highest recall with false alarms <= FA_MAX (ties: fewer false alarms, then larger margins)."""
+    rec = t[..., 0] / np.maximum(t[..., 1], 1)
+    fa = t[..., 2] / np.maximum(t[..., 3], 1)
+    key = np.where(fa <= FA_MAX, rec * 1e6 - fa * 1e3, -np.inf)
+    i, j = np.unravel_index(int(np.argmax(key)), key.shape)
+    return int(i), int(j)
+
+
+def loso(runs_by_model: dict[str, dict], models=MODELS, joint: bool = True):
+    """Per model: in-sample choice and LOSO counts.  joint: one pair for float and fixed
+    (highest lower recall of the two with both false-alarm rates <= FA_MAX)."""
+    arrs = {m: loss_arrays(runs_by_model[m], m) for m in models}
+    names = sorted(set.intersection(*(set(a) for a in arrs.values())))
+    per_seq = {m: {n: table(arrs[m], [n], m) for n in names} for m in models}
+    total = {m: sum(per_seq[m].values()) for m in models}
+
+    def pick(tabs: dict[str, np.ndarray]) -> tuple[int, int]:
+        if not joint:
+            raise NotImplementedError
+        recs, fas = [], []
+        for m, t in tabs.items():
+            recs.append(t[..., 0] / np.maximum(t[..., 1], 1))
+            fas.append(t[..., 2] / np.maximum(t[..., 3], 1))
+        rec, fa = np.minimum(*recs) if len(recs) > 1 else recs[0], np.maximum(*fas) if len(fas) > 1 else fas[0]
+        key = np.where(fa <= FA_MAX, rec * 1e6 - fa * 1e3, -np.inf)
+        i, j = np.unravel_index(int(np.argmax(key)), key.shape)
+        return int(i), int(j)
+
+    i, j = pick(total)
+    ins = {m: total[m][i, j] for m in models}
+    lo = {m: np.zeros(4, np.int64) for m in models}
+    chosen = {}
+    for n in names:
+        rest = {m: total[m] - per_seq[m][n] for m in models}
+        a, b = pick(rest)
+        chosen[n] = (RHO_GRID[a], CON_GRID[b])
+        for m in models:
+            lo[m] += per_seq[m][n][a, b]
+    return (RHO_GRID[i], CON_GRID[j]), ins, lo, chosen
+
+
+def fmt_ld(c) -> str:
+    return f"{c[0] / max(c[1], 1):.3f} / {c[2] / max(c[3], 1):.3f}"
+
+
+def main_loss(tag: str) -> None:
+    runs = {m: load(tag, m) for m in MODELS}
+    (lr, lc), ins, lo, chosen = loso(runs)
+    print(f"joint choice on 22 (in sample): loss_rho {lr:.2f}, loss_contrast {lc:.2f}")
+    print("| model | recall / false alarms, in sample | recall / false alarms, LOSO |")
+    print("|---|---|---|")
+    for m in MODELS:
+        print(f"| {m} | {fmt_ld(ins[m])} | {fmt_ld(lo[m])} |")
+    # the current thresholds as they are
+    p = json.loads((OUT / tag / "params.json").read_text())
+    for m in MODELS:
+        arr = loss_arrays(runs[m], m)
+        c = counts(arr, list(arr), p.get("loss_rho", 0.69), p.get("loss_contrast", 0.25), m)
+        okc = np.zeros(4, np.int64)
+        for a in arr.values():
+            f = ~a["ok"]
+            okc += [int((f & (a["iou"] == 0)).sum()), int((a["iou"] == 0).sum()), int((f & (a["iou"] >= 0.5)).sum()),
+                    int((a["iou"] >= 0.5).sum())]
+        print(f"{m}: run's thresholds recall / FA {fmt_ld(c)} (from ok: {fmt_ld(okc)}; off {okc[1]}, on {okc[3]})")
+    print("LOSO choices:", {n: (float(a), float(b)) for n, (a, b) in chosen.items()})
+
+
+# ----------------------------------------------------------------------------- report / diverge
+def main_report(tag: str, ref: str | None = None) -> None:
+    sc = {m: seq_scores(load(tag, m)) for m in MODELS}
+    print(f"tag {tag}: {json.loads((OUT / tag / 'params.json').read_text())}")
+    print("| model | set | seqs | AUC | P@20 | mean AUC | mean P@20 |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for m in MODELS:
+        for w in ("dev", "validation", "all"):
+            a, p, ma, mp, n = summary(sc[m], w)
+            print(f"| {m} | {w} | {n} | {a:.3f} | {p:.3f} | {ma:.3f} | {mp:.3f} |")
+    print("\n| sequence | set | float AUC | fixed AUC | gap | float P@20 | fixed P@20 |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    within = 0
+    for n in sc["float"]:
+        if n not in sc["fixed"]:
+            continue
+        f, x = sc["float"][n], sc["fixed"][n]
+        within += abs(f[1] - x[1]) <= 0.01
+        print(f"| {n} | {f[0]} | {f[1]:.3f} | {x[1]:.3f} | {x[1] - f[1]:+.3f} | {f[2]:.3f} | {x[2]:.3f} |")
+    print(f"\nwithin 0.01 AUC: {within} of {len(sc['fixed'])}")
+
+
+def main_diverge(tag: str, px: float = 4.0) -> None:
+    runs = {m: load(tag, m) for m in MODELS}
+    print(f"| sequence | first frame > {px:g} px | dec f/x | state f/x | w f/x | iter f/x | conf f/x | frames later > {px:g} px |")
+    print("|---|---:|---|---|---|---|---|---:|")
+    for n, (_, zf, _) in runs["float"].items():
+        zx = runs["fixed"][n][1]
+        d = np.hypot(*(zf["centre"] - zx["centre"]).T)
+        bad = np.nonzero(d > px)[0]
+        if not len(bad):
+            print(f"| {n} | - | | | | | | 0 |")
+            continue
+        i = int(bad[0])
+        j = max(i - 1, 0)
+        print(f"| {n} | {i} | {zf['dec'][j]:.0f}/{zx['dec'][j]:.0f} | {zf['state'][i]:.0f}/{zx['state'][i]:.0f} | "
+              f"{zf['w'][j]:.1f}/{zx['w'][j]:.1f} | {zf['iter'][i]:.0f}/{zx['iter'][i]:.0f} | "
+              f"{zf['conf'][i]:.2f}/{zx['conf'][i]:.2f} | {len(bad)} |")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("cmd", choices=("run", "report", "diverge", "loss"))
+    ap.add_argument("--tag", default="default")
+    ap.add_argument("--set", nargs="*", default=[])
+    ap.add_argument("--models", default="float,fixed")
+    ap.add_argument("--px", type=float, default=4.0)
+    a = ap.parse_args(argv)
+    if a.cmd == "run":
+        main_run(a.tag, parse_sets(a.set), tuple(a.models.split(",")))
+    elif a.cmd == "report":
+        main_report(a.tag)
+    elif a.cmd == "diverge":
+        main_diverge(a.tag, a.px)
+    else:
+        main_loss(a.tag)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -2,6 +2,7 @@
 VENV    ?= .venv
 PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
+VALIDATION ?= ../shared/data/validation
 ARGS    ?=
 
 # Compiled bytecode goes to build/pycache.  The machines may set PYTHONDONTWRITEBYTECODE; then every
@@ -104,7 +105,9 @@ eval: setup
 results: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval_float --quiet
 	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
-	$(PY) tools/results_doc.py
+	$(VENV)/bin/mstrack eval $(VALIDATION) --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt --out out/eval_float_validation --quiet
+	$(VENV)/bin/mstrack eval $(VALIDATION) --model fixed --trackers mstrack-v2,mstrack-v2-colour --out out/eval_fixed_validation --quiet
+	$(PY) tools/results_doc.py $(DATASET) $(VALIDATION)
 
 clean:
 	rm -rf out build .pytest_cache sim_build* results.xml *.egg-info

@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import fields
 from pathlib import Path
 
 import numpy as np
@@ -57,12 +58,17 @@ def parse_sets(items: list[str]) -> dict:
 
 
 def run_one(seq, model: str, kw: dict) -> dict:
+    if model == "float":  # FixedParams fields (widths) are the fixed model's only
+        from mstrack.fixed.formats import FixedParams
+        kw = {k: v for k, v in kw.items() if k not in {f.name for f in fields(FixedParams)}}
     trk = Tracker(model=model, preset="v2", **kw)
     n = len(seq)
     boxes = np.zeros((n, 4))
     cen = np.zeros((n, 2))
     ok = np.ones(n, bool)
-    sig = {k: np.zeros(n) for k in ("rho", "rho_s", "con_s", "share", "dec", "state", "w", "h", "iter", "conf")}
+    sig = {k: np.zeros(n) for k in ("rho", "rho_s", "con_s", "share", "dec", "state", "w", "h", "iter", "conf",
+                                    "rho_ref", "share_ref", "ring")}
+    impl = trk.impl
     one = 65536.0 if model == "fixed" else 1.0
     res = trk.init(seq.frame(0), seq.init_box())
     rho0 = res.extra["rho"] if model == "fixed" else res.rho_c
@@ -84,6 +90,9 @@ def run_one(seq, model: str, kw: dict) -> dict:
         sig["w"][i], sig["h"][i] = r.box.w, r.box.h
         sig["iter"][i] = r.iter_c
         sig["conf"][i] = r.confidence
+        sig["rho_ref"][i] = impl.rho_ref if model == "fixed" else impl._rho_ref
+        sig["share_ref"][i] = impl.share_ref if model == "fixed" else impl._share_ref
+        sig["ring"][i] = e["ring_share"]
     return {"boxes": boxes, "centre": cen, "ok": ok, "rho0": np.array(rho0), "one": np.array(one), **sig}
 
 

@@ -12,7 +12,12 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 RUNS = {"float": REPO / "out" / "eval_float", "fixed": REPO / "out" / "eval_fixed"}
+#: the validation set's runs (`make results`: v2, v2-colour and CSRT; not the paper trackers)
+RUNS_VAL = {"float": REPO / "out" / "eval_float_validation", "fixed": REPO / "out" / "eval_fixed_validation"}
 DOCS = REPO / "docs"
+DATA = REPO.parent / "shared" / "data"
+SETS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-colour", "float"),
+                 ("mstrack-v2-colour", "fixed"), ("opencv-csrt", "float"))
 
 
 def section(md: str, title: str) -> str:
@@ -129,6 +134,86 @@ def loss_section(seq_root: Path, totals: dict | None = None) -> list[str]:
     return out + [""]
 
 
+def sets_section(dev_root: Path, val_root: Path) -> list[str]:
+    """Dev (10), validation (12) and both (22 sequences): AUC and P@20 frame-weighted and as the
+    plain mean over sequences, and the loss flag's recall / false alarms, per tracker, from the
+    cached per-sequence runs of the four `make results` commands; the loss thresholds' leave-one-
+    sequence-out figures from docs/results/accuracy22.json (studies/accuracy22.py doc) when present."""
+    import json
+
+    import numpy as np
+
+    sys.path.insert(0, str(REPO))
+    from mstrack.eval.evaluate import SequenceRun
+    from mstrack.eval.metrics import centre_error, iou, loss_detection, score, valid_gt
+    from mstrack.io.data import load_dataset
+
+    sets = {"dev": (dev_root, RUNS), "validation": (val_root, RUNS_VAL)}
+    per: dict[tuple[str, str], dict[str, tuple[str, float, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = {}
+    for set_name, (root, runs) in sets.items():
+        if not root.is_dir():
+            return [f"(dev / validation table: {root} not found)", ""]
+        for seq in load_dataset(root):
+            for name, model in SETS_TRACKERS:
+                label = name if model == "float" else f"{name}@fixed"
+                f = runs[model] / "results" / label / f"{seq.name}.json"
+                if not f.is_file():
+                    return [f"(dev / validation table: {f.relative_to(REPO)} missing; run `make results`)", ""]
+                run = SequenceRun.from_json(json.loads(f.read_text()))
+                gt = np.asarray(seq.gt[:run.n_frames], dtype=np.float64)
+                sc = score(run.boxes, gt)
+                v = valid_gt(gt)
+                v[0] = False  # the init frame says nothing about loss detection
+                per.setdefault((name, model), {})[seq.name] = (
+                    set_name, sc.auc, sc.precision20, iou(run.boxes[v], gt[v]), run.ok[v],
+                    iou(run.boxes[valid_gt(gt)], gt[valid_gt(gt)]), centre_error(run.boxes[valid_gt(gt)], gt[valid_gt(gt)]))
+    from mstrack.eval.metrics import score_frames
+    out = ["## Dev, validation and both (22 sequences)", "",
+           "The 10 dev sequences above (`../shared/data/sequences`) and the 12 validation sequences "
+           "(`../shared/data/validation`, OTB-100, README there); parameters and thresholds are chosen on "
+           "both together, never per sequence; CI tests use the dev set only.  AUC and P@20 frame-weighted, "
+           "and the plain mean of the per-sequence figures; loss flag: recall / false alarms of `ok` as in "
+           "the loss table.  Commands: the two above and",
+           "`mstrack eval ../shared/data/validation --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt "
+           "--out out/eval_float_validation --quiet`,",
+           "`mstrack eval ../shared/data/validation --model fixed --trackers mstrack-v2,mstrack-v2-colour "
+           "--out out/eval_fixed_validation --quiet` (all four run by `make results`).", "",
+           "| tracker | set | sequences | AUC | P@20 | mean AUC | mean P@20 | loss recall / false alarms |",
+           "|---|---|---:|---:|---:|---:|---:|---|"]
+    for (name, model), d in per.items():
+        label = name if model == "float" else f"{name}@fixed"
+        for which in ("dev", "validation", "both"):
+            part = [x for x in d.values() if which == "both" or x[0] == which]
+            s = score_frames(np.concatenate([x[5] for x in part]), np.concatenate([x[6] for x in part]))
+            ld = loss_detection(np.concatenate([x[3] for x in part]), np.concatenate([x[4] for x in part]))
+            loss = "-" if name.startswith("opencv") else f"{ld.recall:.2f} / {ld.false_alarm:.3f}"
+            out.append(f"| {label} | {which} | {len(part)} | {s.auc:.3f} | {s.precision20:.3f} | "
+                       f"{np.mean([x[1] for x in part]):.3f} | {np.mean([x[2] for x in part]):.3f} | {loss} |")
+    labels = [(n, m) for n, m in SETS_TRACKERS if (n, m) in per]
+    out += ["", "Per sequence AUC (v2 float, v2 fixed, float - fixed gap, CSRT):", "",
+            "| sequence | set | mstrack-v2 | mstrack-v2@fixed | gap | opencv-csrt |", "|---|---|---:|---:|---:|---:|"]
+    f_, x_, c_ = per[("mstrack-v2", "float")], per[("mstrack-v2", "fixed")], per[("opencv-csrt", "float")]
+    within = 0
+    for sname in f_:
+        gap = x_[sname][1] - f_[sname][1]
+        within += abs(gap) <= 0.01
+        out.append(f"| {sname} | {f_[sname][0]} | {f_[sname][1]:.3f} | {x_[sname][1]:.3f} | {gap:+.3f} | {c_[sname][1]:.3f} |")
+    out += ["", f"Float and fixed v2 within 0.01 AUC on {within} of {len(f_)} sequences.", ""]
+    loso = DOCS / "results" / "accuracy22.json"
+    if loso.is_file():
+        j = json.loads(loso.read_text())
+        out += [f"Loss thresholds, leave one sequence out over the 22 (`{j['command']}`; thresholds chosen on 21 "
+                "sequences, max recall at false alarms <= 0.05 for float and fixed together, scored on the 22nd, "
+                "counts summed): [results_accuracy22.md](results_accuracy22.md).", "",
+                "| model | in sample: thresholds, recall / false alarms | leave one sequence out: recall / false alarms |",
+                "|---|---|---|"]
+        for m, r in j["loss"].items():
+            out.append(f"| {m} | {r['in_sample']} | {r['loso']} |")
+        out.append("")
+    del labels
+    return out
+
+
 def _bench_all(path: Path, column: str) -> tuple[str, str]:
     """(value, date) of ``column`` in the "all" row (or the only row) of a `mstrack bench` table."""
     if not path.is_file():
@@ -224,6 +309,7 @@ def main(argv: list[str] | None = None) -> int:
     seq_root = Path(argv[0]) if argv else REPO.parent / "shared" / "data" / "sequences"
     totals: dict = {}
     out += loss_section(seq_root, totals) if seq_root.is_dir() else [f"(loss table: {seq_root} not found)", ""]
+    out += sets_section(seq_root, Path(argv[1]) if len(argv) > 1 else DATA / "validation")
     try:
         out += targets_section(totals)
     except KeyError as exc:  # a run without the trackers the targets name

@@ -141,22 +141,35 @@ def summary(sc: dict, which: str) -> tuple[float, float, float, float, int]:
 
 
 # ----------------------------------------------------------------------------- loss flag
+#: the loss flag's rho reference: "rho0" (rho at init, the tracker's rule) or "rho_ref" (the running
+#: reference of the confidence, as it was before the frame's update)
+LOSS_REF = {"ref": "rho0"}
+
+
 def loss_arrays(runs: dict, model: str) -> dict[str, dict[str, np.ndarray]]:
-    """Per sequence, frames after init with valid GT: iou, rho_s / rho0 parts, con_s, share."""
+    """Per sequence, frames after init with valid GT: iou, rho_s, its reference, con_s, share."""
     out = {}
     for name, (_, z, gt) in runs.items():
         v = valid_gt(gt)
         v[0] = False
+        rho0 = float(z["rho0"])
+        if LOSS_REF["ref"] == "rho_ref":
+            ref = np.concatenate([[rho0], z["rho_ref"][1:-1]]) if "rho_ref" in z else None
+            if ref is None:
+                raise SystemExit(f"run without rho_ref: {name}")
+            ref = np.concatenate([[rho0], ref])[:len(v)] if len(ref) < len(v) else ref
+        else:
+            ref = np.full(len(v), rho0)
         out[name] = {"iou": iou(z["boxes"], gt)[v], "rho_s": z["rho_s"][v], "con_s": z["con_s"][v],
-                     "share": z["share"][v], "rho0": float(z["rho0"]), "ok": z["ok"][v]}
+                     "share": z["share"][v], "ref": ref[v], "ok": z["ok"][v]}
     return out
 
 
 def flag(a: dict, lr: float, lc: float, model: str) -> np.ndarray:
     if model == "fixed":
         rs = a["rho_s"].astype(np.int64)
-        return (a["share"] == 0) | (rs == 0) | ((rs << 16) < q16(lr) * int(a["rho0"])) & (a["con_s"] < q16(lc))
-    return (a["share"] == 0) | (a["rho_s"] == 0) | ((a["rho_s"] < lr * a["rho0"]) & (a["con_s"] < lc))
+        return (a["share"] == 0) | (rs == 0) | ((rs << 16) < q16(lr) * a["ref"].astype(np.int64)) & (a["con_s"] < q16(lc))
+    return (a["share"] == 0) | (a["rho_s"] == 0) | ((a["rho_s"] < lr * a["ref"]) & (a["con_s"] < lc))
 
 
 RHO_GRID = np.round(np.arange(0.50, 1.001, 0.01), 2)
@@ -293,20 +306,115 @@ def main_diverge(tag: str, px: float = 4.0) -> None:
               f"{zf['conf'][i]:.2f}/{zx['conf'][i]:.2f} | {len(bad)} |")
 
 
+def csrt_scores() -> dict:
+    """CSRT's per-sequence runs from the `make results` caches (out/eval_float*, opencv-csrt)."""
+    from mstrack.eval.evaluate import SequenceRun
+    out = {}
+    for set_name, seq in sequences():
+        d = "eval_float" if set_name == "dev" else "eval_float_validation"
+        f = ROOT / "out" / d / "results" / "opencv-csrt" / f"{seq.name}.json"
+        if not f.is_file():
+            continue
+        run = SequenceRun.from_json(json.loads(f.read_text()))
+        s = score(run.boxes, np.asarray(seq.gt[:run.n_frames], dtype=np.float64))
+        out[seq.name] = (set_name, s.auc, s.precision20, s.ious, s.errors)
+    return out
+
+
+def capture(fn, *a) -> list[str]:
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        fn(*a)
+    return buf.getvalue().rstrip().splitlines()
+
+
+def main_doc(tags: list[str], notes: dict[str, str]) -> None:
+    """docs/results_accuracy22.md and docs/results/accuracy22.json from the runs of ``tags``
+    (the first is the defaults)."""
+    cs = csrt_scores()
+    lines = ["# Tracker v2 on 22 sequences: accuracy, float/fixed stability, loss flag", "",
+             "Dev (`../shared/data/sequences`, 10) + validation (`../shared/data/validation`, 12) = 22 OTB "
+             "sequences, 5,286 frames.  Made by `python studies/accuracy22.py run --tag T --set k=v ...` "
+             "(float + fixed v2 with TrackerParams / FixedParams fields k=v, kept in out/acc22/T/) and "
+             "`python studies/accuracy22.py doc` (this page).  AUC / P@20 frame-weighted and as the plain mean "
+             "over sequences; *within 0.01*: sequences whose float and fixed AUC differ by at most 0.01.  "
+             "Every parameter is chosen for the whole set, never per sequence.", "",
+             "## Accuracy of the runs", "",
+             "| run | parameters | model | dev AUC / P@20 | validation AUC / P@20 | 22: AUC / P@20 | 22: mean AUC / mean P@20 | float-fixed within 0.01 |",
+             "|---|---|---|---|---|---|---|---:|"]
+    if cs:
+        a = [summary(cs, w) for w in ("dev", "validation", "all")]
+        lines.append(f"| opencv-csrt | OpenCV defaults | - | {a[0][0]:.3f} / {a[0][1]:.3f} | {a[1][0]:.3f} / {a[1][1]:.3f} | "
+                     f"{a[2][0]:.3f} / {a[2][1]:.3f} | {a[2][2]:.3f} / {a[2][3]:.3f} | |")
+    for tag in tags:
+        sc = {m: seq_scores(load(tag, m)) for m in MODELS}
+        within = sum(abs(sc["float"][n][1] - sc["fixed"][n][1]) <= 0.01 for n in sc["fixed"] if n in sc["float"])
+        par = json.loads((OUT / tag / "params.json").read_text())
+        for m in MODELS:
+            a = [summary(sc[m], w) for w in ("dev", "validation", "all")]
+            lines.append(f"| {tag} | {', '.join(f'{k}={v}' for k, v in par.items()) or 'defaults'} | {m} | "
+                         f"{a[0][0]:.3f} / {a[0][1]:.3f} | {a[1][0]:.3f} / {a[1][1]:.3f} | {a[2][0]:.3f} / {a[2][1]:.3f} | "
+                         f"{a[2][2]:.3f} / {a[2][3]:.3f} | {within if m == 'fixed' else ''} |")
+    lines += [""] + [f"* **{t}**: {notes[t]}" for t in tags if t in notes] + [""]
+    for tag in tags[:2]:
+        lines += [f"## Per sequence, run {tag}", ""] + capture(main_report, tag)[9:] + [""]
+        lines += [f"First frame where the float and fixed centres are more than 4 px apart (run {tag}; "
+                  "decimation and width on the frame before, search state 0 ok / 1 uncertain / 2 lost):", ""]
+        lines += capture(main_diverge, tag, 4.0) + [""]
+    res = {"command": "python studies/accuracy22.py doc", "loss": {}}
+    for tag in tags[:2]:
+        runs = {m: load(tag, m) for m in MODELS}
+        (lr, lc), ins, lo, chosen = loso(runs)
+        p = json.loads((OUT / tag / "params.json").read_text())
+        lines += [f"## Loss flag, run {tag}", "",
+                  "The rule of docs/algorithm.md \"v2.7a Loss flag\" (rho_s < loss_rho rho0 and contrast_s < "
+                  "loss_contrast), re-scored from the kept signals on the grid loss_rho 0.50..1.00, loss_contrast "
+                  "0.00..0.40 (steps 0.01): one pair for float and fixed, the highest lower recall with both "
+                  "false-alarm rates <= 0.05; leave one sequence out: the pair chosen on 21 sequences, scored on "
+                  "the 22nd, counts summed.", "",
+                  "| model | thresholds of the run: recall / false alarms | chosen on 22 (in sample) | leave one sequence out |",
+                  "|---|---|---|---|"]
+        for m in MODELS:
+            arr = loss_arrays(runs[m], m)
+            c = counts(arr, list(arr), p.get("loss_rho", 0.69), p.get("loss_contrast", 0.25), m)
+            lines.append(f"| {m} | {fmt_ld(c)} ({p.get('loss_rho', 0.69)}, {p.get('loss_contrast', 0.25)}) | "
+                         f"{fmt_ld(ins[m])} ({lr:.2f}, {lc:.2f}) | {fmt_ld(lo[m])} |")
+            if tag == tags[0]:
+                res["loss"][m] = {"in_sample": f"{lr:.2f}, {lc:.2f}: {fmt_ld(ins[m])}", "loso": fmt_ld(lo[m])}
+        lines += ["", "Pairs chosen leaving each sequence out: " +
+                  ", ".join(f"{n} ({a:.2f}, {b:.2f})" for n, (a, b) in chosen.items()) + ".", ""]
+    (ROOT / "docs" / "results_accuracy22.md").write_text("\n".join(lines) + "\n")
+    (ROOT / "docs" / "results").mkdir(exist_ok=True)
+    (ROOT / "docs" / "results" / "accuracy22.json").write_text(json.dumps(res, indent=1) + "\n")
+    print(ROOT / "docs" / "results_accuracy22.md")
+
+
+NOTES = {
+    "default": "tracker v2's defaults in both models (the fixed model = core v2).",
+}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("cmd", choices=("run", "report", "diverge", "loss"))
+    ap.add_argument("cmd", choices=("run", "report", "diverge", "loss", "doc"))
+    ap.add_argument("--tags", default="default")
     ap.add_argument("--tag", default="default")
     ap.add_argument("--set", nargs="*", default=[])
     ap.add_argument("--models", default="float,fixed")
     ap.add_argument("--px", type=float, default=4.0)
+    ap.add_argument("--ref", choices=("rho0", "rho_ref"), default="rho0")
     a = ap.parse_args(argv)
+    LOSS_REF["ref"] = a.ref
     if a.cmd == "run":
         main_run(a.tag, parse_sets(a.set), tuple(a.models.split(",")))
     elif a.cmd == "report":
         main_report(a.tag)
     elif a.cmd == "diverge":
         main_diverge(a.tag, a.px)
+    elif a.cmd == "doc":
+        main_doc(a.tags.split(","), NOTES)
     else:
         main_loss(a.tag)
     return 0

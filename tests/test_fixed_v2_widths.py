@@ -138,3 +138,44 @@ def test_wider_formats_track_like_float():
         out[label] = np.array([t.update(f).centre for f in frames[1:]])
     assert np.max(np.abs(out["wide"] - out["float"])) < 2.0
     assert abs(rho0["wide"] - rho0["float"]) <= abs(rho0["fixed"] - rho0["float"])
+
+
+@pytest.mark.parametrize("model", ["float", "fixed"])
+def test_loss_flag_against_running_reference(model):
+    """loss_ref_running (off by default): the loss flag compares the smoothed rho with rho_ref as it
+    was before the frame (the confidence's running reference), not with rho at init; every frame's
+    reported ok is the flag's rule recomputed from the tracker's own values."""
+    from mstrack.fixed.blocks_v2 import ms_loss_flag, q16
+    from mstrack.track.float_v2 import loss_flag
+    from mstrack.track.params import TrackerParams
+
+    frames, gt = _scene(20)
+    flips = 0
+    for running in (False, True):
+        kw = dict(loss_ref_running=running, loss_rho=1.5, loss_contrast=0.9)
+        t = Tracker(model=model, preset="v2", **kw)
+        t.init(frames[0], gt[0])
+        impl = t.impl
+        # a running reference far from rho at init (as after a slow change of the target's look)
+        if model == "fixed":
+            impl.rho_ref = impl.rho0 // 2
+        else:
+            impl._rho_ref = impl._rho0 / 2
+        p = TrackerParams(preset="v2", **kw)
+        for f in frames[1:]:
+            if model == "fixed":
+                ref, rho0 = impl.rho_ref, impl.rho0
+            else:
+                ref, rho0 = impl._rho_ref, impl._rho0
+            r = t.update(f)
+            e = r.extra
+            use = ref if running else rho0
+            if model == "fixed":
+                want = ms_loss_flag(e["rho_s"], use, e["contrast_s"], e["share"], q16(1.5), q16(0.9))
+                other = ms_loss_flag(e["rho_s"], rho0 if running else ref, e["contrast_s"], e["share"], q16(1.5), q16(0.9))
+            else:
+                want = loss_flag(e["rho_s"], e["contrast_s"], use, e["share"], p)
+                other = loss_flag(e["rho_s"], e["contrast_s"], rho0 if running else ref, e["share"], p)
+            assert r.ok == (not want)
+            flips += want != other
+    assert flips > 0  # the two references decide differently on some frames of this scene

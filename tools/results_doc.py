@@ -168,6 +168,11 @@ def sets_section(dev_root: Path, val_root: Path) -> list[str]:
                     set_name, sc.auc, sc.precision20, iou(run.boxes[v], gt[v]), run.ok[v],
                     iou(run.boxes[valid_gt(gt)], gt[valid_gt(gt)]), centre_error(run.boxes[valid_gt(gt)], gt[valid_gt(gt)]))
     from mstrack.eval.metrics import score_frames
+    for model, run in RUNS_VAL.items():  # the validation reports next to the dev ones
+        dst = DOCS / "results" / f"{model}_validation"
+        dst.mkdir(parents=True, exist_ok=True)
+        for f in ("report.md", "report.json"):
+            shutil.copy(run / f, dst / f)
     out = ["## Dev, validation and both (22 sequences)", "",
            "The 10 dev sequences above (`../shared/data/sequences`) and the 12 validation sequences "
            "(`../shared/data/validation`, OTB-100, README there); parameters and thresholds are chosen on "
@@ -177,7 +182,9 @@ def sets_section(dev_root: Path, val_root: Path) -> list[str]:
            "`mstrack eval ../shared/data/validation --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt "
            "--out out/eval_float_validation --quiet`,",
            "`mstrack eval ../shared/data/validation --model fixed --trackers mstrack-v2,mstrack-v2-colour "
-           "--out out/eval_fixed_validation --quiet` (all four run by `make results`).", "",
+           "--out out/eval_fixed_validation --quiet` (all four run by `make results`; their reports: "
+           "[results/float_validation/report.md](results/float_validation/report.md), "
+           "[results/fixed_validation/report.md](results/fixed_validation/report.md)).", "",
            "| tracker | set | sequences | AUC | P@20 | mean AUC | mean P@20 | loss recall / false alarms |",
            "|---|---|---:|---:|---:|---:|---:|---|"]
     for (name, model), d in per.items():

@@ -286,14 +286,15 @@ def ms_scale_test_size(s8: int, d256: int, up: bool) -> int:
     return (s8 * (256 + d256 if up else 256 - d256) + 128) >> 8
 
 
-def ms_scale_test(rho: int, rho_lo: int | None, rho_hi: int | None) -> int:
+def ms_scale_test(rho: int, rho_lo: int | None, rho_hi: int | None, margin: int = 0) -> int:
     """The scale test's verdict from rho at the window x1, x(1 - d), x(1 + d) (Q.16; None: that
-    window did not fit the captured region, it never wins): -1 / 0 / +1, the largest rho, ties to
-    the earlier of (1, 1 - d, 1 + d).  Two 17-bit compares."""
+    window did not fit the captured region, it never wins): -1 / 0 / +1, the largest of rho,
+    rho_lo - margin, rho_hi - margin, ties to the earlier of (1, 1 - d, 1 + d).  ``margin``:
+    round(scale_test_margin 2**16) (default 0: two 17-bit compares; else two subtractions more)."""
     best, v = rho, 0
-    if rho_lo is not None and rho_lo > best:
-        best, v = rho_lo, -1
-    if rho_hi is not None and rho_hi > best:
+    if rho_lo is not None and rho_lo - margin > best:
+        best, v = rho_lo - margin, -1
+    if rho_hi is not None and rho_hi - margin > best:
         v = 1
     return v
 

@@ -181,7 +181,7 @@ class FixedTrackerV2:
             hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
             S = ms_bin_pass(ms_model_scale(self.model.Qn, ker.K, fx.model_frac), hist, fx, fx.model_frac).S
             rhos.append(ms_rho_out(S, ker.K, fx))
-        return ms_scale_test(rho, rhos[0], rhos[1])
+        return ms_scale_test(rho, rhos[0], rhos[1], q16(p.scale_test_margin))
 
     def _box(self) -> Box:
         s = float(1 << self.fixed.centre_frac)
@@ -309,7 +309,8 @@ class FixedTrackerV2:
         ring = ms_ring_share(st, ker.K)
         self.rho_s = ms_loss_filter(self.rho_s, rho, self.loss_k)
         self.con_s = ms_loss_filter(self.con_s, share - ring, self.loss_k)
-        if ms_loss_flag(self.rho_s, self.rho0, self.con_s, share, self.loss_rho16, self.loss_contrast16):
+        ref = self.rho_ref if p.loss_ref_running else self.rho0  # (the running one: before this frame's update)
+        if ms_loss_flag(self.rho_s, ref, self.con_s, share, self.loss_rho16, self.loss_contrast16):
             status = Status.LOST if state == Status.LOST else Status.UNCERTAIN
         else:
             status = Status.REACQUIRED if self.reported_lost else Status.OK

@@ -913,11 +913,11 @@ class FloatTrackerV2:
                     rho: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
         the largest (two more passes at the final centre; ``rho``: the pass at c, hx, hy's)."""
-        d = self.params.scale_test
+        d, m = self.params.scale_test, self.params.scale_test_margin
         best = 1.0
         for s, r in zip((1.0 - d, 1.0 + d), self._rho2(bins, c, hx, hy, (1.0 - d, 1.0 + d))):
-            if r > rho:
-                best, rho = s, r
+            if r - m > rho:  # (margin m: scale_test_margin, 0 by default)
+                best, rho = s, r - m
         return best
 
     # ------------------------------------------------------------------ API
@@ -996,7 +996,8 @@ class FloatTrackerV2:
         state = decide_status(conf, self._lost, p)  # the search state (what the tracker does next)
         self._rho_s = loss_filter(self._rho_s, ps.rho, p)
         self._con_s = loss_filter(self._con_s, ps.share - ps.ring_share, p)
-        flagged = loss_flag(self._rho_s, self._con_s, self._rho0, ps.share, p)  # what it reports (ok False when flagged)
+        ref = self._rho_ref if p.loss_ref_running else self._rho0  # (the running one: before this frame's update)
+        flagged = loss_flag(self._rho_s, self._con_s, ref, ps.share, p)  # what it reports (ok False when flagged)
         status = report_status(state == Status.LOST, flagged, self._reported_lost)
         self._lost = state == Status.LOST
         # a loss stays reported (uncertain frames keep it) until a frame is ok again

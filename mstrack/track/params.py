@@ -138,6 +138,13 @@ class TrackerParams:
         both smoothed by s <- s + loss_smooth (x - s) (1: no smoothing; a power
         of two for the fixed model) (docs/algorithm.md, "v2.7a Loss flag").
         Defaults 0.69 / 0.25 (the joint tracker's); :data:`V2_COLOUR`'s 0.88 / 0.19.
+    scale_test_margin : float
+        The gated scale test's margin (experimental, off by default: 0): a scaled window wins
+        only when its rho exceeds the best so far by more than the margin, so that a verdict
+        does not hang on the last bits of rho (docs/results_accuracy22.md).
+    loss_ref_running : bool
+        Loss flag against the running reference rho_ref (the confidence's, as it is before the
+        frame's update) instead of rho at init (experimental, off by default; docs/results_accuracy22.md).
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -193,6 +200,8 @@ class TrackerParams:
     scale_test_mix: float = 1.0
     scale_test_gate: bool = True
     orient_T: int = 64
+    loss_ref_running: bool = False
+    scale_test_margin: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -225,7 +234,8 @@ class TrackerParams:
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
                                  ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
-                                 ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0)):
+                                 ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
+                                 ("scale_test_margin", 0.0, 0.5)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:

@@ -179,3 +179,27 @@ def test_loss_flag_against_running_reference(model):
             assert r.ok == (not want)
             flips += want != other
     assert flips > 0  # the two references decide differently on some frames of this scene
+
+
+@pytest.mark.parametrize("jx,jy", [(100, 0), (0, 100)])
+def test_widened_search_reacquires_a_jump_beyond_the_default_reach(jx, jy):
+    """search_widen 2 (off by default): a 40 px target that jumps 100 px, beyond the default
+    search's 75 px reach (tests/test_float_v2.py::test_jump_beyond_search_reach), is found again
+    after a few lost frames at decimation 4: float v2 on every seed; the fixed model with the wider
+    model formats (at model_frac 0 the 12 px window at D 4 floors most of the model to 0) on the
+    horizontal jump.  Measured: float IoU >= 0.97 over the last 5 frames."""
+    from test_float_v2 import SEEDS, _boxes, _jump_scene
+
+    from mstrack.eval.metrics import iou
+    for seed in SEEDS:
+        frames, gt = _jump_scene(seed, jx, jy)
+        runs = [("float", {})] + ([("fixed", dict(model_frac=4, bg_frac=16, weight_frac=8))] if jy == 0 else [])
+        for model, kw in runs:
+            t = Tracker(model=model, preset="v2", search_widen=2, **kw)
+            res = [t.init(frames[0], gt[0])] + [t.update(f) for f in frames[1:]]
+            assert max(r.extra["decimation"] for r in res[20:]) == 4, model
+            assert res[-1].ok and iou(_boxes(res[-5:]), gt[-5:]).min() > 0.9, (model, seed)
+            if model == "float":  # without the widening it stays lost
+                t = Tracker(model=model, preset="v2")
+                res = [t.init(frames[0], gt[0])] + [t.update(f) for f in frames[1:]]
+                assert not res[-1].ok

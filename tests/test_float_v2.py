@@ -494,7 +494,9 @@ def test_jump_reacquired_by_wide_search(seed, jx, jy):
     "by design: the wide search starts one window size (search_step) from the last centre and "
     "does not widen while lost, so it reaches +-(search_step * 2 hx + hx) = 75 px of a 40 px "
     "target's last centre; a 100 or 150 px jump leaves the target outside every start window and "
-    "the tracker stays LOST (confidence 0, box at the last place) to the end of the sequence"))
+    "the tracker stays LOST (confidence 0, box at the last place) to the end of the sequence; the "
+    "experimental search_widen (off by default) reaches 100 px: "
+    "tests/test_fixed_v2_widths.py::test_widened_search_reacquires_a_jump_beyond_the_default_reach"))
 @pytest.mark.parametrize("jx", [100, 150])
 def test_jump_beyond_search_reach(jx):
     frames, gt = _jump_scene(0, jx, 0)

@@ -190,6 +190,16 @@ def ms_ring_share(st: TargetStats, K: int) -> int:
     return int(ms_divider((st.nt - st.nt_in) << 16, den, 17)) if den > 0 else 0
 
 
+def ms_lost_decimation(d0: int, lost_n: int, widen: int) -> int:
+    """The decimation after ``lost_n`` consecutive lost frames: d0 while tracking; 2 d0, shifted
+    left once more every ``widen`` lost frames (search_widen; 0: never), at most max(16, 2 d0).
+    A lost-frame counter, one compare per frame (widen a power of two: a shift)."""
+    if lost_n <= 0:
+        return d0
+    k = 1 + ((lost_n - 1) // widen if widen > 0 else 0)
+    return max(min(d0 << k, 16), 2 * d0)
+
+
 def ms_loss_filter(s: int, x: int, k: int) -> int:
     """One step of the loss flag's smoothing: s + ((x - s) >> k) (arithmetic shift = floor).
 

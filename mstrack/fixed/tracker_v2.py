@@ -29,7 +29,7 @@ from ..track.types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_grey, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
 from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,
-                        ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+                        ms_loss_flag, ms_lost_decimation, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
                         ORIENT_FLAT,
@@ -237,6 +237,7 @@ class FixedTrackerV2:
         sp = ms_spread(st)
         self.spread_ref = sp if sp > 0 else ((128 << (fx.kernel_bits + 16)) // (16 + self.pad16) ** 2)
         self.lost = False
+        self.lost_n = 0  # consecutive lost frames (the search's decimation)
         self.reported_lost = False
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
                "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
@@ -267,7 +268,9 @@ class FixedTrackerV2:
         frame = check_frame(frame, self._shape)
         p, fx = self.params, self.fixed
         cf = fx.centre_frac
-        d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
+        d0 = ms_decimation(self.w8, self.h8, self.pad16, p.max_window)
+        d = ms_lost_decimation(d0, self.lost_n, p.search_widen)
+        reach = d // (2 * d0) if self.lost else 1  # the widened search (search_widen; 1 without it)
         sh = d.bit_length() - 1
         img = frame[::d, ::d]
         wd, hd = self._geometry(d, img.shape[:2])
@@ -275,7 +278,7 @@ class FixedTrackerV2:
         Qw = ms_model_scale(self.model.Qn, ker.K, fx.model_frac)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost
-        ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
+        ox, oy = ((self.step16 * wd) >> 4) * reach, ((self.step16 * hd) >> 4) * reach
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
         reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
         sub = self._capture(img, reg, frame, d)
@@ -315,6 +318,7 @@ class FixedTrackerV2:
         else:
             status = Status.REACQUIRED if self.reported_lost else Status.OK
         self.lost = state == Status.LOST
+        self.lost_n = self.lost_n + 1 if self.lost else 0
         self.reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self.reported_lost)
         self.c8 = (c8d[0] << sh, c8d[1] << sh)
         if state == Status.OK:

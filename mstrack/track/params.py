@@ -142,6 +142,11 @@ class TrackerParams:
         The gated scale test's margin (experimental, off by default: 0): a scaled window wins
         only when its rho exceeds the best so far by more than the margin, so that a verdict
         does not hang on the last bits of rho (docs/results_accuracy22.md).
+    search_widen : int
+        Widening of the wide search (experimental, off by default: 0): while lost, the search's
+        decimation (2 D) doubles again after every ``search_widen`` lost frames, up to 16 (the
+        region RAM's bound), so that its start points reach 2x, 4x ... as far at the same memory
+        (docs/results_accuracy22.md).
     loss_ref_running : bool
         Loss flag against the running reference rho_ref (the confidence's, as it is before the
         frame's update) instead of rho at init (experimental, off by default; docs/results_accuracy22.md).
@@ -202,6 +207,7 @@ class TrackerParams:
     orient_T: int = 64
     loss_ref_running: bool = False
     scale_test_margin: float = 0.0
+    search_widen: int = 0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -242,6 +248,8 @@ class TrackerParams:
                 raise ValueError("conf_lost must be <= conf_uncertain")
             if not 7 <= self.max_window <= 1023:
                 raise ValueError("max_window must be in 7..1023")
+            if self.search_widen < 0:
+                raise ValueError("search_widen must be >= 0")
             if self.search_iter < 1:
                 raise ValueError("search_iter must be >= 1")
             if not 0 <= self.orient_T <= 2040:

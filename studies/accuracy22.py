@@ -366,25 +366,34 @@ def main_doc(tags: list[str], notes: dict[str, str]) -> None:
     res = {"command": "python studies/accuracy22.py doc", "loss": {}}
     for tag in tags[:2]:
         runs = {m: load(tag, m) for m in MODELS}
-        (lr, lc), ins, lo, chosen = loso(runs)
         p = json.loads((OUT / tag / "params.json").read_text())
         lines += [f"## Loss flag, run {tag}", "",
-                  "The rule of docs/algorithm.md \"v2.7a Loss flag\" (rho_s < loss_rho rho0 and contrast_s < "
-                  "loss_contrast), re-scored from the kept signals on the grid loss_rho 0.50..1.00, loss_contrast "
-                  "0.00..0.40 (steps 0.01): one pair for float and fixed, the highest lower recall with both "
-                  "false-alarm rates <= 0.05; leave one sequence out: the pair chosen on 21 sequences, scored on "
-                  "the 22nd, counts summed.", "",
-                  "| model | thresholds of the run: recall / false alarms | chosen on 22 (in sample) | leave one sequence out |",
-                  "|---|---|---|---|"]
-        for m in MODELS:
-            arr = loss_arrays(runs[m], m)
-            c = counts(arr, list(arr), p.get("loss_rho", 0.69), p.get("loss_contrast", 0.25), m)
-            lines.append(f"| {m} | {fmt_ld(c)} ({p.get('loss_rho', 0.69)}, {p.get('loss_contrast', 0.25)}) | "
-                         f"{fmt_ld(ins[m])} ({lr:.2f}, {lc:.2f}) | {fmt_ld(lo[m])} |")
-            if tag == tags[0]:
-                res["loss"][m] = {"in_sample": f"{lr:.2f}, {lc:.2f}: {fmt_ld(ins[m])}", "loso": fmt_ld(lo[m])}
-        lines += ["", "Pairs chosen leaving each sequence out: " +
-                  ", ".join(f"{n} ({a:.2f}, {b:.2f})" for n, (a, b) in chosen.items()) + ".", ""]
+                  "The rule of docs/algorithm.md \"v2.7a Loss flag\" (rho_s < loss_rho ref and contrast_s < "
+                  "loss_contrast; ref = rho0, rho at init, the tracker's rule, or rho_ref, the running reference "
+                  "before the frame's update, `loss_ref_running`), re-scored from the kept signals on the grid "
+                  "loss_rho 0.50..1.00, loss_contrast 0.00..0.40 (steps 0.01): one pair for float and fixed, the "
+                  "highest lower recall with both false-alarm rates <= 0.05; leave one sequence out: the pair "
+                  "chosen on 21 sequences, scored on the 22nd, counts summed.  Cells: recall / false alarms.", "",
+                  "| model | ref | thresholds of the run (0.69, 0.25) | chosen on 22 (in sample) | leave one sequence out |",
+                  "|---|---|---|---|---|"]
+        chosen_all = {}
+        for ref in ("rho0", "rho_ref"):
+            LOSS_REF["ref"] = ref
+            (lr, lc), ins, lo, chosen = loso(runs)
+            chosen_all[ref] = chosen
+            for m in MODELS:
+                arr = loss_arrays(runs[m], m)
+                c = counts(arr, list(arr), p.get("loss_rho", 0.69), p.get("loss_contrast", 0.25), m)
+                lines.append(f"| {m} | {ref} | {fmt_ld(c)} | {fmt_ld(ins[m])} ({lr:.2f}, {lc:.2f}) | {fmt_ld(lo[m])} |")
+                if tag == tags[0]:
+                    res["loss"][f"{m}, ref {ref}"] = {"in_sample": f"{lr:.2f}, {lc:.2f}: {fmt_ld(ins[m])}",
+                                                     "loso": fmt_ld(lo[m])}
+        LOSS_REF["ref"] = "rho0"
+        for ref, chosen in chosen_all.items():
+            lines += ["", f"Pairs chosen leaving each sequence out (ref {ref}): " +
+                      ", ".join(f"{n} ({a:.2f}, {b:.2f})" for n, (a, b) in chosen.items()) + "."]
+        lines.append("")
+    lines += ["## Findings", ""] + [f"* {f}" for f in FINDINGS] + [""]
     (ROOT / "docs" / "results_accuracy22.md").write_text("\n".join(lines) + "\n")
     (ROOT / "docs" / "results").mkdir(exist_ok=True)
     (ROOT / "docs" / "results" / "accuracy22.json").write_text(json.dumps(res, indent=1) + "\n")
@@ -392,8 +401,59 @@ def main_doc(tags: list[str], notes: dict[str, str]) -> None:
 
 
 NOTES = {
-    "default": "tracker v2's defaults in both models (the fixed model = core v2).",
+    "defaults": "tracker v2's defaults in both models (the fixed model = core v2).",
+    "wide": "the defaults with the fixed model's wider formats model_frac 4, bg_frac 16, weight_frac 8 "
+            "(FixedParams; float unchanged).  Every run below uses them in the fixed model.",
+    "stm2": "gated scale test margin 0.002 (scale_test_margin).",
+    "stm5": "gated scale test margin 0.005.",
+    "sr0": "no pull toward the init size (scale_reg 0).",
+    "sr03": "scale_reg 0.03.",
+    "sg5sr03": "scale_gain 0.5, scale_reg 0.03.",
+    "sw2": "widened search while lost (search_widen 2).",
+    "lref": "loss flag against the running reference (loss_ref_running) at 0.91 / 0.13, the pair chosen "
+            "for it on the 22 (the boxes are those of defaults: the flag does not steer the tracker).",
 }
+
+
+#: what the runs above show (each item names the run and table it rests on)
+FINDINGS = [
+    "**v2 is below CSRT on the 22** (mean AUC 0.499 / 0.501 float / fixed against 0.563, mean P@20 "
+    "0.718 / 0.713 against 0.796): ahead on the dev set, behind on validation (Car1, Car4, David, Dog1 most).",
+    "**Where float and fixed part (run defaults, divergence table).**  On Car4, Deer and Woman on the first "
+    "frame: rho at init differs by up to 0.23 (Car4 0.794 float, 0.565 fixed).  Two formats of the fixed "
+    "model's init model and bin pass cause it: (1) ms_bg_model's CBWH factors in Q.8 set v = 0 for every ring "
+    "colour more than 256x as frequent as the rarest (large rings: Car1, Car4, Suv, Deer, David); (2) "
+    "ms_model_scale's integer Qw = (Qn K) >> 16 floors most of 4,608 joint bins to 0 in windows of a few "
+    "thousand pixels (Football1, Couple, Surfer, ball1_vot).  With 16 bits for v (bg_frac), 4 fraction "
+    "bits for Qw (model_frac) and a 4.8 weight (weight_frac 8) the init rho differs by at most 0.01 on 15 of 22 "
+    "sequences and 0.02 on 20 (0 of 22 at the core's formats; ClifBar keeps 0.053) and float and fixed stay within 0.01 AUC on 15 of 22 "
+    "sequences instead of 7 (run wide); Car4's gap goes from -0.129 to -0.000, Football1's from -0.192 "
+    "to -0.005.",
+    "**What still parts them (run wide).**  Decision points hit by rounding: the gated scale test's verdict "
+    "(Freeman1: the fixed model takes a size step on frame 50 that float does not; Girl frame 37), the "
+    "search state from the confidence (Girl, Jogging-1), and the init box itself (ball1_vot: float keeps "
+    "23.5 px, fixed rounds to 24).  A margin on the scale test (runs stm2, stm5) does not help: 10 and 12 "
+    "of 22 within 0.01 (the count moves by several sequences with any small change: the remaining gaps "
+    "are losses and recoveries that happen in one model and not the other).",
+    "**Car4, Car1 (grey, the target shrinks to 63 % / 42 % of its init size)**: the box stays near its init "
+    "size (the pull toward w0, scale_reg 0.1, and the gated test's vetoes), the oversized window takes in "
+    "the road and drifts off (Car4: IoU 0.59 at frame 100, 0.19 at 150; Car1 lost at about frame 200).  "
+    "Without the pull (run sr0) Car1 goes from 0.353 to 0.568 (float) and Freeman1 from 0.181 to 0.496, "
+    "but Suv falls from 0.590 to 0.106 and the 22's mean AUC from 0.499 to 0.459; scale_reg 0.03 and "
+    "scale_gain 0.5 (runs sr03, sg5sr03) are also worse on the whole set.  **David** (illumination, the "
+    "face darkens): the confidence falls below conf_lost from frame 12 and the tracker alternates between "
+    "search and tracking with IoU 0.25..0.4 throughout; a grey or chromaticity remedy was not measured.",
+    "**Widened search (run sw2)**: re-acquires a 100 px jump on synthetic frames "
+    "(tests/test_fixed_v2_widths.py), but on real video the lost state is frequent and a wider search "
+    "jumps to distractors: mean AUC 0.407 / 0.431 (float / fixed) against 0.499 / 0.509.",
+    "**Loss flag**: no pair of the two thresholds reaches recall 0.6 at false alarms <= 0.05 on the 22, in "
+    "sample or out (best in sample 0.36 / 0.38 at 0.048 / 0.042 against rho0).  Comparing with the running "
+    "reference rho_ref (loss_ref_running) keeps the pair stable when a sequence is left out (0.90..0.94 / "
+    "0.11..0.16; false alarms out of sample 0.064 / 0.068 against 0.145 / 0.135) but does not raise recall "
+    "(0.35 / 0.41).  The off-target frames the flag misses sit on same-coloured background or distractors "
+    "(Car1 63 frames, Bolt2 39, ClifBar 32: rho_s / rho0 0.76..0.92 there); most false alarms are Woman's "
+    "(135 of its 210 on-target frames: rho_s / rho0 0.55, the target's look changes after frame 1).",
+]
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -248,7 +248,8 @@ def test_v2_follows_a_shift(dx, dy):
     "the truth for (8, 8)), and the mean-shift loop stops at the first step that lowers rho "
     "(paper rule), so it halts up to 3.1 px short of the optimum (the share of target-coloured "
     "pixels, 0.89 there against 0.996 at the truth, would still show the way); repeated updates "
-    "on the same frame stay there for (6, 6), (0, 8), (-8, -8)"))
+    "on the same frame stay there for (6, 6), (0, 8), (-8, -8); the experimental rho_stop_margin "
+    "(off by default) converges: tests/test_fixed_v2_widths.py::test_rho_stop_margin_crosses_the_flat_top_of_rho"))
 @pytest.mark.parametrize("dx,dy", [(6, 6), (0, 8), (-8, -8)])
 def test_v2_converges_to_a_shift(dx, dy):
     err, _ = _shift_error(dx, dy, n_updates=3)

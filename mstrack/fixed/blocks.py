@@ -339,7 +339,7 @@ def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: 
 
     c0 = clamp(start); pass at round(c0) -> S0, sums.  Iteration i = 1..max_iter:
     Sw = 0 -> stop "lost" (keep c0); c1 = centre(sums); pass at round(c1) -> S1;
-    S1 < S0 -> stop "rho" (keep c0, S0); shift2 = |c1 - c0|^2 (Q.2CF);
+    S1 < S0 - m -> stop "rho" (keep c0, S0; m = 0 unless tracker v2's rho_stop_margin); shift2 = |c1 - c0|^2 (Q.2CF);
     c0 = c1; shift2 < EPS2 -> stop "shift"; after max_iter -> "max_iter".
     """
     cf = fp.centre_frac
@@ -358,6 +358,9 @@ def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: 
                        "Sw": bp.Sw, "Swx": bp.Swx, "Swy": bp.Swy})
         return win, h, bp
 
+    # tracker v2's rho_stop_margin (0 by default, and for the paper preset): rho margin m in S's
+    # units, S = rho K 2**(RF - 16): (round(m 2**16) K) >> (16 - RF), one multiplier per frame
+    m_s = (int(round(getattr(tp, "rho_stop_margin", 0.0) * 65536)) * ker.K) >> (16 - fp.rho_frac)
     c0 = clamp_centre(start8, reg, cf)
     win0, _, bp0 = run_pass(c0)
     for it in range(1, tp.max_iter + 1):
@@ -365,7 +368,7 @@ def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: 
         if c1 is None:
             return FeatureFixed(c0, bp0.S, it, "lost", tr)
         win1, _, bp1 = run_pass(c1)
-        if bp1.S < bp0.S:
+        if bp1.S < bp0.S - m_s:
             return FeatureFixed(c0, bp0.S, it, "rho", tr)
         shift2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
         c0, win0, bp0 = c1, win1, bp1

@@ -713,7 +713,7 @@ def meanshift_v2(bins: np.ndarray | LazyBins, n_bins: int, q: np.ndarray, t: np.
             break
         c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
         p1 = window_pass(bins, n_bins, q, t, c1, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
-        if p1.rho < p0.rho:
+        if p1.rho < p0.rho - p.rho_stop_margin:  # (rho_stop_margin: 0 by default)
             break
         s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
         c0, p0 = c1, p1
@@ -811,7 +811,7 @@ class FloatTrackerV2:
 
     def active_path(self) -> str:
         """The path :meth:`update` runs now: "numpy" or "numba"."""
-        if self.path == "numpy":
+        if self.path == "numpy" or self.params.rho_stop_margin > 0:  # (the numba kernel has no margin)
             return "numpy"
         if self._use_numba:  # (the self-check's own run)
             return "numba"

@@ -142,6 +142,11 @@ class TrackerParams:
         The gated scale test's margin (experimental, off by default: 0): a scaled window wins
         only when its rho exceeds the best so far by more than the margin, so that a verdict
         does not hang on the last bits of rho (docs/results_accuracy22.md).
+    rho_stop_margin : float
+        The mean shift's rho stop with a margin (experimental, off by default: 0): a step is
+        refused only when rho falls by more than the margin, so that the loop crosses the flat top
+        of rho (where the padded window holds the whole target) instead of halting short of the
+        optimum (docs/results_accuracy22.md).  The float model then runs its numpy path.
     search_widen : int
         Widening of the wide search (experimental, off by default: 0): while lost, the search's
         decimation (2 D) doubles again after every ``search_widen`` lost frames, up to 16 (the
@@ -208,6 +213,7 @@ class TrackerParams:
     loss_ref_running: bool = False
     scale_test_margin: float = 0.0
     search_widen: int = 0
+    rho_stop_margin: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -241,7 +247,7 @@ class TrackerParams:
                                  ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
                                  ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
-                                 ("scale_test_margin", 0.0, 0.5)):
+                                 ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:

@@ -3,6 +3,7 @@ VENV    ?= .venv
 PY      := $(VENV)/bin/python
 DATASET ?= ../shared/data/sequences
 MULTI_DATASET ?= ../shared/data/multi
+VALIDATION ?= ../shared/data/validation
 ARGS    ?=
 
 # Compiled bytecode goes to build/pycache.  The machines may set PYTHONDONTWRITEBYTECODE; then every
@@ -105,8 +106,10 @@ eval: setup
 results: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval_float --quiet
 	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
-	$(PY) tools/results_doc.py
+	$(VENV)/bin/mstrack eval $(VALIDATION) --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt --out out/eval_float_validation --quiet
+	$(VENV)/bin/mstrack eval $(VALIDATION) --model fixed --trackers mstrack-v2,mstrack-v2-colour --out out/eval_fixed_validation --quiet
 	$(MAKE) --no-print-directory results-multi
+	$(PY) tools/results_doc.py $(DATASET) $(VALIDATION)
 
 .PHONY: results-multi
 # the multi-target section (docs/results_multi.md, linked from docs/results.md): mstrack-v2 float and fixed,

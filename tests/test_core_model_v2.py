@@ -95,7 +95,12 @@ def test_bad_frame_while_lost_keeps_searching() -> None:
 
 @pytest.mark.parametrize("kw,what", [({"motion_gain": 0.5}, "motion_gain"),
                                      ({"scale_test": 0.05, "scale_test_gate": False}, "scale_test without scale_test_gate"),
-                                     ({"orient_T": 64, "motion_gain": 0.5}, "motion_gain")])
+                                     ({"orient_T": 64, "motion_gain": 0.5}, "motion_gain"),
+                                     ({"loss_ref_running": True}, "loss_ref_running"),
+                                     ({"scale_test_margin": 0.005}, "scale_test_margin"),
+                                     ({"search_widen": 2}, "search_widen"),
+                                     ({"rho_stop_margin": 0.002}, "rho_stop_margin"),
+                                     ({"model_frac": 4}, "model_frac"), ({"bg_frac": 16}, "bg_frac")])
 def test_core_config_v2_refuses_options_without_rtl(kw, what):
     """The experimental v2 options without RTL (motion_gain; the ungated scale test) are in
     the float (and fixed) models only: a core configuration for them is refused with a one-line
@@ -103,8 +108,9 @@ def test_core_config_v2_refuses_options_without_rtl(kw, what):
     from mstrack.fixed.formats import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import TrackerParams
+    fp, kw = FixedParams.split(kw)
     with pytest.raises(ValueError, match="no RTL yet for " + what):
-        CoreConfigV2(TrackerParams(preset="v2", **kw), FixedParams())
+        CoreConfigV2(TrackerParams(preset="v2", **kw), fp)
 
 
 def test_core_config_v2_joint():

@@ -248,7 +248,8 @@ def test_v2_follows_a_shift(dx, dy):
     "the truth for (8, 8)), and the mean-shift loop stops at the first step that lowers rho "
     "(paper rule), so it halts up to 3.1 px short of the optimum (the share of target-coloured "
     "pixels, 0.89 there against 0.996 at the truth, would still show the way); repeated updates "
-    "on the same frame stay there for (6, 6), (0, 8), (-8, -8)"))
+    "on the same frame stay there for (6, 6), (0, 8), (-8, -8); the experimental rho_stop_margin "
+    "(off by default) converges: tests/test_fixed_v2_widths.py::test_rho_stop_margin_crosses_the_flat_top_of_rho"))
 @pytest.mark.parametrize("dx,dy", [(6, 6), (0, 8), (-8, -8)])
 def test_v2_converges_to_a_shift(dx, dy):
     err, _ = _shift_error(dx, dy, n_updates=3)
@@ -494,7 +495,9 @@ def test_jump_reacquired_by_wide_search(seed, jx, jy):
     "by design: the wide search starts one window size (search_step) from the last centre and "
     "does not widen while lost, so it reaches +-(search_step * 2 hx + hx) = 75 px of a 40 px "
     "target's last centre; a 100 or 150 px jump leaves the target outside every start window and "
-    "the tracker stays LOST (confidence 0, box at the last place) to the end of the sequence"))
+    "the tracker stays LOST (confidence 0, box at the last place) to the end of the sequence; the "
+    "experimental search_widen (off by default) reaches 100 px: "
+    "tests/test_fixed_v2_widths.py::test_widened_search_reacquires_a_jump_beyond_the_default_reach"))
 @pytest.mark.parametrize("jx", [100, 150])
 def test_jump_beyond_search_reach(jx):
     frames, gt = _jump_scene(0, jx, 0)

@@ -12,7 +12,12 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 RUNS = {"float": REPO / "out" / "eval_float", "fixed": REPO / "out" / "eval_fixed"}
+#: the validation set's runs (`make results`: v2, v2-colour and CSRT; not the paper trackers)
+RUNS_VAL = {"float": REPO / "out" / "eval_float_validation", "fixed": REPO / "out" / "eval_fixed_validation"}
 DOCS = REPO / "docs"
+DATA = REPO.parent / "shared" / "data"
+SETS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-colour", "float"),
+                 ("mstrack-v2-colour", "fixed"), ("opencv-csrt", "float"))
 
 
 def section(md: str, title: str) -> str:
@@ -129,6 +134,93 @@ def loss_section(seq_root: Path, totals: dict | None = None) -> list[str]:
     return out + [""]
 
 
+def sets_section(dev_root: Path, val_root: Path) -> list[str]:
+    """Dev (10), validation (12) and both (22 sequences): AUC and P@20 frame-weighted and as the
+    plain mean over sequences, and the loss flag's recall / false alarms, per tracker, from the
+    cached per-sequence runs of the four `make results` commands; the loss thresholds' leave-one-
+    sequence-out figures from docs/results/accuracy22.json (studies/accuracy22.py doc) when present."""
+    import json
+
+    import numpy as np
+
+    sys.path.insert(0, str(REPO))
+    from mstrack.eval.evaluate import SequenceRun
+    from mstrack.eval.metrics import centre_error, iou, loss_detection, score, valid_gt
+    from mstrack.io.data import load_dataset
+
+    sets = {"dev": (dev_root, RUNS), "validation": (val_root, RUNS_VAL)}
+    per: dict[tuple[str, str], dict[str, tuple[str, float, float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]] = {}
+    for set_name, (root, runs) in sets.items():
+        if not root.is_dir():
+            return [f"(dev / validation table: {root} not found)", ""]
+        for seq in load_dataset(root):
+            for name, model in SETS_TRACKERS:
+                label = name if model == "float" else f"{name}@fixed"
+                f = runs[model] / "results" / label / f"{seq.name}.json"
+                if not f.is_file():
+                    return [f"(dev / validation table: {f.relative_to(REPO)} missing; run `make results`)", ""]
+                run = SequenceRun.from_json(json.loads(f.read_text()))
+                gt = np.asarray(seq.gt[:run.n_frames], dtype=np.float64)
+                sc = score(run.boxes, gt)
+                v = valid_gt(gt)
+                v[0] = False  # the init frame says nothing about loss detection
+                per.setdefault((name, model), {})[seq.name] = (
+                    set_name, sc.auc, sc.precision20, iou(run.boxes[v], gt[v]), run.ok[v],
+                    iou(run.boxes[valid_gt(gt)], gt[valid_gt(gt)]), centre_error(run.boxes[valid_gt(gt)], gt[valid_gt(gt)]))
+    from mstrack.eval.metrics import score_frames
+    for model, run in RUNS_VAL.items():  # the validation reports next to the dev ones
+        dst = DOCS / "results" / f"{model}_validation"
+        dst.mkdir(parents=True, exist_ok=True)
+        for f in ("report.md", "report.json"):
+            shutil.copy(run / f, dst / f)
+    out = ["## Dev, validation and both (22 sequences)", "",
+           "The 10 dev sequences above (`../shared/data/sequences`) and the 12 validation sequences "
+           "(`../shared/data/validation`, OTB-100, README there); parameters and thresholds are chosen on "
+           "both together, never per sequence; CI tests use the dev set only.  AUC and P@20 frame-weighted, "
+           "and the plain mean of the per-sequence figures; loss flag: recall / false alarms of `ok` as in "
+           "the loss table.  Commands: the two above and",
+           "`mstrack eval ../shared/data/validation --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt "
+           "--out out/eval_float_validation --quiet`,",
+           "`mstrack eval ../shared/data/validation --model fixed --trackers mstrack-v2,mstrack-v2-colour "
+           "--out out/eval_fixed_validation --quiet` (all four run by `make results`; their reports: "
+           "[results/float_validation/report.md](results/float_validation/report.md), "
+           "[results/fixed_validation/report.md](results/fixed_validation/report.md)).", "",
+           "| tracker | set | sequences | AUC | P@20 | mean AUC | mean P@20 | loss recall / false alarms |",
+           "|---|---|---:|---:|---:|---:|---:|---|"]
+    for (name, model), d in per.items():
+        label = name if model == "float" else f"{name}@fixed"
+        for which in ("dev", "validation", "both"):
+            part = [x for x in d.values() if which == "both" or x[0] == which]
+            s = score_frames(np.concatenate([x[5] for x in part]), np.concatenate([x[6] for x in part]))
+            ld = loss_detection(np.concatenate([x[3] for x in part]), np.concatenate([x[4] for x in part]))
+            loss = "-" if name.startswith("opencv") else f"{ld.recall:.2f} / {ld.false_alarm:.3f}"
+            out.append(f"| {label} | {which} | {len(part)} | {s.auc:.3f} | {s.precision20:.3f} | "
+                       f"{np.mean([x[1] for x in part]):.3f} | {np.mean([x[2] for x in part]):.3f} | {loss} |")
+    labels = [(n, m) for n, m in SETS_TRACKERS if (n, m) in per]
+    out += ["", "Per sequence AUC (v2 float, v2 fixed, float - fixed gap, CSRT):", "",
+            "| sequence | set | mstrack-v2 | mstrack-v2@fixed | gap | opencv-csrt |", "|---|---|---:|---:|---:|---:|"]
+    f_, x_, c_ = per[("mstrack-v2", "float")], per[("mstrack-v2", "fixed")], per[("opencv-csrt", "float")]
+    within = 0
+    for sname in f_:
+        gap = x_[sname][1] - f_[sname][1]
+        within += abs(gap) <= 0.01
+        out.append(f"| {sname} | {f_[sname][0]} | {f_[sname][1]:.3f} | {x_[sname][1]:.3f} | {gap:+.3f} | {c_[sname][1]:.3f} |")
+    out += ["", f"Float and fixed v2 within 0.01 AUC on {within} of {len(f_)} sequences.", ""]
+    loso = DOCS / "results" / "accuracy22.json"
+    if loso.is_file():
+        j = json.loads(loso.read_text())
+        out += [f"Loss thresholds, leave one sequence out over the 22 (`{j['command']}`; thresholds chosen on 21 "
+                "sequences, max recall at false alarms <= 0.05 for float and fixed together, scored on the 22nd, "
+                "counts summed): [results_accuracy22.md](results_accuracy22.md).", "",
+                "| model | in sample: thresholds, recall / false alarms | leave one sequence out: recall / false alarms |",
+                "|---|---|---|"]
+        for m, r in j["loss"].items():
+            out.append(f"| {m} | {r['in_sample']} | {r['loso']} |")
+        out.append("")
+    del labels
+    return out
+
+
 def _bench_all(path: Path, column: str) -> tuple[str, str]:
     """(value, date) of ``column`` in the "all" row (or the only row) of a `mstrack bench` table."""
     if not path.is_file():
@@ -187,7 +279,7 @@ def targets_section(totals: dict) -> list[str]:
     ok = fps not in ("-", "") and float(fps) >= 200
     rows.append(("fixed v2 >= 200 frames/s at 640x360, 64x64 target (docs/bench_synthetic.md)",
                  f"{fps} fps ({date})", yes(ok)))
-    out = ["## Targets (default tracker v2, `mstrack-v2`)", "",
+    out = ["## Targets on the dev set (default tracker v2, `mstrack-v2`)", "",
            "From the runs above (AUC: frame-weighted overall, or the plain mean of the per-sequence AUCs), "
            "the loss table, and the speed benchmarks in docs/bench.md and docs/bench_synthetic.md (their "
            "dates in brackets).  Parameters are chosen once for the whole set; the loss thresholds were "
@@ -198,12 +290,26 @@ def targets_section(totals: dict) -> list[str]:
 
 
 #: The link to the multi-target results (tools/results_multi_doc.py writes docs/results_multi.md).
-MULTI_SECTION = ["## Several targets (MOT sequences)", "",
-                 "Multi-target tracking (`mstrack.MultiTracker`, docs/multi.md) on the two MOT sequences of "
-                 "`../shared/data/multi`: float and fixed mstrack-v2 against OpenCV CSRT and KCF, per target, per "
-                 "sequence and overall (AUC, P@20, HOTA, MOTA, IDF1, ID switches, the loss table), and the "
-                 "per-target update speed of the float MultiTracker against CamShift's: "
-                 "[results_multi.md](results_multi.md) (`make results-multi`, part of `make results`).", ""]
+def multi_section(page: Path = Path(__file__).resolve().parents[1] / "docs" / "results_multi.md") -> list[str]:
+    """The multi-target section: the overall table of docs/results_multi.md (written by
+    tools/results_multi_doc.py, `make results-multi`, which `make results` runs first) and a link to it."""
+    out = ["## Several targets (MOT sequences)", "",
+           "Multi-target tracking (`mstrack.MultiTracker`, docs/multi.md) on the two MOT sequences of "
+           "`../shared/data/multi`: float and fixed mstrack-v2 against OpenCV CSRT and KCF (one instance per "
+           "target), both sequences together.  Per sequence and per target, the protocol, the commands and the "
+           "per-target update speed of the float MultiTracker against CamShift's: "
+           "[results_multi.md](results_multi.md).", ""]
+    lines = page.read_text().splitlines() if page.exists() else []
+    start = next((i for i, ln in enumerate(lines) if ln.startswith("## Overall")), None)
+    if start is None:
+        return out + ["(no multi-target results yet: run `make results-multi`)", ""]
+    table = []
+    for ln in lines[start + 1:]:
+        if ln.startswith("|"):
+            table.append(ln)
+        elif table:
+            break
+    return out + table + [""]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -233,11 +339,12 @@ def main(argv: list[str] | None = None) -> int:
     seq_root = Path(argv[0]) if argv else REPO.parent / "shared" / "data" / "sequences"
     totals: dict = {}
     out += loss_section(seq_root, totals) if seq_root.is_dir() else [f"(loss table: {seq_root} not found)", ""]
+    out += sets_section(seq_root, Path(argv[1]) if len(argv) > 1 else DATA / "validation")
     try:
         out += targets_section(totals)
     except KeyError as exc:  # a run without the trackers the targets name
         out += [f"(targets: no run of {exc} in the reports; run `make results`)", ""]
-    out += MULTI_SECTION
+    out += multi_section()
     out += ["## Reading the numbers", "",
             "* **Tracker v2** (`preset=\"v2\"`, tracker `mstrack-v2`, the default; "
             "docs/algorithm.md \"Tracker v2\", fixed-point model docs/fixed_point.md \"Tracker v2\") is "

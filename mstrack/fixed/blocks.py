@@ -286,15 +286,21 @@ def ms_weight(Q: np.ndarray, H: np.ndarray, fp: FixedParams) -> np.ndarray:
     return w
 
 
-def ms_bin_pass(Q: np.ndarray, hist: Hist, fp: FixedParams) -> BinPass:
+def ms_bin_pass(Q: np.ndarray, hist: Hist, fp: FixedParams, q_frac: int = 0) -> BinPass:
     """Bhattacharyya sum, weight table and weighted position sums (one pass over the bins).
 
     Bins with H Q = 0 add isqrt(0) = 0 and have weight 0: only the others are evaluated.
+    ``q_frac``: Q carries q_frac fraction bits (tracker v2's FixedParams.model_frac; 0 for the
+    paper's cores): the term is isqrt(H Q 2**(2 RF + q_frac)) >> q_frac (the same floor of
+    sqrt(H Q') 2**RF for Q' = Q 2**-q_frac, computed with H 2**q_frac) and the weight divides
+    Q 2**(2 WF) by H 2**q_frac.
     """
-    hq = hist.H * Q
+    H = hist.H << q_frac if q_frac else hist.H
+    hq = H * Q
     nz = np.flatnonzero(hq)
-    S = int(ms_isqrt(hq[nz] << (2 * fp.rho_frac)).sum())
-    w = ms_weight(Q, hist.H, fp)
+    S = int(ms_isqrt(hq[nz] << (2 * fp.rho_frac)).sum()) if not q_frac else \
+        int((ms_isqrt(hq[nz] << (2 * fp.rho_frac)) >> q_frac).sum())
+    w = ms_weight(Q, H, fp)
     wn = w[nz]
     return BinPass(S=S, w=w, Sw=int((wn * hist.N[nz]).sum()), Swx=int((wn * hist.SX[nz]).sum()),
                    Swy=int((wn * hist.SY[nz]).sum()))
@@ -328,12 +334,12 @@ STOP_CODES = {"shift": 0, "rho": 1, "max_iter": 2, "lost": 3}
 
 def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: Region, ker: ms_kernel,
                  tp: TrackerParams, fp: FixedParams, n_bins: int, shift_q: int,
-                 trace: bool = False) -> FeatureFixed:
+                 trace: bool = False, q_frac: int = 0) -> FeatureFixed:
     """Iteration controller (rtl/ms_meanshift.vhd): the loop of docs/algorithm.md in integers.
 
     c0 = clamp(start); pass at round(c0) -> S0, sums.  Iteration i = 1..max_iter:
     Sw = 0 -> stop "lost" (keep c0); c1 = centre(sums); pass at round(c1) -> S1;
-    S1 < S0 -> stop "rho" (keep c0, S0); shift2 = |c1 - c0|^2 (Q.2CF);
+    S1 < S0 - m -> stop "rho" (keep c0, S0; m = 0 unless tracker v2's rho_stop_margin); shift2 = |c1 - c0|^2 (Q.2CF);
     c0 = c1; shift2 < EPS2 -> stop "shift"; after max_iter -> "max_iter".
     """
     cf = fp.centre_frac
@@ -343,7 +349,7 @@ def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: 
     def run_pass(c8: tuple[int, int]) -> tuple[tuple[int, int], Hist, BinPass]:
         win = (ms_round_centre(c8[0], cf), ms_round_centre(c8[1], cf))
         h = ms_histogram(bins, reg, win, ker, n_bins)
-        bp = ms_bin_pass(Q, h, fp)
+        bp = ms_bin_pass(Q, h, fp, q_frac)
         if trace:
             nz = np.nonzero(h.N)[0]
             tr.append({"centre": list(c8), "win": list(win), "bins": nz.tolist(),
@@ -352,6 +358,9 @@ def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: 
                        "Sw": bp.Sw, "Swx": bp.Swx, "Swy": bp.Swy})
         return win, h, bp
 
+    # tracker v2's rho_stop_margin (0 by default, and for the paper preset): rho margin m in S's
+    # units, S = rho K 2**(RF - 16): (round(m 2**16) K) >> (16 - RF), one multiplier per frame
+    m_s = (int(round(getattr(tp, "rho_stop_margin", 0.0) * 65536)) * ker.K) >> (16 - fp.rho_frac)
     c0 = clamp_centre(start8, reg, cf)
     win0, _, bp0 = run_pass(c0)
     for it in range(1, tp.max_iter + 1):
@@ -359,7 +368,7 @@ def ms_meanshift(bins: np.ndarray, Q: np.ndarray, start8: tuple[int, int], reg: 
         if c1 is None:
             return FeatureFixed(c0, bp0.S, it, "lost", tr)
         win1, _, bp1 = run_pass(c1)
-        if bp1.S < bp0.S:
+        if bp1.S < bp0.S - m_s:
             return FeatureFixed(c0, bp0.S, it, "rho", tr)
         shift2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
         c0, win0, bp0 = c1, win1, bp1

@@ -88,7 +88,7 @@ class ModelV2:
 
 
 def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: int,
-                n_bins: int) -> ModelV2:
+                n_bins: int, bg_frac: int = BG_FRAC) -> ModelV2:
     """CBWH target model of the box of diameters (wb, hb) decimated px centred on pixel (cx, cy).
 
     Box: the pixels of the ellipse (2dx/wb)^2 + (2dy/hb)^2 < 1 (exact integer
@@ -96,7 +96,9 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     rectangle grown by g = (ring16 * n) >> 4 on each side (n = wb, hb), clipped
     to the image, that lie outside the box's rectangle (|dx| > ex or
     |dy| > ey) -> counts O.  o* = the smallest non-zero O;
-    v_u = min(floor(o* 2**8 / O_u), 2**8) (2**8 where O_u = 0);
+    v_u = min(floor(o* 2**BF / O_u), 2**BF) (2**BF where O_u = 0; BF = ``bg_frac``,
+    FixedParams.bg_frac, default 8: a ring colour more than 2**BF times as frequent as the rarest
+    gets v_u = 0);
     Qn_u = floor(Q_u v_u 2**16 / sum(Q v));  T_u = 1 where Q_u sum(O) > O_u sum(Q)
     (q_u > o_u, exact); without any ring pixel: v = 1 and T_u = (Q_u > 0).
     When sum(Q v) = 0 (every colour of the box more than 256x as frequent in the ring as the
@@ -115,7 +117,7 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     outside = (np.abs(xx - cx) > ex) | (np.abs(yy - cy) > ey)
     O = np.bincount(bins[yy[outside], xx[outside]], minlength=n_bins).astype(np.int64)
     nq, no = int(Q.sum()), int(O.sum())
-    one_v = 1 << BG_FRAC
+    one_v = 1 << bg_frac
     if no == 0:
         v = np.full(n_bins, one_v, np.int64)
         T = (Q > 0).astype(np.int64)
@@ -123,7 +125,7 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
         omin = int(O[O > 0].min())
         v = np.full(n_bins, one_v, np.int64)
         nz = O > 0
-        v[nz] = np.minimum(ms_divider(omin << BG_FRAC, O[nz], BG_FRAC + 1), one_v)
+        v[nz] = np.minimum(ms_divider(omin << bg_frac, O[nz], bg_frac + 1), one_v)
         T = (Q * no > O * nq).astype(np.int64)
     qv = Q * v
     tot = int(qv.sum())
@@ -134,9 +136,10 @@ def ms_bg_model(bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: in
     return ModelV2(Qn=Qn, T=T, Q=Q, O=O)
 
 
-def ms_model_scale(Qn: np.ndarray, K: int) -> np.ndarray:
-    """The model at a window of K pixels: Qw_u = (Qn_u K) >> 16 (so sum Qw ~ K, like H)."""
-    return (Qn * K) >> QN_BITS
+def ms_model_scale(Qn: np.ndarray, K: int, frac: int = 0) -> np.ndarray:
+    """The model at a window of K pixels: Qw_u = (Qn_u K) >> (16 - frac) (so sum Qw ~ K 2**frac,
+    like H 2**frac); ``frac``: FixedParams.model_frac (default 0)."""
+    return (Qn * K) >> (QN_BITS - frac)
 
 
 # ----------------------------------------------------------------------------- per-pass statistics
@@ -185,6 +188,16 @@ def ms_ring_share(st: TargetStats, K: int) -> int:
     """
     den = K - st.n_in
     return int(ms_divider((st.nt - st.nt_in) << 16, den, 17)) if den > 0 else 0
+
+
+def ms_lost_decimation(d0: int, lost_n: int, widen: int) -> int:
+    """The decimation after ``lost_n`` consecutive lost frames: d0 while tracking; 2 d0, shifted
+    left once more every ``widen`` lost frames (search_widen; 0: never), at most max(16, 2 d0).
+    A lost-frame counter, one compare per frame (widen a power of two: a shift)."""
+    if lost_n <= 0:
+        return d0
+    k = 1 + ((lost_n - 1) // widen if widen > 0 else 0)
+    return max(min(d0 << k, 16), 2 * d0)
 
 
 def ms_loss_filter(s: int, x: int, k: int) -> int:
@@ -283,14 +296,15 @@ def ms_scale_test_size(s8: int, d256: int, up: bool) -> int:
     return (s8 * (256 + d256 if up else 256 - d256) + 128) >> 8
 
 
-def ms_scale_test(rho: int, rho_lo: int | None, rho_hi: int | None) -> int:
+def ms_scale_test(rho: int, rho_lo: int | None, rho_hi: int | None, margin: int = 0) -> int:
     """The scale test's verdict from rho at the window x1, x(1 - d), x(1 + d) (Q.16; None: that
-    window did not fit the captured region, it never wins): -1 / 0 / +1, the largest rho, ties to
-    the earlier of (1, 1 - d, 1 + d).  Two 17-bit compares."""
+    window did not fit the captured region, it never wins): -1 / 0 / +1, the largest of rho,
+    rho_lo - margin, rho_hi - margin, ties to the earlier of (1, 1 - d, 1 + d).  ``margin``:
+    round(scale_test_margin 2**16) (default 0: two 17-bit compares; else two subtractions more)."""
     best, v = rho, 0
-    if rho_lo is not None and rho_lo > best:
-        best, v = rho_lo, -1
-    if rho_hi is not None and rho_hi > best:
+    if rho_lo is not None and rho_lo - margin > best:
+        best, v = rho_lo - margin, -1
+    if rho_hi is not None and rho_hi - margin > best:
         v = 1
     return v
 

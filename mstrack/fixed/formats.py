@@ -40,6 +40,15 @@ class FixedParams:
         AF: fraction bits of the fusion weights alpha_c, alpha_e.
     rho_out_frac : int
         Fraction bits of the rho values reported in results (paper: 16).
+    model_frac : int
+        Tracker v2 only: fraction bits of the model at the window Qw = (Qn K) >> (16 - model_frac)
+        (default 0: integer counts, core v2).  With 4608 joint bins and windows of a few thousand
+        pixels most Qw floor to 0 at 0 fraction bits; the bin pass then scales H by 2**model_frac
+        for the weight and the Bhattacharyya term (docs/fixed_point.md, "Model fraction bits").
+    bg_frac : int
+        Tracker v2 only: fraction bits of the CBWH factors v_u = min(o* / O_u, 1) of the init
+        model (ms_bg_model; default 8, core v2).  At 8 a ring colour more than 256 times as
+        frequent as the rarest ring colour gets v_u = 0, where the float model keeps o* / o_u.
     """
 
     max_half: int = 63
@@ -52,9 +61,15 @@ class FixedParams:
     kernel_bits: int = 8
     alpha_frac: int = 8
     rho_out_frac: int = 16
+    model_frac: int = 0
+    bg_frac: int = 8
 
     def __post_init__(self) -> None:
         check_param_types(self)
+        if not 0 <= self.model_frac <= 8:
+            raise ValueError("model_frac must be in 0..8")
+        if not 8 <= self.bg_frac <= 24:
+            raise ValueError("bg_frac must be in 8..24")
         if not 1 <= self.max_half <= 255:
             raise ValueError("max_half must be in 1..255")
         if not 0 <= self.margin <= 255:

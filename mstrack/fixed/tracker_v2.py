@@ -29,7 +29,7 @@ from ..track.types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_grey, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
 from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,
-                        ms_loss_flag, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+                        ms_loss_flag, ms_lost_decimation, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
                         ORIENT_FLAT,
@@ -141,7 +141,7 @@ class FixedTrackerV2:
         if sub is None:
             sub = self._capture(img, reg)
         tp = p.with_(max_iter=max_iter)
-        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_bins_v2, self.widths.shift_q)
+        r = ms_meanshift(sub, Qw, start8, reg, ker, tp, fx, p.n_bins_v2, self.widths.shift_q, q_frac=fx.model_frac)
         win = (ms_round_centre(r.c8[0], cf) - reg.x, ms_round_centre(r.c8[1], cf) - reg.y)
         st = ms_target_stats(sub, self.model.T, win, ker, fx.kernel_bits, self.pad16)
         return r.c8, r.S, r.iterations, r.stop, st
@@ -179,9 +179,9 @@ class FixedTrackerV2:
                 rhos.append(None)
                 continue
             hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
-            S = ms_bin_pass(ms_model_scale(self.model.Qn, ker.K), hist, fx).S
+            S = ms_bin_pass(ms_model_scale(self.model.Qn, ker.K, fx.model_frac), hist, fx, fx.model_frac).S
             rhos.append(ms_rho_out(S, ker.K, fx))
-        return ms_scale_test(rho, rhos[0], rhos[1])
+        return ms_scale_test(rho, rhos[0], rhos[1], q16(p.scale_test_margin))
 
     def _box(self) -> Box:
         s = float(1 << self.fixed.centre_frac)
@@ -220,10 +220,10 @@ class FixedTrackerV2:
         # keep the box inside the decimated interior
         cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
-        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2)
+        self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2, fx.bg_frac)
         wd, hd = self._geometry(d, bins.shape)
         ker = self._kernel(wd, hd)
-        Qw = ms_model_scale(self.model.Qn, ker.K)
+        Qw = ms_model_scale(self.model.Qn, ker.K, fx.model_frac)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one pass at the init centre (no iteration) gives the references
         if p.orient_T > 0:
@@ -237,6 +237,7 @@ class FixedTrackerV2:
         sp = ms_spread(st)
         self.spread_ref = sp if sp > 0 else ((128 << (fx.kernel_bits + 16)) // (16 + self.pad16) ** 2)
         self.lost = False
+        self.lost_n = 0  # consecutive lost frames (the search's decimation)
         self.reported_lost = False
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
                "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
@@ -256,7 +257,7 @@ class FixedTrackerV2:
         win = (ms_round_centre(c8[0], cf), ms_round_centre(c8[1], cf))
         sub = self._capture(img, reg)
         hist = ms_histogram(sub, reg, win, ker, p.n_bins_v2)
-        S = ms_bin_pass(Qw, hist, fx).S
+        S = ms_bin_pass(Qw, hist, fx, fx.model_frac).S
         st = ms_target_stats(sub, self.model.T, (win[0] - reg.x, win[1] - reg.y), ker, fx.kernel_bits, self.pad16)
         return c8, S, 0, "shift", st
 
@@ -267,15 +268,17 @@ class FixedTrackerV2:
         frame = check_frame(frame, self._shape)
         p, fx = self.params, self.fixed
         cf = fx.centre_frac
-        d = ms_decimation(self.w8, self.h8, self.pad16, p.max_window) * (2 if self.lost else 1)
+        d0 = ms_decimation(self.w8, self.h8, self.pad16, p.max_window)
+        d = ms_lost_decimation(d0, self.lost_n, p.search_widen)
+        reach = d // (2 * d0) if self.lost else 1  # the widened search (search_widen; 1 without it)
         sh = d.bit_length() - 1
         img = frame[::d, ::d]
         wd, hd = self._geometry(d, img.shape[:2])
         ker = self._kernel(wd, hd)
-        Qw = ms_model_scale(self.model.Qn, ker.K)
+        Qw = ms_model_scale(self.model.Qn, ker.K, fx.model_frac)
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost
-        ox, oy = (self.step16 * wd) >> 4, (self.step16 * hd) >> 4
+        ox, oy = ((self.step16 * wd) >> 4) * reach, ((self.step16 * hd) >> 4) * reach
         margin = fx.margin + (max(ox, oy) if self.lost else 0)
         reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
         sub = self._capture(img, reg, frame, d)
@@ -309,11 +312,13 @@ class FixedTrackerV2:
         ring = ms_ring_share(st, ker.K)
         self.rho_s = ms_loss_filter(self.rho_s, rho, self.loss_k)
         self.con_s = ms_loss_filter(self.con_s, share - ring, self.loss_k)
-        if ms_loss_flag(self.rho_s, self.rho0, self.con_s, share, self.loss_rho16, self.loss_contrast16):
+        ref = self.rho_ref if p.loss_ref_running else self.rho0  # (the running one: before this frame's update)
+        if ms_loss_flag(self.rho_s, ref, self.con_s, share, self.loss_rho16, self.loss_contrast16):
             status = Status.LOST if state == Status.LOST else Status.UNCERTAIN
         else:
             status = Status.REACQUIRED if self.reported_lost else Status.OK
         self.lost = state == Status.LOST
+        self.lost_n = self.lost_n + 1 if self.lost else 0
         self.reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self.reported_lost)
         self.c8 = (c8d[0] << sh, c8d[1] << sh)
         if state == Status.OK:

@@ -341,7 +341,11 @@ class CoreConfigV2:
         # RTL: the gated scale test (scale_test with scale_test_gate: generic SCALE_TEST_D256) and the
         # joint bins (orient_T: generic ORIENT_T); the ungated scale test has no fixed model either.
         tp = self.tp
-        rtl_less = [k for k, off in (("motion_gain", 0.0),) if getattr(tp, k) != off]
+        rtl_less = [k for k, off in (("motion_gain", 0.0), ("loss_ref_running", False),
+                                          ("scale_test_margin", 0.0), ("search_widen", 0),
+                                          ("rho_stop_margin", 0.0)) if getattr(tp, k) != off]
+        # the wider model formats of the fixed model (FixedParams.model_frac, bg_frac) have no RTL yet
+        rtl_less += [k for k, off in (("model_frac", 0), ("bg_frac", 8)) if getattr(self.fp, k) != off]
         if tp.scale_test != 0.0 and not tp.scale_test_gate:
             rtl_less.append("scale_test without scale_test_gate")
         if rtl_less:

@@ -682,6 +682,17 @@ def decimation(w: float, h: float, p: TrackerParams) -> int:
     return d
 
 
+def lost_decimation(d0: int, lost_n: int, p: TrackerParams) -> int:
+    """The decimation of a frame after ``lost_n`` consecutive lost frames (0: tracking, d0):
+    2 d0, doubled again every ``search_widen`` lost frames (0: never), at most max(16, 2 d0).
+    The wide search's start points go d / (2 d0) times as far (in window sizes), so its region
+    holds the same number of decimated pixels at every step."""
+    if lost_n <= 0:
+        return d0
+    k = 1 + ((lost_n - 1) // p.search_widen if p.search_widen > 0 else 0)
+    return max(min(d0 << k, 16), 2 * d0)
+
+
 def meanshift_v2(bins: np.ndarray | LazyBins, n_bins: int, q: np.ndarray, t: np.ndarray,
                  start: tuple[float, float], hx: float, hy: float, p: TrackerParams,
                  max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
@@ -702,7 +713,7 @@ def meanshift_v2(bins: np.ndarray | LazyBins, n_bins: int, q: np.ndarray, t: np.
             break
         c1 = clamp((p0.swx / p0.sw, p0.swy / p0.sw))
         p1 = window_pass(bins, n_bins, q, t, c1, hx, hy, inner2, p.kernel)  # type: ignore[arg-type]
-        if p1.rho < p0.rho:
+        if p1.rho < p0.rho - p.rho_stop_margin:  # (rho_stop_margin: 0 by default)
             break
         s2 = (c1[0] - c0[0]) ** 2 + (c1[1] - c0[1]) ** 2
         c0, p0 = c1, p1
@@ -740,9 +751,10 @@ def report_status(searching: bool, flagged: bool, was_flagged_lost: bool) -> Sta
 
 
 def search_starts(start: tuple[float, float], hx: float, hy: float,
-                  p: TrackerParams) -> list[tuple[float, float]]:
-    """The 8 wide-search start points: start +- search_step window diameters in x and y."""
-    return [(start[0] + sx * p.search_step * 2 * hx, start[1] + sy * p.search_step * 2 * hy)
+                  p: TrackerParams, reach: int = 1) -> list[tuple[float, float]]:
+    """The 8 wide-search start points: start +- reach x search_step window diameters in x and y
+    (``reach`` > 1: the widened search, :func:`lost_decimation`)."""
+    return [(start[0] + sx * reach * p.search_step * 2 * hx, start[1] + sy * reach * p.search_step * 2 * hy)
             for sy in (-1, 0, 1) for sx in (-1, 0, 1) if sx or sy]
 
 
@@ -799,7 +811,7 @@ class FloatTrackerV2:
 
     def active_path(self) -> str:
         """The path :meth:`update` runs now: "numpy" or "numba"."""
-        if self.path == "numpy":
+        if self.path == "numpy" or self.params.rho_stop_margin > 0:  # (the numba kernel has no margin)
             return "numpy"
         if self._use_numba:  # (the self-check's own run)
             return "numba"
@@ -913,11 +925,11 @@ class FloatTrackerV2:
                     rho: float) -> float:
         """Scale test (off by default): the window scale among 1 -+ scale_test and 1 whose rho is
         the largest (two more passes at the final centre; ``rho``: the pass at c, hx, hy's)."""
-        d = self.params.scale_test
+        d, m = self.params.scale_test, self.params.scale_test_margin
         best = 1.0
         for s, r in zip((1.0 - d, 1.0 + d), self._rho2(bins, c, hx, hy, (1.0 - d, 1.0 + d))):
-            if r > rho:
-                best, rho = s, r
+            if r - m > rho:  # (margin m: scale_test_margin, 0 by default)
+                best, rho = s, r - m
         return best
 
     # ------------------------------------------------------------------ API
@@ -946,6 +958,7 @@ class FloatTrackerV2:
         self._rho0 = ps.rho  # the loss flag's reference: rho at init
         self._rho_s, self._con_s = ps.rho, ps.share - ps.ring_share  # its filters start at init
         self._lost = False
+        self._lost_n = 0  # consecutive lost frames (the search's decimation)
         self._reported_lost = False
         self._vel = (0.0, 0.0)  # last centre step (frame px), for motion_gain
         return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
@@ -960,7 +973,9 @@ class FloatTrackerV2:
         p = self.params
         w, h = self._size
         # lost: the whole search runs at twice the decimation (a region 2x wider in the same memory)
-        d = self.decimation(w, h) * (2 if self._lost else 1)
+        d0 = self.decimation(w, h)
+        d = lost_decimation(d0, self._lost_n, p)
+        reach = d // (2 * d0) if self._lost else 1  # the widened search: its start points reach as far x reach
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d
         if self.active_path() == "numba":
@@ -987,7 +1002,7 @@ class FloatTrackerV2:
         searched = 0
         if self._lost:
             # wide search: mean shift from start points around the last centre, best confidence wins
-            for s0 in search_starts(start, hx, hy, p):
+            for s0 in search_starts(start, hx, hy, p, reach):
                 c2, ps2, _ = self._track(bins, s0, hx, hy, p.search_iter)
                 searched += 1
                 conf2 = self._confidence(ps2)
@@ -996,9 +1011,11 @@ class FloatTrackerV2:
         state = decide_status(conf, self._lost, p)  # the search state (what the tracker does next)
         self._rho_s = loss_filter(self._rho_s, ps.rho, p)
         self._con_s = loss_filter(self._con_s, ps.share - ps.ring_share, p)
-        flagged = loss_flag(self._rho_s, self._con_s, self._rho0, ps.share, p)  # what it reports (ok False when flagged)
+        ref = self._rho_ref if p.loss_ref_running else self._rho0  # (the running one: before this frame's update)
+        flagged = loss_flag(self._rho_s, self._con_s, ref, ps.share, p)  # what it reports (ok False when flagged)
         status = report_status(state == Status.LOST, flagged, self._reported_lost)
         self._lost = state == Status.LOST
+        self._lost_n = self._lost_n + 1 if self._lost else 0
         # a loss stays reported (uncertain frames keep it) until a frame is ok again
         self._reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self._reported_lost)
         old = self._centre

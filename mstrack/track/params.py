@@ -137,6 +137,23 @@ class TrackerParams:
         both smoothed by s <- s + loss_smooth (x - s) (1: no smoothing; a power
         of two for the fixed model) (docs/algorithm.md, "v2.7a Loss flag").
         Defaults 0.69 / 0.25 (the joint tracker's); :data:`V2_COLOUR`'s 0.88 / 0.19.
+    scale_test_margin : float
+        The gated scale test's margin (experimental, off by default: 0): a scaled window wins
+        only when its rho exceeds the best so far by more than the margin, so that a verdict
+        does not hang on the last bits of rho (docs/results_accuracy22.md).
+    rho_stop_margin : float
+        The mean shift's rho stop with a margin (experimental, off by default: 0): a step is
+        refused only when rho falls by more than the margin, so that the loop crosses the flat top
+        of rho (where the padded window holds the whole target) instead of halting short of the
+        optimum (docs/results_accuracy22.md).  The float model then runs its numpy path.
+    search_widen : int
+        Widening of the wide search (experimental, off by default: 0): while lost, the search's
+        decimation (2 D) doubles again after every ``search_widen`` lost frames, up to 16 (the
+        region RAM's bound), so that its start points reach 2x, 4x ... as far at the same memory
+        (docs/results_accuracy22.md).
+    loss_ref_running : bool
+        Loss flag against the running reference rho_ref (the confidence's, as it is before the
+        frame's update) instead of rho at init (experimental, off by default; docs/results_accuracy22.md).
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -192,6 +209,10 @@ class TrackerParams:
     scale_test_mix: float = 1.0
     scale_test_gate: bool = True
     orient_T: int = 64
+    loss_ref_running: bool = False
+    scale_test_margin: float = 0.0
+    search_widen: int = 0
+    rho_stop_margin: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -224,13 +245,16 @@ class TrackerParams:
                                  ("conf_uncertain", 0.0, 1.0), ("conf_reacquire", 0.0, 1.0),
                                  ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
-                                 ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0)):
+                                 ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
+                                 ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:
                 raise ValueError("conf_lost must be <= conf_uncertain")
             if not 7 <= self.max_window <= 1023:
                 raise ValueError("max_window must be in 7..1023")
+            if self.search_widen < 0:
+                raise ValueError("search_widen must be >= 0")
             if self.search_iter < 1:
                 raise ValueError("search_iter must be >= 1")
             if not 0 <= self.orient_T <= 2040:

@@ -1,0 +1,490 @@
+"""Tracker v2 on the 22 sequences (dev + validation): accuracy, float/fixed stability, loss flag.
+
+Usage::
+
+    python studies/accuracy22.py run [--tag T] [--set k=v ...]   # float + fixed v2 -> out/acc22/<T>/
+    python studies/accuracy22.py report [--tag T]                # tables of one run (stdout)
+    python studies/accuracy22.py diverge [--tag T]               # first float/fixed divergence per sequence
+    python studies/accuracy22.py loss [--tag T]                  # loss thresholds: in sample and LOSO
+
+``run`` keeps, per sequence and model, the boxes, centres, the loss flag's smoothed signals
+(rho_s, contrast_s, rho0, share) and the per-frame decimation / search state / size, so that the
+other commands need no tracking.  The loss flag does not steer the tracker (the search state
+comes from the confidence), so its thresholds are re-scored from the kept signals: float in
+float arithmetic, fixed with the integer comparison of ms_loss_flag (the same decision).
+Sequences: ../shared/data/sequences (dev, 10) and ../shared/data/validation (12).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from mstrack.eval.metrics import centre_error, iou, score, valid_gt  # noqa: E402
+from mstrack.fixed.blocks_v2 import q16  # noqa: E402
+from mstrack.io.data import load_dataset  # noqa: E402
+from mstrack.track.tracker import Tracker  # noqa: E402
+from mstrack.track.types import Status  # noqa: E402
+
+DATA = ROOT.parent / "shared" / "data"
+SETS = {"dev": DATA / "sequences", "validation": DATA / "validation"}
+OUT = ROOT / "out" / "acc22"
+MODELS = ("float", "fixed")
+FA_MAX = 0.05
+
+
+def sequences() -> list[tuple[str, object]]:
+    out = []
+    for set_name, root in SETS.items():
+        if not root.is_dir():
+            raise SystemExit(f"{root} not found (needs ../shared/data)")
+        out += [(set_name, s) for s in load_dataset(root)]
+    return out
+
+
+def parse_sets(items: list[str]) -> dict:
+    kw = {}
+    for it in items:
+        k, v = it.split("=", 1)
+        kw[k] = json.loads(v.lower()) if v.lower() in ("true", "false") else (int(v) if v.lstrip("-").isdigit() else float(v))
+    return kw
+
+
+def run_one(seq, model: str, kw: dict) -> dict:
+    if model == "float":  # FixedParams fields (widths) are the fixed model's only
+        from mstrack.fixed.formats import FixedParams
+        kw = {k: v for k, v in kw.items() if k not in {f.name for f in fields(FixedParams)}}
+    trk = Tracker(model=model, preset="v2", **kw)
+    n = len(seq)
+    boxes = np.zeros((n, 4))
+    cen = np.zeros((n, 2))
+    ok = np.ones(n, bool)
+    sig = {k: np.zeros(n) for k in ("rho", "rho_s", "con_s", "share", "dec", "state", "w", "h", "iter", "conf",
+                                    "rho_ref", "share_ref", "ring")}
+    impl = trk.impl
+    one = 65536.0 if model == "fixed" else 1.0
+    res = trk.init(seq.frame(0), seq.init_box())
+    rho0 = res.extra["rho"] if model == "fixed" else res.rho_c
+    boxes[0] = res.box.as_tuple()
+    cen[0] = res.centre
+    for i in range(1, n):
+        r = trk.update(seq.frame(i))
+        boxes[i] = r.box.as_tuple()
+        cen[i] = r.centre
+        ok[i] = r.ok
+        e = r.extra
+        sig["rho"][i] = e["rho"] if model == "fixed" else r.rho_c
+        sig["rho_s"][i] = e["rho_s"]
+        sig["con_s"][i] = e["contrast_s"]
+        sig["share"][i] = e["share"]
+        sig["dec"][i] = e["decimation"]
+        st = e["state"]
+        sig["state"][i] = st if isinstance(st, (int, np.integer)) else {"ok": 0, "uncertain": 1, "lost": 2, "reacquired": 3}.get(st, 9)
+        sig["w"][i], sig["h"][i] = r.box.w, r.box.h
+        sig["iter"][i] = r.iter_c
+        sig["conf"][i] = r.confidence
+        sig["rho_ref"][i] = impl.rho_ref if model == "fixed" else impl._rho_ref
+        sig["share_ref"][i] = impl.share_ref if model == "fixed" else impl._share_ref
+        sig["ring"][i] = e["ring_share"]
+    return {"boxes": boxes, "centre": cen, "ok": ok, "rho0": np.array(rho0), "one": np.array(one), **sig}
+
+
+def main_run(tag: str, kw: dict, models: tuple[str, ...]) -> None:
+    d = OUT / tag
+    d.mkdir(parents=True, exist_ok=True)
+    (d / "params.json").write_text(json.dumps(kw))
+    for set_name, seq in sequences():
+        for model in models:
+            f = d / f"{model}_{seq.name}.npz"
+            if f.is_file():
+                continue
+            np.savez(f, set=set_name, **run_one(seq, model, kw))
+        print(tag, seq.name, flush=True)
+
+
+def load(tag: str, model: str) -> dict[str, tuple[str, dict, np.ndarray]]:
+    """name -> (set, arrays, gt)."""
+    out = {}
+    for set_name, seq in sequences():
+        f = OUT / tag / f"{model}_{seq.name}.npz"
+        if not f.is_file():
+            continue
+        z = dict(np.load(f))
+        out[seq.name] = (set_name, z, np.asarray(seq.gt[:len(z["boxes"])], dtype=np.float64))
+    return out
+
+
+def seq_scores(runs: dict) -> dict[str, tuple[str, float, float, np.ndarray, np.ndarray]]:
+    """name -> (set, AUC, P@20, ious, errors) on valid-GT frames."""
+    out = {}
+    for name, (set_name, z, gt) in runs.items():
+        s = score(z["boxes"], gt)
+        out[name] = (set_name, s.auc, s.precision20, s.ious, s.errors)
+    return out
+
+
+def summary(sc: dict, which: str) -> tuple[float, float, float, float, int]:
+    """(frame-weighted AUC, P@20, mean AUC over sequences, mean P@20 over sequences, n seqs)."""
+    from mstrack.eval.metrics import score_frames
+    part = [v for v in sc.values() if which == "all" or v[0] == which]
+    if not part:
+        return (float("nan"),) * 4 + (0,)  # type: ignore[return-value]
+    s = score_frames(np.concatenate([p[3] for p in part]), np.concatenate([p[4] for p in part]))
+    return s.auc, s.precision20, float(np.mean([p[1] for p in part])), float(np.mean([p[2] for p in part])), len(part)
+
+
+# ----------------------------------------------------------------------------- loss flag
+#: the loss flag's rho reference: "rho0" (rho at init, the tracker's rule) or "rho_ref" (the running
+#: reference of the confidence, as it was before the frame's update)
+LOSS_REF = {"ref": "rho0"}
+
+
+def loss_arrays(runs: dict, model: str) -> dict[str, dict[str, np.ndarray]]:
+    """Per sequence, frames after init with valid GT: iou, rho_s, its reference, con_s, share."""
+    out = {}
+    for name, (_, z, gt) in runs.items():
+        v = valid_gt(gt)
+        v[0] = False
+        rho0 = float(z["rho0"])
+        if LOSS_REF["ref"] == "rho_ref":
+            ref = np.concatenate([[rho0], z["rho_ref"][1:-1]]) if "rho_ref" in z else None
+            if ref is None:
+                raise SystemExit(f"run without rho_ref: {name}")
+            ref = np.concatenate([[rho0], ref])[:len(v)] if len(ref) < len(v) else ref
+        else:
+            ref = np.full(len(v), rho0)
+        out[name] = {"iou": iou(z["boxes"], gt)[v], "rho_s": z["rho_s"][v], "con_s": z["con_s"][v],
+                     "share": z["share"][v], "ref": ref[v], "ok": z["ok"][v]}
+    return out
+
+
+def flag(a: dict, lr: float, lc: float, model: str) -> np.ndarray:
+    if model == "fixed":
+        rs = a["rho_s"].astype(np.int64)
+        return (a["share"] == 0) | (rs == 0) | ((rs << 16) < q16(lr) * a["ref"].astype(np.int64)) & (a["con_s"] < q16(lc))
+    return (a["share"] == 0) | (a["rho_s"] == 0) | ((a["rho_s"] < lr * a["ref"]) & (a["con_s"] < lc))
+
+
+RHO_GRID = np.round(np.arange(0.50, 1.001, 0.01), 2)
+CON_GRID = np.round(np.arange(0.00, 0.401, 0.01), 2)
+
+
+def counts(arr: dict, names: list[str], lr: float, lc: float, model: str) -> tuple[int, int, int, int]:
+    offf = off = onf = on = 0
+    for n in names:
+        a = arr[n]
+        f = flag(a, lr, lc, model)
+        o, g = a["iou"] == 0, a["iou"] >= 0.5
+        offf += int((f & o).sum())
+        off += int(o.sum())
+        onf += int((f & g).sum())
+        on += int(g.sum())
+    return offf, off, onf, on
+
+
+def table(arr: dict, names: list[str], model: str) -> np.ndarray:
+    """(rho, con) grid -> (offf, off, onf, on) per sequence summed over names."""
+    t = np.zeros((len(RHO_GRID), len(CON_GRID), 4), np.int64)
+    for i, lr in enumerate(RHO_GRID):
+        for j, lc in enumerate(CON_GRID):
+            t[i, j] = counts(arr, names, lr, lc, model)
+    return t
+
+
+def choose(t: np.ndarray) -> tuple[int, int]:
+    """Highest recall with false alarms <= FA_MAX (ties: fewer false alarms, then larger margins)."""
+    rec = t[..., 0] / np.maximum(t[..., 1], 1)
+    fa = t[..., 2] / np.maximum(t[..., 3], 1)
+    key = np.where(fa <= FA_MAX, rec * 1e6 - fa * 1e3, -np.inf)
+    i, j = np.unravel_index(int(np.argmax(key)), key.shape)
+    return int(i), int(j)
+
+
+def loso(runs_by_model: dict[str, dict], models=MODELS, joint: bool = True):
+    """Per model: in-sample choice and LOSO counts.  joint: one pair for float and fixed
+    (highest lower recall of the two with both false-alarm rates <= FA_MAX)."""
+    arrs = {m: loss_arrays(runs_by_model[m], m) for m in models}
+    names = sorted(set.intersection(*(set(a) for a in arrs.values())))
+    per_seq = {m: {n: table(arrs[m], [n], m) for n in names} for m in models}
+    total = {m: sum(per_seq[m].values()) for m in models}
+
+    def pick(tabs: dict[str, np.ndarray]) -> tuple[int, int]:
+        if not joint:
+            raise NotImplementedError
+        recs, fas = [], []
+        for m, t in tabs.items():
+            recs.append(t[..., 0] / np.maximum(t[..., 1], 1))
+            fas.append(t[..., 2] / np.maximum(t[..., 3], 1))
+        rec, fa = np.minimum(*recs) if len(recs) > 1 else recs[0], np.maximum(*fas) if len(fas) > 1 else fas[0]
+        key = np.where(fa <= FA_MAX, rec * 1e6 - fa * 1e3, -np.inf)
+        i, j = np.unravel_index(int(np.argmax(key)), key.shape)
+        return int(i), int(j)
+
+    i, j = pick(total)
+    ins = {m: total[m][i, j] for m in models}
+    lo = {m: np.zeros(4, np.int64) for m in models}
+    chosen = {}
+    for n in names:
+        rest = {m: total[m] - per_seq[m][n] for m in models}
+        a, b = pick(rest)
+        chosen[n] = (RHO_GRID[a], CON_GRID[b])
+        for m in models:
+            lo[m] += per_seq[m][n][a, b]
+    return (RHO_GRID[i], CON_GRID[j]), ins, lo, chosen
+
+
+def fmt_ld(c) -> str:
+    return f"{c[0] / max(c[1], 1):.3f} / {c[2] / max(c[3], 1):.3f}"
+
+
+def main_loss(tag: str) -> None:
+    runs = {m: load(tag, m) for m in MODELS}
+    (lr, lc), ins, lo, chosen = loso(runs)
+    print(f"joint choice on 22 (in sample): loss_rho {lr:.2f}, loss_contrast {lc:.2f}")
+    print("| model | recall / false alarms, in sample | recall / false alarms, LOSO |")
+    print("|---|---|---|")
+    for m in MODELS:
+        print(f"| {m} | {fmt_ld(ins[m])} | {fmt_ld(lo[m])} |")
+    # the current thresholds as they are
+    p = json.loads((OUT / tag / "params.json").read_text())
+    for m in MODELS:
+        arr = loss_arrays(runs[m], m)
+        c = counts(arr, list(arr), p.get("loss_rho", 0.69), p.get("loss_contrast", 0.25), m)
+        okc = np.zeros(4, np.int64)
+        for a in arr.values():
+            f = ~a["ok"]
+            okc += [int((f & (a["iou"] == 0)).sum()), int((a["iou"] == 0).sum()), int((f & (a["iou"] >= 0.5)).sum()),
+                    int((a["iou"] >= 0.5).sum())]
+        print(f"{m}: run's thresholds recall / FA {fmt_ld(c)} (from ok: {fmt_ld(okc)}; off {okc[1]}, on {okc[3]})")
+    print("LOSO choices:", {n: (float(a), float(b)) for n, (a, b) in chosen.items()})
+
+
+# ----------------------------------------------------------------------------- report / diverge
+def main_report(tag: str, ref: str | None = None) -> None:
+    sc = {m: seq_scores(load(tag, m)) for m in MODELS}
+    print(f"tag {tag}: {json.loads((OUT / tag / 'params.json').read_text())}")
+    print("| model | set | seqs | AUC | P@20 | mean AUC | mean P@20 |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for m in MODELS:
+        for w in ("dev", "validation", "all"):
+            a, p, ma, mp, n = summary(sc[m], w)
+            print(f"| {m} | {w} | {n} | {a:.3f} | {p:.3f} | {ma:.3f} | {mp:.3f} |")
+    print("\n| sequence | set | float AUC | fixed AUC | gap | float P@20 | fixed P@20 |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    within = 0
+    for n in sc["float"]:
+        if n not in sc["fixed"]:
+            continue
+        f, x = sc["float"][n], sc["fixed"][n]
+        within += abs(f[1] - x[1]) <= 0.01
+        print(f"| {n} | {f[0]} | {f[1]:.3f} | {x[1]:.3f} | {x[1] - f[1]:+.3f} | {f[2]:.3f} | {x[2]:.3f} |")
+    print(f"\nwithin 0.01 AUC: {within} of {len(sc['fixed'])}")
+
+
+def main_diverge(tag: str, px: float = 4.0) -> None:
+    runs = {m: load(tag, m) for m in MODELS}
+    print(f"| sequence | first frame > {px:g} px | dec f/x | state f/x | w f/x | iter f/x | conf f/x | frames later > {px:g} px |")
+    print("|---|---:|---|---|---|---|---|---:|")
+    for n, (_, zf, _) in runs["float"].items():
+        zx = runs["fixed"][n][1]
+        d = np.hypot(*(zf["centre"] - zx["centre"]).T)
+        bad = np.nonzero(d > px)[0]
+        if not len(bad):
+            print(f"| {n} | - | | | | | | 0 |")
+            continue
+        i = int(bad[0])
+        j = max(i - 1, 0)
+        print(f"| {n} | {i} | {zf['dec'][j]:.0f}/{zx['dec'][j]:.0f} | {zf['state'][i]:.0f}/{zx['state'][i]:.0f} | "
+              f"{zf['w'][j]:.1f}/{zx['w'][j]:.1f} | {zf['iter'][i]:.0f}/{zx['iter'][i]:.0f} | "
+              f"{zf['conf'][i]:.2f}/{zx['conf'][i]:.2f} | {len(bad)} |")
+
+
+def csrt_scores() -> dict:
+    """CSRT's per-sequence runs from the `make results` caches (out/eval_float*, opencv-csrt)."""
+    from mstrack.eval.evaluate import SequenceRun
+    out = {}
+    for set_name, seq in sequences():
+        d = "eval_float" if set_name == "dev" else "eval_float_validation"
+        f = ROOT / "out" / d / "results" / "opencv-csrt" / f"{seq.name}.json"
+        if not f.is_file():
+            continue
+        run = SequenceRun.from_json(json.loads(f.read_text()))
+        s = score(run.boxes, np.asarray(seq.gt[:run.n_frames], dtype=np.float64))
+        out[seq.name] = (set_name, s.auc, s.precision20, s.ious, s.errors)
+    return out
+
+
+def capture(fn, *a) -> list[str]:
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        fn(*a)
+    return buf.getvalue().rstrip().splitlines()
+
+
+def main_doc(tags: list[str], notes: dict[str, str]) -> None:
+    """docs/results_accuracy22.md and docs/results/accuracy22.json from the runs of ``tags``
+    (the first is the defaults)."""
+    cs = csrt_scores()
+    lines = ["# Tracker v2 on 22 sequences: accuracy, float/fixed stability, loss flag", "",
+             "Dev (`../shared/data/sequences`, 10) + validation (`../shared/data/validation`, 12) = 22 OTB "
+             "sequences, 5,286 frames.  Made by `python studies/accuracy22.py run --tag T --set k=v ...` "
+             "(float + fixed v2 with TrackerParams / FixedParams fields k=v, kept in out/acc22/T/) and "
+             "`python studies/accuracy22.py doc` (this page).  AUC / P@20 frame-weighted and as the plain mean "
+             "over sequences; *within 0.01*: sequences whose float and fixed AUC differ by at most 0.01.  "
+             "Every parameter is chosen for the whole set, never per sequence.", "",
+             "## Accuracy of the runs", "",
+             "| run | parameters | model | dev AUC / P@20 | validation AUC / P@20 | 22: AUC / P@20 | 22: mean AUC / mean P@20 | float-fixed within 0.01 |",
+             "|---|---|---|---|---|---|---|---:|"]
+    if cs:
+        a = [summary(cs, w) for w in ("dev", "validation", "all")]
+        lines.append(f"| opencv-csrt | OpenCV defaults | - | {a[0][0]:.3f} / {a[0][1]:.3f} | {a[1][0]:.3f} / {a[1][1]:.3f} | "
+                     f"{a[2][0]:.3f} / {a[2][1]:.3f} | {a[2][2]:.3f} / {a[2][3]:.3f} | |")
+    for tag in tags:
+        sc = {m: seq_scores(load(tag, m)) for m in MODELS}
+        within = sum(abs(sc["float"][n][1] - sc["fixed"][n][1]) <= 0.01 for n in sc["fixed"] if n in sc["float"])
+        par = json.loads((OUT / tag / "params.json").read_text())
+        for m in MODELS:
+            a = [summary(sc[m], w) for w in ("dev", "validation", "all")]
+            lines.append(f"| {tag} | {', '.join(f'{k}={v}' for k, v in par.items()) or 'defaults'} | {m} | "
+                         f"{a[0][0]:.3f} / {a[0][1]:.3f} | {a[1][0]:.3f} / {a[1][1]:.3f} | {a[2][0]:.3f} / {a[2][1]:.3f} | "
+                         f"{a[2][2]:.3f} / {a[2][3]:.3f} | {within if m == 'fixed' else ''} |")
+    lines += [""] + [f"* **{t}**: {notes[t]}" for t in tags if t in notes] + [""]
+    for tag in tags[:2]:
+        lines += [f"## Per sequence, run {tag}", ""] + capture(main_report, tag)[9:] + [""]
+        lines += [f"First frame where the float and fixed centres are more than 4 px apart (run {tag}; "
+                  "decimation and width on the frame before, search state 0 ok / 1 uncertain / 2 lost):", ""]
+        lines += capture(main_diverge, tag, 4.0) + [""]
+    res = {"command": "python studies/accuracy22.py doc", "loss": {}}
+    for tag in tags[:2]:
+        runs = {m: load(tag, m) for m in MODELS}
+        p = json.loads((OUT / tag / "params.json").read_text())
+        lines += [f"## Loss flag, run {tag}", "",
+                  "The rule of docs/algorithm.md \"v2.7a Loss flag\" (rho_s < loss_rho ref and contrast_s < "
+                  "loss_contrast; ref = rho0, rho at init, the tracker's rule, or rho_ref, the running reference "
+                  "before the frame's update, `loss_ref_running`), re-scored from the kept signals on the grid "
+                  "loss_rho 0.50..1.00, loss_contrast 0.00..0.40 (steps 0.01): one pair for float and fixed, the "
+                  "highest lower recall with both false-alarm rates <= 0.05; leave one sequence out: the pair "
+                  "chosen on 21 sequences, scored on the 22nd, counts summed.  Cells: recall / false alarms.", "",
+                  "| model | ref | thresholds of the run (0.69, 0.25) | chosen on 22 (in sample) | leave one sequence out |",
+                  "|---|---|---|---|---|"]
+        chosen_all = {}
+        for ref in ("rho0", "rho_ref"):
+            LOSS_REF["ref"] = ref
+            (lr, lc), ins, lo, chosen = loso(runs)
+            chosen_all[ref] = chosen
+            for m in MODELS:
+                arr = loss_arrays(runs[m], m)
+                c = counts(arr, list(arr), p.get("loss_rho", 0.69), p.get("loss_contrast", 0.25), m)
+                lines.append(f"| {m} | {ref} | {fmt_ld(c)} | {fmt_ld(ins[m])} ({lr:.2f}, {lc:.2f}) | {fmt_ld(lo[m])} |")
+                if tag == tags[0]:
+                    res["loss"][f"{m}, ref {ref}"] = {"in_sample": f"{lr:.2f}, {lc:.2f}: {fmt_ld(ins[m])}",
+                                                     "loso": fmt_ld(lo[m])}
+        LOSS_REF["ref"] = "rho0"
+        for ref, chosen in chosen_all.items():
+            lines += ["", f"Pairs chosen leaving each sequence out (ref {ref}): " +
+                      ", ".join(f"{n} ({a:.2f}, {b:.2f})" for n, (a, b) in chosen.items()) + "."]
+        lines.append("")
+    lines += ["## Findings", ""] + [f"* {f}" for f in FINDINGS] + [""]
+    (ROOT / "docs" / "results_accuracy22.md").write_text("\n".join(lines) + "\n")
+    (ROOT / "docs" / "results").mkdir(exist_ok=True)
+    (ROOT / "docs" / "results" / "accuracy22.json").write_text(json.dumps(res, indent=1) + "\n")
+    print(ROOT / "docs" / "results_accuracy22.md")
+
+
+NOTES = {
+    "defaults": "tracker v2's defaults in both models (the fixed model = core v2).",
+    "wide": "the defaults with the fixed model's wider formats model_frac 4, bg_frac 16, weight_frac 8 "
+            "(FixedParams; float unchanged).  Every run below uses them in the fixed model.",
+    "stm2": "gated scale test margin 0.002 (scale_test_margin).",
+    "stm5": "gated scale test margin 0.005.",
+    "sr0": "no pull toward the init size (scale_reg 0).",
+    "sr03": "scale_reg 0.03.",
+    "sg5sr03": "scale_gain 0.5, scale_reg 0.03.",
+    "sw2": "widened search while lost (search_widen 2).",
+    "rsm2": "the mean shift's rho stop with a margin of 0.002 (rho_stop_margin; float on its numpy path).",
+    "lref": "loss flag against the running reference (loss_ref_running) at 0.91 / 0.13, the pair chosen "
+            "for it on the 22 (the boxes are those of defaults: the flag does not steer the tracker).",
+}
+
+
+#: what the runs above show (each item names the run and table it rests on)
+FINDINGS = [
+    "**v2 is below CSRT on the 22** (mean AUC 0.499 / 0.501 float / fixed against 0.563, mean P@20 "
+    "0.718 / 0.713 against 0.796): ahead on the dev set, behind on validation (Car1, Car4, David, Dog1 most).",
+    "**Where float and fixed part (run defaults, divergence table).**  On Car4, Deer and Woman on the first "
+    "frame: rho at init differs by up to 0.23 (Car4 0.794 float, 0.565 fixed).  Two formats of the fixed "
+    "model's init model and bin pass cause it: (1) ms_bg_model's CBWH factors in Q.8 set v = 0 for every ring "
+    "colour more than 256x as frequent as the rarest (large rings: Car1, Car4, Suv, Deer, David); (2) "
+    "ms_model_scale's integer Qw = (Qn K) >> 16 floors most of 4,608 joint bins to 0 in windows of a few "
+    "thousand pixels (Football1, Couple, Surfer, ball1_vot).  With 16 bits for v (bg_frac), 4 fraction "
+    "bits for Qw (model_frac) and a 4.8 weight (weight_frac 8) the init rho differs by at most 0.01 on 15 of 22 "
+    "sequences and 0.02 on 20 (0 of 22 at the core's formats; ClifBar keeps 0.053) and float and fixed stay within 0.01 AUC on 15 of 22 "
+    "sequences instead of 7 (run wide); Car4's gap goes from -0.129 to -0.000, Football1's from -0.192 "
+    "to -0.005.",
+    "**What still parts them (run wide).**  Decision points hit by rounding: the gated scale test's verdict "
+    "(Freeman1: the fixed model takes a size step on frame 50 that float does not; Girl frame 37), the "
+    "search state from the confidence (Girl, Jogging-1), and the init box itself (ball1_vot: float keeps "
+    "23.5 px, fixed rounds to 24).  A margin on the scale test (runs stm2, stm5) does not help: 10 and 12 "
+    "of 22 within 0.01 (the count moves by several sequences with any small change: the remaining gaps "
+    "are losses and recoveries that happen in one model and not the other).",
+    "**Car4, Car1 (grey, the target shrinks to 63 % / 42 % of its init size)**: the box stays near its init "
+    "size (the pull toward w0, scale_reg 0.1, and the gated test's vetoes), the oversized window takes in "
+    "the road and drifts off (Car4: IoU 0.59 at frame 100, 0.19 at 150; Car1 lost at about frame 200).  "
+    "Without the pull (run sr0) Car1 goes from 0.353 to 0.568 (float) and Freeman1 from 0.181 to 0.496, "
+    "but Suv falls from 0.590 to 0.106 and the 22's mean AUC from 0.499 to 0.459; scale_reg 0.03 and "
+    "scale_gain 0.5 (runs sr03, sg5sr03) are also worse on the whole set.  **David** (illumination, the "
+    "face darkens): the confidence falls below conf_lost from frame 12 and the tracker alternates between "
+    "search and tracking with IoU 0.25..0.4 throughout; a grey or chromaticity remedy was not measured.",
+    "**Widened search (run sw2)**: re-acquires a 100 px jump on synthetic frames "
+    "(tests/test_fixed_v2_widths.py), but on real video the lost state is frequent and a wider search "
+    "jumps to distractors: mean AUC 0.407 / 0.431 (float / fixed) against 0.499 / 0.509.",
+    "**rho stop with a margin (run rsm2)**: on the synthetic shifts of tests/test_float_v2.py float v2 stops "
+    "up to 3.1 px short on rho's flat top where the fixed model (its quantised S ties instead of falling) "
+    "goes on to the optimum; a margin of 0.002 makes float converge too "
+    "(tests/test_fixed_v2_widths.py), but on the 22 it costs AUC (mean 0.493 / 0.501 against 0.499 / "
+    "0.509) and P@20 (0.715 / 0.716 against 0.718 / 0.733), and 12 of 22 sequences within 0.01.",
+        "**Loss flag**: no pair of the two thresholds reaches recall 0.6 at false alarms <= 0.05 on the 22, in "
+    "sample or out (best in sample 0.36 / 0.38 at 0.048 / 0.042 against rho0).  Comparing with the running "
+    "reference rho_ref (loss_ref_running) keeps the pair stable when a sequence is left out (0.90..0.94 / "
+    "0.11..0.16; false alarms out of sample 0.064 / 0.068 against 0.145 / 0.135) but does not raise recall "
+    "(0.35 / 0.41).  The off-target frames the flag misses sit on same-coloured background or distractors "
+    "(Car1 63 frames, Bolt2 39, ClifBar 32: rho_s / rho0 0.76..0.92 there); most false alarms are Woman's "
+    "(135 of its 210 on-target frames: rho_s / rho0 0.55, the target's look changes after frame 1).",
+]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("cmd", choices=("run", "report", "diverge", "loss", "doc"))
+    ap.add_argument("--tags", default="default")
+    ap.add_argument("--tag", default="default")
+    ap.add_argument("--set", nargs="*", default=[])
+    ap.add_argument("--models", default="float,fixed")
+    ap.add_argument("--px", type=float, default=4.0)
+    ap.add_argument("--ref", choices=("rho0", "rho_ref"), default="rho0")
+    a = ap.parse_args(argv)
+    LOSS_REF["ref"] = a.ref
+    if a.cmd == "run":
+        main_run(a.tag, parse_sets(a.set), tuple(a.models.split(",")))
+    elif a.cmd == "report":
+        main_report(a.tag)
+    elif a.cmd == "diverge":
+        main_diverge(a.tag, a.px)
+    elif a.cmd == "doc":
+        main_doc(a.tags.split(","), NOTES)
+    else:
+        main_loss(a.tag)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -158,7 +158,7 @@ def sets_section(dev_root: Path, val_root: Path) -> list[str]:
                 label = name if model == "float" else f"{name}@fixed"
                 f = runs[model] / "results" / label / f"{seq.name}.json"
                 if not f.is_file():
-                    return [f"(dev / validation table: {f.relative_to(REPO)} missing; run `make results`)", ""]
+                    return [f"(dev / validation table: {f} missing; run `make results`)", ""]
                 run = SequenceRun.from_json(json.loads(f.read_text()))
                 gt = np.asarray(seq.gt[:run.n_frames], dtype=np.float64)
                 sc = score(run.boxes, gt)

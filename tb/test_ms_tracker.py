@@ -93,9 +93,11 @@ class TB:
         self.last_beat_cycles: list[int] = []
         self.result_cycles: list[int] = []
         self.stall_cycles = 0
+        self.frame_budget = 0
 
     async def reset(self, w: int, h: int) -> None:
         d = self.dut
+        self.frame_budget = 40 * w * h + 400_000          # watchdog per frame (cycles)
         d.frame_width.value = w
         d.frame_height.value = h
         d.s_init_tvalid.value = 0
@@ -179,22 +181,30 @@ async def recv_result(tb: TB, layout_g: dict, timeout_cycles: int,
     return unpack(int(fr.tdata[0]), layout_g)
 
 
-@cocotb.test()
-async def run_job(dut):
-    """Stream the job's frames and compare every result with the fixed model."""
+async def start_job(dut, load: Callable[[dict], list[np.ndarray]]
+                    ) -> tuple[dict, list[np.ndarray], tuple[int, int, int, int], dict[int, str], TB]:
+    """The job of MSTRACK_JOB: its frames (``load(job)``), init box and faults {frame: fault}, and the
+    bench, reset to the frames' size with its monitor running."""
     job = json.loads(os.environ["MSTRACK_JOB"])
-    cfg = config_of(job)
-    g = cfg.generics()
-    frames = load_frames(job)
+    frames = load(job)
     h, w = frames[0].shape[:2]
-    box = tuple(job["box"])
-    faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
-    good = [f for i, f in enumerate(frames) if i not in faults]
-    exp_good = expected_results(good, box, cfg.tp, cfg.fp)
     tb = TB(dut, job)
     await tb.reset(w, h)
     cocotb.start_soon(tb.monitor(h))
-    per_frame_budget = 40 * w * h + 400_000          # watchdog per frame (cycles)
+    faults = {int(k): v for k, v in job.get("faults", {}).items()}
+    return job, frames, tuple(job["box"]), faults, tb
+
+
+@cocotb.test()
+async def run_job(dut):
+    """Stream the job's frames and compare every result with the fixed model."""
+    job, frames, box, faults, tb = await start_job(dut, load_frames)
+    h, w = frames[0].shape[:2]
+    cfg = config_of(job)
+    g = cfg.generics()
+    good = [f for i, f in enumerate(frames) if i not in faults]
+    exp_good = expected_results(good, box, cfg.tp, cfg.fp)
+    per_frame_budget = tb.frame_budget
     offset = 0
     mismatches: list[str] = []
     if "bad_box" in job:

@@ -14,7 +14,6 @@ frame's last pixel to its result.
 from __future__ import annotations
 
 import json
-import os
 
 import pytest
 
@@ -24,7 +23,7 @@ from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, unpack_result_v2
 from mstrack.hw.cosim import COMPARED_FIELDS_V2, CoreConfigV2, diff_fields, expected_results_v2, flags_word
 from mstrack.track.params import V2_COLOUR, TrackerParams
-from test_ms_tracker import TB, _gt_box, _job_env, _seq, lines_of, load_frames, recv_result
+from test_ms_tracker import _gt_box, _job_env, _seq, lines_of, load_frames, recv_result, start_job
 
 STATUS_ERROR = 6
 
@@ -52,19 +51,13 @@ def config_of(job: dict) -> CoreConfigV2:
 @cocotb.test()
 async def run_job_v2(dut):
     """Stream the job's frames and compare every field of every result word v2 with FixedTrackerV2."""
-    job = json.loads(os.environ["MSTRACK_JOB"])
+    job, frames, box, faults, tb = await start_job(dut, load_frames_v2)
+    h, w = frames[0].shape[:2]
     cfg = config_of(job)
     g = cfg.generics()
-    frames = load_frames_v2(job)
-    h, w = frames[0].shape[:2]
-    box = tuple(job["box"])
-    faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
     good = [f for i, f in enumerate(frames) if i not in faults]
     exp_good = expected_results_v2(good, box, cfg.tp, cfg.fp)
-    tb = TB(dut, job)
-    await tb.reset(w, h)
-    cocotb.start_soon(tb.monitor(h))
-    per_frame_budget = 40 * w * h + 400_000
+    per_frame_budget = tb.frame_budget
     await tb.init(box)
     for i, frame in enumerate(frames):
         for line in lines_of(frame, faults.get(i)):

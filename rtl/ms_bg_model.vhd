@@ -23,10 +23,7 @@
 --           qv[u] = Q[u] v[u], tot = sum qv; {T, qv} written back over {Q, O};
 --   pass 3: Qn[u] = floor(qv[u] 2**16 / tot) (0 when qv[u] = 0); {T, Qn} written into the
 --           model RAM; the count word cleared (ready for the next init).
--- One pipelined ms_divider (17 quotient bits) serves passes 2 and 3 (o* 2**8 / O < 2**9 never
--- saturates it); its results come out in bin order, so a counter gives their bin and Q waits
--- beside it in a 32-word LUT RAM (not in its tag).  The products Q no, nq O, v Q are ms_mult_r4
--- LUT multipliers (no MULT18X18D).
+-- One pipelined ms_divider serves passes 2 and 3; the products are ms_mult_r4 LUT multipliers.
 --
 -- Pixel input: any order (each pixel carries its coordinates), at most one per clock, gaps
 -- allowed; px_last marks the frame's last pixel.  The caller streams every pixel of the image
@@ -37,14 +34,9 @@
 -- forwarding from the 4 pixels before (any sequence of bins, runs of one bin included, counts
 -- exactly).
 --
--- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W), an ms_ram_sdp with RD_LAT 3 (on ECP5
--- DP16KD x18 tiles with their output register and a registered row multiplexer: 2 DP16KD at the
--- defaults, 512 x 32; 10 at N_ORIENT 9, 5 rows of 1,024; before, the inferred RAM read without the
--- output register was core v2's critical path), model RAM N_ORIENT banks of N_BINS x 18 {T | Qn} (1 DP16KD per bank), XR table
--- 2**HALF_W x HALF_W and the Q delay memory (LUT RAM).
--- Cost (ECP5 alone, default generics, yosys synth_ecp5 + nextpnr seed 1; docs/blocks/ms_bg_model.md):
--- 1,866 LUT4, 2,654 FF, 729 CCU2C, 2 DP16KD, 0 MULT18X18D, 16 TRELLIS_DPR16X4; 125.6 MHz (measured
--- before the count RAM became an ms_ram_sdp with RD_LAT 3: now 3 DP16KD; not re-measured).
+-- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W) (ms_ram_sdp, RD_LAT 3), model RAM N_ORIENT
+-- banks of N_BINS x 18 {T | Qn}, XR table and Q delay memory (LUT RAM); the ECP5 mapping, cost and
+-- Fmax: docs/blocks/ms_bg_model.md.
 --
 -- Latency (tb/test_ms_bg_model.py measures both):
 --   start -> counting : the kernel-table set-up of (wb, hb) (flat ms_kernel_tables: at most
@@ -55,13 +47,9 @@
 --                       drain 7, pass 1 N + 4, pass 2 N + 31 (read 3, T products M(Q_W) = 4, T 1,
 --                       divider 18, v Q M(9) = 4, end 1), pass 3 N + 23 (read 3, divider 18,
 --                       end, done 2); M(a) = 1 + max(1, ceil(log2(ceil(a / 2)))) is the
---                       ms_mult_r4 latency (constant LAT_DONE; the count RAM's read latency 3
---                       costs 4 clocks against the 3 N + 61 of a 2-clock read).  1,601 clocks at
---                       N = 512 against the 3 x 517 = 1,551 of the v2 budget (python -m
---                       mstrack.hw.synth --v2-budget: init frame 5,800 clocks, so 5,850 with this
---                       block).  N_ORIENT 9 (N = 4,608): 13,889 clocks (passes 1 / 2 / 3: 4,612 /
---                       4,639 / 4,631, drain 7), on the init frame only: the init frame's estimate
---                       becomes about 18,100 of the 99,000 clocks of 1080p60 blanking.
+--                       ms_mult_r4 latency (constant LAT_DONE).  1,601 clocks at N = 512; 13,889 at
+--                       N_ORIENT 9 (N = 4,608), on the init frame only (the v2 budget:
+--                       docs/blocks/ms_bg_model.md).
 -- Throughput: one pixel per clock while counting; one model per init.
 -- Handshake : `start` (with cx, cy, wb, hb, ring16) is taken when busy = 0; busy stays high
 --             until `done` (one-clock pulse); n_box, n_ring, o_min, qv_sum are stable from done
@@ -69,10 +57,8 @@
 --             one clock later: bank m_rd_obin; m_qn_all, m_t_all: every bank at m_rd_addr, from
 --             the banks' read registers) may be used at any time; during a model computation it
 --             shows a mix of the old and the new model.
---             Init stream with joint bins: one count port; pixels may come in any order with
---             gaps, so the top can merge the Sobel's interior pixels and ms_frontend's border
---             pixels through a small FIFO (or have ms_sobel emit the border, obin 8); two pixels
---             in one clock need that merge (a second count port is not provided).
+--             One count port: with joint bins the top merges the Sobel's interior pixels and
+--             the border pixels into one stream (ms_init_merge).
 -- Reset     : synchronous, active high; control state; then N clocks clear the count RAM
 --             (busy = 1 meanwhile; 4,608 at N_ORIENT 9).  The model RAM keeps its contents.  To
 --             abandon an init frame (stream error), reset the block.

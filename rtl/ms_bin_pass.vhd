@@ -13,15 +13,8 @@
 -- Must match mstrack.fixed.blocks.ms_bin_pass / ms_weight (and sum(H) for k_sum).
 -- The product H Q is kept in SQRT_IN_W - 2RF bits (the model sizes SQRT_IN_W for H, Q <= the
 -- largest possible histogram value, so it never truncates in use).
--- The Q RAM is read one clock ahead (address = index of the next returning bin) and its word
--- registered beside H in stage A, so the H Q product and the divider are fed from registers,
--- not from the block RAM's 5.6 ns output (ECP5: 79 MHz -> the multiplier path).
--- The products H Q, w N, w SX, w SY are pipelined radix-4 LUT multipliers (ms_mult_r4, latency
--- M(a) = 1 + max(1, ceil(log2(ceil(a/2)))) for an a of a bits), not MULT18X18D (unregistered as
--- yosys maps it on ECP5); H = 0 forces the ratio, not the weight, to 0 (isqrt(0) = 0).
--- N, SX, SY do not travel through the divider and isqrt stages: they wait in a small delay
--- memory (2**ceil(log2(DLY)) x (COUNT_W + 2 POSSUM_W), DLY = the two latencies) and two
--- registers, read out beside the weight.
+-- The products are pipelined radix-4 LUT multipliers (ms_mult_r4, latency M(a) = 1 + max(1,
+-- ceil(log2(ceil(a/2)))) for an a of a bits); timing and resource notes: docs/blocks/ms_bin_pass.md.
 --
 -- ITERATIVE = 1 (for few bins, e.g. the 16 edge bins): same results, ports and handshake, with
 -- iterative arithmetic: one bin at a time is requested (the next when the previous leaves stage
@@ -41,15 +34,9 @@
 -- ceil(log2(N_ORIENT)) levels (TL = 0 with one bank) adding the N_ORIENT terms of each clock
 -- (H, t, w N, w SX, w SY) before the accumulators.  A pass still walks N_BINS addresses.  Integer
 -- sums: s_sum, sw, swx, swy, k_sum equal ms_bin_pass / sum H over the N_ORIENT N_BINS joint bins
--- exactly, in any order.  Widths: the accumulators (and the tree's partial sums, which wrap like
--- them: two's complement sums modulo 2**width are exact when the total fits) hold the same totals
--- as with a flat histogram of N_ORIENT N_BINS bins, and none of the bounds the widths come from
--- (mstrack.fixed.formats.widths, docs/fixed_point.md) counts bins: sum H = K < 2**HIST_W (every
--- window pixel in one bin), S = sum isqrt(H Q 2**2RF) <= K 2**RF (Cauchy-Schwarz, sum Q <= K),
--- sw <= w_max sum N <= w_max pixels, |swx|, |swy| <= w_max sum |SX| <= w_max pixels MAX_HALF;
--- per-bin values (H, Q, N, SX, SY, H Q) are bounded by the same window sums.  So the generics are
--- unchanged.  External Q load, two ports (both only while idle, not in the same clock): one word
--- per clock as before, q_ext_bank selects the bank (joint bin N_ORIENT q_ext_addr + q_ext_bank; a
+-- exactly, in any order, with the same generics (the width bounds count no bins:
+-- docs/blocks/ms_bin_pass.md).  External Q load, two ports (both only while idle, not in the same
+-- clock): one word per clock, q_ext_bank selects the bank (joint bin N_ORIENT q_ext_addr + q_ext_bank; a
 -- full load takes N_ORIENT N_BINS clocks), or all N_ORIENT banks of address q_ext_addr in one
 -- clock (q_ext_all_we, q_ext_all_data: bank o at bits o*HIST_W; a full load takes N_BINS clocks).
 -- With N_ORIENT = 1 the parallel port writes Q[q_ext_addr] as the word port does.

@@ -34,9 +34,7 @@
 --              after the address (PeakRDL regblock + AXI4-Lite adapter), 2 transactions in flight.
 -- Throughput : the core's: PPC pixels per clock while a frame streams in.
 -- Reset      : rst synchronous, active high (core and registers; every register to its reset value).
--- Cost       : over the core, ECP5 (yosys synth_ecp5, default generics, RESULT_STREAM false): PRESET 0
---              +1,466 LUT4, +750 FF, +165 CCU2C (+1,509 / +748 / +161 on older RTL); PRESET 1 +1,811
---              LUT4, +787 FF, +111 CCU2C; no RAM, no multiplier (docs/blocks/ms_tracker_axi.md, Resources).
+-- Cost       : over the core, logic only (no RAM, no multiplier): docs/blocks/ms_tracker_axi.md, Resources.
 -- Generics: those of ms_tracker (passed through; the derived widths come from
 -- mstrack.fixed.vhdl_pkg.core_generics, core v2's from mstrack.hw.cosim.CoreConfigV2.tracker_generics)
 -- and RESULT_STREAM.

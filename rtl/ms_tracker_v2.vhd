@@ -1,79 +1,38 @@
--- ms_tracker_v2: the sequencer of core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2)
--- bit for bit, on the ports and stream behaviour of ms_tracker, with result word v2.
+-- ms_tracker_v2: the sequencer of core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2) bit for
+-- bit, on the ports and stream behaviour of ms_tracker, with result word v2.  Integrators instantiate
+-- ms_tracker with PRESET 1, which passes every port and generic here.  The block page,
+-- docs/blocks/ms_tracker_v2.md, gives each step, the joint bins, the gated scale test, the stream
+-- faults, the measured latencies and the tests.
 --
--- Computes, per video frame (docs/blocks/ms_tracker_v2.md, docs/architecture.md "Core v2"):
---   before the frame (between frames, input closed): log2 D = ms_decimation(w8, h8) (+ 1 while the
---   search state is lost: D x 2), the decimated frame size ((W - 1) >> log2 D) + 1, the window
---   diameters wd, hd = ms_window_size, the search offsets ox, oy = (STEP16 wd, hd) >> 4, the region
---   (mstrack.fixed.blocks.ms_region, inline: margin MARGIN, + max(ox, oy) while lost, at most
---   MARGIN_MAX) around c8 >> log2 D, in decimated px; on an init frame also the box (ms_box_size,
---   centre clamped into the decimated interior) and the start of ms_bg_model;
---   during the frame: ms_frontend -> ms_decimate -> ms_region_capture (colour region RAM) and,
---   on the init frame, every pixel of the decimated frame (border included: ms_frontend av_*)
---   into ms_bg_model;
---   after the frame: ms_kernel_tables (wd, hd; flat pass tables + the KA/KB of ms_target_stats;
---   K = the window's pixel count summed from the row extents XR), Qw = ms_model_scale(Qn, K)
---   written into the engine's Q RAM (and T into ms_target_stats), ms_meanshift from c8 >> log2 D
---   (init frame: one pass without moving, `single`), ms_target_stats on the pixel-pass tap (the
---   statistics of the pass at the result centre), rho (ms_fusion, colour only), ms_share and
---   ms_confidence of the result; while lost 8 more start points (c +- (ox, oy)) x SEARCH_ITER
---   iterations in the same region, the best confidence wins; then for the winner ms_spread,
---   ms_ring_share, ms_loss_filter x 2, ms_loss_flag, the search state and the reported status,
---   ms_ref_update x 2 (OK frames), ms_scale and ms_resize x 2.
---   With SCALE_TEST_D256 > 0 (the gated scale test, the default 13: FixedTrackerV2 with scale_test and
---   scale_test_gate, _scale_verdict), when the scale branch is taken (SCALE_GAIN > 0, nt > 0), before
---   ms_scale, for the sizes x(1 - d) then x(1 + d) (T_ST_SIZE .. T_ST_NEXT): ms_scale_test_size (a
---   constant multiply, round half up), ms_window_size (the frame set-up's instances, inputs muxed),
---   the fit test (a window that leaves the captured region does not count), ms_kernel_tables + K
---   (T_TABLES), the Qw load (T_QLOAD), one pass of the engine without moving (`single`) at the final
---   centre, rho (ms_fusion); then the verdict (ms_scale_test: the largest rho, ties to the earlier
---   of x1, x(1 - d), x(1 + d)) and ms_scale_gate (T_ST_GATE) give ms_scale's spread.  The main run's
---   window tables, K, Q RAM and S are overwritten (nothing after T_DECIDE reads them: rho, share,
---   spread, ring share, confidence and the loss flag are registered by then; the next frame rebuilds
---   them); the window registers wd, hd, ex, ey, hi_x, hi_y likewise (set up again before the frame).
---   With ORIENT_T >= 0 (the joint colour x gradient-orientation bins, the default 64: FixedTrackerV2
---   with orient_T = ORIENT_T, tracker mstrack-v2 with the gated scale test): a pixel's bin is
---   (colour, ms_orient_bin(ms_grey(frame), ORIENT_T)) = 9 colour + obin, 4,608 bins.  ms_frontend's
---   ip_obin rides ms_decimate's edge path into a 4-bit orientation region RAM beside the colour one
---   (same addresses, same latency: ram_obin); on the init frame ms_init_merge feeds ms_bg_model
---   (N_ORIENT 9) the decimated frame's interior pixels from the Sobel (dp_*) and its border pixels
---   (obin 8) from av_*; the Qw load walks the 512 colour addresses with 9 ms_model_scale in lockstep
---   (m_qn_all -> the engine's q_ext_all_*) and writes ms_target_stats' 512 x 9 T words (m_t_all)
---   beside it; ms_meanshift, ms_pixel_pass, ms_histogram, ms_bin_pass and ms_target_stats run with
---   N_ORIENT 9 (9 banks per colour address, a pass still walks 512 addresses).  Cost in clocks: the
---   init frame's ms_bg_model passes walk 4,608 joint bins (13,889 clocks instead of 1,601), the bin
---   pass + 4 clocks (its adder tree); everything else as with colour bins.
+-- Computes, per video frame:
+--   before the frame (input closed): log2 D = ms_decimation(w8, h8) (+ 1 while lost), the decimated
+--   frame size, the window diameters (ms_window_size), the search offsets (STEP16) and the region
+--   around c8 >> log2 D (margin MARGIN, + the offset while lost, at most MARGIN_MAX); on an init frame
+--   the box (ms_box_size) and the start of ms_bg_model;
+--   during the frame: ms_frontend -> ms_decimate -> ms_region_capture (colour region RAM, + the 4-bit
+--   orientation RAM with ORIENT_T >= 0); on the init frame ms_bg_model counts the decimated frame;
+--   after the frame: ms_kernel_tables + K, the Qw load (ms_model_scale into the engine's Q RAM, T into
+--   ms_target_stats), ms_meanshift from c8 >> log2 D (init frame: one pass, `single`), ms_target_stats,
+--   rho (ms_fusion), ms_share, ms_confidence; while lost 8 more start points x SEARCH_ITER iterations,
+--   the best confidence wins; for the winner ms_spread, ms_ring_share, ms_loss_filter x 2,
+--   ms_loss_flag, the search state and status, ms_ref_update x 2, with SCALE_TEST_D256 > 0 the gated
+--   scale test (x(1 - d), x(1 + d): tables, Qw load, one pass, rho each; ms_scale_test, ms_scale_gate),
+--   ms_scale and ms_resize x 2.
 -- Result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2): cx, cy, w8, h8, rho, confidence,
--- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.
+-- status, iter, stop, decim_log2, searched, flags, err_code, frame_count.  Init box and stream faults:
+-- as ms_tracker (error result with status 6; state unchanged; a fault on the init frame re-arms
+-- ms_bg_model, and a start of frame that cuts the init frame is held until then).
 --
--- Init box (s_init, between frames): clipped to the frame interior (ms_box_clip, no shrink: large
--- targets are decimated); rejected as in ms_tracker.  Protocol errors and a frame of another size
--- than the target's: error result (status 6 "error", flag error, err_code), state unchanged, as in
--- ms_tracker (a lost target stays lost).  A stream error on the init frame resets ms_bg_model and the
--- next good frame is the init frame.  While an init is pending, a start of frame that would cut a
--- frame ms_bg_model has counted pixels of is held (s_axis_tready low, the only place where tready
--- follows tuser) until ms_bg_model is re-armed, so the frame that cuts (error cut) is learnt from
--- its first pixel (docs/architecture.md "Core v2: stream faults"; mstrack.hw.cosim.CoreModelV2).
---
--- Status: bit-exact with the model on generated scenes (GHDL) and real sequences (Verilator),
--- tracking, lost state and re-acquisition included (tb/test_ms_tracker_v2.py).  Placed and routed
--- on the LFE5U-85F (docs/performance.md "Core v2"); the region (T_REGION .. T_REGION_WAIT, 6 clocks)
--- and the init box clamp (T_BOX .. T_BOX2, 3 clocks) are computed one carry chain per clock.
---
--- Between frames (after the result, input closed): the geometry, about 24 clocks (the region 6 of
--- them), + on an init frame ms_bg_model's reset and set-up.
--- Latency per frame: the frame's last pixel -> result: on a tracking frame the kernel tables
--- (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
--- statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
--- shifts with their confidence; on the init frame ms_bg_model's 3 N_BINS + 65 clocks first.
--- With the gated scale test (SCALE_TEST_D256 > 0), on frames that scale: 2 x (about 8 clocks of size,
--- window size and fit test + the kernel tables + the Qw load (N_BINS + 6) + one pixel pass and one
--- bin pass + ms_fusion's rho), a window that does not fit skipping all but the first 8; measured
--- on the first tracking frame (LANES 4, 512 bins): 3,462 clocks more (Girl, 128x96), 3,607
--- (Couple), 5,041 (MotorRolling, D = 2); at MAX_WINDOW 127 about 2 x 4,800 (estimated, not measured).
--- Measured: docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).  Throughput: 1 pixel per clock while a frame streams;
--- the input is closed from a frame's last pixel until its result is in the FIFO (as ms_tracker).
--- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1).
+-- Latency: between frames about 24 clocks (+ ms_bg_model's reset and set-up before an init frame);
+-- last pixel -> result: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
+-- (docs/realtime.md), ~60 clocks of statistics and about 230 of confidence, loss flag, scale and
+-- resize; while lost 8 more mean shifts with their confidence; on the init frame ms_bg_model's
+-- 3 N_BINS + 65 clocks first; the gated scale test adds about 2 x (tables + Qw load + one pass) on a
+-- frame that scales.  Measured per sequence: docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).
+-- Throughput: 1 pixel per clock while a frame streams; the input is closed from a frame's last pixel
+-- until its result is in the FIFO (as ms_tracker).
+-- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1), s_init
+-- valid / ready (taken between frames), busy = the engine is running.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;

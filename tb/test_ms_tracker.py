@@ -20,6 +20,7 @@ import json
 import os
 import random
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import pytest
@@ -82,6 +83,9 @@ def lines_of(frame: np.ndarray, fault: str | None = None, ppc: int = 1) -> list[
 
 # ----------------------------------------------------------------------------- cocotb side
 class TB:
+    """Clock, reset, AXI4-Stream models, init handshake and cycle monitor of a core with ms_tracker's
+    ports (either preset; tb/test_ms_tracker_v2.py uses it too)."""
+
     def __init__(self, dut, job: dict) -> None:
         self.dut = dut
         self.job = job
@@ -89,9 +93,11 @@ class TB:
         self.last_beat_cycles: list[int] = []
         self.result_cycles: list[int] = []
         self.stall_cycles = 0
+        self.frame_budget = 0
 
     async def reset(self, w: int, h: int) -> None:
         d = self.dut
+        self.frame_budget = 40 * w * h + 400_000          # watchdog per frame (cycles)
         d.frame_width.value = w
         d.frame_height.value = h
         d.s_init_tvalid.value = 0
@@ -151,29 +157,54 @@ class TB:
             if int(d.m_axis_result_tvalid.value) and int(d.m_axis_result_tready.value):
                 self.result_cycles.append(self.cycle)
 
+    async def finish(self, frames: int, w: int, h: int, box: tuple[int, int, int, int], faults: bool,
+                     mismatches: list[str], **fields: list[int]) -> None:
+        """After the last result: no result more; the job's report file (frames, size, box, the cycles
+        from each frame's last beat to its result (none with faults), stalls, *fields*, mismatches);
+        then every mismatch fails the test."""
+        await ClockCycles(self.dut.clk, 10)
+        assert self.sink.empty(), "the core produced more results than frames"
+        lat = [r - b for b, r in zip(self.last_beat_cycles, self.result_cycles)] if not faults else []
+        report = self.job.get("report")
+        if report:
+            Path(report).write_text(json.dumps({
+                "frames": frames, "width": w, "height": h, "box": list(box),
+                "latency_cycles": lat, "stall_cycles": self.stall_cycles, "total_cycles": self.cycle,
+                **fields, "mismatches": mismatches}))
+        assert not mismatches, "\n".join(mismatches)
 
-async def recv_result(tb: TB, layout_g: dict, timeout_cycles: int) -> dict[str, int]:
+
+async def recv_result(tb: TB, layout_g: dict, timeout_cycles: int,
+                      unpack: Callable[[int, dict], dict[str, int]] = unpack_result) -> dict[str, int]:
+    """The next result word, unpacked (result word v2: ``unpack=unpack_result_v2``)."""
     fr = await with_timeout(tb.sink.recv(), timeout_cycles * CLK_NS, "ns")  # watchdog: never hang
-    word = int(fr.tdata[0])
-    return unpack_result(word, layout_g)
+    return unpack(int(fr.tdata[0]), layout_g)
+
+
+async def start_job(dut, load: Callable[[dict], list[np.ndarray]]
+                    ) -> tuple[dict, list[np.ndarray], tuple[int, int, int, int], dict[int, str], TB]:
+    """The job of MSTRACK_JOB: its frames (``load(job)``), init box and faults {frame: fault}, and the
+    bench, reset to the frames' size with its monitor running."""
+    job = json.loads(os.environ["MSTRACK_JOB"])
+    frames = load(job)
+    h, w = frames[0].shape[:2]
+    tb = TB(dut, job)
+    await tb.reset(w, h)
+    cocotb.start_soon(tb.monitor(h))
+    faults = {int(k): v for k, v in job.get("faults", {}).items()}
+    return job, frames, tuple(job["box"]), faults, tb
 
 
 @cocotb.test()
 async def run_job(dut):
     """Stream the job's frames and compare every result with the fixed model."""
-    job = json.loads(os.environ["MSTRACK_JOB"])
+    job, frames, box, faults, tb = await start_job(dut, load_frames)
+    h, w = frames[0].shape[:2]
     cfg = config_of(job)
     g = cfg.generics()
-    frames = load_frames(job)
-    h, w = frames[0].shape[:2]
-    box = tuple(job["box"])
-    faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
     good = [f for i, f in enumerate(frames) if i not in faults]
     exp_good = expected_results(good, box, cfg.tp, cfg.fp)
-    tb = TB(dut, job)
-    await tb.reset(w, h)
-    cocotb.start_soon(tb.monitor(h))
-    per_frame_budget = 40 * w * h + 400_000          # watchdog per frame (cycles)
+    per_frame_budget = tb.frame_budget
     offset = 0
     mismatches: list[str] = []
     if "bad_box" in job:
@@ -228,17 +259,8 @@ async def run_job(dut):
             mismatches.append(f"frame {i} ({faults.get(i, 'good')}): " + "; ".join(d))
             if len(mismatches) > 5:
                 break
-    await ClockCycles(dut.clk, 10)
-    assert tb.sink.empty(), "the core produced more results than frames"
-    lat = [r - b for b, r in zip(tb.last_beat_cycles, tb.result_cycles)] if not faults else []
-    report = job.get("report")
-    if report:
-        Path(report).write_text(json.dumps({
-            "frames": len(frames), "width": w, "height": h, "box": list(box),
-            "latency_cycles": lat, "stall_cycles": tb.stall_cycles, "total_cycles": tb.cycle,
-            "iter_c": [e["iter_c"] for e in exp_good], "iter_e": [e["iter_e"] for e in exp_good],
-            "mismatches": mismatches}))
-    assert not mismatches, "\n".join(mismatches)
+    await tb.finish(len(frames), w, h, box, bool(faults), mismatches,
+                    iter_c=[e["iter_c"] for e in exp_good], iter_e=[e["iter_e"] for e in exp_good])
 
 
 # ----------------------------------------------------------------------------- pytest side
@@ -253,11 +275,11 @@ def _seq(name: str) -> Path:
     return p
 
 
-def _gt_box(seq: Path) -> tuple[int, int, int, int]:
+def _gt_box(seq: Path, start: int = 0) -> tuple[int, int, int, int]:
     from mstrack.io.data import load_sequence
     from mstrack.fixed.blocks import round_box
     s = load_sequence(seq)
-    return round_box(*[float(v) for v in s.gt[0]])
+    return round_box(*[float(v) for v in s.gt[start]])
 
 
 SMALL = {"fp": {"max_half": 15, "margin": 8}}

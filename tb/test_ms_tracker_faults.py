@@ -394,8 +394,10 @@ async def play_plan(b: Bench, frames: list[np.ndarray], plan: list, stall_every:
             await b.frame(frames[i], *(p or (None, 0)))
 
 
-async def run_directed(dut, body, seed: int = 1, size: tuple[int, int] = (48, 40)) -> Bench:
-    b = Bench(dut, seed, label=body.__qualname__.split(".")[0])
+async def run_directed(dut, body, seed: int = 1, size: tuple[int, int] = (48, 40),
+                       bench: type[Bench] = Bench) -> Bench:
+    """One directed case: *body* drives a fresh *bench*; every result is compared with its model."""
+    b = bench(dut, seed, label=body.__qualname__.split(".")[0])
     await b.start(*size)
     await body(b)
     errs = await b.finish()
@@ -963,30 +965,37 @@ async def fuzz_seed(dut, seed: int, first: bool, cover: dict[str, int], bench: t
     return b
 
 
-@cocotb.test()
-async def fuzz(dut):
-    """Constrained-random protocol test: seeds ``first:count`` of MSTRACK_FUZZ, one reset each."""
+async def run_fuzz(dut, bench: type[Bench] = Bench, name: str = "fuzz",
+                   replay: str = "make test-fuzz SEEDS={seed} N=1") -> None:
+    """Seeds ``first:count`` of MSTRACK_FUZZ of :func:`fuzz_seed` on *bench*, one reset each; the
+    summary (results, beats, coverage) to the log and to MSTRACK_FUZZ_REPORT."""
     first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "1:3").split(":"))
     report = os.environ.get("MSTRACK_FUZZ_REPORT")
     cover: dict[str, int] = {}
     t0 = time.time()
     done, results, beats = 0, 0, 0
     for seed in range(first, first + count):
-        dut._log.info(f"fuzz seed {seed}")
+        dut._log.info(f"{name} seed {seed}")
         try:
-            b = await fuzz_seed(dut, seed, done == 0, cover)
+            b = await fuzz_seed(dut, seed, done == 0, cover, bench=bench, replay=replay)
         except BaseException:
-            dut._log.error(f"FUZZ SEED {seed} FAILED (replay: make test-fuzz SEEDS={seed} N=1)")
+            dut._log.error(f"FUZZ SEED {seed} FAILED (replay: {replay.format(seed=seed)})")
             raise
         done += 1
         results += b.stats.results
         beats += b.stats.beats
     summary = {"first": first, "seeds": done, "results": results, "beats": beats,
                "seconds": round(time.time() - t0, 1), "coverage": dict(sorted(cover.items()))}
-    dut._log.info("fuzz: " + json.dumps(summary))
+    dut._log.info(f"{name}: " + json.dumps(summary))
     if report:
         with open(report, "w") as f:
             json.dump(summary, f, indent=1)
+
+
+@cocotb.test()
+async def fuzz(dut):
+    """Constrained-random protocol test: seeds ``first:count`` of MSTRACK_FUZZ, one reset each."""
+    await run_fuzz(dut)
 
 
 @pytest.mark.ghdl

@@ -4,7 +4,7 @@ Core v2 runs as the engine ms_tracker_v2 alone (the GHDL scenes, protocol errors
 instantiate it, ms_tracker with generic PRESET = 1 (test_tracker_v2_preset_generic under GHDL; the
 Verilator runs, long set included, through :func:`mstrack.hw.fastsim.simulate`'s default top).
 
-cocotb module and pytest entry points in one file, in the style of tb/test_ms_tracker.py: a *job*
+cocotb module and pytest entry points in one file, on the bench of tb/test_ms_tracker.py (TB, lines_of): a *job*
 (JSON in MSTRACK_JOB) names the frames (real sequence images or a generated scene), the init box,
 the stream conditions (random tvalid gaps, result back-pressure, protocol faults).  Every field of
 every result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2) is compared with
@@ -14,26 +14,17 @@ frame's last pixel to its result.
 from __future__ import annotations
 
 import json
-import os
-import random
-from pathlib import Path
 
 import pytest
 
 import cocotb
-from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, RisingEdge, with_timeout
-from cocotbext.axi import AxiStreamBus, AxiStreamSink, AxiStreamSource
 
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import DEFAULT_LANES, unpack_result_v2
 from mstrack.hw.cosim import COMPARED_FIELDS_V2, CoreConfigV2, diff_fields, expected_results_v2, flags_word
 from mstrack.track.params import V2_COLOUR, TrackerParams
-from test_ms_tracker import lines_of, load_frames
+from test_ms_tracker import _gt_box, _job_env, _seq, lines_of, load_frames, recv_result, start_job
 
-REPO = Path(__file__).resolve().parents[1]
-SEQ_ROOT = REPO.parent / "shared" / "data" / "sequences"
-CLK_NS = 10
 STATUS_ERROR = 6
 
 
@@ -57,90 +48,16 @@ def config_of(job: dict) -> CoreConfigV2:
 
 
 # ----------------------------------------------------------------------------- cocotb side
-class TB:
-    def __init__(self, dut, job: dict) -> None:
-        self.dut = dut
-        self.job = job
-        self.cycle = 0
-        self.last_beat_cycles: list[int] = []
-        self.result_cycles: list[int] = []
-        self.stall_cycles = 0
-
-    async def reset(self, w: int, h: int) -> None:
-        d = self.dut
-        d.frame_width.value = w
-        d.frame_height.value = h
-        d.s_init_tvalid.value = 0
-        d.s_init_x.value = 0
-        d.s_init_y.value = 0
-        d.s_init_w.value = 0
-        d.s_init_h.value = 0
-        d.s_axis_tvalid.value = 0
-        d.m_axis_result_tready.value = 0
-        d.rst.value = 1
-        cocotb.start_soon(Clock(d.clk, CLK_NS, unit="ns").start())
-        await ClockCycles(d.clk, 3)
-        self.source = AxiStreamSource(AxiStreamBus.from_prefix(d, "s_axis"), d.clk, d.rst, byte_lanes=1)
-        self.sink = AxiStreamSink(AxiStreamBus.from_prefix(d, "m_axis_result"), d.clk, d.rst, byte_lanes=1)
-        rng = random.Random(self.job.get("seed", 1))
-        if self.job.get("pause_in"):
-            self.source.set_pause_generator(iter(lambda: rng.random() < 0.3, None))
-        if self.job.get("pause_out"):
-            self.sink.set_pause_generator(iter(lambda: rng.random() < 0.5, None))
-        await ClockCycles(d.clk, 2)
-        d.rst.value = 0
-        await ClockCycles(d.clk, 5)
-
-    async def init(self, box: tuple[int, int, int, int]) -> None:
-        d = self.dut
-        d.s_init_x.value = box[0]
-        d.s_init_y.value = box[1]
-        d.s_init_w.value = box[2]
-        d.s_init_h.value = box[3]
-        d.s_init_tvalid.value = 1
-        while True:
-            await RisingEdge(d.clk)
-            if int(d.s_init_tready.value):
-                break
-        d.s_init_tvalid.value = 0
-
-    async def monitor(self, frame_h: int) -> None:
-        d = self.dut
-        lines = 0
-        while True:
-            await RisingEdge(d.clk)
-            self.cycle += 1
-            tv = int(d.s_axis_tvalid.value)
-            tr = int(d.s_axis_tready.value)
-            if tv and tr:
-                if int(d.s_axis_tuser.value):
-                    lines = 0
-                if int(d.s_axis_tlast.value):
-                    lines += 1
-                    if lines == frame_h:
-                        self.last_beat_cycles.append(self.cycle)
-            elif tv and not tr:
-                self.stall_cycles += 1
-            if int(d.m_axis_result_tvalid.value) and int(d.m_axis_result_tready.value):
-                self.result_cycles.append(self.cycle)
-
-
 @cocotb.test()
 async def run_job_v2(dut):
     """Stream the job's frames and compare every field of every result word v2 with FixedTrackerV2."""
-    job = json.loads(os.environ["MSTRACK_JOB"])
+    job, frames, box, faults, tb = await start_job(dut, load_frames_v2)
+    h, w = frames[0].shape[:2]
     cfg = config_of(job)
     g = cfg.generics()
-    frames = load_frames_v2(job)
-    h, w = frames[0].shape[:2]
-    box = tuple(job["box"])
-    faults: dict[int, str] = {int(k): v for k, v in job.get("faults", {}).items()}
     good = [f for i, f in enumerate(frames) if i not in faults]
     exp_good = expected_results_v2(good, box, cfg.tp, cfg.fp)
-    tb = TB(dut, job)
-    await tb.reset(w, h)
-    cocotb.start_soon(tb.monitor(h))
-    per_frame_budget = 40 * w * h + 400_000
+    per_frame_budget = tb.frame_budget
     await tb.init(box)
     for i, frame in enumerate(frames):
         for line in lines_of(frame, faults.get(i)):
@@ -148,8 +65,7 @@ async def run_job_v2(dut):
     mismatches: list[str] = []
     gi = 0
     for i in range(len(frames)):
-        fr = await with_timeout(tb.sink.recv(), per_frame_budget * CLK_NS, "ns")
-        got = unpack_result_v2(int(fr.tdata[0]), g)
+        got = await recv_result(tb, g, per_frame_budget, unpack_result_v2)
         if i in faults:
             exp = {"flags": flags_word(error=1), "status": STATUS_ERROR, "frame_count": i & 0xFFFF}
             d = diff_fields(got, exp, fields=("flags", "status", "frame_count"))
@@ -163,38 +79,11 @@ async def run_job_v2(dut):
             mismatches.append(f"frame {i} ({faults.get(i, 'good')}): " + "; ".join(d))
             if len(mismatches) > 5:
                 break
-    await ClockCycles(dut.clk, 10)
-    assert tb.sink.empty(), "the core produced more results than frames"
-    lat = [r - b for b, r in zip(tb.last_beat_cycles, tb.result_cycles)] if not faults else []
-    report = job.get("report")
-    if report:
-        Path(report).write_text(json.dumps({
-            "frames": len(frames), "width": w, "height": h, "box": list(box),
-            "latency_cycles": lat, "stall_cycles": tb.stall_cycles, "total_cycles": tb.cycle,
-            "status": [e["status"] for e in exp_good], "decim_log2": [e["decim_log2"] for e in exp_good],
-            "mismatches": mismatches}))
-    assert not mismatches, "\n".join(mismatches)
+    await tb.finish(len(frames), w, h, box, bool(faults), mismatches,
+                    status=[e["status"] for e in exp_good], decim_log2=[e["decim_log2"] for e in exp_good])
 
 
 # ----------------------------------------------------------------------------- pytest side
-def _job_env(job: dict) -> dict[str, str]:
-    return {"MSTRACK_JOB": json.dumps(job)}
-
-
-def _seq(name: str) -> Path:
-    p = SEQ_ROOT / name
-    if not p.is_dir():
-        pytest.skip(f"{p} not found: the real-video co-simulation needs ../shared/data/sequences")
-    return p
-
-
-def _gt_box(seq: Path, start: int = 0) -> tuple[int, int, int, int]:
-    from mstrack.io.data import load_sequence
-    from mstrack.fixed.blocks import round_box
-    s = load_sequence(seq)
-    return round_box(*[float(v) for v in s.gt[start]])
-
-
 def _run(job: dict, build_name: str, top: str = "ms_tracker_v2") -> None:
     """GHDL run of the job on ``top``: the engine ms_tracker_v2, or ms_tracker with PRESET 1 (the entity
     integrators instantiate; CoreConfigV2.tracker_generics)."""

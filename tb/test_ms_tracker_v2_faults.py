@@ -17,22 +17,20 @@ from __future__ import annotations
 
 import json
 import os
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import cocotb
-from cocotb.triggers import RisingEdge
 
 from mstrack.fixed import FixedParams
 from mstrack.fixed.vhdl_pkg import unpack_result_v2
-from mstrack.hw.cosim import COMPARED_FIELDS_V2, CoreConfigV2, CoreModelV2, frame_words
+from mstrack.hw.cosim import COMPARED_FIELDS_V2, CoreConfigV2, CoreModelV2
 from mstrack.track.params import V2_COLOUR, TrackerParams
-from test_ms_tracker_faults import MAX_FRAME_W, Bench, beats_of, fuzz_seed, play_plan, scene
+import test_ms_tracker_faults as faults
+from test_ms_tracker_faults import H0, MAX_FRAME_W, W0, Bench, beats_of, kinds_of, play_plan, scene
 
-W0, H0 = 48, 40
 ERROR = 6                       # status error (STATUS_V2)
 LOST = 2
 
@@ -57,19 +55,8 @@ class BenchV2(Bench):
         return unpack_result_v2(word, self.g)
 
 
-async def run_directed(dut, body, seed: int = 1, size: tuple[int, int] = (W0, H0)) -> BenchV2:
-    b = BenchV2(dut, seed, label=body.__qualname__.split(".")[0])
-    await b.start(*size)
-    await body(b)
-    errs = await b.finish()
-    b.stop()
-    dut._log.info(f"{b.label}: {b.stats}")
-    assert not errs, "\n".join(errs[:20])
-    return b
-
-
-def kinds_of(b: Bench) -> list[str]:
-    return list(b.model.kinds)
+async def run_directed(dut, body, seed: int = 1, size: tuple[int, int] = (W0, H0)) -> Bench:
+    return await faults.run_directed(dut, body, seed, size, bench=BenchV2)
 
 
 def blank(w: int = W0, h: int = H0) -> np.ndarray:
@@ -260,24 +247,7 @@ DIRECTED = ["init_frame_faults", "cut_init_frame", "tuser_stuck_init_frame", "fa
 @cocotb.test()
 async def fuzz(dut):
     """Constrained-random protocol test on core v2: seeds ``first:count`` of MSTRACK_FUZZ."""
-    first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "1:3").split(":"))
-    report = os.environ.get("MSTRACK_FUZZ_REPORT")
-    cover: dict[str, int] = {}
-    t0 = time.time()
-    done, results, beats = 0, 0, 0
-    for seed in range(first, first + count):
-        dut._log.info(f"v2 fuzz seed {seed}")
-        b = await fuzz_seed(dut, seed, done == 0, cover, bench=BenchV2,
-                            replay="make test-fuzz-v2 SEEDS={seed} N=1")
-        done += 1
-        results += b.stats.results
-        beats += b.stats.beats
-    summary = {"first": first, "seeds": done, "results": results, "beats": beats,
-               "seconds": round(time.time() - t0, 1), "coverage": dict(sorted(cover.items()))}
-    dut._log.info("v2 fuzz: " + json.dumps(summary))
-    if report:
-        with open(report, "w") as f:
-            json.dump(summary, f, indent=1)
+    await faults.run_fuzz(dut, BenchV2, "v2 fuzz", "make test-fuzz-v2 SEEDS={seed} N=1")
 
 
 # ----------------------------------------------------------------------------- pytest side

@@ -219,8 +219,6 @@ def test_core_v2_vhdl_defaults_are_the_models():
     assert len(own) >= len(V2_GENERICS) - 2
     assert {k: top[k] for k in own} == {k: want[k] for k in own}
     keys = [k for k in want if k != "MAX_FRAME_W"]        # the frame width is the integrator's choice
-    for path, entity in ((TRACKER_VHD.with_name("ms_tracker_v2.vhd"), "ms_tracker_v2"),
-                         (TRACKER_VHD.parent / "wrappers" / "ms_tracker_v2_pins.vhd", "ms_tracker_v2_pins")):
-        eng = _vhdl_defaults(path, entity)
-        assert set(keys) <= set(eng), entity
-        assert {k: eng[k] for k in keys} == {k: want[k] for k in keys}, entity
+    eng = _vhdl_defaults(TRACKER_VHD.with_name("ms_tracker_v2.vhd"), "ms_tracker_v2")
+    assert set(keys) <= set(eng)
+    assert {k: eng[k] for k in keys} == {k: want[k] for k in keys}

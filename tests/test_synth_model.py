@@ -153,40 +153,45 @@ def test_nexus_table_row():
 
 # ----------------------------------------------------------------------------- core v2
 def test_v2_config_has_v2_generics_and_wrapper():
-    """Configuration "v2": ms_tracker_v2 with CoreConfigV2's generics, placed through ms_tracker_v2_pins,
-    whose generics are exactly ms_tracker_v2's (every one passed through); the paper configurations unchanged."""
+    """Configuration "v2": ms_tracker_v2 with CoreConfigV2's generics, placed through ms_tracker_pins with
+    PRESET 1; the one pins wrapper has exactly ms_tracker's generics (every one passed through, the same
+    defaults), so every generic the flow sets exists on it; the paper configurations unchanged."""
     import re
 
     from mstrack.fixed import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import TrackerParams
     c = synth.CONFIGS["v2"]
-    assert c.v2 and c.core == "ms_tracker_v2" and c.pins_top == "ms_tracker_v2_pins"
+    assert c.v2 and c.core == "ms_tracker_v2" and c.pins_top == "ms_tracker_pins"
     g = c.generics()
     assert g == CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).generics()
     assert g["RESULT_W"] == 160 and g["REGION_MAX"] == 256 and g["STRIDE"] == 64 and g["FEATURES"] == 1
     d = synth.CONFIGS["default"]
     assert (d.core, d.pins_top) == ("ms_tracker", "ms_tracker_pins") and "RESULT_W" in d.generics()
     assert d.generics()["RESULT_W"] != 160
+    assert c.pins_generics() == CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).tracker_generics()
+    assert d.pins_generics() == d.generics() and "PRESET" not in d.generics()
     srcs = synth.pins_sources(c.pins_top)
-    assert srcs[-1] == synth.PINS_VHD_V2 and any(p.name == "ms_tracker_v2.vhd" for p in srcs)
-    assert synth.pins_sources()[-1] == synth.PINS_VHD
+    assert srcs[-1] == synth.PINS_VHD and {"ms_tracker.vhd", "ms_tracker_v2.vhd"} <= {p.name for p in srcs}
 
-    def generic_names(path, entity):
+    def generics(path, entity):
+        """(name, type and default) of each generic, comments and spacing left out."""
         t = path.read_text()
         t = t[t.index(f"entity {entity} is"):]
-        t = t[t.index("generic ("):t.index("  port (")]
-        return re.findall(r"^\s+(\w+)\s*:", t, re.M)
-    core = generic_names(synth.REPO_ROOT / "rtl" / "ms_tracker_v2.vhd", "ms_tracker_v2")
-    assert generic_names(synth.PINS_VHD_V2, "ms_tracker_v2_pins") == core
-    body = synth.PINS_VHD_V2.read_text()
-    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n in core)
-    assert set(g) <= set(core)                 # every generic the flow sets exists on the wrapper
+        t = re.sub(r"--[^\n]*", "", t[t.index("generic ("):t.index("  port (")])
+        return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
+    core = generics(synth.REPO_ROOT / "rtl" / "ms_tracker.vhd", "ms_tracker")
+    assert len(core) > 70 and core[0][0] == "PRESET"
+    assert generics(synth.PINS_VHD, "ms_tracker_pins") == core
+    body = synth.PINS_VHD.read_text()
+    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n, _ in core)
+    engine = {n for n, _ in generics(synth.REPO_ROOT / "rtl" / "ms_tracker_v2.vhd", "ms_tracker_v2")}
+    assert set(c.pins_generics()) <= {n for n, _ in core} and set(g) <= engine
 
 
 def test_v2_configs_are_the_v2_trackers():
     """Configuration "v2": ms_tracker_v2 with the generics of tracker v2's default parameters (mstrack-v2:
-    ORIENT_T 64, the gated scale test SCALE_TEST_D256 13; the VHDL defaults of ms_tracker_v2_pins, which
+    ORIENT_T 64, the gated scale test SCALE_TEST_D256 13; the VHDL defaults of ms_tracker_pins, which
     nextpnr places); "v2-colour": those of mstrack-v2-colour (V2_COLOUR: ORIENT_T -1, SCALE_TEST_D256 0)."""
     import re
 
@@ -194,7 +199,7 @@ def test_v2_configs_are_the_v2_trackers():
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import V2_COLOUR, TrackerParams
     c = synth.CONFIGS["v2"]
-    assert c.v2 and c.pins_top == "ms_tracker_v2_pins"
+    assert c.v2 and c.pins_top == "ms_tracker_pins"
     g = c.generics()
     tp = TrackerParams(preset="v2", orient_T=64, scale_test=0.05, scale_test_gate=True, loss_rho=0.69,
                        loss_contrast=0.25)
@@ -203,7 +208,7 @@ def test_v2_configs_are_the_v2_trackers():
     col = synth.CONFIGS["v2-colour"]
     assert col.v2 and col.generics() == CoreConfigV2(TrackerParams(preset="v2", **V2_COLOUR), FixedParams()).generics()
     assert col.generics()["ORIENT_T"] == -1 and col.generics()["SCALE_TEST_D256"] == 0
-    body = synth.PINS_VHD_V2.read_text()
+    body = synth.PINS_VHD.read_text()
     assert re.search(r"^\s+ORIENT_T\s*: integer range -1 to 2047 := 64", body, re.M)
 
 
@@ -279,11 +284,9 @@ def test_speed_grade_selection(tmp_path, monkeypatch):
         ap.parse_args(["--speed", "5"])
 
 
-@pytest.mark.parametrize("vhd, pdc", [(synth.PINS_VHD, (synth.NEXUS_PDC,)), (synth.PINS_VHD_V2, synth.NEXUS_PDC_V2)],
-                         ids=["paper", "v2"])
-def test_nexus_pdc_places_every_pin_of_its_wrapper(vhd, pdc):
-    """nextpnr-nexus refuses an unconstrained I/O: each pins wrapper's PDC gives every port bit a
-    site, and no site twice (the v2 wrapper has res_last, which the paper wrapper has not)."""
+def test_nexus_pdc_places_every_pin_of_its_wrapper(vhd=synth.PINS_VHD, pdc=(synth.NEXUS_PDC,)):
+    """nextpnr-nexus refuses an unconstrained I/O: the pins wrapper's PDC gives every port bit a
+    site, and no site twice (the wrapper has the same pins for both presets)."""
     import re
     text = vhd.read_text()
     ports = text[text.index("port ("):text.index("end entity")]

@@ -18,9 +18,9 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
   chain + a result serialiser, ~40 pins), one run per seed, ``--freq`` 150 MHz; the report
   gives max and median Fmax over the seeds and the critical path of the worst seed; speed
   grade 6 (the slowest of the LFE5U-85F, nextpnr's default) unless ``--speed`` says 7 or 8;
-* core v2 (configuration ``v2``): the same flow on ``ms_tracker_v2`` (generics from
-  :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_v2_pins.vhd``
-  (160-bit result word v2); the cycle table is the paper core's only.
+* core v2 (configurations ``v2``, ``v2-colour``): the same flow on ``ms_tracker_v2`` (generics from
+  :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` with
+  PRESET 1 (160-bit result word v2); the cycle table is the paper core's only.
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
@@ -52,10 +52,8 @@ PERF_MD = REPO_ROOT / "docs" / "performance.md"
 SYNTH_DIR = REPO_ROOT / "build" / "synth"
 PINS_TOP = "ms_tracker_pins"
 PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_pins.vhd"
-#: core v2: its top and its pin wrapper (a sibling of ms_tracker_pins for the 160-bit result word v2)
+#: core v2's engine, synthesised alone for its resources (placed through PINS_TOP with PRESET 1)
 TOP_V2 = "ms_tracker_v2"
-PINS_TOP_V2 = "ms_tracker_v2_pins"
-PINS_VHD_V2 = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_v2_pins.vhd"
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
@@ -77,8 +75,6 @@ SEEDS = (1, 2, 3)
 #: 5 LRAM, 56 18x18 multipliers; speed grade 7 = the slowest, like the ECP5 runs' default grade 6)
 NEXUS_DEVICE = "LIFCL-40-7BG400C"
 NEXUS_PDC = REPO_ROOT / "tools" / "hdl" / "ms_tracker_pins_lifcl40.pdc"
-#: ms_tracker_v2_pins: NEXUS_PDC plus this file (its res_last pin)
-NEXUS_PDC_V2 = (NEXUS_PDC, REPO_ROOT / "tools" / "hdl" / "ms_tracker_v2_pins_lifcl40_extra.pdc")
 
 #: AMD Vitis Vision xf::cv::MeanShift, 10 targets, 300 MHz, UltraScale+ (figures of the issue)
 VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
@@ -90,8 +86,8 @@ class Config:
     """One generic set of the core: model parameters + LANES (+ MAX_FRAME_W, PPC).
 
     ``core``: the top synthesised, ``ms_tracker`` (the paper core) or ``ms_tracker_v2`` (core v2:
-    tracker preset "v2", generics from :class:`mstrack.hw.cosim.CoreConfigV2`, placed through
-    rtl/wrappers/ms_tracker_v2_pins.vhd)."""
+    tracker preset "v2", generics from :class:`mstrack.hw.cosim.CoreConfigV2`); both are placed through
+    rtl/wrappers/ms_tracker_pins.vhd (:meth:`pins_generics`)."""
 
     name: str
     note: str
@@ -108,8 +104,8 @@ class Config:
 
     @property
     def pins_top(self) -> str:
-        """The pin wrapper nextpnr places for this core."""
-        return PINS_TOP_V2 if self.v2 else PINS_TOP
+        """The pin wrapper nextpnr places for this core (one for both presets)."""
+        return PINS_TOP
 
     def params(self) -> tuple[TrackerParams, FixedParams]:
         tp = TrackerParams(preset="v2", **self.tp) if self.v2 else TrackerParams(**self.tp)
@@ -126,6 +122,10 @@ class Config:
         if self.ppc != 1:
             g["PPC"] = self.ppc
         return g
+
+    def pins_generics(self) -> dict[str, int]:
+        """The generics of the pin wrapper (those of ms_tracker): :meth:`generics`, with PRESET 1 for core v2."""
+        return {"PRESET": 1, **self.generics()} if self.v2 else self.generics()
 
 
 CONFIGS: dict[str, Config] = {c.name: c for c in (
@@ -203,9 +203,9 @@ def sources(top: str, extra: Sequence[Path] = ()) -> list[Path]:
 
 
 def pins_sources(top: str = PINS_TOP) -> list[Path]:
-    """The core + its pin wrapper: rtl/wrappers/ms_tracker_pins.vhd, or ms_tracker_v2_pins.vhd for
-    ``top`` = :data:`PINS_TOP_V2` (the wrapper always from the working tree)."""
-    return sources(top, extra=[PINS_VHD_V2 if top == PINS_TOP_V2 else PINS_VHD])
+    """The core (either preset) + its pin wrapper rtl/wrappers/ms_tracker_pins.vhd (the wrapper always
+    from the working tree)."""
+    return sources(top, extra=[PINS_VHD])
 
 
 # ----------------------------------------------------------------------------- nextpnr
@@ -290,7 +290,7 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
     """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381, speed grade *speed*) or nextpnr-nexus (family
     "nexus", :data:`NEXUS_DEVICE`) on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus``
     netlist) with one seed; *pdc*: the Nexus pin constraint files, joined into ``<synth_dir>/pins.pdc``
-    (default :data:`NEXUS_PDC`, the paper core's pins wrapper; :data:`NEXUS_PDC_V2` for core v2's).
+    (default :data:`NEXUS_PDC`, the pins of ms_tracker_pins).
 
     Writes ``nextpnr_s<seed>[_g<speed>].log`` / ``report_s<seed>[_g<speed>].json`` there (``_g<speed>``
     for an ECP5 grade other than 6).  Returns ``{"seed", "speed", "fmax_mhz", "utilization": {bel: (used,
@@ -380,7 +380,8 @@ def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds:
 
     if pnr:
         t0 = time.monotonic()
-        rp = yosys_cached("ecp5", cfg.pins_top, g, pins_sources(cfg.pins_top), f"ecp5pnr_{cfg.name}")
+        rp = yosys_cached("ecp5", cfg.pins_top, cfg.pins_generics(), pins_sources(cfg.pins_top),
+                          f"ecp5pnr_{cfg.name}")
         secs["ecp5_pins_yosys"] = round(time.monotonic() - t0, 1)
         out["ecp5_pins"] = {k: rp[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D",
                                                 "TRELLIS_DPR16X4")}
@@ -429,12 +430,12 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         log(f"[{cfg.name}] nexus core: {out['nexus']} ({secs['nexus_core']} s)")
         if pnr:
             t0 = time.monotonic()
-            npins = yosys_cached("nexus", cfg.pins_top, g, pins_sources(cfg.pins_top), f"nexuspnr_{cfg.name}")
+            npins = yosys_cached("nexus", cfg.pins_top, cfg.pins_generics(), pins_sources(cfg.pins_top),
+                                 f"nexuspnr_{cfg.name}")
             secs["nexus_pins_yosys"] = round(time.monotonic() - t0, 1)
             nruns = []
             for sd in seeds:
-                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus",
-                                 pdc=NEXUS_PDC_V2 if cfg.v2 else (NEXUS_PDC,))
+                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus")
                 nruns.append(pr)
                 secs[f"nextpnr_nexus_s{sd}"] = pr["seconds"]
                 cp = pr["critical_path"]

@@ -1,19 +1,15 @@
--- ms_tracker_pins: ms_tracker with few pins, for place-and-route (Fmax) runs only.
+-- ms_tracker_pins: ms_tracker (either preset) with few pins, for place-and-route (Fmax) runs only.
 --
--- The core has 258 ports (a 144-bit result word, 80 bits of frame size and init box): in a
--- system they are internal (video from a receiver, results to a CPU), and they are more than
--- the LFE5U-85F bonds in CABGA381 (about 200 user I/Os by Lattice's data sheet; nextpnr 0.11
--- counts 365 IO sites in this package and would place them all).  This wrapper keeps the video
--- stream ports as they are, loads frame_width, frame_height and the init box from a serial
--- configuration chain (cfg_shift/cfg_din, 6 x (COORD_W + 2) register bits, LSB first:
--- frame_width, frame_height, init x, y, w, h) and shifts each result word out one bit per clock
--- (res_dout, res_valid high while shifting; the core's result FIFO holds the next ones).
--- Every result bit stays observable, so synthesis removes nothing of the core.
--- Cost over the core: 6 (COORD_W + 2) + RESULT_W + clog2(RESULT_W) + 1 flip-flops and a few
--- LUTs per bit (ECP5, default generics: +234 FF, +87 LUT4, +19 CCU2C); no RAM, no multiplier.
--- Resource figures of the core itself come from synthesising ms_tracker (mstrack/hw/synth.py);
--- this top is only for nextpnr.
--- Generics: exactly those of ms_tracker (passed through).
+-- Computes nothing of its own: the core's ~260 ports are more than the LFE5U-85F CABGA381 has user
+-- I/Os, so the video stream ports stay as they are, frame_width, frame_height and the init box come
+-- from a serial configuration chain (cfg_shift / cfg_din, 6 x (COORD_W + 2) register bits, LSB
+-- first: frame_width, frame_height, init x, y, w, h) and each result word (RESULT_W bits: 144 for
+-- PRESET 0, 160 for PRESET 1) is shifted out one bit per clock, LSB first, on res_dout while
+-- res_valid is high.  Every result bit stays observable, so synthesis removes nothing of the core.
+-- Latency / throughput / handshake: those of ms_tracker, plus RESULT_W clocks to shift a result word
+-- out (the core's result is taken when the shifter is empty; its result FIFO holds the next ones).
+-- Cost over the core and the flow that places it: docs/performance.md, mstrack/hw/synth.py.
+-- Generics: exactly those of ms_tracker, passed through (the same names and defaults).
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -21,9 +17,10 @@ use work.ms_formats_pkg.all;
 
 entity ms_tracker_pins is
   generic (
-    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth)
-    RGB_PACKING    : natural := 0;               -- s_axis_tdata layout (ms_tracker)
-    PPC            : natural := 1;               -- pixels per clock (ms_tracker)
+    PRESET         : natural := 0;               -- 0 the paper core, 1 core v2 (ms_tracker_v2)
+    MAX_FRAME_W    : natural := 2048;            -- widest frame (line buffer depth); 3 .. 2**COORD_W - 1
+    RGB_PACKING    : natural := 0;               -- s_axis_tdata layout: 0 R 23:16 G 15:8 B 7:0; 1 AMD UG934 (R B G)
+    PPC            : natural := 1;               -- pixels per clock (s_axis beat): 1, 2 or 4 (<= LANES)
     LANES          : natural := D_LANES;         -- pixels per clock of a pixel pass
     COLOUR_BITS    : natural := D_COLOUR_BITS;   -- bits per channel of the colour bin
     EDGE_BINS_LOG2 : natural := D_EDGE_BINS_LOG2;-- log2 edge bins
@@ -65,7 +62,38 @@ entity ms_tracker_pins is
     RHO_OUT_W      : natural := D_RHO_OUT_W;
     ALPHA_W        : natural := D_ALPHA_W;
     WIN_W          : natural := D_WIN_W;
-    RESULT_W       : natural := D_RESULT_W
+    RESULT_W       : natural := D_RESULT_W;       -- PRESET 0: 144 (result word), 1: 160 (result word v2)
+    -- core v2 only (PRESET 1; ms_tracker_v2's defaults; mstrack.hw.cosim.CoreConfigV2.generics)
+    PAD16          : natural := 4;               -- pad in 1/16
+    RING16         : natural := 10;              -- bg_ring in 1/16
+    MAX_WINDOW     : natural := 127;             -- largest window diameter (decimated px)
+    KT_W           : natural := 9;               -- KA/KB width (KERNEL_BITS + 1)
+    ST2_W          : natural := 23;
+    SHARE_W        : natural := 17;
+    SPREAD_W       : natural := 25;
+    SIZE_W         : natural := 20;              -- w8, h8 bits (COORD_W + 8)
+    SCALE_W        : natural := 17;
+    SCALE_GAIN     : natural := 19661;
+    SCALE_REG      : natural := 6554;
+    SCALE_STEP     : natural := 6554;
+    SCALE_RATIO_Q_W: natural := 17;
+    WR_Q_W         : natural := 27;
+    CON_W          : natural := 18;
+    LOSS_K         : natural := 1;
+    REF_K          : natural := 6;
+    LOSS_RHO       : natural := 45220;
+    LOSS_CONTRAST  : integer := 16384;
+    CONF_LOST      : natural := 26214;           -- round(conf_lost 2**16)
+    CONF_UNCERTAIN : natural := 32768;
+    CONF_REACQUIRE : natural := 32768;
+    SPREAD_DEFAULT : natural := 5368709;         -- spread_ref when the init spread is 0
+    BG_Q_W         : natural := 14;
+    BG_O_W         : natural := 17;
+    SEARCH_ITER    : natural := 5;               -- iterations per start point while lost
+    STEP16         : natural := 16;              -- search_step in 1/16
+    MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
+    SCALE_TEST_D256: natural range 0 to 255 := 13; -- PRESET 1: the gated scale test: round(256 scale_test); 0 = off (mstrack-v2-colour)
+    ORIENT_T       : integer range -1 to 2047 := 64 -- PRESET 1: the joint colour x orientation bins: orient_T; -1 = off (mstrack-v2-colour)
   );
   port (
     clk           : in  std_logic;                      -- core clock
@@ -110,51 +138,82 @@ begin
 
   u_core : entity work.ms_tracker
     generic map (
-      MAX_FRAME_W  => MAX_FRAME_W,
-      RGB_PACKING  => RGB_PACKING,
-      PPC          => PPC,
-      LANES        => LANES,
-      COLOUR_BITS  => COLOUR_BITS,
-      EDGE_BINS_LOG2=> EDGE_BINS_LOG2,
-      EDGE_SHIFT   => EDGE_SHIFT,
-      FEATURES     => FEATURES,
-      KERNEL_EPAN  => KERNEL_EPAN,
-      KERNEL_BITS  => KERNEL_BITS,
-      MAX_HALF     => MAX_HALF,
-      MARGIN       => MARGIN,
-      COORD_W      => COORD_W,
-      CF           => CF,
-      WI           => WI,
-      WF           => WF,
-      RF           => RF,
-      AF           => AF,
-      RHO_OUT_FRAC => RHO_OUT_FRAC,
-      MAX_ITER     => MAX_ITER,
-      EPS2         => EPS2,
-      HALF_W       => HALF_W,
-      REGION_MAX   => REGION_MAX,
-      REGION_W     => REGION_W,
-      STRIDE       => STRIDE,
-      ADDR_W       => ADDR_W,
-      KVAL_W       => KVAL_W,
-      HIST_W       => HIST_W,
-      COUNT_W      => COUNT_W,
-      POSSUM_W     => POSSUM_W,
-      KD_W         => KD_W,
-      SQRT_IN_W    => SQRT_IN_W,
-      RHO_SUM_W    => RHO_SUM_W,
-      RATIO_Q_W    => RATIO_Q_W,
-      WEIGHT_W     => WEIGHT_W,
-      SW_W         => SW_W,
-      SWX_W        => SWX_W,
-      SHIFT_Q_W    => SHIFT_Q_W,
-      CENTRE_W     => CENTRE_W,
-      CENTRE_ABS_W => CENTRE_ABS_W,
-      ITER_W       => ITER_W,
-      RHO_OUT_W    => RHO_OUT_W,
-      ALPHA_W      => ALPHA_W,
-      WIN_W        => WIN_W,
-      RESULT_W     => RESULT_W
+      PRESET          => PRESET,
+      MAX_FRAME_W     => MAX_FRAME_W,
+      RGB_PACKING     => RGB_PACKING,
+      PPC             => PPC,
+      LANES           => LANES,
+      COLOUR_BITS     => COLOUR_BITS,
+      EDGE_BINS_LOG2  => EDGE_BINS_LOG2,
+      EDGE_SHIFT      => EDGE_SHIFT,
+      FEATURES        => FEATURES,
+      KERNEL_EPAN     => KERNEL_EPAN,
+      KERNEL_BITS     => KERNEL_BITS,
+      MAX_HALF        => MAX_HALF,
+      MARGIN          => MARGIN,
+      COORD_W         => COORD_W,
+      CF              => CF,
+      WI              => WI,
+      WF              => WF,
+      RF              => RF,
+      AF              => AF,
+      RHO_OUT_FRAC    => RHO_OUT_FRAC,
+      MAX_ITER        => MAX_ITER,
+      EPS2            => EPS2,
+      HALF_W          => HALF_W,
+      REGION_MAX      => REGION_MAX,
+      REGION_W        => REGION_W,
+      STRIDE          => STRIDE,
+      ADDR_W          => ADDR_W,
+      KVAL_W          => KVAL_W,
+      HIST_W          => HIST_W,
+      COUNT_W         => COUNT_W,
+      POSSUM_W        => POSSUM_W,
+      KD_W            => KD_W,
+      SQRT_IN_W       => SQRT_IN_W,
+      RHO_SUM_W       => RHO_SUM_W,
+      RATIO_Q_W       => RATIO_Q_W,
+      WEIGHT_W        => WEIGHT_W,
+      SW_W            => SW_W,
+      SWX_W           => SWX_W,
+      SHIFT_Q_W       => SHIFT_Q_W,
+      CENTRE_W        => CENTRE_W,
+      CENTRE_ABS_W    => CENTRE_ABS_W,
+      ITER_W          => ITER_W,
+      RHO_OUT_W       => RHO_OUT_W,
+      ALPHA_W         => ALPHA_W,
+      WIN_W           => WIN_W,
+      RESULT_W        => RESULT_W,
+      PAD16           => PAD16,
+      RING16          => RING16,
+      MAX_WINDOW      => MAX_WINDOW,
+      KT_W            => KT_W,
+      ST2_W           => ST2_W,
+      SHARE_W         => SHARE_W,
+      SPREAD_W        => SPREAD_W,
+      SIZE_W          => SIZE_W,
+      SCALE_W         => SCALE_W,
+      SCALE_GAIN      => SCALE_GAIN,
+      SCALE_REG       => SCALE_REG,
+      SCALE_STEP      => SCALE_STEP,
+      SCALE_RATIO_Q_W => SCALE_RATIO_Q_W,
+      WR_Q_W          => WR_Q_W,
+      CON_W           => CON_W,
+      LOSS_K          => LOSS_K,
+      REF_K           => REF_K,
+      LOSS_RHO        => LOSS_RHO,
+      LOSS_CONTRAST   => LOSS_CONTRAST,
+      CONF_LOST       => CONF_LOST,
+      CONF_UNCERTAIN  => CONF_UNCERTAIN,
+      CONF_REACQUIRE  => CONF_REACQUIRE,
+      SPREAD_DEFAULT  => SPREAD_DEFAULT,
+      BG_Q_W          => BG_Q_W,
+      BG_O_W          => BG_O_W,
+      SEARCH_ITER     => SEARCH_ITER,
+      STEP16          => STEP16,
+      MARGIN_MAX      => MARGIN_MAX,
+      SCALE_TEST_D256 => SCALE_TEST_D256,
+      ORIENT_T        => ORIENT_T
     )
     port map (
       clk => clk, rst => rst,

@@ -256,10 +256,16 @@ def sequence_digest(seq: Sequence, n_frames: int) -> str:
 
     The ground truth (0-based, as loaded) and, per frame file, its name, size and modification
     time (not its path: a moved dataset keeps its cache).  Part of the cache key."""
+    return files_digest(np.ascontiguousarray(seq.gt[:n_frames], dtype=np.float64).tobytes(), seq.img_files[:n_frames])
+
+
+def files_digest(data: bytes, files: Iterable[str | Path]) -> str:
+    """Short hash of ``data`` (the ground truth) and, per file, its name, size and modification time
+    (not its path: a moved dataset keeps its cache)."""
     import hashlib
 
-    h = hashlib.sha1(np.ascontiguousarray(seq.gt[:n_frames], dtype=np.float64).tobytes())
-    for f in seq.img_files[:n_frames]:
+    h = hashlib.sha1(data)
+    for f in files:
         try:
             st = Path(f).stat()
             h.update(f"{Path(f).name}:{st.st_size}:{st.st_mtime_ns};".encode())

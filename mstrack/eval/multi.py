@@ -39,7 +39,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
-from .evaluate import (Evaluation, frame_error_types, make_tracker, result_confidence, result_status,
+from .evaluate import (Evaluation, files_digest, frame_error_types, make_tracker, result_confidence, result_status,
                        run_label, to_box, tracker_fingerprint, uses_model, OK_STATUSES)
 from .metrics import Scores, concat_scores, iou, loss_detection, LossDetection, score, valid_gt
 from ..io.data import DataError
@@ -392,14 +392,7 @@ def aggregate_mot(runs: dict[str, dict[str, MotRun]], sequences: list[MotSequenc
 # ----------------------------------------------------------------------------- evaluate (cached)
 def mot_digest(seq: MotSequence, n_frames: int) -> str:
     """Short hash of the ground truth and of the first ``n_frames`` frame files (name, size, mtime)."""
-    h = hashlib.sha1(np.ascontiguousarray(seq.rows[seq.rows[:, 0] < n_frames]).tobytes())
-    for f in seq.img_files[:n_frames]:
-        try:
-            st = Path(f).stat()
-            h.update(f"{Path(f).name}:{st.st_size}:{st.st_mtime_ns};".encode())
-        except OSError:
-            h.update(f"{Path(f).name}:missing;".encode())
-    return h.hexdigest()[:16]
+    return files_digest(np.ascontiguousarray(seq.rows[seq.rows[:, 0] < n_frames]).tobytes(), seq.img_files[:n_frames])
 
 
 def _params_key(harness: Any) -> str:

@@ -65,8 +65,28 @@ class DataWarning(UserWarning):
     """Recoverable data problem (e.g. ground truth and image counts differ)."""
 
 
+class FrameFiles:
+    """Frames read lazily from a list of image files ``img_files`` (:class:`Sequence`,
+    :class:`mstrack.io.mot.MotSequence`)."""
+
+    img_files: list[Path]
+
+    def __len__(self) -> int:
+        return len(self.img_files)
+
+    def frame(self, i: int) -> np.ndarray:
+        """Read frame ``i`` (BGR uint8, shape (H, W, 3)); raises DataError if unreadable."""
+        return read_image(self.img_files[i])
+
+    def frames(self, max_frames: int | None = None) -> Iterator[np.ndarray]:
+        """Iterate over the frames lazily (one image in memory at a time)."""
+        n = len(self) if max_frames is None else min(len(self), max_frames)
+        for i in range(n):
+            yield self.frame(i)
+
+
 @dataclass
-class Sequence:
+class Sequence(FrameFiles):
     """An annotated image sequence.
 
     Attributes
@@ -95,19 +115,6 @@ class Sequence:
     fps: float | None = None
     meta: dict[str, Any] = field(default_factory=dict)
     path: Path = Path(".")
-
-    def __len__(self) -> int:
-        return len(self.img_files)
-
-    def frame(self, i: int) -> np.ndarray:
-        """Read frame ``i`` (BGR uint8, shape (H, W, 3)); raises DataError if unreadable."""
-        return read_image(self.img_files[i])
-
-    def frames(self, max_frames: int | None = None) -> Iterator[np.ndarray]:
-        """Iterate over the frames lazily (one image in memory at a time)."""
-        n = len(self) if max_frames is None else min(len(self), max_frames)
-        for i in range(n):
-            yield self.frame(i)
 
     def __iter__(self) -> Iterator[np.ndarray]:
         return self.frames()

@@ -21,12 +21,12 @@ import re
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
 from ..track.types import Box
-from .data import DataError, DataWarning, _find_image_dir, _meta_name, _meta_number, list_images, read_image
+from .data import DataError, DataWarning, FrameFiles, _find_image_dir, _meta_name, _meta_number, list_images
 
 MOT_GT = "gt.txt"
 
@@ -56,7 +56,7 @@ class MotTrack:
 
 
 @dataclass
-class MotSequence:
+class MotSequence(FrameFiles):
     """A multi-object sequence.
 
     Attributes
@@ -80,18 +80,6 @@ class MotSequence:
     fps: float | None = None
     meta: dict[str, Any] = field(default_factory=dict)
     path: Path = Path(".")
-
-    def __len__(self) -> int:
-        return len(self.img_files)
-
-    def frame(self, i: int) -> np.ndarray:
-        """Frame ``i`` (0-based), BGR uint8 (H, W, 3); DataError if unreadable."""
-        return read_image(self.img_files[i])
-
-    def frames(self, max_frames: int | None = None) -> Iterator[np.ndarray]:
-        n = len(self) if max_frames is None else min(len(self), max_frames)
-        for i in range(n):
-            yield self.frame(i)
 
     @property
     def ids(self) -> list[int]:

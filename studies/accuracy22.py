@@ -93,6 +93,11 @@ def run_one(seq, model: str, kw: dict) -> dict:
         sig["rho_ref"][i] = impl.rho_ref if model == "fixed" else impl._rho_ref
         sig["share_ref"][i] = impl.share_ref if model == "fixed" else impl._share_ref
         sig["ring"][i] = e["ring_share"]
+        for k in ("jump", "latch"):  # the loss flag's motion latch (loss_jump > 0)
+            if k in e:
+                sig.setdefault(k, np.zeros(n))[i] = e[k]
+        if "jump" in e:
+            sig.setdefault("wh", np.zeros(n))[i] = e["wh8" if model == "fixed" else "wh"]
     return {"boxes": boxes, "centre": cen, "ok": ok, "rho0": np.array(rho0), "one": np.array(one), **sig}
 
 
@@ -264,6 +269,115 @@ def main_loss(tag: str) -> None:
                     int((a["iou"] >= 0.5).sum())]
         print(f"{m}: run's thresholds recall / FA {fmt_ld(c)} (from ok: {fmt_ld(okc)}; off {okc[1]}, on {okc[3]})")
     print("LOSO choices:", {n: (float(a), float(b)) for n, (a, b) in chosen.items()})
+
+
+# ----------------------------------------------------------------------------- loss flag: motion latch
+#: the grid of the motion latch's rule (docs/algorithm.md "v2.7a Loss flag"): loss_rho, loss_contrast
+#: (the base rule, against the running reference rho_ref), loss_jump (sixteenths), loss_stay
+M_RHO = np.round(np.arange(0.80, 0.951, 0.01), 2)
+M_CON = np.round(np.arange(0.00, 0.161, 0.02), 2)
+M_JUMP = (1.0, 1.25, 1.5, 1.75, 2.0)
+M_STAY = (0.9, 0.925, 0.95, 0.975)
+
+
+def running_ref(z: dict) -> np.ndarray:
+    """Per frame, the running reference rho_ref as it was before the frame's update (frame 0, 1: rho0)."""
+    rho0 = float(z["rho0"])
+    n = len(z["rho_s"])
+    return np.concatenate([[rho0, rho0], z["rho_ref"][1:n - 1]])[:n]
+
+
+def motion_latch(z: dict, model: str, cf: int = 8) -> np.ndarray:
+    """(frames, len(M_JUMP) x len(M_STAY)): the latch of every (loss_jump, loss_stay) pair,
+    recomputed from the kept signals with the models' own comparisons (fixed: ms_loss_jump and
+    ms_loss_latch's integer tests; float: loss_jump, loss_latch)."""
+    ref = running_ref(z)
+    n = len(ref)
+    if model == "fixed":
+        jl = z["jump"].astype(np.int64)[:, None] << 13
+        jumps = jl > (np.array([round(j * 16) for j in M_JUMP], np.int64)[None, :] * z["wh"].astype(np.int64)[:, None]) << cf
+        stays = (z["rho_s"].astype(np.int64)[:, None] << 16) < np.array([q16(m) for m in M_STAY], np.int64)[None, :] * \
+            ref.astype(np.int64)[:, None]
+    else:
+        jumps = z["jump"][:, None] > np.array(M_JUMP)[None, :] * z["wh"][:, None] / 2.0
+        stays = z["rho_s"][:, None] < np.array(M_STAY)[None, :] * ref[:, None]
+    jumps = np.repeat(jumps, len(M_STAY), axis=1)   # (n, J x M), M fastest
+    stays = np.tile(stays, (1, len(M_JUMP)))
+    out = np.zeros((n, jumps.shape[1]), bool)
+    prev = np.zeros(jumps.shape[1], bool)
+    for i in range(1, n):
+        prev = jumps[i] | (prev & stays[i])
+        out[i] = prev
+    return out
+
+
+def motion_tables(runs: dict, model: str, cf: int = 8) -> dict[str, np.ndarray]:
+    """Per sequence: (len(M_RHO) x len(M_CON), len(M_JUMP) x len(M_STAY), 4) counts (off flagged,
+    off, on flagged, on) of the rule base(loss_rho, loss_contrast; ref rho_ref) or latch."""
+    out = {}
+    for name, (_, z, gt) in runs.items():
+        if "jump" not in z:
+            raise SystemExit(f"run without the motion signals (loss_jump 0): {name}")
+        v = valid_gt(gt)
+        v[0] = False
+        io = iou(z["boxes"], gt)
+        off, on = (io == 0) & v, (io >= 0.5) & v
+        lat = motion_latch(z, model, cf)
+        a = {"rho_s": z["rho_s"], "con_s": z["con_s"], "share": z["share"], "ref": running_ref(z)}
+        base = np.stack([flag(a, lr, lc, model) for lr in M_RHO for lc in M_CON], axis=1)
+        t = np.zeros((base.shape[1], lat.shape[1], 4), np.int64)
+        for k, m in ((0, off), (2, on)):
+            b, la = base[m].astype(np.int64), lat[m].astype(np.int64)
+            both = np.einsum("tb,tl->bl", b, la)  # integer counts
+            t[..., k] = b.sum(0)[:, None] + la.sum(0)[None, :] - both
+            t[..., k + 1] = int(m.sum())
+        out[name] = t
+    return out
+
+
+def motion_key(i: int, j: int) -> tuple[float, float, float, float]:
+    return (float(M_RHO[i // len(M_CON)]), float(M_CON[i % len(M_CON)]), float(M_JUMP[j // len(M_STAY)]),
+            float(M_STAY[j % len(M_STAY)]))
+
+
+def pick_joint(tabs: dict[str, np.ndarray], fa_max: float) -> tuple[int, ...]:
+    """One grid point for all models: the highest lower recall with every false-alarm rate <= fa_max
+    (ties: fewer false alarms, then the first point of the grid)."""
+    rec = np.minimum.reduce([t[..., 0] / np.maximum(t[..., 1], 1) for t in tabs.values()])
+    fa = np.maximum.reduce([t[..., 2] / np.maximum(t[..., 3], 1) for t in tabs.values()])
+    key = np.where(fa <= fa_max, rec * 1e6 - fa * 1e3, -np.inf)
+    if not np.isfinite(key).any():
+        raise SystemExit(f"no grid point with false alarms <= {fa_max}")
+    return tuple(int(x) for x in np.unravel_index(int(np.argmax(key)), key.shape))
+
+
+def loso_motion(tag: str, fa_fit: float = FA_MAX, cf: int = 8):
+    """The motion latch's rule: the point chosen on all sequences (in sample; false alarms <= fa_fit)
+    and leave one sequence out (chosen on the others, scored on the one left out, counts summed)."""
+    per = {m: motion_tables(load(tag, m), m, cf) for m in MODELS}
+    names = sorted(set.intersection(*(set(p) for p in per.values())))
+    total = {m: sum(per[m][n] for n in names) for m in MODELS}
+    i, j = pick_joint(total, fa_fit)
+    ins = {m: total[m][i, j] for m in MODELS}
+    lo = {m: np.zeros(4, np.int64) for m in MODELS}
+    chosen = {}
+    for n in names:
+        a, b = pick_joint({m: total[m] - per[m][n] for m in MODELS}, fa_fit)
+        chosen[n] = motion_key(a, b)
+        for m in MODELS:
+            lo[m] += per[m][n][a, b]
+    return motion_key(i, j), ins, lo, chosen
+
+
+def main_loss_motion(tag: str, fa_fit: float) -> None:
+    key, ins, lo, chosen = loso_motion(tag, fa_fit)
+    print(f"motion latch, chosen on all with false alarms <= {fa_fit}: loss_rho {key[0]:.2f}, loss_contrast "
+          f"{key[1]:.2f}, loss_jump {key[2]:g}, loss_stay {key[3]:g} (ref rho_ref)")
+    print("| model | recall / false alarms, in sample | recall / false alarms, LOSO |")
+    print("|---|---|---|")
+    for m in MODELS:
+        print(f"| {m} | {fmt_ld(ins[m])} | {fmt_ld(lo[m])} |")
+    print("LOSO choices:", chosen)
 
 
 # ----------------------------------------------------------------------------- report / diverge
@@ -471,6 +585,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--models", default="float,fixed")
     ap.add_argument("--px", type=float, default=4.0)
     ap.add_argument("--ref", choices=("rho0", "rho_ref"), default="rho0")
+    ap.add_argument("--motion", action="store_true", help="loss: the motion latch's rule (a run with loss_jump > 0)")
+    ap.add_argument("--fa-fit", type=float, default=FA_MAX, help="loss --motion: false-alarm bound of the choice")
     a = ap.parse_args(argv)
     LOSS_REF["ref"] = a.ref
     if a.cmd == "run":
@@ -481,6 +597,8 @@ def main(argv: list[str] | None = None) -> int:
         main_diverge(a.tag, a.px)
     elif a.cmd == "doc":
         main_doc(a.tags.split(","), NOTES)
+    elif a.motion:
+        main_loss_motion(a.tag, a.fa_fit)
     else:
         main_loss(a.tag)
     return 0

@@ -224,6 +224,32 @@ def ms_loss_flag(rho_s: int, rho0: int, con_s: int, share: int, loss_rho: int, l
     return share == 0 or rho_s == 0 or (rho_s << 16 < loss_rho * rho0 and con_s < loss_contrast)
 
 
+def ms_loss_jump(step: tuple[int, int], prev: tuple[int, int], w8: int, h8: int, jump16: int, cf: int) -> bool:
+    """The loss flag's motion test: the centre's step against the previous frame's step,
+    |sx - px| + |sy - py| > jump16 / 16 x (w + h) / 2, exact in integers:
+
+        (|sx - px| + |sy - py|) 2**(SIZE_FRAC + 5)  >  jump16 (w8 + h8) 2**cf.
+
+    step, prev: the frame's and the previous frame's centre steps, signed Q.cf frame px (frames up
+    to 4096 px: |step| < 2**(12 + cf), 14 + cf bits signed; the L1 distance < 2**(14 + cf)); w8, h8:
+    the box before the frame's resize, unsigned Q.8 px (w8 + h8 < 2**21); jump16 = loss_jump in
+    sixteenths (unsigned, 0 .. 128: 8 bits).  Left side < 2**(27 + cf), right side < 2**(29 + cf):
+    one 8 x 21 bit product, two shifts, one unsigned compare of 29 + cf bits (37 at centre_frac 8).
+    jump16 = 0: off (never true).
+    """
+    if jump16 <= 0:
+        return False
+    j = abs(step[0] - prev[0]) + abs(step[1] - prev[1])
+    return j << (SIZE_FRAC + 5) > (jump16 * (w8 + h8)) << cf
+
+
+def ms_loss_latch(latch: bool, jump: bool, rho_s: int, ref: int, loss_stay: int) -> bool:
+    """The loss flag's motion latch: set by a jump (:func:`ms_loss_jump`), kept while
+    rho_s 2**16 < loss_stay ref (rho_s, ref unsigned Q1.16; loss_stay unsigned Q1.16, 0 .. 2**17:
+    the same 18 x 17 bit product and compare as :func:`ms_loss_flag`).  One state bit per target."""
+    return jump or (latch and rho_s << 16 < loss_stay * ref)
+
+
 def ms_spread(st: TargetStats) -> int:
     """spread = floor(st2 2**16 / nt): mean d2q of the target-coloured pixels, Q.(KB + 16); 0 if nt = 0."""
     return int(ms_divider(st.st2 << 16, st.nt, 40)) if st.nt else 0

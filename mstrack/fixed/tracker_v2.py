@@ -29,7 +29,7 @@ from ..track.types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_grey, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
 from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,
-                        ms_loss_flag, ms_lost_decimation, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+                        ms_loss_flag, ms_loss_jump, ms_loss_latch, ms_lost_decimation, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
                         ORIENT_FLAT,
@@ -94,6 +94,8 @@ class FixedTrackerV2:
         self.ref_k = rate_shift(p.ref_rate)
         self.loss_rho16, self.loss_contrast16 = q16(p.loss_rho), q16(p.loss_contrast)
         self.loss_k = rate_shift(p.loss_smooth)
+        self.loss_jump16 = sixteenths(p.loss_jump, "loss_jump")  # the motion latch (0: off, the default)
+        self.loss_stay16 = q16(p.loss_stay)
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
         if p.motion_gain > 0 or (p.scale_test > 0 and not p.scale_test_gate):
@@ -239,6 +241,8 @@ class FixedTrackerV2:
         self.lost = False
         self.lost_n = 0  # consecutive lost frames (the search's decimation)
         self.reported_lost = False
+        self.loss_step = (0, 0)  # the motion latch: the last centre step (Q.cf frame px) and the latch bit
+        self.loss_latch = False
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": self.rho_ref,
                "confidence": ONE, "status": STATUS_CODES_V2[Status.CLIPPED if clipped else Status.INIT],
                "iter": 0, "decimation": d, "share": self.share_ref, "spread": self.spread_ref,
@@ -313,14 +317,25 @@ class FixedTrackerV2:
         self.rho_s = ms_loss_filter(self.rho_s, rho, self.loss_k)
         self.con_s = ms_loss_filter(self.con_s, share - ring, self.loss_k)
         ref = self.rho_ref if p.loss_ref_running else self.rho0  # (the running one: before this frame's update)
-        if ms_loss_flag(self.rho_s, ref, self.con_s, share, self.loss_rho16, self.loss_contrast16):
+        flagged = ms_loss_flag(self.rho_s, ref, self.con_s, share, self.loss_rho16, self.loss_contrast16)
+        c8 = (c8d[0] << sh, c8d[1] << sh)
+        step = (c8[0] - self.c8[0], c8[1] - self.c8[1])
+        motion: dict[str, int] = {}
+        if self.loss_jump16 > 0:  # the motion latch (off by default)
+            jump = ms_loss_jump(step, self.loss_step, self.w8, self.h8, self.loss_jump16, cf)
+            self.loss_latch = ms_loss_latch(self.loss_latch, jump, self.rho_s, ref, self.loss_stay16)
+            flagged = flagged or self.loss_latch
+            motion = {"jump": abs(step[0] - self.loss_step[0]) + abs(step[1] - self.loss_step[1]),
+                      "wh8": self.w8 + self.h8, "latch": int(self.loss_latch)}
+        self.loss_step = step
+        if flagged:
             status = Status.LOST if state == Status.LOST else Status.UNCERTAIN
         else:
             status = Status.REACQUIRED if self.reported_lost else Status.OK
         self.lost = state == Status.LOST
         self.lost_n = self.lost_n + 1 if self.lost else 0
         self.reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self.reported_lost)
-        self.c8 = (c8d[0] << sh, c8d[1] << sh)
+        self.c8 = c8
         if state == Status.OK:
             self.rho_ref = ms_ref_update(self.rho_ref, rho, self.ref_k)
             self.share_ref = ms_ref_update(self.share_ref, share, self.ref_k)
@@ -339,7 +354,7 @@ class FixedTrackerV2:
                "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched,
                "nt": st.nt, "n_in": st.n_in, "nt_in": st.nt_in, "K": ker.K,
                "ring_share": ring, "state": STATUS_CODES_V2[state], "rho_s": self.rho_s,
-               "contrast_s": self.con_s}
+               "contrast_s": self.con_s, **motion}
         return TrackResult(box=self._box(), centre=(self.c8[0] / (1 << cf), self.c8[1] / (1 << cf)),
                            rho_c=rho / 65536.0, rho_e=0.0, alpha_c=1.0, alpha_e=0.0, iter_c=it, iter_e=0,
                            status=status, confidence=conf / 65536.0, extra=raw)

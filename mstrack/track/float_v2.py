@@ -742,6 +742,19 @@ def loss_flag(rho_s: float, con_s: float, rho0: float, share: float, p: TrackerP
     return share == 0 or rho_s == 0 or (rho_s < p.loss_rho * rho0 and con_s < p.loss_contrast)
 
 
+def loss_jump(step: tuple[float, float], prev: tuple[float, float], w: float, h: float,
+              p: TrackerParams) -> bool:
+    """The loss flag's motion test (docs/algorithm.md "v2.7a Loss flag"; off: loss_jump 0): the
+    centre's step against the previous frame's step, |sx - px| + |sy - py| > loss_jump (w + h) / 2
+    (frame px; w, h the box before the frame's resize)."""
+    return p.loss_jump > 0 and abs(step[0] - prev[0]) + abs(step[1] - prev[1]) > p.loss_jump * (w + h) / 2.0
+
+
+def loss_latch(latch: bool, jump: bool, rho_s: float, ref: float, p: TrackerParams) -> bool:
+    """The loss flag's motion latch: set by a jump (:func:`loss_jump`), kept while rho_s < loss_stay ref."""
+    return jump or (latch and rho_s < p.loss_stay * ref)
+
+
 def report_status(searching: bool, flagged: bool, was_flagged_lost: bool) -> Status:
     """The reported status: flagged -> lost (while the wide search runs) or uncertain; not
     flagged -> reacquired on the first unflagged frame after a reported loss, else ok."""
@@ -961,6 +974,8 @@ class FloatTrackerV2:
         self._lost_n = 0  # consecutive lost frames (the search's decimation)
         self._reported_lost = False
         self._vel = (0.0, 0.0)  # last centre step (frame px), for motion_gain
+        self._loss_step = (0.0, 0.0)  # the loss flag's motion latch: the last centre step (frame px), the latch
+        self._loss_latch = False
         return TrackResult(box=box, centre=(cx, cy), rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=0, iter_e=0, status=Status.CLIPPED if clipped else Status.INIT,
                            message="init box clipped to the frame" if clipped else "",
@@ -1013,13 +1028,23 @@ class FloatTrackerV2:
         self._con_s = loss_filter(self._con_s, ps.share - ps.ring_share, p)
         ref = self._rho_ref if p.loss_ref_running else self._rho0  # (the running one: before this frame's update)
         flagged = loss_flag(self._rho_s, self._con_s, ref, ps.share, p)  # what it reports (ok False when flagged)
+        centre = (c[0] * d, c[1] * d)  # searching: the search's best candidate
+        step = (centre[0] - self._centre[0], centre[1] - self._centre[1])
+        motion: dict[str, float] = {}
+        if p.loss_jump > 0:  # the motion latch (off by default)
+            self._loss_latch = loss_latch(self._loss_latch, loss_jump(step, self._loss_step, w, h, p),
+                                          self._rho_s, ref, p)
+            flagged = flagged or self._loss_latch
+            motion = {"jump": abs(step[0] - self._loss_step[0]) + abs(step[1] - self._loss_step[1]),
+                      "wh": w + h, "latch": int(self._loss_latch)}
+        self._loss_step = step
         status = report_status(state == Status.LOST, flagged, self._reported_lost)
         self._lost = state == Status.LOST
         self._lost_n = self._lost_n + 1 if self._lost else 0
         # a loss stays reported (uncertain frames keep it) until a frame is ok again
         self._reported_lost = status == Status.LOST or (status == Status.UNCERTAIN and self._reported_lost)
         old = self._centre
-        self._centre = (c[0] * d, c[1] * d)  # searching: the search's best candidate
+        self._centre = centre
         self._vel = (self._centre[0] - old[0], self._centre[1] - old[1]) if state == Status.OK else (0.0, 0.0)
         if state == Status.OK:
             a = p.ref_rate
@@ -1035,7 +1060,7 @@ class FloatTrackerV2:
                            extra={"decimation": d, "share": ps.share, "spread": ps.spread,
                                   "searched": searched, "nt": ps.nt, "n_in": ps.n_in, "nt_in": ps.nt_in,
                                   "n": ps.n, "ring_share": ps.ring_share, "state": state.value,
-                                  "rho_s": self._rho_s, "contrast_s": self._con_s})
+                                  "rho_s": self._rho_s, "contrast_s": self._con_s, **motion})
 
 
 _NUMBA_OK: bool | None = None

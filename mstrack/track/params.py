@@ -154,6 +154,13 @@ class TrackerParams:
     loss_ref_running : bool
         Loss flag against the running reference rho_ref (the confidence's, as it is before the
         frame's update) instead of rho at init (experimental, off by default; docs/results_accuracy22.md).
+    loss_jump, loss_stay : float
+        Motion latch of the loss flag (experimental, off by default: loss_jump 0): a frame whose
+        centre step differs from the previous frame's step by more than loss_jump x (w + h) / 2
+        (L1 norm, frame px; w, h the box before the frame's resize) sets a latch that stays set
+        while rho_s < loss_stay x the loss flag's reference; the flag is raised while the latch
+        is set (docs/algorithm.md "v2.7a Loss flag", docs/results_accuracy22.md).  The fixed
+        model needs loss_jump in sixteenths.
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -213,6 +220,8 @@ class TrackerParams:
     scale_test_margin: float = 0.0
     search_widen: int = 0
     rho_stop_margin: float = 0.0
+    loss_jump: float = 0.0
+    loss_stay: float = 0.95
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -246,7 +255,8 @@ class TrackerParams:
                                  ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
                                  ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
-                                 ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5)):
+                                 ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5),
+                                 ("loss_jump", 0.0, 8.0), ("loss_stay", 0.0, 2.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:

@@ -6,12 +6,16 @@ Usage::
     python studies/accuracy22.py report [--tag T]                # tables of one run (stdout)
     python studies/accuracy22.py diverge [--tag T]               # first float/fixed divergence per sequence
     python studies/accuracy22.py loss [--tag T]                  # loss thresholds: in sample and LOSO
+    python studies/accuracy22.py loss --tag T --motion [--orient] [--fa-fit F]   # the motion latch's rule
+    python studies/accuracy22.py orient --tag T                  # the orientation cue on the kept boxes
 
 ``run`` keeps, per sequence and model, the boxes, centres, the loss flag's smoothed signals
 (rho_s, contrast_s, rho0, share) and the per-frame decimation / search state / size, so that the
 other commands need no tracking.  The loss flag does not steer the tracker (the search state
 comes from the confidence), so its thresholds are re-scored from the kept signals: float in
 float arithmetic, fixed with the integer comparison of ms_loss_flag (the same decision).
+With loss_jump > 0 the run also keeps the motion latch's signals (jump, w + h, latch), from
+which ``loss --motion`` re-scores the latch exactly for any loss_jump / loss_stay.
 Sequences: ../shared/data/sequences (dev, 10) and ../shared/data/validation (12).
 """
 from __future__ import annotations

@@ -154,6 +154,23 @@ class TrackerParams:
     loss_ref_running : bool
         Loss flag against the running reference rho_ref (the confidence's, as it is before the
         frame's update) instead of rho at init (experimental, off by default; docs/results_accuracy22.md).
+    scale_ring_guard : float
+        Shrink guard of the scale update (experimental, off by default: 0): a size step that
+        shrinks the box (s < 1) is not taken while the share of target-coloured pixels in the
+        window's ring around the box is at least scale_ring_guard x their share in the box (the
+        target still fills the ring: the box is not too large), so that the box can follow a
+        shrinking target without the pull toward the init size (scale_reg 0) and does not
+        collapse inside a uniform target (docs/algorithm.md "v2.5a", docs/results_accuracy22.md).
+    model_rate : float
+        Guarded model update (experimental, off by default: 0): on frames whose search state is
+        ok and whose loss flag is down, the background-weighted model q' is learnt again at the
+        tracked box in the frame (the init's CBWH model, the same ring) and blended in:
+        r <- r + model_rate (q'_new - r) (r starts at q'_0, the init's), and the tracker uses
+        q' = q'_0 + model_mix (r - q'_0); t (the target-coloured bins) becomes the new model's.  Powers of
+        two for the fixed model (docs/algorithm.md "v2.6a", docs/results_accuracy22.md).
+    model_mix : float
+        The running model's share in the guarded model update (1: the running model alone; 1/2:
+        half the init model is always kept).  Only with model_rate > 0.
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -213,6 +230,9 @@ class TrackerParams:
     scale_test_margin: float = 0.0
     search_widen: int = 0
     rho_stop_margin: float = 0.0
+    scale_ring_guard: float = 0.0
+    model_rate: float = 0.0
+    model_mix: float = 1.0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -246,7 +266,8 @@ class TrackerParams:
                                  ("loss_rho", 0.0, 2.0), ("loss_contrast", -1.0, 1.0), ("loss_smooth", 0.0, 1.0),
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
                                  ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
-                                 ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5)):
+                                 ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5),
+                                 ("scale_ring_guard", 0.0, 4.0), ("model_rate", 0.0, 1.0), ("model_mix", 0.0, 1.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:

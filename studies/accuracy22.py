@@ -448,6 +448,10 @@ NOTES = {
     "mu64m2": "guarded model update at rate 1/64, model_mix 1/2.",
     "mu64rg5": "guarded model update at 1/64 and shrink guard 0.5 (scale_reg 0.1).",
     "mu64rg5sr05": "guarded model update at 1/64, shrink guard 0.5, scale_reg 0.05.",
+    "chroma1": "normalised-chromaticity bins with 1 intensity bit (chroma_bins; docs/algorithm.md v2.2b; "
+               "float on its numpy path).",
+    "chroma2": "chromaticity bins with 2 intensity bits.",
+    "chroma3": "chromaticity bins with 3 intensity bits.",
     "lref": "loss flag against the running reference (loss_ref_running) at 0.91 / 0.13, the pair chosen "
             "for it on the 22 (the boxes are those of defaults: the flag does not steer the tracker).",
 }
@@ -512,6 +516,13 @@ FINDINGS = [
     "together (run mu64rg5): 0.508 / 0.527, P@20 0.765 / 0.795, the highest fixed mean AUC measured, "
     "still 0.036 below CSRT; with scale_reg 0.05 as well (mu64rg5sr05) 0.502 / 0.519.  The rates were "
     "compared on these 22 sequences only (in sample).",
+    "**Chromaticity bins (runs chroma*, docs/algorithm.md v2.2b)**: r, g at 3 bits and 1, 2 or 3 "
+    "intensity bits in place of RGB at 3 bits lift David (0.384 -> 0.499 / 0.472 / 0.431 float with 1 / "
+    "2 / 3 bits), Skiing and Girl, but lose where target and background differ mostly in brightness, "
+    "the grey sequences among them (2 bits: Surfer 0.456 -> 0.133, Car4 0.412 -> 0.189, Couple, Woman, "
+    "MotorRolling, ClifBar; 1 bit: Bolt2 0.554 -> 0.010, Subway 0.695 -> 0.202): mean AUC 0.406 / 0.451 / "
+    "0.467 float, 0.423 / 0.451 / 0.466 fixed, below every other run.  The guarded model update does "
+    "more for David with fewer losses elsewhere.",
         "**Loss flag**: no pair of the two thresholds reaches recall 0.6 at false alarms <= 0.05 on the 22, in "
     "sample or out (best in sample 0.36 / 0.38 at 0.048 / 0.042 against rho0).  Comparing with the running "
     "reference rho_ref (loss_ref_running) keeps the pair stable when a sequence is left out (0.90..0.94 / "

@@ -1,8 +1,9 @@
 """Tracker v2's experimental scale and illumination options (off by default; no RTL): the shrink
-guard (TrackerParams.scale_ring_guard) and the guarded model update (model_rate, model_mix).
+guard (TrackerParams.scale_ring_guard), the guarded model update (model_rate, model_mix) and the
+normalised-chromaticity bins (chroma_bins).
 
 Each fixed block against its exact definition (Python integers / Fraction), the option's effect on
-a synthetic scene in both models, and the defaults unchanged (docs/algorithm.md "v2.5a", "v2.6a";
+a synthetic scene in both models, and the defaults unchanged (docs/algorithm.md "v2.2b", "v2.5a", "v2.6a";
 docs/fixed_point.md "The shrink guard and the guarded model update"; figures on 22 sequences in
 docs/results_accuracy22.md).
 """
@@ -15,7 +16,8 @@ import pytest
 
 from mstrack import Tracker
 from mstrack.eval.metrics import iou
-from mstrack.fixed.blocks_v2 import ONE, ms_model_update, ms_no_shrink, ms_ring_guard, q16
+from mstrack.fixed.blocks_v2 import ONE, ms_chroma_bin, ms_model_update, ms_no_shrink, ms_ring_guard, q16
+from mstrack.track.features import chroma_bins
 from mstrack.track.float_v2 import PassV2, ring_guard
 from mstrack.track.params import TrackerParams
 
@@ -73,6 +75,22 @@ def test_model_update_against_exact_definition(k):
     want = [int(a) + int(Fraction(int(b) - int(a), 1 << k).__floor__()) for a, b in zip(old, new)]
     assert got.tolist() == want
     assert np.all(got >= np.minimum(old, new)) and np.all(got <= np.maximum(old, new))
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_chroma_bin_against_exact_definition(k):
+    """ms_chroma_bin (fixed) and chroma_bins (float) against Fraction arithmetic on random pixels and
+    the extremes; 3 colour bits: every bin < 2**(6 + k) <= 512."""
+    rng = np.random.default_rng(k)
+    px = rng.integers(0, 256, (64, 64, 3)).astype(np.uint8)
+    px[0, :4] = [[0, 0, 0], [255, 255, 255], [0, 0, 255], [255, 0, 0]]
+    got = ms_chroma_bin(px, 3, k)
+    assert np.array_equal(got, chroma_bins(px, 3, k)) and got.max() < 1 << (6 + k)
+    for (y, x) in [(0, 0), (0, 1), (0, 2), (0, 3)] + [tuple(rng.integers(0, 64, 2)) for _ in range(300)]:
+        b, g, r = (int(v) for v in px[y, x])
+        s = r + g + b
+        want = ((s * (1 << k)) // 1024 << 6) + (int(Fraction(8 * r, s + 1)) << 3) + int(Fraction(8 * g, s + 1))
+        assert got[y, x] == want
 
 
 def test_float_ring_guard_rule():
@@ -152,13 +170,26 @@ def test_model_update_keeps_the_init_model_share():
     assert not np.array_equal(impl.Qr, q0)  # the running model moved
 
 
+@pytest.mark.parametrize("model,kw", MODELS)
+def test_chroma_bins_keep_a_darkening_target(model, kw):
+    """The target darkening to half (previous test): with chromaticity bins (2 intensity bits) the box
+    stays on it (IoU >= 0.5 over the last 10 frames) where the RGB bins lose it."""
+    frames, gt = _scene(100, dark=0.5)
+    last = {}
+    for k in (0, 2):
+        t = Tracker(model=model, preset="v2", chroma_bins=k, **kw)
+        res = [t.init(frames[0], gt[0])] + [t.update(f) for f in frames[1:]]
+        last[k] = iou(_boxes(res[-10:]), gt[-10:])
+    assert last[0].max() < 0.3 and last[2].min() > 0.5, last
+
+
 @pytest.mark.parametrize("model,kw", MODELS + [("fixed", {})])
 def test_options_off_change_nothing(model, kw):
-    """scale_ring_guard 0, model_rate 0 and model_mix 1 (the defaults, spelt out) give the defaults'
-    results bit for bit."""
+    """scale_ring_guard 0, model_rate 0, model_mix 1 and chroma_bins 0 (the defaults, spelt out) give
+    the defaults' results bit for bit."""
     frames, gt = _scene(25, shrink=0.8, dark=0.8)
     runs = []
-    for extra in ({}, dict(scale_ring_guard=0.0, model_rate=0.0, model_mix=1.0)):
+    for extra in ({}, dict(scale_ring_guard=0.0, model_rate=0.0, model_mix=1.0, chroma_bins=0)):
         t = Tracker(model=model, preset="v2", **extra, **kw)
         res = [t.init(frames[0], gt[0])] + [t.update(f) for f in frames[1:]]
         runs.append([(r.box.as_tuple(), r.confidence, r.status) for r in res])
@@ -170,5 +201,7 @@ def test_fixed_rates_must_be_powers_of_two():
         Tracker(model="fixed", preset="v2", model_rate=0.1)
     with pytest.raises(ValueError, match="model_mix"):
         Tracker(model="fixed", preset="v2", model_rate=0.0625, model_mix=0.3)
+    with pytest.raises(ValueError, match="chroma_bins"):
+        TrackerParams(preset="v2", chroma_bins=4)
     with pytest.raises(ValueError, match="scale_ring_guard"):
         TrackerParams(preset="v2", scale_ring_guard=-0.1)

@@ -339,3 +339,14 @@ def ms_model_update(Qn: np.ndarray, Qn_new: np.ndarray, k: int) -> np.ndarray:
     shift = floor; Qn, Qn_new 17-bit unsigned, the difference 18-bit signed; the result stays in
     [min, max] of the two, so within 17 bits).  k = rate_shift(model_rate)."""
     return Qn + ((Qn_new - Qn) >> k)
+
+
+def ms_chroma_bin(frame: np.ndarray, bits: int, k: int) -> np.ndarray:
+    """Normalised-chromaticity bin (TrackerParams.chroma_bins = k, 1..bits; off by default): S = R + G + B
+    (10 bits), bin = ((S >> (10 - k)) << 2b) | (floor(2**b R / (S + 1)) << b) | floor(2**b G / (S + 1)).
+    Each quotient is b bits (R <= S, so 2**b R / (S + 1) < 2**b): a (8 + b)-bit by 10-bit divider,
+    or 2**b - 1 compares of 2**b R with j (S + 1), per channel; the intensity is S's top k bits.
+    (H, W) int64, < 2**(2b + k) <= 2**(3b)."""
+    f = frame.astype(np.int64)
+    s = f[..., 0] + f[..., 1] + f[..., 2]
+    return ((s >> (10 - k)) << (2 * bits)) | (((f[..., 2] << bits) // (s + 1)) << bits) | ((f[..., 1] << bits) // (s + 1))

@@ -34,7 +34,7 @@ from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
                         ORIENT_FLAT,
                         ms_scale_gate, ms_scale_test, ms_scale_test_size, ms_model_update, ms_no_shrink,
-                        ms_ring_guard)
+                        ms_ring_guard, ms_chroma_bin)
 from .formats import FixedParams, widths
 
 # Integer fields of one v2 result (what result word v2 will carry).
@@ -43,13 +43,14 @@ STATUS_CODES_V2 = {Status.OK: 0, Status.UNCERTAIN: 1, Status.LOST: 2, Status.REA
                    Status.INIT: 4, Status.CLIPPED: 5, Status.ERROR: 6}
 
 
-def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region) -> np.ndarray:
+def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region, chroma: int = 0) -> np.ndarray:
     """``ms_joint_bin(ms_colour_bin(img), ms_orient_bin(ms_grey(frame), T)[::d, ::d])`` of the
     decimated image ``img = frame[::d, ::d]`` over region ``reg`` only (the region capture): the
     grey of the frame pixels under the region and its 1-px ring, Gx, Gy as ms_orient_bin forms
     them at the region's pixels (integers: the same values), 8 on the frame's 1-px border."""
     fh, fw = frame.shape[:2]
-    c = ms_colour_bin(frame[::d, ::d][reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], bits)
+    img = frame[::d, ::d][reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
+    c = ms_chroma_bin(img, bits, chroma) if chroma else ms_colour_bin(img, bits)
     n, m = c.shape
     if n == 0 or m == 0:
         return c
@@ -111,7 +112,7 @@ class FixedTrackerV2:
 
     # ------------------------------------------------------------------ helpers
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
-        c = ms_colour_bin(frame[::d, ::d], self.params.colour_bits)
+        c = self._colour(frame[::d, ::d])
         if self.params.orient_T <= 0:
             return c
         # joint bins (the default, orient_T 64; 0 = colour bins): Sobel on the full-resolution grey frame
@@ -158,9 +159,14 @@ class FixedTrackerV2:
         p = self.params
         if p.orient_T > 0:
             if frame is not None:
-                return joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg)
+                return joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg, p.chroma_bins)
             return self._joint[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
-        return ms_colour_bin(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], self.params.colour_bits)
+        return self._colour(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w])
+
+    def _colour(self, img: np.ndarray) -> np.ndarray:
+        """The colour bins of ``img``: ms_colour_bin, or ms_chroma_bin with chroma_bins (off by default)."""
+        p = self.params
+        return ms_chroma_bin(img, p.colour_bits, p.chroma_bins) if p.chroma_bins else ms_colour_bin(img, p.colour_bits)
 
     def _scale_verdict(self, sub: np.ndarray, reg: Region, c8d: tuple[int, int], d: int,
                        rho: int, dims: tuple[int, int]) -> int:

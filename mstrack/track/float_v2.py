@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 
 from . import float_model as _fm
-from .features import _GREY_W, colour_bins
+from .features import _GREY_W, chroma_bins, colour_bins
 from .frames import check_frame, clip_box
 from .numba_kernels import (_SHIFT2_BAND, _jit, _jit_inline, _nb_columns, _nb_normalise, _nb_run, _nb_scan, _nb_sum,
                             _nb_sum3, _prefetch)
@@ -650,8 +650,8 @@ class LazyBins:
     depend on which rectangles were asked for, so results equal those of the whole image.
     """
 
-    def __init__(self, image: np.ndarray, bits: int, margin: int) -> None:
-        self.image, self.bits, self.margin = image, bits, margin
+    def __init__(self, image: np.ndarray, bits: int, margin: int, chroma: int = 0) -> None:
+        self.image, self.bits, self.margin, self.chroma = image, bits, margin, chroma
         self.shape = image.shape[:2]
         self.values = np.empty(self.shape, np.intp)
         self.box: tuple[int, int, int, int] | None = None  # y0, y1, x0, x1 (half-open)
@@ -664,7 +664,8 @@ class LazyBins:
         ny0, ny1, nx0, nx1 = max(0, y0 - m), min(self.shape[0], y1 + m), max(0, x0 - m), min(self.shape[1], x1 + m)
         if b is not None:
             ny0, ny1, nx0, nx1 = min(ny0, b[0]), max(ny1, b[1]), min(nx0, b[2]), max(nx1, b[3])
-        self.values[ny0:ny1, nx0:nx1] = colour_bins(self.image[ny0:ny1, nx0:nx1], self.bits)
+        img = self.image[ny0:ny1, nx0:nx1]
+        self.values[ny0:ny1, nx0:nx1] = chroma_bins(img, self.bits, self.chroma) if self.chroma else colour_bins(img, self.bits)
         self.box = (ny0, ny1, nx0, nx1)
 
     def __getitem__(self, key: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -828,7 +829,8 @@ class FloatTrackerV2:
 
     def active_path(self) -> str:
         """The path :meth:`update` runs now: "numpy" or "numba"."""
-        if self.path == "numpy" or self.params.rho_stop_margin > 0:  # (the numba kernel has no margin)
+        if self.path == "numpy" or self.params.rho_stop_margin > 0 or self.params.chroma_bins:
+            # (the numba kernel has neither the margin nor the chromaticity bins)
             return "numpy"
         if self._use_numba:  # (the self-check's own run)
             return "numba"
@@ -845,7 +847,8 @@ class FloatTrackerV2:
 
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
         p = self.params
-        c = colour_bins(frame[::d, ::d], p.colour_bits)
+        img = frame[::d, ::d]
+        c = chroma_bins(img, p.colour_bits, p.chroma_bins) if p.chroma_bins else colour_bins(img, p.colour_bits)
         if p.orient_T <= 0:
             return c
         # joint colour x orientation (off by default): Sobel on the full-resolution grey frame
@@ -855,7 +858,7 @@ class FloatTrackerV2:
 
     def _lazy_bins(self, frame: np.ndarray, d: int, w: float, h: float) -> LazyBins:
         """Bins computed around the windows the frame's mean shift visits (same values)."""
-        return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8)
+        return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8, self.params.chroma_bins)
 
     def _track(self, bins: np.ndarray | LazyBins, start: tuple[float, float], hx: float, hy: float,
                max_iter: int) -> tuple[tuple[float, float], PassV2, int]:

@@ -171,6 +171,12 @@ class TrackerParams:
     model_mix : float
         The running model's share in the guarded model update (1: the running model alone; 1/2:
         half the init model is always kept).  Only with model_rate > 0.
+    chroma_bins : int
+        Normalised-chromaticity colour bins (experimental, off by default: 0): k = chroma_bins
+        intensity bits (1 <= k <= colour_bits); with S = R + G + B and b = colour_bits, bin =
+        ((S >> (10 - k)) << 2b) | (floor(2**b R / (S + 1)) << b) | floor(2**b G / (S + 1)):
+        chromaticity r, g at b bits and the intensity at k bits, in place of R, G, B at b bits (the
+        joint bins join these).  The float model then runs its numpy path (docs/algorithm.md "v2.2b").
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -233,6 +239,7 @@ class TrackerParams:
     scale_ring_guard: float = 0.0
     model_rate: float = 0.0
     model_mix: float = 1.0
+    chroma_bins: int = 0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -274,6 +281,8 @@ class TrackerParams:
                 raise ValueError("conf_lost must be <= conf_uncertain")
             if not 7 <= self.max_window <= 1023:
                 raise ValueError("max_window must be in 7..1023")
+            if not 0 <= self.chroma_bins <= self.colour_bits:
+                raise ValueError(f"chroma_bins must be in 0..colour_bits ({self.colour_bits}), got {self.chroma_bins}")
             if self.search_widen < 0:
                 raise ValueError("search_widen must be >= 0")
             if self.search_iter < 1:

@@ -157,6 +157,22 @@ def test_model_update_follows_a_darkening_target(model, kw):
     assert last[0.0].max() < 0.3 and last[0.0625].min() > 0.8, last
 
 
+@pytest.mark.parametrize("model,kw", MODELS)
+def test_model_contrast_guard(model, kw):
+    """model_contrast: the update learns only on frames with contrast_s >= model_contrast; at 1.0
+    (contrast_s < 1 here) it learns nothing and the results equal model_rate 0's bit for bit, at -1
+    (the default) the update changes them."""
+    frames, gt = _scene(30, dark=0.6)
+    runs = {}
+    for label, extra in (("off", {}), ("c1", dict(model_rate=0.25, model_contrast=1.0)),
+                         ("c-1", dict(model_rate=0.25))):
+        t = Tracker(model=model, preset="v2", **extra, **kw)
+        res = [t.init(frames[0], gt[0])] + [t.update(f) for f in frames[1:]]
+        runs[label] = [(r.box.as_tuple(), r.confidence) for r in res]
+        assert max(r.extra["contrast_s"] for r in res[1:]) < (ONE if model == "fixed" else 1.0)
+    assert runs["c1"] == runs["off"] and runs["c-1"] != runs["off"]
+
+
 def test_model_update_keeps_the_init_model_share():
     """model_mix 1/2 (fixed): Qn = Qn0 + ((Qr - Qn0) >> 1) after every update, Qr the running model."""
     frames, gt = _scene(20, dark=0.7)

@@ -98,6 +98,7 @@ class FixedTrackerV2:
         self.loss_k = rate_shift(p.loss_smooth)
         self.guard16 = q16(p.scale_ring_guard)  # the shrink guard (0: off, the default)
         self.model_k = rate_shift(p.model_rate, "model_rate") if p.model_rate > 0 else -1  # guarded model update (-1: off)
+        self.model_con16 = q16(p.model_contrast)  # the update's contrast guard (Q.16 signed; -2**16: none)
         self.mix_k = rate_shift(p.model_mix, "model_mix")  # its running model's share 2**-mix_k (0: all)
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
@@ -369,7 +370,7 @@ class FixedTrackerV2:
             self.h8 = ms_resize(self.h8, s, fh)
         else:
             w8_used, h8_used = self.w8, self.h8
-        if self.model_k >= 0 and state == Status.OK and not flagged:
+        if self.model_k >= 0 and state == Status.OK and not flagged and self.con_s >= self.model_con16:
             self._model_update(frame, d, c8d, w8_used, h8_used)
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": rho,
                "confidence": conf, "status": STATUS_CODES_V2[status], "iter": it, "decimation": d,

@@ -1051,7 +1051,7 @@ class FloatTrackerV2:
             est_rho = self._scale_test(bins, c, hx, hy, ps.rho) if p.scale_test > 0 else None
             self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho,
                                  ring_guard(ps, p))
-        if p.model_rate > 0 and state == Status.OK and not flagged:
+        if p.model_rate > 0 and state == Status.OK and not flagged and self._con_s >= p.model_contrast:
             # guarded model update (off by default): the init's CBWH model at the tracked box (the
             # size this frame tracked with), blended in; t becomes the new model's
             mb = self._bins(frame, d)

@@ -171,6 +171,10 @@ class TrackerParams:
     model_mix : float
         The running model's share in the guarded model update (1: the running model alone; 1/2:
         half the init model is always kept).  Only with model_rate > 0.
+    model_contrast : float
+        A further guard of the model update: it learns only on frames whose smoothed contrast
+        (the loss flag's contrast_s, share - ring_share) is at least model_contrast (default -1:
+        every ok, unflagged frame).  Only with model_rate > 0.
     chroma_bins : int
         Normalised-chromaticity colour bins (experimental, off by default: 0): k = chroma_bins
         intensity bits (1 <= k <= colour_bits); with S = R + G + B and b = colour_bits, bin =
@@ -239,6 +243,7 @@ class TrackerParams:
     scale_ring_guard: float = 0.0
     model_rate: float = 0.0
     model_mix: float = 1.0
+    model_contrast: float = -1.0
     chroma_bins: int = 0
 
     def __post_init__(self) -> None:
@@ -274,7 +279,8 @@ class TrackerParams:
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
                                  ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
                                  ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5),
-                                 ("scale_ring_guard", 0.0, 4.0), ("model_rate", 0.0, 1.0), ("model_mix", 0.0, 1.0)):
+                                 ("scale_ring_guard", 0.0, 4.0), ("model_rate", 0.0, 1.0), ("model_mix", 0.0, 1.0),
+                                 ("model_contrast", -1.0, 1.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:

@@ -101,6 +101,10 @@ def test_bad_frame_while_lost_keeps_searching() -> None:
                                      ({"search_widen": 2}, "search_widen"),
                                      ({"rho_stop_margin": 0.002}, "rho_stop_margin"),
                                      ({"loss_jump": 1.25}, "loss_jump"),
+                                     ({"scale_ring_guard": 0.5}, "scale_ring_guard"),
+                                     ({"model_rate": 0.0625}, "model_rate"), ({"model_mix": 0.5}, "model_mix"),
+                                     ({"chroma_bins": 2}, "chroma_bins"),
+                                     ({"model_contrast": 0.15}, "model_contrast"),
                                      ({"model_frac": 4}, "model_frac"), ({"bg_frac": 16}, "bg_frac")])
 def test_core_config_v2_refuses_options_without_rtl(kw, what):
     """The experimental v2 options without RTL (motion_gain; the ungated scale test) are in

@@ -8,14 +8,17 @@ import pytest
 
 from mstrack.fixed import tracker_v2 as tv2
 from mstrack.fixed.blocks import Region, ms_colour_bin, ms_grey
-from mstrack.fixed.blocks_v2 import ms_joint_bin, ms_orient_bin
+from mstrack.fixed.blocks_v2 import ms_chroma_bin, ms_joint_bin, ms_orient_bin
 from mstrack.fixed.tracker_v2 import FixedTrackerV2, joint_bins_region
 from mstrack.track.params import TrackerParams
 
 
-def _whole_frame(frame, d, bits, T, reg):
-    """The definition: the whole frame's joint bins, decimated, then the region (the former path)."""
-    full = ms_joint_bin(ms_colour_bin(frame[::d, ::d], bits), ms_orient_bin(ms_grey(frame), T)[::d, ::d])
+def _whole_frame(frame, d, bits, T, reg, chroma=0):
+    """The definition: the whole frame's joint bins, decimated, then the region (the former path);
+    ``chroma`` > 0: the chromaticity bins (TrackerParams.chroma_bins) in place of the RGB bins."""
+    img = frame[::d, ::d]
+    c = ms_chroma_bin(img, bits, chroma) if chroma else ms_colour_bin(img, bits)
+    full = ms_joint_bin(c, ms_orient_bin(ms_grey(frame), T)[::d, ::d])
     return full[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
 
 
@@ -33,8 +36,9 @@ def test_joint_bins_region_equals_whole_frame(shape):
                 regs.append((x, y, int(rng.integers(1, wd - x + 1)), int(rng.integers(1, hd - y + 1))))
             for x, y, w, h in regs:
                 reg = Region(x, y, w, h, (0, 0), (0, 0))
-                got = joint_bins_region(frame, d, 3, T, reg)
-                assert np.array_equal(got, _whole_frame(frame, d, 3, T, reg)), (d, T, x, y, w, h)
+                for k in (0, 2):
+                    got = joint_bins_region(frame, d, 3, T, reg, k)
+                    assert np.array_equal(got, _whole_frame(frame, d, 3, T, reg, k)), (d, T, x, y, w, h, k)
 
 
 def _scenes():

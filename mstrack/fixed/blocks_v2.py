@@ -37,11 +37,11 @@ def sixteenths(x: float, name: str) -> int:
     return n
 
 
-def rate_shift(rate: float) -> int:
+def rate_shift(rate: float, name: str = "ref_rate") -> int:
     """ref_rate = 2**-k -> k (the running references update with a shift)."""
     k = int(round(-np.log2(rate))) if rate > 0 else 0
     if rate <= 0 or abs(2.0 ** -k - rate) > 1e-12:
-        raise ValueError(f"ref_rate = {rate} must be a power of two 2**-k for the fixed-point model")
+        raise ValueError(f"{name} = {rate} must be a power of two 2**-k for the fixed-point model")
     return k
 
 
@@ -343,3 +343,36 @@ def ms_scale_gate(spread: int, spread_ref: int, verdict: int) -> int:
     if (spread > spread_ref and verdict > 0) or (spread < spread_ref and verdict < 0):
         return spread
     return spread_ref
+
+
+# ----------------------------------------------------------------------------- shrink guard, guarded model update
+# Experimental options, off by default (TrackerParams.scale_ring_guard, model_rate; docs/fixed_point.md
+# "The shrink guard and the guarded model update"); core v2 has no RTL for them.
+def ms_ring_guard(share: int, ring: int, guard16: int) -> bool:
+    """The shrink guard: True (no shrinking step) when ring_share >= guard share, as
+    ring 2**16 >= guard16 share (ring, share Q.16 <= 2**16, 17 bits; guard16 = round(scale_ring_guard
+    2**16), 19 bits: one 17 x 19-bit product and one 36-bit compare); False when guard16 = 0 (off)."""
+    return guard16 > 0 and (ring << 16) >= guard16 * share
+
+
+def ms_no_shrink(s: int, veto: bool) -> int:
+    """The scale factor (Q.16) after the shrink guard: max(s, 2**16) when vetoed, else s."""
+    return max(s, ONE) if veto else s
+
+
+def ms_model_update(Qn: np.ndarray, Qn_new: np.ndarray, k: int) -> np.ndarray:
+    """The guarded model update's blend, per bin: Qn_u + ((Qn_new_u - Qn_u) >> k) (arithmetic
+    shift = floor; Qn, Qn_new 17-bit unsigned, the difference 18-bit signed; the result stays in
+    [min, max] of the two, so within 17 bits).  k = rate_shift(model_rate)."""
+    return Qn + ((Qn_new - Qn) >> k)
+
+
+def ms_chroma_bin(frame: np.ndarray, bits: int, k: int) -> np.ndarray:
+    """Normalised-chromaticity bin (TrackerParams.chroma_bins = k, 1..bits; off by default): S = R + G + B
+    (10 bits), bin = ((S >> (10 - k)) << 2b) | (floor(2**b R / (S + 1)) << b) | floor(2**b G / (S + 1)).
+    Each quotient is b bits (R <= S, so 2**b R / (S + 1) < 2**b): a (8 + b)-bit by 10-bit divider,
+    or 2**b - 1 compares of 2**b R with j (S + 1), per channel; the intensity is S's top k bits.
+    (H, W) int64, < 2**(2b + k) <= 2**(3b)."""
+    f = frame.astype(np.int64)
+    s = f[..., 0] + f[..., 1] + f[..., 2]
+    return ((s >> (10 - k)) << (2 * bits)) | (((f[..., 2] << bits) // (s + 1)) << bits) | ((f[..., 1] << bits) // (s + 1))

@@ -33,7 +33,8 @@ from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
                         ORIENT_FLAT,
-                        ms_scale_gate, ms_scale_test, ms_scale_test_size)
+                        ms_scale_gate, ms_scale_test, ms_scale_test_size, ms_model_update, ms_no_shrink,
+                        ms_ring_guard, ms_chroma_bin)
 from .formats import FixedParams, widths
 
 # Integer fields of one v2 result (what result word v2 will carry).
@@ -42,13 +43,14 @@ STATUS_CODES_V2 = {Status.OK: 0, Status.UNCERTAIN: 1, Status.LOST: 2, Status.REA
                    Status.INIT: 4, Status.CLIPPED: 5, Status.ERROR: 6}
 
 
-def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region) -> np.ndarray:
+def joint_bins_region(frame: np.ndarray, d: int, bits: int, T: int, reg: Region, chroma: int = 0) -> np.ndarray:
     """``ms_joint_bin(ms_colour_bin(img), ms_orient_bin(ms_grey(frame), T)[::d, ::d])`` of the
     decimated image ``img = frame[::d, ::d]`` over region ``reg`` only (the region capture): the
     grey of the frame pixels under the region and its 1-px ring, Gx, Gy as ms_orient_bin forms
     them at the region's pixels (integers: the same values), 8 on the frame's 1-px border."""
     fh, fw = frame.shape[:2]
-    c = ms_colour_bin(frame[::d, ::d][reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], bits)
+    img = frame[::d, ::d][reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
+    c = ms_chroma_bin(img, bits, chroma) if chroma else ms_colour_bin(img, bits)
     n, m = c.shape
     if n == 0 or m == 0:
         return c
@@ -96,6 +98,10 @@ class FixedTrackerV2:
         self.loss_k = rate_shift(p.loss_smooth)
         self.loss_jump16 = sixteenths(p.loss_jump, "loss_jump")  # the motion latch (0: off, the default)
         self.loss_stay16 = q16(p.loss_stay)
+        self.guard16 = q16(p.scale_ring_guard)  # the shrink guard (0: off, the default)
+        self.model_k = rate_shift(p.model_rate, "model_rate") if p.model_rate > 0 else -1  # guarded model update (-1: off)
+        self.model_con16 = q16(p.model_contrast)  # the update's contrast guard (Q.16 signed; -2**16: none)
+        self.mix_k = rate_shift(p.model_mix, "model_mix")  # its running model's share 2**-mix_k (0: all)
         if p.kernel != "flat":
             raise ValueError("the fixed-point v2 model has the flat kernel only")
         if p.motion_gain > 0 or (p.scale_test > 0 and not p.scale_test_gate):
@@ -109,7 +115,7 @@ class FixedTrackerV2:
 
     # ------------------------------------------------------------------ helpers
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
-        c = ms_colour_bin(frame[::d, ::d], self.params.colour_bits)
+        c = self._colour(frame[::d, ::d])
         if self.params.orient_T <= 0:
             return c
         # joint bins (the default, orient_T 64; 0 = colour bins): Sobel on the full-resolution grey frame
@@ -156,9 +162,14 @@ class FixedTrackerV2:
         p = self.params
         if p.orient_T > 0:
             if frame is not None:
-                return joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg)
+                return joint_bins_region(frame, d, p.colour_bits, p.orient_T, reg, p.chroma_bins)
             return self._joint[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w]
-        return ms_colour_bin(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w], self.params.colour_bits)
+        return self._colour(img[reg.y: reg.y + reg.h, reg.x: reg.x + reg.w])
+
+    def _colour(self, img: np.ndarray) -> np.ndarray:
+        """The colour bins of ``img``: ms_colour_bin, or ms_chroma_bin with chroma_bins (off by default)."""
+        p = self.params
+        return ms_chroma_bin(img, p.colour_bits, p.chroma_bins) if p.chroma_bins else ms_colour_bin(img, p.colour_bits)
 
     def _scale_verdict(self, sub: np.ndarray, reg: Region, c8d: tuple[int, int], d: int,
                        rho: int, dims: tuple[int, int]) -> int:
@@ -223,6 +234,7 @@ class FixedTrackerV2:
         cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
               min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
         self.model: ModelV2 = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2, fx.bg_frac)
+        self.Qn0 = self.Qr = self.model.Qn  # the guarded model update's init and running models
         wd, hd = self._geometry(d, bins.shape)
         ker = self._kernel(wd, hd)
         Qw = ms_model_scale(self.model.Qn, ker.K, fx.model_frac)
@@ -264,6 +276,25 @@ class FixedTrackerV2:
         S = ms_bin_pass(Qw, hist, fx, fx.model_frac).S
         st = ms_target_stats(sub, self.model.T, (win[0] - reg.x, win[1] - reg.y), ker, fx.kernel_bits, self.pad16)
         return c8, S, 0, "shift", st
+
+    def _model_update(self, frame: np.ndarray, d: int, c8d: tuple[int, int], w8: int, h8: int) -> None:
+        """The guarded model update (model_rate > 0; off by default): ms_bg_model at the tracked
+        box (centre c8d rounded, the size the frame tracked with, kept inside the decimated interior
+        as at init) on the frame's bins, blended into the running model Qr by ms_model_update (shift
+        model_k), and Qn = ms_model_update(Qn0, Qr, mix_k) (mix_k 0: Qn = Qr); T becomes the new model's."""
+        p, fx = self.params, self.fixed
+        cf = fx.centre_frac
+        bins = self._bins(frame, d)
+        hd_, wd_ = bins.shape
+        wb = ms_box_size(w8, d, min(p.max_window, wd_ - 2))
+        hb = ms_box_size(h8, d, min(p.max_window, hd_ - 2))
+        cd = (ms_round_centre(c8d[0], cf), ms_round_centre(c8d[1], cf))
+        cd = (min(max(cd[0], (wb - 1) // 2 + 1), wd_ - 2 - (wb - 1) // 2),
+              min(max(cd[1], (hb - 1) // 2 + 1), hd_ - 2 - (hb - 1) // 2))
+        new = ms_bg_model(bins, cd[0], cd[1], wb, hb, self.ring16, p.n_bins_v2, fx.bg_frac)
+        m = self.model
+        self.Qr = ms_model_update(self.Qr, new.Qn, self.model_k)
+        self.model = ModelV2(Qn=ms_model_update(self.Qn0, self.Qr, self.mix_k), T=new.T, Q=m.Q, O=m.O)
 
     def update(self, frame: np.ndarray) -> TrackResult:
         """Track one frame.  Bad frames raise FrameError and leave the state unchanged."""
@@ -346,9 +377,15 @@ class FixedTrackerV2:
                 sp = ms_scale_gate(spread, self.spread_ref,
                                    self._scale_verdict(sub, reg, c8d, d, rho, img.shape[:2]))
             s = ms_scale(sp, self.spread_ref, self.w8, self.w0_8, p)
+            s = ms_no_shrink(s, ms_ring_guard(share, ring, self.guard16))
             fh, fw = self._shape
+            w8_used, h8_used = self.w8, self.h8
             self.w8 = ms_resize(self.w8, s, fw)
             self.h8 = ms_resize(self.h8, s, fh)
+        else:
+            w8_used, h8_used = self.w8, self.h8
+        if self.model_k >= 0 and state == Status.OK and not flagged and self.con_s >= self.model_con16:
+            self._model_update(frame, d, c8d, w8_used, h8_used)
         raw = {"cx": self.c8[0], "cy": self.c8[1], "w8": self.w8, "h8": self.h8, "rho": rho,
                "confidence": conf, "status": STATUS_CODES_V2[status], "iter": it, "decimation": d,
                "share": share, "spread": spread, "stop": STOP_CODES[stop], "searched": searched,

@@ -343,7 +343,9 @@ class CoreConfigV2:
         tp = self.tp
         rtl_less = [k for k, off in (("motion_gain", 0.0), ("loss_ref_running", False),
                                           ("scale_test_margin", 0.0), ("search_widen", 0),
-                                          ("rho_stop_margin", 0.0), ("loss_jump", 0.0)) if getattr(tp, k) != off]
+                                          ("rho_stop_margin", 0.0), ("loss_jump", 0.0), ("scale_ring_guard", 0.0),
+                                          ("model_rate", 0.0), ("model_mix", 1.0),
+                                          ("chroma_bins", 0), ("model_contrast", -1.0)) if getattr(tp, k) != off]
         # the wider model formats of the fixed model (FixedParams.model_frac, bg_frac) have no RTL yet
         rtl_less += [k for k, off in (("model_frac", 0), ("bg_frac", 8)) if getattr(self.fp, k) != off]
         if tp.scale_test != 0.0 and not tp.scale_test_gate:

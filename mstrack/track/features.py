@@ -26,6 +26,16 @@ def colour_bins(frame: np.ndarray, bits: int) -> np.ndarray:
     return (f[:, :, 2] << (2 * bits)) | (f[:, :, 1] << bits) | f[:, :, 0]
 
 
+def chroma_bins(frame: np.ndarray, bits: int, k: int) -> np.ndarray:
+    """Normalised-chromaticity bin per pixel (TrackerParams.chroma_bins = k): with S = R + G + B,
+    ((S >> (10 - k)) << 2b) | (floor(2**b R / (S + 1)) << b) | floor(2**b G / (S + 1)), b = ``bits``.
+
+    frame: (H, W, 3) uint8 BGR.  Returns (H, W) int32 in [0, 2**(2b + k)) (integers throughout)."""
+    f = frame.astype(np.int32)
+    s = f[:, :, 0] + f[:, :, 1] + f[:, :, 2]
+    return ((s >> (10 - k)) << (2 * bits)) | (((f[:, :, 2] << bits) // (s + 1)) << bits) | ((f[:, :, 1] << bits) // (s + 1))
+
+
 def edge_magnitude(frame: np.ndarray) -> np.ndarray:
     """|G| = |Gx| + |Gy| of the 3x3 Sobel on the float grey image.
 

@@ -35,7 +35,7 @@ import cv2
 import numpy as np
 
 from . import float_model as _fm
-from .features import _GREY_W, colour_bins
+from .features import _GREY_W, chroma_bins, colour_bins
 from .frames import check_frame, clip_box
 from .numba_kernels import (_SHIFT2_BAND, _jit, _jit_inline, _nb_columns, _nb_normalise, _nb_run, _nb_scan, _nb_sum,
                             _nb_sum3, _prefetch)
@@ -650,8 +650,8 @@ class LazyBins:
     depend on which rectangles were asked for, so results equal those of the whole image.
     """
 
-    def __init__(self, image: np.ndarray, bits: int, margin: int) -> None:
-        self.image, self.bits, self.margin = image, bits, margin
+    def __init__(self, image: np.ndarray, bits: int, margin: int, chroma: int = 0) -> None:
+        self.image, self.bits, self.margin, self.chroma = image, bits, margin, chroma
         self.shape = image.shape[:2]
         self.values = np.empty(self.shape, np.intp)
         self.box: tuple[int, int, int, int] | None = None  # y0, y1, x0, x1 (half-open)
@@ -664,7 +664,8 @@ class LazyBins:
         ny0, ny1, nx0, nx1 = max(0, y0 - m), min(self.shape[0], y1 + m), max(0, x0 - m), min(self.shape[1], x1 + m)
         if b is not None:
             ny0, ny1, nx0, nx1 = min(ny0, b[0]), max(ny1, b[1]), min(nx0, b[2]), max(nx1, b[3])
-        self.values[ny0:ny1, nx0:nx1] = colour_bins(self.image[ny0:ny1, nx0:nx1], self.bits)
+        img = self.image[ny0:ny1, nx0:nx1]
+        self.values[ny0:ny1, nx0:nx1] = chroma_bins(img, self.bits, self.chroma) if self.chroma else colour_bins(img, self.bits)
         self.box = (ny0, ny1, nx0, nx1)
 
     def __getitem__(self, key: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
@@ -783,10 +784,12 @@ def decide_status(conf: float, was_lost: bool, p: TrackerParams) -> Status:
 
 
 def rescale(size: tuple[float, float], size0: tuple[float, float], spread: float, spread_ref: float,
-            shape: tuple[int, int], p: TrackerParams, est_rho: float | None = None) -> tuple[float, float]:
+            shape: tuple[int, int], p: TrackerParams, est_rho: float | None = None,
+            no_shrink: bool = False) -> tuple[float, float]:
     """One frame's size update: est = sqrt(spread / spread_ref) clamped to 1 +- step;
     s = clamp(1 + gain (est - 1) - reg (w / w0 - 1), 1 +- step); size s, in [3, frame].
-    ``est_rho`` (the scale test, off by default): est <- mix est_rho + (1 - mix) est."""
+    ``est_rho`` (the scale test, off by default): est <- mix est_rho + (1 - mix) est.
+    ``no_shrink`` (the shrink guard, :func:`ring_guard`): s <- max(s, 1)."""
     w, h = size
     est = math.sqrt(spread / spread_ref)
     est = min(max(est, 1.0 - p.scale_step), 1.0 + p.scale_step)
@@ -796,7 +799,22 @@ def rescale(size: tuple[float, float], size0: tuple[float, float], spread: float
         est = p.scale_test_mix * est_rho + (1.0 - p.scale_test_mix) * est
     s = 1.0 + p.scale_gain * (est - 1.0) - p.scale_reg * (w / size0[0] - 1.0)
     s = min(max(s, 1.0 - p.scale_step), 1.0 + p.scale_step)
+    if no_shrink:
+        s = max(s, 1.0)
     return (min(max(w * s, 3.0), float(shape[1])), min(max(h * s, 3.0), float(shape[0])))
+
+
+def ring_guard(ps: PassV2, p: TrackerParams) -> bool:
+    """The shrink guard (scale_ring_guard > 0; off by default): True (no shrinking step this
+    frame) when the window's ring holds target-coloured pixels at a share of at least
+    scale_ring_guard x their share in the box: ring_share >= scale_ring_guard share."""
+    return p.scale_ring_guard > 0 and ps.ring_share >= p.scale_ring_guard * ps.share
+
+
+def blend_model(qb: np.ndarray, qb_new: np.ndarray, rate: float) -> np.ndarray:
+    """The guarded model update's blend: qb + rate (qb_new - qb) (model_rate: r and q'_new; model_mix:
+    q'_0 and r)."""
+    return qb + rate * (qb_new - qb)
 
 
 class FloatTrackerV2:
@@ -824,7 +842,8 @@ class FloatTrackerV2:
 
     def active_path(self) -> str:
         """The path :meth:`update` runs now: "numpy" or "numba"."""
-        if self.path == "numpy" or self.params.rho_stop_margin > 0:  # (the numba kernel has no margin)
+        if self.path == "numpy" or self.params.rho_stop_margin > 0 or self.params.chroma_bins:
+            # (the numba kernel has neither the margin nor the chromaticity bins)
             return "numpy"
         if self._use_numba:  # (the self-check's own run)
             return "numba"
@@ -841,7 +860,8 @@ class FloatTrackerV2:
 
     def _bins(self, frame: np.ndarray, d: int) -> np.ndarray:
         p = self.params
-        c = colour_bins(frame[::d, ::d], p.colour_bits)
+        img = frame[::d, ::d]
+        c = chroma_bins(img, p.colour_bits, p.chroma_bins) if p.chroma_bins else colour_bins(img, p.colour_bits)
         if p.orient_T <= 0:
             return c
         # joint colour x orientation (off by default): Sobel on the full-resolution grey frame
@@ -851,7 +871,7 @@ class FloatTrackerV2:
 
     def _lazy_bins(self, frame: np.ndarray, d: int, w: float, h: float) -> LazyBins:
         """Bins computed around the windows the frame's mean shift visits (same values)."""
-        return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8)
+        return LazyBins(frame[::d, ::d], self.params.colour_bits, int(max(w, h) / d) // 2 + 8, self.params.chroma_bins)
 
     def _track(self, bins: np.ndarray | LazyBins, start: tuple[float, float], hx: float, hy: float,
                max_iter: int) -> tuple[tuple[float, float], PassV2, int]:
@@ -961,6 +981,7 @@ class FloatTrackerV2:
         bins = self._bins(frame, d)
         self._q, self._qb, self._t = background_model(bins, p.n_bins_v2, cx / d, cy / d, box.w / d,
                                                       box.h / d, p.bg_ring, p.kernel)
+        self._qb0 = self._qr = self._qb  # the guarded model update's init and running models
         pad = 1.0 + p.pad
         ps = window_pass(bins, p.n_bins_v2, self._qb, self._t, (cx / d, cy / d), pad * box.w / 2 / d,
                          pad * box.h / 2 / d, 1.0 / pad ** 2, p.kernel)
@@ -1053,7 +1074,15 @@ class FloatTrackerV2:
         # scale: every frame (a lost or uncertain target changes size too), from the spread
         if p.scale_gain > 0 and ps.nt > 0:
             est_rho = self._scale_test(bins, c, hx, hy, ps.rho) if p.scale_test > 0 else None
-            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho)
+            self._size = rescale((w, h), self._size0, ps.spread, self._spread_ref, self._shape, p, est_rho,
+                                 ring_guard(ps, p))
+        if p.model_rate > 0 and state == Status.OK and not flagged and self._con_s >= p.model_contrast:
+            # guarded model update (off by default): the init's CBWH model at the tracked box (the
+            # size this frame tracked with), blended in; t becomes the new model's
+            mb = self._bins(frame, d)
+            _, qb_new, self._t = background_model(mb, p.n_bins_v2, c[0], c[1], w / d, h / d, p.bg_ring, p.kernel)
+            self._qr = blend_model(self._qr, qb_new, p.model_rate)
+            self._qb = self._qr if p.model_mix == 1.0 else blend_model(self._qb0, self._qr, p.model_mix)
         box = box_from_centre_index(*self._centre, *self._size)
         return TrackResult(box=box, centre=self._centre, rho_c=ps.rho, rho_e=0.0, alpha_c=1.0, alpha_e=0.0,
                            iter_c=it, iter_e=0, status=status, confidence=conf,

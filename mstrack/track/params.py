@@ -161,6 +161,33 @@ class TrackerParams:
         while rho_s < loss_stay x the loss flag's reference; the flag is raised while the latch
         is set (docs/algorithm.md "v2.7a Loss flag", docs/results_accuracy22.md).  The fixed
         model needs loss_jump in sixteenths.
+    scale_ring_guard : float
+        Shrink guard of the scale update (experimental, off by default: 0): a size step that
+        shrinks the box (s < 1) is not taken while the share of target-coloured pixels in the
+        window's ring around the box is at least scale_ring_guard x their share in the box (the
+        target still fills the ring: the box is not too large), so that the box can follow a
+        shrinking target without the pull toward the init size (scale_reg 0) and does not
+        collapse inside a uniform target (docs/algorithm.md "v2.5a", docs/results_accuracy22.md).
+    model_rate : float
+        Guarded model update (experimental, off by default: 0): on frames whose search state is
+        ok and whose loss flag is down, the background-weighted model q' is learnt again at the
+        tracked box in the frame (the init's CBWH model, the same ring) and blended in:
+        r <- r + model_rate (q'_new - r) (r starts at q'_0, the init's), and the tracker uses
+        q' = q'_0 + model_mix (r - q'_0); t (the target-coloured bins) becomes the new model's.  Powers of
+        two for the fixed model (docs/algorithm.md "v2.6a", docs/results_accuracy22.md).
+    model_mix : float
+        The running model's share in the guarded model update (1: the running model alone; 1/2:
+        half the init model is always kept).  Only with model_rate > 0.
+    model_contrast : float
+        A further guard of the model update: it learns only on frames whose smoothed contrast
+        (the loss flag's contrast_s, share - ring_share) is at least model_contrast (default -1:
+        every ok, unflagged frame).  Only with model_rate > 0.
+    chroma_bins : int
+        Normalised-chromaticity colour bins (experimental, off by default: 0): k = chroma_bins
+        intensity bits (1 <= k <= colour_bits); with S = R + G + B and b = colour_bits, bin =
+        ((S >> (10 - k)) << 2b) | (floor(2**b R / (S + 1)) << b) | floor(2**b G / (S + 1)):
+        chromaticity r, g at b bits and the intensity at k bits, in place of R, G, B at b bits (the
+        joint bins join these).  The float model then runs its numpy path (docs/algorithm.md "v2.2b").
     ref_rate : float
         Rate of the running references of rho and share (confident frames).
     search_step : float
@@ -222,6 +249,11 @@ class TrackerParams:
     rho_stop_margin: float = 0.0
     loss_jump: float = 0.0
     loss_stay: float = 0.95
+    scale_ring_guard: float = 0.0
+    model_rate: float = 0.0
+    model_mix: float = 1.0
+    model_contrast: float = -1.0
+    chroma_bins: int = 0
 
     def __post_init__(self) -> None:
         for name in ALIASES:
@@ -256,13 +288,17 @@ class TrackerParams:
                                  ("ref_rate", 0.0, 1.0), ("search_step", 0.0, 4.0), ("motion_gain", 0.0, 2.0),
                                  ("scale_test", 0.0, 0.5), ("scale_test_mix", 0.0, 1.0),
                                  ("scale_test_margin", 0.0, 0.5), ("rho_stop_margin", 0.0, 0.5),
-                                 ("loss_jump", 0.0, 8.0), ("loss_stay", 0.0, 2.0)):
+                                 ("loss_jump", 0.0, 8.0), ("loss_stay", 0.0, 2.0),
+                                 ("scale_ring_guard", 0.0, 4.0), ("model_rate", 0.0, 1.0), ("model_mix", 0.0, 1.0),
+                                 ("model_contrast", -1.0, 1.0)):
                 if not lo <= getattr(self, name) <= hi:
                     raise ValueError(f"{name} must be in {lo}..{hi}, got {getattr(self, name)}")
             if not self.conf_lost <= self.conf_uncertain:
                 raise ValueError("conf_lost must be <= conf_uncertain")
             if not 7 <= self.max_window <= 1023:
                 raise ValueError("max_window must be in 7..1023")
+            if not 0 <= self.chroma_bins <= self.colour_bits:
+                raise ValueError(f"chroma_bins must be in 0..colour_bits ({self.colour_bits}), got {self.chroma_bins}")
             if self.search_widen < 0:
                 raise ValueError("search_widen must be >= 0")
             if self.search_iter < 1:

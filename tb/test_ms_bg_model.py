@@ -426,9 +426,9 @@ def real_cases_joint(g: dict, orient_t: int = 64) -> list[dict]:
     orig = tv2.ms_bg_model
     calls: list[tuple] = []
 
-    def rec(bins, cx, cy, wb, hb, ring16, n_bins):
+    def rec(bins, cx, cy, wb, hb, ring16, n_bins, *more):  # more: the model's optional widths (defaults: core v2's)
         calls.append((bins.copy(), cx, cy, wb, hb, ring16, n_bins))
-        return orig(bins, cx, cy, wb, hb, ring16, n_bins)
+        return orig(bins, cx, cy, wb, hb, ring16, n_bins, *more)
 
     tv2.ms_bg_model = rec
     try:

@@ -80,9 +80,9 @@ def tracker_case(name: str, frame: np.ndarray, box, max_window: int | None = Non
     ds: list[int] = []
     orig = tv2.ms_bg_model
 
-    def rec(bins, cx, cy, wb, hb, ring16, n_bins):
+    def rec(bins, cx, cy, wb, hb, ring16, n_bins, *more):  # more: the model's optional widths (defaults: core v2's)
         calls.append((bins.copy(), cx, cy, wb, hb, ring16, n_bins))
-        return orig(bins, cx, cy, wb, hb, ring16, n_bins)
+        return orig(bins, cx, cy, wb, hb, ring16, n_bins, *more)
 
     tv2.ms_bg_model = rec
     try:

@@ -351,8 +351,8 @@ def real_calls(segments) -> list[dict]:
     orig = tv2.ms_meanshift
     where = [""]
 
-    def rec(sub, Qw, start8, reg, ker, tp, fx, n_bins, shift_q, trace=False):
-        r = orig(sub, Qw, start8, reg, ker, tp, fx, n_bins, shift_q, trace)
+    def rec(sub, Qw, start8, reg, ker, tp, fx, n_bins, shift_q, trace=False, **more):  # more: q_frac (0: core v2's)
+        r = orig(sub, Qw, start8, reg, ker, tp, fx, n_bins, shift_q, trace, **more)
         out.append({"sub": np.asarray(sub).copy(), "Qw": np.asarray(Qw).copy(), "start8": tuple(int(v) for v in start8),
                     "reg": reg, "ker": ker, "max_iter": tp.max_iter, "n_bins": n_bins, "shift_q": shift_q,
                     "c8": tuple(int(v) for v in r.c8), "S": int(r.S), "iter": int(r.iterations), "stop": r.stop,

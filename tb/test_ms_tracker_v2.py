@@ -118,8 +118,8 @@ def scale_test_trace(frames: list, box: tuple[int, int, int, int],
     gates: list[bool] = []
     test0, gate0 = tv2.ms_scale_test, tv2.ms_scale_gate
 
-    def test(rho, lo, hi):
-        v = test0(rho, lo, hi)
+    def test(rho, lo, hi, *more):  # more: the test's margin (0: core v2's)
+        v = test0(rho, lo, hi, *more)
         tests.append((lo is not None, hi is not None, v))
         return v
 

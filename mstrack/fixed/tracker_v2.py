@@ -304,7 +304,7 @@ class FixedTrackerV2:
         p, fx = self.params, self.fixed
         cf = fx.centre_frac
         d0 = ms_decimation(self.w8, self.h8, self.pad16, p.max_window)
-        d = ms_lost_decimation(d0, self.lost_n, p.search_widen)
+        d = ms_lost_decimation(d0, max(self.lost_n, int(self.lost)), p.search_widen)  # lost: at least one lost frame
         reach = d // (2 * d0) if self.lost else 1  # the widened search (search_widen; 1 without it)
         sh = d.bit_length() - 1
         img = frame[::d, ::d]

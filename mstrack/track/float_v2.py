@@ -1010,7 +1010,7 @@ class FloatTrackerV2:
         w, h = self._size
         # lost: the whole search runs at twice the decimation (a region 2x wider in the same memory)
         d0 = self.decimation(w, h)
-        d = lost_decimation(d0, self._lost_n, p)
+        d = lost_decimation(d0, max(self._lost_n, int(self._lost)), p)  # lost: at least one lost frame
         reach = d // (2 * d0) if self._lost else 1  # the widened search: its start points reach as far x reach
         pad = 1.0 + p.pad
         hx, hy = pad * w / 2.0 / d, pad * h / 2.0 / d

@@ -4,7 +4,8 @@
   work period of its authors (``WORD`` below, matched case-insensitively, also inside other words):
   history goes to commit messages and the changelog's versions, not to files.
 * README.md and docs/ (the prose pages) name no issue number, "(issue N" or "issue N", and no
-  "helper": each page says what is true now, in the project's own terms.
+  assistant of its authors (``ASSISTANT`` below): each page says what is true now, in the
+  project's own terms.
 * Every ``tools/...`` or ``studies/...`` script that a tracked text file names exists, so the
   commands the docs give can be run (tools/ holds the tools the build uses; studies/ the scripts
   that regenerate a docs table, studies/README.md).
@@ -23,13 +24,15 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 #: the forbidden word, assembled so that this file does not contain it
 WORD = "ses" + "sion"
-#: prose pages checked for issue numbers and "helper"
+#: the word for an assistant of the authors, assembled so that this file does not contain it
+ASSISTANT = "hel" + "per"
+#: prose pages checked for issue numbers and ASSISTANT
 PROSE_GLOBS = ("README.md", "docs/*.md", "docs/blocks/*.md")
 #: text files whose script references must resolve
 TEXT_SUFFIXES = {".md", ".py", ".toml", ".txt", ".sh", ".vhd", ".core", ".yml", ".yaml", ""}
 SCRIPT_REF = re.compile(r"(?<![\w./-])((?:tools|studies)/[\w./-]*\w\.(?:py|sh))\b")
 ISSUE_REF = re.compile(r"\(issue\b|\bissues?\s+\d", re.IGNORECASE)
-HELPER = re.compile(r"helper", re.IGNORECASE)
+ASSISTANT_REF = re.compile(ASSISTANT, re.IGNORECASE)
 
 
 def tracked_files() -> list[Path]:
@@ -58,16 +61,16 @@ def test_no_tracked_file_names_a_work_period():
                      f"goes to commit messages): " + "; ".join(f"{p}: {h}" for p, h in sorted(bad.items())))
 
 
-def test_prose_names_no_issue_numbers_or_helpers():
+def test_prose_names_no_issue_numbers_or_assistants():
     files = sorted({p for g in PROSE_GLOBS for p in REPO.glob(g)})
     assert files, "no README.md or docs/*.md found"
     bad = {}
     for path in files:
         text = path.read_text()
-        hits = _hits(ISSUE_REF, text) + _hits(HELPER, text)
+        hits = _hits(ISSUE_REF, text) + _hits(ASSISTANT_REF, text)
         if hits:
             bad[str(path.relative_to(REPO))] = hits[:3]
-    assert not bad, "issue numbers or 'helper' in the docs: " + "; ".join(
+    assert not bad, f"issue numbers or '{ASSISTANT}' in the docs: " + "; ".join(
         f"{p}: {h}" for p, h in sorted(bad.items()))
 
 
@@ -91,7 +94,7 @@ def test_patterns_catch_what_they_should():
     """The checks themselves: each pattern matches its example and leaves the legitimate uses."""
     assert ISSUE_REF.search("done (issue 11)") and ISSUE_REF.search("Issue 10's target")
     assert not ISSUE_REF.search("GHDL issue #2041") and not ISSUE_REF.search("issue + division")
-    assert HELPER.search("a Helper run")
+    assert ASSISTANT_REF.search(f"a {ASSISTANT.title()} run")
     assert SCRIPT_REF.findall("run `python studies/v2_mean.py --md`, then tools/setup.sh") == [
         "studies/v2_mean.py", "tools/setup.sh"]
     assert SCRIPT_REF.findall("mstrack/tools/x.py") == []

@@ -67,7 +67,8 @@ def test_parameter_representation():
 
 
 # ----------------------------------------------------------------------------- model
-def _bg_model_exact(bins, cx, cy, wb, hb, ring16, n_bins):
+def _bg_model_exact(bins, cx, cy, wb, hb, ring16, n_bins, bf=8):
+    """ms_bg_model by its definition in exact fractions (bf: the CBWH factors' fraction bits, bg_frac)."""
     ker = ms_kernel(wb, hb, "flat", 8)
     ex, ey = ker.ex, ker.ey
     Q = [0] * n_bins
@@ -84,7 +85,7 @@ def _bg_model_exact(bins, cx, cy, wb, hb, ring16, n_bins):
                 O[bins[y, x]] += 1
     nq, no = sum(Q), sum(O)
     omin = min(o for o in O if o > 0)
-    v = [min(floor_frac(Fraction(omin * 256, o)), 256) if o else 256 for o in O]
+    v = [min(floor_frac(Fraction(omin << bf, o)), 1 << bf) if o else 1 << bf for o in O]
     tot = sum(q * vv for q, vv in zip(Q, v))
     Qn = [floor_frac(Fraction(q * vv * ONE, tot)) for q, vv in zip(Q, v)]
     T = [int(Fraction(q, nq) > Fraction(o, no)) for q, o in zip(Q, O)]

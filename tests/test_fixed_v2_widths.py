@@ -17,6 +17,7 @@ from mstrack import Tracker
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import Hist, ms_bin_pass, ms_kernel
 from mstrack.fixed.blocks_v2 import ONE, ms_bg_model, ms_model_scale
+from test_fixed_v2 import _bg_model_exact  # the exact definition, bg_frac as a parameter
 
 
 def _isqrt_frac(x: Fraction) -> int:
@@ -24,27 +25,6 @@ def _isqrt_frac(x: Fraction) -> int:
     s = math.isqrt(math.floor(x))
     assert s * s <= x < (s + 1) ** 2
     return s
-
-
-def _bg_model_exact(bins, cx, cy, wb, hb, ring16, n_bins, bf):
-    ker = ms_kernel(wb, hb, "flat", 8)
-    ex, ey = ker.ex, ker.ey
-    Q = [0] * n_bins
-    for dy in range(-ey, ey + 1):
-        for dx in range(-ex, ex + 1):
-            if Fraction(2 * dx, wb) ** 2 + Fraction(2 * dy, hb) ** 2 < 1:
-                Q[bins[cy + dy, cx + dx]] += 1
-    gx, gy = ring16 * wb // 16, ring16 * hb // 16
-    H, W = bins.shape
-    O = [0] * n_bins
-    for y in range(max(0, cy - ey - gy), min(H - 1, cy + ey + gy) + 1):
-        for x in range(max(0, cx - ex - gx), min(W - 1, cx + ex + gx) + 1):
-            if abs(x - cx) > ex or abs(y - cy) > ey:
-                O[bins[y, x]] += 1
-    omin = min(o for o in O if o > 0)
-    v = [min(math.floor(Fraction(omin << bf, o)), 1 << bf) if o else 1 << bf for o in O]
-    tot = sum(q * vv for q, vv in zip(Q, v))
-    return [math.floor(Fraction(q * vv * ONE, tot)) for q, vv in zip(Q, v)]
 
 
 @pytest.mark.parametrize("bf", [8, 12, 16, 24])
@@ -58,7 +38,7 @@ def test_bg_model_bg_frac_against_exact_definition(seed, bf):
     wb, hb = int(rng.integers(9, 30)), int(rng.integers(9, 25))
     cx, cy = 40, 30
     m = ms_bg_model(bins, cx, cy, wb, hb, 10, n_bins, bf)
-    assert m.Qn.tolist() == _bg_model_exact(bins, cx, cy, wb, hb, 10, n_bins, bf)
+    assert m.Qn.tolist() == _bg_model_exact(bins, cx, cy, wb, hb, 10, n_bins, bf)[2]
     if bf == 8:  # the default is the block's default
         assert m.Qn.tolist() == ms_bg_model(bins, cx, cy, wb, hb, 10, n_bins).Qn.tolist()
 

@@ -358,11 +358,16 @@ def load_dataset(path: str | Path, names: list[str] | None = None, strict: bool 
         seqs = [load_sequence(p, strict=strict) for p in sorted(d.iterdir()) if _is_sequence_dir(p)]
     if not seqs:
         raise DataError("no sequence folders (with groundtruth_rect.txt / groundtruth.txt)", d)
+    return unique_names(seqs, d)
+
+
+def unique_names(seqs: list[Any], root: Path) -> list[Any]:
+    """``seqs`` (sequences with ``name`` and ``path``) unchanged, or DataError if two share a name."""
     seen: dict[str, Path] = {}
     for s in seqs:
         if s.name in seen:
             raise DataError(f"two sequences named {s.name!r} ({seen[s.name].name}/ and {s.path.name}/; "
-                            "see their meta.json 'name')", d)
+                            "see their meta.json 'name')", root)
         seen[s.name] = s.path
     return seqs
 

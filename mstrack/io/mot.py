@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..track.types import Box
-from .data import DataError, DataWarning, FrameFiles, _find_image_dir, _meta_name, _meta_number, list_images
+from .data import DataError, DataWarning, FrameFiles, _find_image_dir, unique_names, _meta_name, _meta_number, list_images
 
 MOT_GT = "gt.txt"
 
@@ -225,13 +225,7 @@ def load_mot_dataset(path: str | Path, names: list[str] | None = None, strict: b
         seqs = [load_mot_sequence(d / n, strict) for n in avail]
     if not seqs:
         raise DataError(f"no MOT sequence folders (with {MOT_GT})", d)
-    seen: dict[str, Path] = {}
-    for s in seqs:
-        if s.name in seen:
-            raise DataError(f"two sequences named {s.name!r} ({seen[s.name].name}/ and {s.path.name}/; "
-                            "see their meta.json 'name')", d)
-        seen[s.name] = s.path
-    return seqs
+    return unique_names(seqs, d)
 
 
 def write_mot_gt(path: str | Path, rows: np.ndarray | list, base: int = 1) -> Path:

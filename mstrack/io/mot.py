@@ -26,7 +26,8 @@ from typing import Any
 import numpy as np
 
 from ..track.types import Box
-from .data import DataError, DataWarning, FrameFiles, _find_image_dir, unique_names, _meta_name, _meta_number, list_images
+from .data import (DataError, DataWarning, FrameFiles, _find_image_dir, _meta_name, _meta_number, list_images,
+                   unique_names)
 
 MOT_GT = "gt.txt"
 

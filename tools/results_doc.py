@@ -215,7 +215,10 @@ def sets_section(dev_root: Path, val_root: Path) -> list[str]:
                 "| model | in sample: thresholds, recall / false alarms | leave one sequence out: recall / false alarms |",
                 "|---|---|---|"]
         for m, r in j["loss"].items():
-            out.append(f"| {m} | {r['in_sample']} | {r['loso']} |")
+            if isinstance(r["in_sample"], dict):  # one rule for both models: a row per model
+                out += [f"| {m}: {k} | {r['in_sample'][k]} | {r['loso'][k]} |" for k in r["in_sample"]]
+            else:
+                out.append(f"| {m} | {r['in_sample']} | {r['loso']} |")
         out.append("")
     del labels
     return out

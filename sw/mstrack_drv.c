@@ -1,8 +1,16 @@
 /* mstrack_drv: bare-metal driver of the mstrack tracking core (see mstrack_drv.h). */
 #include "mstrack_drv.h"
 
-/* one aligned 32-bit access at the offset of a register of the generated map */
-#define REG(dev, NAME) (*(volatile uint32_t *)((dev)->base + offsetof(ms_tracker_regs_t, NAME)))
+/* one aligned 32-bit access at the offset of a register of the generated map: a volatile load or
+ * store, or with MSTRACK_IO_EXTERN the platform's mstrack_io_read32 / mstrack_io_write32 */
+#define ADDR(dev, NAME) ((dev)->base + offsetof(ms_tracker_regs_t, NAME))
+#ifdef MSTRACK_IO_EXTERN
+#define RD(dev, NAME) mstrack_io_read32(ADDR(dev, NAME))
+#define WR(dev, NAME, v) mstrack_io_write32(ADDR(dev, NAME), (v))
+#else
+#define RD(dev, NAME) (*(volatile uint32_t *)ADDR(dev, NAME))
+#define WR(dev, NAME, v) (*(volatile uint32_t *)ADDR(dev, NAME) = (v))
+#endif
 /* field of a register value, with the generated mask / position */
 #define FIELD(v, REGNAME, FNAME) \
     (((v) & MS_TRACKER_REGS__##REGNAME##__##FNAME##_bm) >> MS_TRACKER_REGS__##REGNAME##__##FNAME##_bp)
@@ -29,23 +37,23 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
     dev->result_version = 0;
     dev->last.valid = 0;
     dev->last_v2.valid = 0;
-    if (REG(dev, ID) != MSTRACK_MAGIC) {
+    if (RD(dev, ID) != MSTRACK_MAGIC) {
         return MSTRACK_ERR_ID;
     }
-    v = REG(dev, VERSION);
+    v = RD(dev, VERSION);
     if (FIELD(v, VERSION, MAP_MAJOR) != MSTRACK_MAP_MAJOR || FIELD(v, VERSION, RESULT_VERSION) < 1u ||
         FIELD(v, VERSION, RESULT_VERSION) > 2u) {
         return MSTRACK_ERR_VERSION;
     }
     dev->result_version = FIELD(v, VERSION, RESULT_VERSION);
-    if (width < 3u || height < 3u || width > FIELD(REG(dev, FORMAT), FORMAT, MAX_FRAME_W) || height > 0xFFFFu) {
+    if (width < 3u || height < 3u || width > FIELD(RD(dev, FORMAT), FORMAT, MAX_FRAME_W) || height > 0xFFFFu) {
         return MSTRACK_ERR_ARG;
     }
-    REG(dev, CTRL) = 0;                                    /* frames dropped from the next start */
-    REG(dev, INT_ENABLE) = 0;
-    REG(dev, INT_STATUS) = MSTRACK_IRQ_ALL;                /* W1C */
-    REG(dev, CMD) = PUT(CMD, CLEAR_COUNTERS, 1u);
-    REG(dev, FRAME_SIZE) = PUT(FRAME_SIZE, WIDTH, width) | PUT(FRAME_SIZE, HEIGHT, height);
+    WR(dev, CTRL, 0);                                      /* frames dropped from the next start */
+    WR(dev, INT_ENABLE, 0);
+    WR(dev, INT_STATUS, MSTRACK_IRQ_ALL);                  /* W1C */
+    WR(dev, CMD, PUT(CMD, CLEAR_COUNTERS, 1u));
+    WR(dev, FRAME_SIZE, PUT(FRAME_SIZE, WIDTH, width) | PUT(FRAME_SIZE, HEIGHT, height));
     return MSTRACK_OK;
 }
 
@@ -54,19 +62,19 @@ int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t
     if (x < -32768 || x > 32767 || y < -32768 || y > 32767 || w > 0xFFFFu || h > 0xFFFFu) {
         return MSTRACK_ERR_ARG;
     }
-    REG(dev, INIT_POS) = PUT(INIT_POS, X, (uint32_t)x & 0xFFFFu) | PUT(INIT_POS, Y, (uint32_t)y & 0xFFFFu);
-    REG(dev, INIT_SIZE) = PUT(INIT_SIZE, WIDTH, w) | PUT(INIT_SIZE, HEIGHT, h);
-    REG(dev, CMD) = PUT(CMD, INIT, 1u);                    /* box copied now, taken between frames */
+    WR(dev, INIT_POS, PUT(INIT_POS, X, (uint32_t)x & 0xFFFFu) | PUT(INIT_POS, Y, (uint32_t)y & 0xFFFFu));
+    WR(dev, INIT_SIZE, PUT(INIT_SIZE, WIDTH, w) | PUT(INIT_SIZE, HEIGHT, h));
+    WR(dev, CMD, PUT(CMD, INIT, 1u));                      /* box copied now, taken between frames */
     dev->irq_mask = irq_mask & MSTRACK_IRQ_ALL;
-    REG(dev, INT_ENABLE) = dev->irq_mask;
-    REG(dev, CTRL) = PUT(CTRL, ENABLE, 1u);
+    WR(dev, INT_ENABLE, dev->irq_mask);
+    WR(dev, CTRL, PUT(CTRL, ENABLE, 1u));
     return MSTRACK_OK;
 }
 
 void mstrack_stop(mstrack_dev_t *dev)
 {
-    REG(dev, CTRL) = 0;
-    REG(dev, INT_ENABLE) = 0;
+    WR(dev, CTRL, 0);
+    WR(dev, INT_ENABLE, 0);
     dev->irq_mask = 0;
 }
 
@@ -74,28 +82,28 @@ void mstrack_stop(mstrack_dev_t *dev)
  * both result words have; the macro fills them in either result struct. */
 #define READ_HEAD(dev, r, v)                                  \
     do {                                                      \
-        (v) = REG(dev, RES_HEAD);                             \
+        (v) = RD(dev, RES_HEAD);                              \
         (r)->valid = FIELD(v, RES_HEAD, VALID);               \
         (r)->frame_count = FIELD(v, RES_HEAD, FRAME_COUNT);   \
         (r)->flags = FIELD(v, RES_HEAD, FLAGS);               \
         (r)->err_code = FIELD(v, RES_HEAD, ERR_CODE);         \
-        (r)->cx = REG(dev, RES_CX);                           \
-        (r)->cy = REG(dev, RES_CY);                           \
+        (r)->cx = RD(dev, RES_CX);                            \
+        (r)->cy = RD(dev, RES_CY);                            \
     } while (0)
 
 int mstrack_read_result(const mstrack_dev_t *dev, mstrack_result_t *r)
 {
     uint32_t v;
     READ_HEAD(dev, r, v);
-    r->rho_c = REG(dev, RES_RHO_C);
-    r->rho_e = REG(dev, RES_RHO_E);
-    r->alpha_c = REG(dev, RES_ALPHA);
-    v = REG(dev, RES_ITER);
+    r->rho_c = RD(dev, RES_RHO_C);
+    r->rho_e = RD(dev, RES_RHO_E);
+    r->alpha_c = RD(dev, RES_ALPHA);
+    v = RD(dev, RES_ITER);
     r->iter_c = FIELD(v, RES_ITER, ITER_C);
     r->iter_e = FIELD(v, RES_ITER, ITER_E);
     r->stop_c = FIELD(v, RES_ITER, STOP_C);
     r->stop_e = FIELD(v, RES_ITER, STOP_E);
-    v = REG(dev, RES_BOX);
+    v = RD(dev, RES_BOX);
     r->box_w = FIELD(v, RES_BOX, BOX_W);
     r->box_h = FIELD(v, RES_BOX, BOX_H);
     return r->valid ? MSTRACK_OK : MSTRACK_NO_RESULT;
@@ -105,11 +113,11 @@ int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r)
 {
     uint32_t v;
     READ_HEAD(dev, r, v);
-    r->rho = REG(dev, RES_RHO_C);
-    r->w8 = REG(dev, RES_W8);
-    r->h8 = REG(dev, RES_H8);
-    r->confidence = REG(dev, RES_CONF);
-    v = REG(dev, RES_STATE);
+    r->rho = RD(dev, RES_RHO_C);
+    r->w8 = RD(dev, RES_W8);
+    r->h8 = RD(dev, RES_H8);
+    r->confidence = RD(dev, RES_CONF);
+    v = RD(dev, RES_STATE);
     r->status = FIELD(v, RES_STATE, STATUS);
     r->iter = FIELD(v, RES_STATE, ITER);
     r->stop = FIELD(v, RES_STATE, STOP);
@@ -120,11 +128,11 @@ int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r)
 
 void mstrack_read_raw(const mstrack_dev_t *dev, uint32_t words[5])
 {
-    words[0] = REG(dev, RES_RAW0);
-    words[1] = REG(dev, RES_RAW1);
-    words[2] = REG(dev, RES_RAW2);
-    words[3] = REG(dev, RES_RAW3);
-    words[4] = REG(dev, RES_RAW4);
+    words[0] = RD(dev, RES_RAW0);
+    words[1] = RD(dev, RES_RAW1);
+    words[2] = RD(dev, RES_RAW2);
+    words[3] = RD(dev, RES_RAW3);
+    words[4] = RD(dev, RES_RAW4);
 }
 
 void mstrack_decode_word(const uint32_t *words, mstrack_result_t *r)
@@ -167,7 +175,7 @@ void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r)
 
 uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
 {
-    uint32_t st = REG(dev, INT_STATUS) & MSTRACK_IRQ_ALL;
+    uint32_t st = RD(dev, INT_STATUS) & MSTRACK_IRQ_ALL;
     if (st == 0u) {
         return 0u;
     }
@@ -198,20 +206,20 @@ uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
             *r = dev->last;
         }
     }
-    REG(dev, INT_STATUS) = st;                             /* W1C: exactly the bits handled */
+    WR(dev, INT_STATUS, st);                               /* W1C: exactly the bits handled */
     return st;
 }
 
 void mstrack_read_counters(const mstrack_dev_t *dev, mstrack_counters_t *c)
 {
-    c->results = REG(dev, RESULT_COUNT);
-    c->lost = REG(dev, LOST_COUNT);
-    c->errors = REG(dev, ERROR_COUNT);
-    c->rejected = REG(dev, REJECT_COUNT);
-    c->dropped = REG(dev, DROP_COUNT);
+    c->results = RD(dev, RESULT_COUNT);
+    c->lost = RD(dev, LOST_COUNT);
+    c->errors = RD(dev, ERROR_COUNT);
+    c->rejected = RD(dev, REJECT_COUNT);
+    c->dropped = RD(dev, DROP_COUNT);
 }
 
 void mstrack_clear_counters(const mstrack_dev_t *dev)
 {
-    REG(dev, CMD) = PUT(CMD, CLEAR_COUNTERS, 1u);
+    WR(dev, CMD, PUT(CMD, CLEAR_COUNTERS, 1u));
 }

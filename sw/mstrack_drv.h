@@ -8,7 +8,10 @@
  * C99, no allocation, no libc beyond
  * <stdint.h> / <stddef.h>.  Every register access is one aligned 32-bit volatile load or store
  * (never through the generated packed struct, which a compiler may split into byte accesses:
- * RES_HEAD has a read side effect).
+ * RES_HEAD has a read side effect).  Compiled with -DMSTRACK_IO_EXTERN, every access goes through
+ * mstrack_io_read32 / mstrack_io_write32 instead, which the platform provides (a bus bridge, a
+ * Linux UIO mapping, or the co-simulation harness tools/hdl/drv_main.cpp, whose accesses are
+ * AXI4-Lite transactions on the simulated core).
  *
  * Typical use (docs/integration.md):
  *     mstrack_dev_t dev;
@@ -27,6 +30,12 @@
 
 #ifdef __cplusplus
 extern "C" {
+#endif
+
+#ifdef MSTRACK_IO_EXTERN
+/* one aligned 32-bit register read / write at byte address addr (base + offset) */
+uint32_t mstrack_io_read32(uintptr_t addr);
+void mstrack_io_write32(uintptr_t addr, uint32_t value);
 #endif
 
 #define MSTRACK_MAGIC 0x4D53544Bu          /* ID register ("MSTK") */

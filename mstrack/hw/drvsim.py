@@ -1,0 +1,231 @@
+"""The C driver against the RTL: ``sw/mstrack_drv.c`` driving ``ms_tracker_axi`` under Verilator.
+
+The GHDL netlist of ``ms_tracker_axi`` (generics baked in) is verilated and linked with
+``tools/hdl/drv_main.cpp`` and the driver compiled with ``-DMSTRACK_IO_EXTERN``: every register access
+of the driver is one AXI4-Lite transaction on the simulated core, clocked with the video, which does
+not wait for the CPU.  The harness calls ``mstrack_init`` and ``mstrack_start``, streams the frames,
+runs ``mstrack_irq_handler`` whenever ``irq`` is high, records each result as the driver decoded it
+and its raw word, and ends with ``mstrack_read_counters`` and ``mstrack_stop``
+(docs/integration.md, "The driver against the RTL").
+
+Usage::
+
+    from mstrack.hw import drvsim
+    from mstrack.hw.cosim import expected_results_v2
+
+    run = drvsim.simulate_driver(frames, box)
+    assert not drvsim.check_run(run, expected_results_v2(frames, box))
+"""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from . import fastsim, hdl
+from .cosim import COMPARED_FIELDS, COMPARED_FIELDS_V2, CoreConfig, CoreConfigV2, diff_fields
+from ..fixed import FixedParams
+from ..fixed.vhdl_pkg import RESULT_FLAGS, STATUS_V2, unpack_result, unpack_result_v2
+from ..track.params import TrackerParams
+
+DRV_CPP = hdl.TOOLS_HDL_DIR / "drv_main.cpp"
+SW_DIR = hdl.REPO_ROOT / "sw"
+TOP = "ms_tracker_axi"
+
+FLAG = {f: 1 << i for i, f in enumerate(RESULT_FLAGS)}
+STATUS = {name: i for i, name in enumerate(STATUS_V2)}
+
+
+def irq_bits() -> dict[str, int]:
+    """The interrupt bits (INT_STATUS fields of regs/ms_tracker_regs.rdl: the driver's MSTRACK_IRQ_*)."""
+    from .regs import register_map
+    return {n: 1 << f.lsb for n, f in register_map()["INT_STATUS"].fields.items()}
+
+
+class DriverSimError(RuntimeError):
+    """The driver harness stopped early or could not run."""
+
+
+@dataclass
+class DriverRun:
+    """Outcome of one driver co-simulation.
+
+    ``results``: one dict per interrupt that carried a result, in order: ``word`` (the raw result
+    word read from RES_RAW0..4), ``fields`` (``word`` decoded by Python), ``driver`` (the fields the
+    driver read from the RES_* registers and decoded), ``irq`` (the INT_STATUS bits the handler saw and
+    cleared), ``irq_cycle`` / ``handled_cycle`` (clock at which the handler was entered / returned).
+    ``calls``: return codes of ``mstrack_init`` and ``mstrack_start``.  ``counters``: the driver's
+    ``mstrack_read_counters`` at the end.  ``other_irqs``: interrupts without a result bit.
+    """
+    results: list[dict] = field(default_factory=list)
+    calls: dict[str, int] = field(default_factory=dict)
+    counters: dict[str, int] = field(default_factory=dict)
+    other_irqs: list[tuple[int, int]] = field(default_factory=list)
+    bus_errors: int = 0
+    cycles: int = 0
+    seconds: float = 0.0
+    status: str = "missing"
+    detail: str = ""
+    build_seconds: float = 0.0
+
+    def handler_clocks(self) -> list[int]:
+        """Clocks from irq high to the handler's return, per result."""
+        return [r["handled_cycle"] - r["irq_cycle"] for r in self.results]
+
+
+def axi_generics(cfg: CoreConfig | CoreConfigV2) -> dict[str, int]:
+    """The generics of ms_tracker_axi for *cfg*: those of ms_tracker, results through the registers
+    only (RESULT_STREAM false, as a CPU-only integration builds it)."""
+    g: dict[str, int] = dict(cfg.tracker_generics() if isinstance(cfg, CoreConfigV2) else cfg.generics())
+    g["RESULT_STREAM"] = 0
+    return g
+
+
+def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False) -> tuple[Path, float]:
+    """Build (or find in the cache) the driver harness for *cfg*: (executable, seconds spent building)."""
+    import time
+    g = axi_generics(cfg)
+    vg = {k: (v != 0) if k == "RESULT_STREAM" else v for k, v in g.items()}
+    t0 = time.monotonic()
+    net_dir = fastsim.FASTSIM_DIR / f"netlist_{fastsim._generics_hash(g)}_{TOP}"
+    with fastsim._lock(net_dir.with_suffix(".lock")):
+        vfile = hdl.ghdl_to_verilog(TOP, vg, out_path=net_dir / f"{TOP}.v")
+    exe, built = fastsim.verilate(vfile.read_text(), g, TOP, [DRV_CPP, SW_DIR / "mstrack_drv.c"],
+                                  include_dirs=[SW_DIR], defines=["MSTRACK_IO_EXTERN"], exe_name="Vdrv",
+                                  verbose=verbose)
+    return exe, (time.monotonic() - t0) if built else 0.0
+
+
+def _parse(out: Path, g: dict[str, int], v2: bool) -> DriverRun:
+    run = DriverRun()
+    unpack = unpack_result_v2 if v2 else unpack_result
+    for line in out.read_text().splitlines():
+        p = line.split()
+        if not p:
+            continue
+        if p[0] == "D":
+            run.calls[p[1]] = int(p[2])
+        elif p[0] == "R":
+            word = int(p[2], 16)
+            drv = {k: int(v) for k, v in (kv.split("=", 1) for kv in p[6:])}
+            run.results.append({"word": word, "fields": unpack(word, g), "driver": drv, "irq": int(p[3]),
+                                "irq_cycle": int(p[4]), "handled_cycle": int(p[5])})
+        elif p[0] == "Q":
+            run.other_irqs.append((int(p[1]), int(p[2])))
+        elif p[0] == "C":
+            run.counters = dict(zip(("results", "lost", "errors", "rejected", "dropped"), map(int, p[1:6])))
+        elif p[0] == "B":
+            run.bus_errors = int(p[1])
+        elif p[0] == "E":
+            run.status, run.cycles, run.seconds, run.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
+    return run
+
+
+def simulate_driver(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: TrackerParams | None = None,
+                    fp: FixedParams | None = None, *, v2: bool = True, lanes: int | None = None,
+                    max_frame_w: int = 2048, hblank: int = 0, vblank: int = 0, io_gap: int = 0,
+                    irq_mask: int = 15, watchdog: int | None = None, tail: int = 200,
+                    workdir: Path | str | None = None, check: bool = True) -> DriverRun:
+    """Run the driver against ms_tracker_axi on *frames*, the init box *box* given by ``mstrack_start``.
+
+    v2: core v2 (PRESET 1, tracker v2 parameters, default), else the paper core.  hblank, vblank: video
+    blanking in clocks (:data:`mstrack.hw.fastsim.HD1080P60`); with none, the core back-pressures the
+    video while it tracks.  io_gap: idle clocks before each register access (a slower CPU).
+    irq_mask: the interrupts enabled (``MSTRACK_IRQ_*``, :func:`irq_bits`).  Raises :class:`DriverSimError` when the run
+    does not end with every result read (unless ``check`` is false).
+    """
+    from ..fixed.vhdl_pkg import DEFAULT_LANES
+    fp = fp or FixedParams()
+    lanes = lanes or DEFAULT_LANES
+    cfg: CoreConfig | CoreConfigV2
+    if v2:
+        cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp, lanes=lanes, max_frame_w=max_frame_w)
+    else:
+        cfg = CoreConfig(tp or TrackerParams(), fp, lanes=lanes, max_frame_w=max_frame_w)
+    g = cfg.generics()
+    exe, build_s = build_driver(cfg)
+    tmp = tempfile.TemporaryDirectory(prefix="drvsim_") if workdir is None else None
+    wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
+    wd.mkdir(parents=True, exist_ok=True)
+    try:
+        n, w, h = fastsim._write_pixels(frames, wd / "pixels.bin")
+        if w > max_frame_w:
+            raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
+        job = {"width": w, "height": h, "frames": n, "pixels": str(wd / "pixels.bin"),
+               "init_x": int(box[0]), "init_y": int(box[1]), "init_w": int(box[2]), "init_h": int(box[3]),
+               "irq_mask": irq_mask, "hblank": hblank, "vblank": vblank, "io_gap": io_gap, "results": n,
+               "tail": tail, "watchdog": watchdog if watchdog is not None else fastsim.default_watchdog(g)}
+        (wd / "job.txt").write_text("".join(f"{k} {v}\n" for k, v in job.items()))
+        import subprocess
+        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
+        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
+            raise DriverSimError(f"driver harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+        run = _parse(wd / "out.txt", g, v2)
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+    run.build_seconds = build_s
+    if check and run.status != "done":
+        raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
+                             f"{len(run.results)} results of {n})")
+    return run
+
+
+def check_run(run: DriverRun, expected: Sequence[dict[str, int]], v2: bool = True) -> list[str]:
+    """Everything the driver run must show for the model's *expected* results, one string per
+    difference (empty: the driver and the core agree with the model):
+
+    * ``mstrack_init`` and ``mstrack_start`` returned MSTRACK_OK, no bus error;
+    * one result interrupt per frame; the raw word's fields equal the model's, field by field;
+    * the driver's decoded fields (read from the RES_* registers) equal the raw word's;
+    * the interrupt bits: result always, lost / reacquired (v2) exactly on the model's lost /
+      reacquired results, error exactly when the model's result carries the error flag;
+    * the counters: results, lost, errors equal the model's counts, nothing rejected or dropped.
+    """
+    out = []
+    if run.calls != {"init": 0, "start": 0}:
+        out.append(f"driver calls returned {run.calls} (MSTRACK_OK = 0)")
+    if run.bus_errors:
+        out.append(f"{run.bus_errors} register accesses answered SLVERR")
+    fields = COMPARED_FIELDS_V2 if v2 else COMPARED_FIELDS
+    irq = irq_bits()
+    for i in range(max(len(run.results), len(expected))):
+        if i >= len(run.results):
+            out.append(f"frame {i}: no result read by the driver")
+            continue
+        if i >= len(expected):
+            out.append(f"frame {i}: extra result read by the driver")
+            continue
+        got, exp = run.results[i], expected[i]
+        d = diff_fields(got["fields"], exp, fields)
+        if d:
+            out.append(f"frame {i}: raw word: " + "; ".join(d))
+        drv = got["driver"]
+        bad = [f"{k}: driver={v} word={got['fields'][k]}" for k, v in drv.items()
+               if k != "valid" and got["fields"].get(k) != v]
+        if drv.get("valid") != 1:
+            bad.append(f"valid: driver={drv.get('valid')}")
+        if bad:
+            out.append(f"frame {i}: driver decode: " + "; ".join(bad))
+        want = irq["result"] | (irq["error"] if exp["flags"] & FLAG["error"] else 0)
+        if v2:
+            want |= irq["lost"] if exp["status"] == STATUS["lost"] else 0
+            want |= irq["reacquired"] if exp["status"] == STATUS["reacquired"] else 0
+        else:
+            want |= irq["lost"] if exp["flags"] & FLAG["lost"] else 0
+        if got["irq"] != want:
+            out.append(f"frame {i}: interrupt bits {got['irq']:#x}, expected {want:#x}")
+    if run.other_irqs:
+        out.append(f"interrupts without a result: {run.other_irqs[:5]}")
+    lost = sum(1 for e in expected if (e["status"] == STATUS["lost"] if v2 else e["flags"] & FLAG["lost"]))
+    errors = sum(1 for e in expected if e["flags"] & FLAG["error"])
+    want_c = {"results": len(expected), "lost": lost, "errors": errors, "rejected": 0, "dropped": 0}
+    if run.counters != want_c:
+        out.append(f"counters {run.counters}, expected {want_c}")
+    return out
+
+
+__all__ = ["DriverRun", "DriverSimError", "build_driver", "simulate_driver", "check_run", "axi_generics"]

@@ -315,5 +315,38 @@ def result_fields_v2(extra: dict[str, int], frame_count: int = 0) -> dict[str, i
             "frame_count": frame_count & ((1 << FRAME_COUNT_W) - 1)}
 
 
+# ----------------------------------------------------------------------------- result word of the multi-target core
+# One word per live target per frame: result word v2 (result_width_v2 bits) with the target's id
+# (its slot, 0 .. MAX_TARGETS - 1 <= 15) above it (docs/multi_target_core.md, "Ports and result
+# stream"; the executable model is mstrack.hw.cosim_multi.CoreModelMulti).
+TARGET_ID_W = 4
+
+
+def result_layout_multi(g: dict[str, int] | None = None) -> list[tuple[str, int, int]]:
+    """Fields of the multi-target core's result word, LSB first: :func:`result_layout_v2`, then
+    ``target_id`` (:data:`TARGET_ID_W` bits) at bit :func:`result_width_v2` (160 by default)."""
+    return [*result_layout_v2(g), ("target_id", result_width_v2(g), TARGET_ID_W)]
+
+
+def result_width_multi(g: dict[str, int] | None = None) -> int:
+    """Width of the multi-target core's result word: result word v2 + the id (164 by default)."""
+    return result_width_v2(g) + TARGET_ID_W
+
+
+def pack_result_multi(fields: dict[str, int], g: dict[str, int] | None = None) -> int:
+    """:func:`pack_result_v2` of the fields with ``target_id`` above them (ValueError when it does not fit)."""
+    tid = int(fields.get("target_id", 0))
+    if not 0 <= tid < 1 << TARGET_ID_W:
+        raise ValueError(f"target_id = {tid} does not fit in {TARGET_ID_W} bits")
+    word = pack_result_v2({k: v for k, v in fields.items() if k != "target_id"}, g)
+    return word | tid << result_width_v2(g)
+
+
+def unpack_result_multi(word: int, g: dict[str, int] | None = None) -> dict[str, int]:
+    """Split a word of the multi-target core: :func:`unpack_result_v2` and ``target_id``."""
+    w = result_width_v2(g)
+    return {**unpack_result_v2(word & ((1 << w) - 1), g), "target_id": (word >> w) & ((1 << TARGET_ID_W) - 1)}
+
+
 if __name__ == "__main__":
     print(write_formats_pkg(Path(sys.argv[1]) if len(sys.argv) > 1 else PKG_PATH))

@@ -1,0 +1,173 @@
+"""mstrack.hw.cosim_multi.CoreModelMulti, the stream-level model of the multi-target core
+(docs/multi_target_core.md, "Ports and result stream"), against what it is built from: core v2's
+model for one target, single fixed-point trackers for several, the capacity rule for refusals, and
+the multi-target result word's layout."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from mstrack.fixed import FixedParams
+from mstrack.fixed.blocks import round_box
+from mstrack.fixed.multi_capacity import ADD_FULL, ADD_OK, MultiCoreConfig
+from mstrack.fixed.vhdl_pkg import (RESULT_FLAGS, STATUS_V2, pack_result_multi, result_fields_v2,
+                                    result_layout_multi, result_width_multi, unpack_result_multi)
+from mstrack.hw.cosim import COMPARED_FIELDS_V2, ERR_SHORT_LINE, CoreModelV2, frame_words
+from mstrack.hw.cosim_multi import ADD_BOX, CoreModelMulti
+from mstrack.io.synthetic import make_multi_scene, make_scene
+from mstrack.track.params import TrackerParams
+from mstrack.track.tracker import Tracker
+
+TP, FP = TrackerParams(preset="v2"), FixedParams()
+FLAG = {f: 1 << i for i, f in enumerate(RESULT_FLAGS)}
+ERROR = STATUS_V2.index("error")
+
+
+def _beats(words: np.ndarray, fault: str | None = None) -> list[tuple[int, int, int]]:
+    """One frame's beats; short_line: row 5 three pixels short."""
+    h, w = words.shape
+    out = []
+    for y, row in enumerate(words):
+        px = [int(v) for v in row][: w - 3 if fault == "short_line" and y == 5 else w]
+        out += [(v, int(y == 0 and x == 0), int(x == len(px) - 1)) for x, v in enumerate(px)]
+    return out
+
+
+def _feed(m, words: np.ndarray, fault: str | None = None) -> None:
+    h, w = words.shape
+    for b in _beats(words, fault):
+        m.beat(*b, w, h)
+
+
+def _v2(word: dict[str, int]) -> dict[str, int]:
+    return {k: word[k] for k in COMPARED_FIELDS_V2}
+
+
+def test_result_word_layout() -> None:
+    """Result word v2 with the 4-bit id at bits 163..160; round trip; an id that does not fit raises."""
+    assert result_layout_multi()[-1] == ("target_id", 160, 4) and result_width_multi() == 164
+    f = {"cx": 1234, "cy": 99, "w8": 256 * 30, "h8": 256 * 40, "rho": 40000, "confidence": 65536, "status": 3,
+         "iter": 5, "stop": 1, "decim_log2": 2, "searched": 8, "flags": 5, "err_code": 0, "frame_count": 77,
+         "target_id": 13}
+    word = pack_result_multi(f)
+    assert word >> 160 == 13
+    assert {k: v for k, v in unpack_result_multi(word).items() if k in f} == f
+    with pytest.raises(ValueError, match="target_id"):
+        pack_result_multi({**f, "target_id": 16})
+
+
+def test_one_target_is_core_v2() -> None:
+    """One add and a stream with two faults after the init frame: every word equals core v2's result
+    (CoreModelV2), with id 0."""
+    frames, gt = make_scene(9, 48, 40, seed=19, target_size=(14, 12))
+    words = [frame_words(f) for f in frames]
+    box = round_box(*map(float, gt[0]))
+    m, v = CoreModelMulti(TP, FP, 64), CoreModelV2(TP, FP, 64)
+    m.add(box, 48, 40)
+    v.init(box, 48, 40)
+    for i, f in enumerate(words):
+        fault = {3: "short_line", 6: "short_line"}.get(i)
+        _feed(m, f, fault)
+        _feed(v, f, fault)
+    assert [len(f) for f in m.frames] == [1] * 9 and m.kinds == v.kinds
+    assert [_v2(w) for w in m.results] == [_v2(r) for r in v.results]
+    assert all(w["target_id"] == 0 for w in m.results)
+    assert m.results[3]["err_code"] == ERR_SHORT_LINE and m.results[3]["status"] == ERROR
+
+
+def _multi(n: int = 10, **kw):
+    frames, rows = make_multi_scene(n, 96, 80, n_targets=3, seed=3, **kw)
+    boxes = {(int(r[0]), int(r[1])): tuple(int(v) for v in r[2:6]) for r in rows}
+    return [frame_words(f) for f in frames], frames, boxes
+
+
+def _single(frames: np.ndarray, box, first: int, last: int) -> list[dict[str, int]]:
+    """A single fixed-point tracker v2 from frame ``first`` to ``last`` (inclusive): result word v2 fields."""
+    t = Tracker(model="fixed", params=TP)
+    out = [t.init(frames[first], box)]
+    out += [t.update(frames[i]) for i in range(first + 1, last + 1)]
+    return [result_fields_v2(r.extra) for r in out]
+
+
+def test_targets_added_and_removed_match_single_trackers() -> None:
+    """Targets 1, 2 added before frame 0, target 3 before frame 3, id 0 removed before frame 5 and its
+    slot given to target 1 again before frame 7: each frame's words are in id order, one per live target,
+    each equal to a single fixed-point tracker of that target from its add, the frame count the same."""
+    words, frames, boxes = _multi()
+    m = CoreModelMulti(TP, FP, 128)
+    cmds = {0: [("add", 1), ("add", 2)], 3: [("add", 3)], 5: [("remove", 0)], 7: [("add", 1)]}
+    for i, f in enumerate(words):
+        for op, arg in cmds.get(i, []):
+            m.add(boxes[(i, arg)], 96, 80) if op == "add" else m.remove(arg)
+        _feed(m, f)
+    ids = [[w["target_id"] for w in fr] for fr in m.frames]
+    assert ids == [[0, 1]] * 3 + [[0, 1, 2]] * 2 + [[1, 2]] * 2 + [[0, 1, 2]] * 3
+    assert [(a.frame, a.code, a.target_id) for a in m.adds] == [(0, ADD_OK, 0), (0, ADD_OK, 1), (3, ADD_OK, 2),
+                                                              (7, ADD_OK, 0)]
+    runs = {(0, 0): _single(frames, boxes[(0, 1)], 0, 4), (1, 0): _single(frames, boxes[(0, 2)], 0, 9),
+            (2, 3): _single(frames, boxes[(3, 3)], 3, 9), (0, 7): _single(frames, boxes[(7, 1)], 7, 9)}
+    for i, fr in enumerate(m.frames):
+        assert len({w["frame_count"] for w in fr}) == 1 and fr[0]["frame_count"] == i
+        for w in fr:
+            (tid, first), = [k for k in runs if k[0] == w["target_id"] and k[1] <= i
+                             and i - k[1] < len(runs[k])][-1:]
+            exp = runs[(tid, first)][i - first]
+            assert {k: w[k] for k in exp if k != "frame_count"} == {k: v for k, v in exp.items()
+                                                                    if k != "frame_count"}, (i, tid)
+
+
+def test_refused_adds() -> None:
+    """MAX_TARGETS 2: the third add is refused (ADD_FULL), a box outside the frame too (ADD_BOX); each sets
+    `rejected` on the first word of its frame and nothing else, and gets no id and no word."""
+    words, frames, boxes = _multi(4)
+    m = CoreModelMulti(TP, FP, 128, capacity=MultiCoreConfig(max_targets=2))
+    m.add(boxes[(0, 1)], 96, 80)
+    m.add(boxes[(0, 2)], 96, 80)
+    _feed(m, words[0])
+    m.add(boxes[(1, 3)], 96, 80)
+    _feed(m, words[1])
+    _feed(m, words[2])
+    m.remove(1)
+    m.add((500, 500, 20, 20), 96, 80)
+    _feed(m, words[3])
+    assert [(a.frame, a.code, a.target_id) for a in m.adds] == [(0, ADD_OK, 0), (0, ADD_OK, 1), (1, ADD_FULL, -1),
+                                                              (3, ADD_BOX, -1)]
+    rej = [[bool(w["flags"] & FLAG["rejected"]) for w in fr] for fr in m.frames]
+    assert rej == [[False, False], [True, False], [False, False], [True]]
+    assert [[w["target_id"] for w in fr] for fr in m.frames] == [[0, 1], [0, 1], [0, 1], [0]]
+
+
+def test_fault_gives_one_error_word_per_target() -> None:
+    """A short line on frame 3 with two targets: two error words (err_code, each target's centre and size),
+    and the next frames as if frame 3 had never come."""
+    words, frames, boxes = _multi(7)
+    ref = CoreModelMulti(TP, FP, 128)
+    m = CoreModelMulti(TP, FP, 128)
+    for model in (m, ref):
+        model.add(boxes[(0, 1)], 96, 80)
+        model.add(boxes[(0, 2)], 96, 80)
+    for i, f in enumerate(words):
+        _feed(m, f, "short_line" if i == 3 else None)
+        if i != 3:
+            _feed(ref, f)
+    bad = m.frames[3]
+    assert [(w["target_id"], w["status"], w["err_code"], w["flags"]) for w in bad] == \
+        [(0, ERROR, ERR_SHORT_LINE, FLAG["error"]), (1, ERROR, ERR_SHORT_LINE, FLAG["error"])]
+    for w, prev in zip(bad, m.frames[2]):
+        assert (w["cx"], w["cy"], w["w8"], w["h8"]) == (prev["cx"], prev["cy"], prev["w8"], prev["h8"])
+    strip = [[{k: v for k, v in w.items() if k != "frame_count"} for w in fr] for fr in m.frames[:3] + m.frames[4:]]
+    assert strip == [[{k: v for k, v in w.items() if k != "frame_count"} for w in fr] for fr in ref.frames]
+
+
+def test_no_live_target_gives_one_no_target_word() -> None:
+    """Before any add and after the last remove: one word per frame, id 0, flag no_target."""
+    words, frames, boxes = _multi(3)
+    m = CoreModelMulti(TP, FP, 128)
+    _feed(m, words[0])
+    m.add(boxes[(1, 1)], 96, 80)
+    _feed(m, words[1])
+    m.remove(0)
+    _feed(m, words[2])
+    assert [len(fr) for fr in m.frames] == [1, 1, 1] and m.kinds == ["no_target", "init", "no_target"]
+    for fr in (m.frames[0], m.frames[2]):
+        assert fr[0]["flags"] == FLAG["no_target"] and fr[0]["target_id"] == 0

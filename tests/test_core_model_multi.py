@@ -1,7 +1,7 @@
-"""mstrack.hw.cosim_multi.CoreModelMulti, the stream-level model of the multi-target core
+"""mstrack.hw.cosim_multi.CoreModelMulti, the stream-level model of the multi-target core ms_tracker_multi
 (docs/multi_target_core.md, "Ports and result stream"), against what it is built from: core v2's
-model for one target, single fixed-point trackers for several, the capacity rule for refusals, and
-the multi-target result word's layout."""
+model for one target, single fixed-point trackers for several, and the multi-target result word's
+layout; refusals, faults and frames without a live target."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,11 +9,10 @@ import pytest
 
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import round_box
-from mstrack.fixed.multi_capacity import ADD_FULL, ADD_OK, MultiCoreConfig
 from mstrack.fixed.vhdl_pkg import (RESULT_FLAGS, STATUS_V2, pack_result_multi, result_fields_v2,
                                     result_layout_multi, result_width_multi, unpack_result_multi)
 from mstrack.hw.cosim import COMPARED_FIELDS_V2, ERR_SHORT_LINE, CoreModelV2, frame_words
-from mstrack.hw.cosim_multi import ADD_BOX, CoreModelMulti
+from mstrack.hw.cosim_multi import CMD_BOX, CMD_OK, CMD_REFUSED, CoreModelMulti, Outcome
 from mstrack.io.synthetic import make_multi_scene, make_scene
 from mstrack.track.params import TrackerParams
 from mstrack.track.tracker import Tracker
@@ -56,23 +55,24 @@ def test_result_word_layout() -> None:
         pack_result_multi({**f, "target_id": 16})
 
 
-def test_one_target_is_core_v2() -> None:
-    """One add and a stream with two faults after the init frame: every word equals core v2's result
-    (CoreModelV2), with id 0."""
+@pytest.mark.parametrize("n", [1, 3])
+def test_one_target_is_core_v2(n) -> None:
+    """One add (before the first frame), a stream fault on the init frame and two after it: with 1 or 3
+    slots every word equals core v2's result (CoreModelV2), with id 0."""
     frames, gt = make_scene(9, 48, 40, seed=19, target_size=(14, 12))
     words = [frame_words(f) for f in frames]
     box = round_box(*map(float, gt[0]))
-    m, v = CoreModelMulti(TP, FP, 64), CoreModelV2(TP, FP, 64)
-    m.add(box, 48, 40)
+    m, v = CoreModelMulti(TP, FP, 64, max_targets=n), CoreModelV2(TP, FP, 64)
+    assert m.add(box, 48, 40) == 0
     v.init(box, 48, 40)
     for i, f in enumerate(words):
-        fault = {3: "short_line", 6: "short_line"}.get(i)
+        fault = {0: "short_line", 3: "short_line", 6: "short_line"}.get(i)
         _feed(m, f, fault)
         _feed(v, f, fault)
-    assert [len(f) for f in m.frames] == [1] * 9 and m.kinds == v.kinds
+    assert [len(f) for f in m.frames] == [1] * 9
     assert [_v2(w) for w in m.results] == [_v2(r) for r in v.results]
     assert all(w["target_id"] == 0 for w in m.results)
-    assert m.results[3]["err_code"] == ERR_SHORT_LINE and m.results[3]["status"] == ERROR
+    assert v.kinds[:2] == ["error:short_line", "init"] and m.results[3]["err_code"] == ERR_SHORT_LINE
 
 
 def _multi(n: int = 10, **kw):
@@ -90,11 +90,11 @@ def _single(frames: np.ndarray, box, first: int, last: int) -> list[dict[str, in
 
 
 def test_targets_added_and_removed_match_single_trackers() -> None:
-    """Targets 1, 2 added before frame 0, target 3 before frame 3, id 0 removed before frame 5 and its
-    slot given to target 1 again before frame 7: each frame's words are in id order, one per live target,
-    each equal to a single fixed-point tracker of that target from its add, the frame count the same."""
+    """Targets 1, 2 added before frame 0, target 3 before frame 3, slot 0 removed before frame 5 and given
+    to target 1 again before frame 7: each frame's words are in slot order, one per live target, each
+    equal to a single fixed-point tracker of that target from its add, the frame count the same."""
     words, frames, boxes = _multi()
-    m = CoreModelMulti(TP, FP, 128)
+    m = CoreModelMulti(TP, FP, 128, max_targets=3)
     cmds = {0: [("add", 1), ("add", 2)], 3: [("add", 3)], 5: [("remove", 0)], 7: [("add", 1)]}
     for i, f in enumerate(words):
         for op, arg in cmds.get(i, []):
@@ -102,8 +102,8 @@ def test_targets_added_and_removed_match_single_trackers() -> None:
         _feed(m, f)
     ids = [[w["target_id"] for w in fr] for fr in m.frames]
     assert ids == [[0, 1]] * 3 + [[0, 1, 2]] * 2 + [[1, 2]] * 2 + [[0, 1, 2]] * 3
-    assert [(a.frame, a.code, a.target_id) for a in m.adds] == [(0, ADD_OK, 0), (0, ADD_OK, 1), (3, ADD_OK, 2),
-                                                              (7, ADD_OK, 0)]
+    assert m.outcomes == [Outcome(CMD_OK, 0), Outcome(CMD_OK, 1), Outcome(CMD_OK, 2), Outcome(CMD_OK, 0),
+                          Outcome(CMD_OK, 0)]
     runs = {(0, 0): _single(frames, boxes[(0, 1)], 0, 4), (1, 0): _single(frames, boxes[(0, 2)], 0, 9),
             (2, 3): _single(frames, boxes[(3, 3)], 3, 9), (0, 7): _single(frames, boxes[(7, 1)], 7, 9)}
     for i, fr in enumerate(m.frames):
@@ -117,32 +117,35 @@ def test_targets_added_and_removed_match_single_trackers() -> None:
 
 
 def test_refused_adds() -> None:
-    """MAX_TARGETS 2: the third add is refused (ADD_FULL), a box outside the frame too (ADD_BOX); each sets
-    `rejected` on the first word of its frame and nothing else, and gets no id and no word."""
-    words, frames, boxes = _multi(4)
-    m = CoreModelMulti(TP, FP, 128, capacity=MultiCoreConfig(max_targets=2))
+    """Two slots: the third add is refused (full); a box outside the frame is taken by a slot whose engine
+    rejects it (box, the slot free again); each sets `rejected` on the first word of the next frame only,
+    and gets no word; a remove of a slot that is not live is refused."""
+    words, frames, boxes = _multi(5)
+    m = CoreModelMulti(TP, FP, 128, max_targets=2)
     m.add(boxes[(0, 1)], 96, 80)
     m.add(boxes[(0, 2)], 96, 80)
     _feed(m, words[0])
-    m.add(boxes[(1, 3)], 96, 80)
+    assert m.add(boxes[(1, 3)], 96, 80) is None
     _feed(m, words[1])
     _feed(m, words[2])
     m.remove(1)
-    m.add((500, 500, 20, 20), 96, 80)
+    assert m.add((500, 500, 20, 20), 96, 80) == 1 and m.live == [0, 1]
     _feed(m, words[3])
-    assert [(a.frame, a.code, a.target_id) for a in m.adds] == [(0, ADD_OK, 0), (0, ADD_OK, 1), (1, ADD_FULL, -1),
-                                                              (3, ADD_BOX, -1)]
+    assert m.live == [0] and not m.remove(1)
+    _feed(m, words[4])
+    assert m.outcomes == [Outcome(CMD_OK, 0), Outcome(CMD_OK, 1), Outcome(CMD_REFUSED, 0), Outcome(CMD_OK, 1),
+                          Outcome(CMD_OK, 1), Outcome(CMD_BOX, 1), Outcome(CMD_REFUSED, 1)]
     rej = [[bool(w["flags"] & FLAG["rejected"]) for w in fr] for fr in m.frames]
-    assert rej == [[False, False], [True, False], [False, False], [True]]
-    assert [[w["target_id"] for w in fr] for fr in m.frames] == [[0, 1], [0, 1], [0, 1], [0]]
+    assert rej == [[False, False], [True, False], [False, False], [True], [False]]
+    assert [[w["target_id"] for w in fr] for fr in m.frames] == [[0, 1], [0, 1], [0, 1], [0], [0]]
 
 
 def test_fault_gives_one_error_word_per_target() -> None:
     """A short line on frame 3 with two targets: two error words (err_code, each target's centre and size),
     and the next frames as if frame 3 had never come."""
     words, frames, boxes = _multi(7)
-    ref = CoreModelMulti(TP, FP, 128)
-    m = CoreModelMulti(TP, FP, 128)
+    ref = CoreModelMulti(TP, FP, 128, max_targets=3)
+    m = CoreModelMulti(TP, FP, 128, max_targets=3)
     for model in (m, ref):
         model.add(boxes[(0, 1)], 96, 80)
         model.add(boxes[(0, 2)], 96, 80)
@@ -160,14 +163,14 @@ def test_fault_gives_one_error_word_per_target() -> None:
 
 
 def test_no_live_target_gives_one_no_target_word() -> None:
-    """Before any add and after the last remove: one word per frame, id 0, flag no_target."""
+    """Before any add and after the last remove: one word per frame, slot 0's, flag no_target."""
     words, frames, boxes = _multi(3)
-    m = CoreModelMulti(TP, FP, 128)
+    m = CoreModelMulti(TP, FP, 128, max_targets=2)
     _feed(m, words[0])
     m.add(boxes[(1, 1)], 96, 80)
     _feed(m, words[1])
     m.remove(0)
     _feed(m, words[2])
-    assert [len(fr) for fr in m.frames] == [1, 1, 1] and m.kinds == ["no_target", "init", "no_target"]
+    assert [len(fr) for fr in m.frames] == [1, 1, 1] and m.results[1]["status"] == STATUS_V2.index("init")
     for fr in (m.frames[0], m.frames[2]):
         assert fr[0]["flags"] == FLAG["no_target"] and fr[0]["target_id"] == 0

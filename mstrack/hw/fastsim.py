@@ -384,6 +384,91 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
     return run
 
 
+MULTI_CPP = hdl.TOOLS_HDL_DIR / "multi_main.cpp"
+MULTI_TOP = "ms_tracker_multi"
+
+
+@dataclass
+class MultiRun:
+    """Outcome of one :func:`simulate_multi` run: ``words`` (field dicts of
+    :func:`mstrack.fixed.vhdl_pkg.unpack_result_multi` with ``last`` and ``cycle``), ``reports``
+    ((cmd_code, cmd_id) per cmd_done), ``taken`` ((frame, command index, cycle) per command taken)."""
+    words: list[dict] = field(default_factory=list)
+    reports: list[tuple[int, int]] = field(default_factory=list)
+    taken: list[tuple[int, int, int]] = field(default_factory=list)
+    cycles: int = 0
+    seconds: float = 0.0
+    status: str = "missing"
+    detail: str = ""
+    build_seconds: float = 0.0
+
+
+def build_multi(cfg: CoreConfigV2, max_targets: int, verbose: bool = False) -> tuple[Path, float]:
+    """Build (or find in the cache) the harness of ms_tracker_multi with *max_targets* core v2 engines."""
+    g = {"MAX_TARGETS": max_targets, **cfg.generics()}
+    t0 = time.monotonic()
+    net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}_{MULTI_TOP}"
+    with _lock(net_dir.with_suffix(".lock")):
+        vfile = hdl.ghdl_to_verilog(MULTI_TOP, g, out_path=net_dir / f"{MULTI_TOP}.v")
+    exe, built = verilate(vfile.read_text(), g, MULTI_TOP, [MULTI_CPP], exe_name="Vmulti", verbose=verbose)
+    return exe, (time.monotonic() - t0) if built else 0.0
+
+
+def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]], tp: TrackerParams | None = None,
+                   fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int = 4, max_frame_w: int = 2048,
+                   hblank: int = 0, vblank: int = 0, out_pause_pct: int = 0, seed: int = 1,
+                   words: int | None = None, watchdog: int = 4_000_000, workdir: Path | str | None = None,
+                   check: bool = True) -> MultiRun:
+    """Stream *frames* through the verilated ms_tracker_multi, with *commands* given before the frames
+    they are keyed by: ``{frame: [("add", (x, y, w, h)) | ("remove", id), ...]}`` (a key of len(frames):
+    after the last frame).  *words*: result words to wait for (default: one per frame at least).
+    Raise :class:`FastsimError` when the harness stops early (unless ``check`` is false)."""
+    from ..fixed.vhdl_pkg import unpack_result_multi
+    cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes, max_frame_w=max_frame_w)
+    g = cfg.generics()
+    exe, build_s = build_multi(cfg, max_targets)
+    tmp = tempfile.TemporaryDirectory(prefix="multisim_") if workdir is None else None
+    wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
+    wd.mkdir(parents=True, exist_ok=True)
+    cw = g["COORD_W"]
+    try:
+        n, w, h = _write_pixels(frames, wd / "pixels.bin")
+        lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", f"hblank {hblank}",
+                 f"vblank {vblank}", f"out_pause_pct {out_pause_pct}", f"seed {seed}",
+                 f"words {words if words is not None else n}", f"watchdog {watchdog}"]
+        for fr in sorted(commands):
+            for op, arg in commands[fr]:
+                if op == "add":
+                    x, y, bw, bh = (int(v) for v in arg)
+                    lines.append(f"cmd {fr} 0 0 {_mask(x, cw + 2)} {_mask(y, cw + 2)} {_mask(bw, cw + 1)} "
+                                 f"{_mask(bh, cw + 1)}")
+                elif op == "remove":
+                    lines.append(f"cmd {fr} 1 {int(arg) & 0xF} 0 0 0 0")
+                else:
+                    raise ValueError(f"command {op!r}: add or remove")
+        (wd / "job.txt").write_text("\n".join(lines) + "\n")
+        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
+        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
+            raise FastsimError(f"harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+        run = MultiRun(build_seconds=build_s)
+        for line in (wd / "out.txt").read_text().splitlines():
+            p = line.split()
+            if p[0] == "W":
+                run.words.append({**unpack_result_multi(int(p[2], 16), g), "last": int(p[3]), "cycle": int(p[4])})
+            elif p[0] == "K":
+                run.reports.append((int(p[1]), int(p[2])))
+            elif p[0] == "T":
+                run.taken.append((int(p[1]), int(p[2]), int(p[3])))
+            elif p[0] == "E":
+                run.status, run.cycles, run.seconds, run.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+    if check and run.status != "done":
+        raise FastsimError(f"multi harness stopped: {run.status} {run.detail}")
+    return run
+
+
 def run_fastsim(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: TrackerParams | None = None,
                 fp: FixedParams | None = None, lanes: int = 2, hblank: int = 0, vblank: int = 0,
                 **kw) -> list[dict]:
@@ -409,5 +494,5 @@ def compare(results: Sequence[dict], expected: Sequence[dict],
     return out
 
 
-__all__ = ["FastsimRun", "FastsimError", "HD1080P60", "VIDEO_MODES", "build", "simulate", "run_fastsim", "compare",
+__all__ = ["FastsimRun", "FastsimError", "MultiRun", "simulate_multi", "build_multi", "HD1080P60", "VIDEO_MODES", "build", "simulate", "run_fastsim", "compare",
            "default_watchdog"]

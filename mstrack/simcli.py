@@ -44,7 +44,7 @@ from .io.data import DataError, VideoSource
 from .fixed import FixedParams
 from .fixed.blocks import STOP_CODES, ms_box_clip, round_box
 from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, STATUS_V2, pack_result, pack_result_v2
-from .track.params import TrackerParams
+from .track.params import V2_COLOUR, TrackerParams
 from .track.types import Box, Status, box_from_centre_index
 
 #: Columns of results.csv.  ``frame``: index in VIDEO; x, y, w, h: the core's box (0-based
@@ -234,6 +234,25 @@ def check_frame_size(w: int, h: int, g: dict[str, int]) -> None:
         raise SimInputError(f"frames are {w}x{h}: smaller than the core's {MIN_FRAME}x{MIN_FRAME} minimum")
 
 
+def check_box(box: Box, size: tuple[int, int], cfg: CoreConfig | CoreConfigV2) -> tuple[int, int, int, int]:
+    """The integer box the init port takes for ``box`` on a ``size`` = (W, H) frame; SimInputError when
+    it is empty, does not fit the port or leaves less than 3 x 3 px inside the frame."""
+    if box.w <= 0 or box.h <= 0:
+        raise SimInputError(f"--box {box.as_tuple()}: width and height must be positive")
+    ib = round_box(*box.as_tuple())
+    cw = cfg.generics()["COORD_W"]
+    if not (-(1 << (cw + 1)) <= ib[0] < 1 << (cw + 1) and -(1 << (cw + 1)) <= ib[1] < 1 << (cw + 1)
+            and ib[2] < 1 << (cw + 1) and ib[3] < 1 << (cw + 1)):
+        raise SimInputError(f"--box {ib}: does not fit the core's init port (COORD_W = {cw})")
+    # core v2 clips the box to the frame without shrinking it (large targets are decimated), as
+    # FixedTrackerV2.init
+    clipped, _ = ms_box_clip(*ib, size[0], size[1], 4095 if isinstance(cfg, CoreConfigV2) else cfg.fp.max_half)
+    if clipped is None:
+        raise SimInputError(f"--box {ib} leaves less than 3x3 px inside the {size[0]}x{size[1]} frame "
+                            "(the core rejects it; 1-px border excluded)")
+    return ib
+
+
 def prepare(video: str | Path, box: Box | None, frame_range: tuple[int, int] | None, max_frames: int | None,
             cfg: CoreConfig | CoreConfigV2) -> SimJob:
     """Open ``video``, pick the frames and the init box and check them against the core.
@@ -273,20 +292,9 @@ def prepare(video: str | Path, box: Box | None, frame_range: tuple[int, int] | N
             box = Box.of(g0)
     if box is None:
         raise SimInputError("--box x,y,w,h is required unless VIDEO is a sequence folder with ground truth")
-    if box.w <= 0 or box.h <= 0:
-        raise SimInputError(f"--box {box.as_tuple()}: width and height must be positive")
-    ib = round_box(*box.as_tuple())
-    g = cfg.generics()
-    cw = g["COORD_W"]
-    if not (-(1 << (cw + 1)) <= ib[0] < 1 << (cw + 1) and -(1 << (cw + 1)) <= ib[1] < 1 << (cw + 1)
-            and ib[2] < 1 << (cw + 1) and ib[3] < 1 << (cw + 1)):
-        raise SimInputError(f"--box {ib}: does not fit the core's init port (COORD_W = {cw})")
-    # core v2 clips the box to the frame without shrinking it (large targets are decimated), as
-    # FixedTrackerV2.init
+    ib = check_box(box, size, cfg)
     clipped, _ = ms_box_clip(*ib, size[0], size[1], 4095 if isinstance(cfg, CoreConfigV2) else cfg.fp.max_half)
-    if clipped is None:
-        raise SimInputError(f"--box {ib} leaves less than 3x3 px inside the {size[0]}x{size[1]} frame "
-                            "(the core rejects it; 1-px border excluded)")
+    assert clipped is not None
     job = SimJob(src, first, count, ib, box, cfg, size, gt)
     note = init_box_note(box, Box(clipped.x, clipped.y, clipped.w, clipped.h), (size[1], size[0]))
     if note:
@@ -374,6 +382,84 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
     return rep
 
 
+#: Columns of results.csv of the multi-target core (several ``--box``): the slot id after the frame,
+#: then :data:`SIM_CSV_FIELDS_V2` (without latency: words follow one another per frame).
+SIM_CSV_FIELDS_MULTI = ("frame", "target_id", *[f for f in SIM_CSV_FIELDS_V2 if f not in ("frame", "latency")])
+
+
+def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path, slots: int,
+                  progress: bool = False, command: str = "") -> dict[str, Any]:
+    """Several targets: the boxes added before the first frame of the multi-target core
+    ``ms_tracker_multi`` (``slots`` core v2 engines, :func:`mstrack.hw.fastsim.simulate_multi`), every
+    word compared with :func:`mstrack.hw.cosim_multi.expected_multi`; writes results.csv
+    (:data:`SIM_CSV_FIELDS_MULTI`, one row per word), overlay.mp4 and bitexact.json to ``out``."""
+    from .hw import fastsim
+    from .hw.cosim_multi import expected_multi
+    from .io.data import open_video_writer
+    from .multicli import draw_multi_overlay
+
+    assert isinstance(job.cfg, CoreConfigV2)
+    cfg = job.cfg
+    g = {"MAX_TARGETS": slots, **cfg.generics()}
+    say = (lambda m: print(f"mstrack sim: {m}", file=sys.stderr, flush=True)) if progress else (lambda m: None)
+    frames = list(job.frames())
+    cmds: dict[int, list[tuple]] = {0: [("add", b) for b in boxes]}
+    say(f"running the fixed-point model of {slots} slots on {len(frames)} frames...")
+    t1 = time.monotonic()
+    m = expected_multi(frames, cmds, cfg.tp, cfg.fp, slots, cfg.max_frame_w)
+    t_model = time.monotonic() - t1
+    say(f"co-simulating ms_tracker_multi ({slots} engines; the first run of a generic set builds the Verilator "
+        "model, several minutes)...")
+    t0 = time.monotonic()
+    run = fastsim.simulate_multi(frames, cmds, cfg.tp, cfg.fp, max_targets=slots, lanes=cfg.lanes,
+                                 max_frame_w=cfg.max_frame_w, words=len(m.results), check=False)
+    t_sim = time.monotonic() - t0
+    keys = [*COMPARED_FIELDS_V2, "target_id"]
+    frame_of = [job.first + i for i, fr in enumerate(m.frames) for _ in fr]
+    mism: list[dict[str, Any]] = []
+    for i in range(max(len(run.words), len(m.results))):
+        if i >= len(run.words) or i >= len(m.results):
+            mism.append({"word": i, "frame": frame_of[i] if i < len(frame_of) else None,
+                         "fields": {"missing": "dut" if i >= len(run.words) else "model"}})
+            continue
+        d = {k: {"dut": run.words[i][k], "model": m.results[i][k]} for k in keys if run.words[i][k] != m.results[i][k]}
+        if d:
+            mism.append({"word": i, "frame": frame_of[i], "fields": d})
+    rows = [{**decode_row_v2(w, g, frame_of[i] if i < len(frame_of) else -1), "target_id": w["target_id"]}
+            for i, w in enumerate(run.words)]
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "results.csv", "w", newline="") as fh:
+        wr = csv.DictWriter(fh, fieldnames=SIM_CSV_FIELDS_MULTI, extrasaction="ignore")
+        wr.writeheader()
+        wr.writerows(rows)
+    video = None
+    writer = None
+    try:
+        for i, frame in enumerate(frames):
+            here = [{**r, "id": r["target_id"]} for r in rows if r["frame"] == job.first + i]
+            img = draw_multi_overlay(frame, job.first + i, here)
+            if writer is None:
+                writer, video = open_video_writer(out / "overlay.mp4", job.source.fps, (img.shape[1], img.shape[0]))
+            writer.write(img)
+    finally:
+        if writer is not None:
+            writer.release()
+    rep = {"bit_exact": not mism and run.status == "done", "words": len(run.words), "expected_words": len(m.results),
+           "mismatches": len(mism), "compared_fields": keys, "model": "mstrack.hw.cosim_multi.expected_multi",
+           "command": command, "source": str(job.source.path), "kind": job.source.kind, "first_frame": job.first,
+           "frames_streamed": job.count, "frame_size": list(job.size), "init_boxes": [list(b) for b in boxes],
+           "slots": slots, "lanes": cfg.lanes, "generics": g,
+           "simulation": {"status": run.status, "detail": run.detail, "cycles": run.cycles,
+                          "seconds": round(run.seconds, 3), "build_seconds": round(run.build_seconds, 1),
+                          "wall_seconds": round(t_sim, 1)},
+           "model_seconds": round(t_model, 1),
+           "files": {"csv": str(out / "results.csv"), "video": None if video is None else str(video),
+                     "report": str(out / "bitexact.json")},
+           "listed": mism[:MAX_LISTED]}
+    (out / "bitexact.json").write_text(json.dumps(rep, indent=1) + "\n")
+    return rep
+
+
 # ----------------------------------------------------------------------------- CLI
 def _cmd_sim(args: argparse.Namespace) -> int:
     from .cli import check_out_dir
@@ -384,21 +470,34 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         print(f"mstrack sim: error: {msg}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
-    if args.preset not in CORE_PRESETS:
-        return bad(f"--preset {args.preset}: the RTL core implements the presets {', '.join(CORE_PRESETS)}")
+    boxes = args.box or []
+    multi = len(boxes) > 1 or args.slots is not None
+    preset = args.preset or ("v2" if multi else "paper")
+    if preset not in CORE_PRESETS:
+        return bad(f"--preset {preset}: the RTL core implements the presets {', '.join(CORE_PRESETS)}")
+    if multi and preset != "v2":
+        return bad("several --box (or --slots) run the multi-target core, whose engines are core v2: "
+                   "leave out --preset paper")
+    slots = args.slots if args.slots is not None else len(boxes)
+    if multi and not 1 <= len(boxes) <= slots <= 16:
+        return bad(f"--slots {slots} with {len(boxes)} --box: the multi-target core has 1 .. 16 slots, "
+                   "at least one per box")
     if args.lanes & (args.lanes - 1):
         return bad(f"--lanes {args.lanes}: LANES must be a power of two (1, 2, 4, 8, ...)")
     try:
         cfg: CoreConfig | CoreConfigV2
-        if args.preset == "v2":
-            cfg = CoreConfigV2(TrackerParams(preset="v2"), FixedParams(), lanes=args.lanes,
-                               max_frame_w=args.max_frame_width)
+        if args.colour and preset != "v2":
+            return bad("--colour is core v2 on colour bins alone: it needs --preset v2 (or several --box)")
+        if preset == "v2":
+            tp = TrackerParams(preset="v2", **(V2_COLOUR if args.colour else {}))
+            cfg = CoreConfigV2(tp, FixedParams(), lanes=args.lanes, max_frame_w=args.max_frame_width)
         else:
             cfg = CoreConfig(TrackerParams(preset="paper"), FixedParams(), lanes=args.lanes,
                              max_frame_w=args.max_frame_width)
         cfg.generics()
         out = Path(args.out) if args.out else Path("out/sim") / Path(args.video).resolve().name
-        job = prepare(args.video, args.box, args.frames, args.max_frames, cfg)
+        job = prepare(args.video, boxes[0] if boxes else None, args.frames, args.max_frames, cfg)
+        more = [check_box(b, job.size, cfg) for b in boxes[1:]]
         check_out_dir(out)
     except (DataError, ValueError) as exc:
         return bad(str(exc))
@@ -406,6 +505,19 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         print(f"mstrack: warning: {n}", file=sys.stderr)
     if job.source.truncated:
         print(f"mstrack: warning: {job.source.path}: {job.source.truncated}", file=sys.stderr)
+    if multi:
+        rep = run_sim_multi(job, [job.box, *more], out, slots, progress=not args.quiet,
+                            command=getattr(args, "command_line", ""))
+        sim = rep["simulation"]
+        print(f"{rep['words']} words for {job.count} frames {job.size[0]}x{job.size[1]}, {len(boxes)} targets in "
+              f"{slots} slots, {sim['cycles']} clocks ({sim['status']})")
+        print(f"bit-exact: {'yes' if rep['bit_exact'] else 'NO'} ({rep['words']} words, {rep['mismatches']} differ "
+              "from mstrack.hw.cosim_multi.expected_multi)")
+        print(f"wrote {rep['files']['csv']}, {rep['files']['video']}, {rep['files']['report']}")
+        if sim["status"] != "done":
+            print(f"mstrack sim: error: the harness stopped early: {sim['status']} {sim['detail']}", file=sys.stderr)
+            return EXIT_MISMATCH
+        return EXIT_OK if rep["bit_exact"] else EXIT_MISMATCH
     rep = run_sim(job, out, progress=not args.quiet, command=getattr(args, "command_line", ""))
     sim = rep["simulation"]
     print(f"{rep['results']} results for {job.count} frames {job.size[0]}x{job.size[1]}, {sim['cycles']} clocks "
@@ -426,11 +538,14 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
                                    "(every result field vs the fixed-point model). Exit 0 bit-exact, 1 mismatch "
                                    "or simulation failure, 2 bad input.")
     p.add_argument("video", metavar="VIDEO", help="video file, image folder or OTB/VOT sequence folder")
-    p.add_argument("--box", type=_box_arg, metavar="X,Y,W,H",
+    p.add_argument("--box", type=_box_arg, metavar="X,Y,W,H", action="append",
                    help="init box on the first frame, 0-based pixels (rounded to integers as the init port "
                         "takes them), e.g. --box=-5,10,20,20 (default for a sequence folder: its ground truth); "
                         "a box partly outside the frame is clipped, one larger than the core's window shrunk, "
-                        "with a warning")
+                        "with a warning.  Several --box: the multi-target core ms_tracker_multi, one slot "
+                        "(core v2 engine) per box")
+    p.add_argument("--slots", type=_positive, metavar="N",
+                   help="multi-target core with N slots (MAX_TARGETS, 1 .. 16; default: one per --box)")
     p.add_argument("--frames", type=parse_frame_range, metavar="FIRST,LAST",
                    help="stream frames FIRST..LAST (0-based, inclusive; init on FIRST); default all")
     p.add_argument("--max-frames", type=_positive, metavar="N", help="stream at most N frames")
@@ -438,9 +553,12 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
                    help=f"LANES generic, pixels per clock in the bin passes, a power of two (default {DEFAULT_LANES}; "
                         "one Verilator build per value, cached)")
     p.add_argument("--max-frame-width", type=_positive, default=2048, help="MAX_FRAME_W generic (default 2048)")
-    p.add_argument("--preset", default="paper",
-                   help="tracker preset of the core: paper (default; generic PRESET 0) or v2 (core v2, PRESET 1: "
-                        "result word v2, results.csv with confidence and status)")
+    p.add_argument("--preset", default=None,
+                   help="tracker preset of the core: paper (default with one box; generic PRESET 0) or v2 (core v2, "
+                        "PRESET 1: result word v2, results.csv with confidence and status; the multi-target "
+                        "core's engines)")
+    p.add_argument("--colour", action="store_true",
+                   help="core v2 on colour bins alone (tracker mstrack-v2-colour's generics, ORIENT_T -1)")
     p.add_argument("--out", help="output folder (default out/sim/<VIDEO name>)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=_cmd_sim)
@@ -456,6 +574,6 @@ def _positive(s: str) -> int:
     return _positive_int(s)
 
 
-__all__ = ["SIM_CSV_FIELDS", "SIM_CSV_FIELDS_V2", "SimInputError", "SimJob", "bitexact_report", "decode_row",
+__all__ = ["SIM_CSV_FIELDS", "SIM_CSV_FIELDS_V2", "SIM_CSV_FIELDS_MULTI", "run_sim_multi", "check_box", "SimInputError", "SimJob", "bitexact_report", "decode_row",
            "decode_row_v2", "field_mismatches",
            "parse_frame_range", "prepare", "register_cli", "report_line", "result_status", "run_sim"]

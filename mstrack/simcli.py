@@ -574,6 +574,7 @@ def _positive(s: str) -> int:
     return _positive_int(s)
 
 
-__all__ = ["SIM_CSV_FIELDS", "SIM_CSV_FIELDS_V2", "SIM_CSV_FIELDS_MULTI", "run_sim_multi", "check_box", "SimInputError", "SimJob", "bitexact_report", "decode_row",
-           "decode_row_v2", "field_mismatches",
-           "parse_frame_range", "prepare", "register_cli", "report_line", "result_status", "run_sim"]
+__all__ = [
+    "SIM_CSV_FIELDS", "SIM_CSV_FIELDS_V2", "SIM_CSV_FIELDS_MULTI", "run_sim_multi", "check_box",
+    "SimInputError", "SimJob", "bitexact_report", "decode_row", "decode_row_v2", "field_mismatches",
+    "parse_frame_range", "prepare", "register_cli", "report_line", "result_status", "run_sim"]

@@ -494,5 +494,6 @@ def compare(results: Sequence[dict], expected: Sequence[dict],
     return out
 
 
-__all__ = ["FastsimRun", "FastsimError", "MultiRun", "simulate_multi", "build_multi", "HD1080P60", "VIDEO_MODES", "build", "simulate", "run_fastsim", "compare",
-           "default_watchdog"]
+__all__ = [
+    "FastsimRun", "FastsimError", "MultiRun", "simulate_multi", "build_multi", "HD1080P60", "VIDEO_MODES",
+    "build", "simulate", "run_fastsim", "compare", "default_watchdog"]

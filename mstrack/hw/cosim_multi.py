@@ -140,11 +140,25 @@ class CoreModelMulti:
         self.count += 1
 
 
+def frame_beats(words, fault: str | None = None) -> list[tuple[int, int, int]]:
+    """The beats (data, tuser, tlast) of one frame of 24-bit words as the harness streams it: whole, or
+    with a fault: ``short_line`` (row 5 three pixels short, tlast on its last), ``cut`` (the first 700
+    beats only; the next frame's start of frame cuts it)."""
+    h, w = words.shape
+    out = []
+    for y in range(h):
+        n = w - 3 if fault == "short_line" and y == 5 else w
+        out += [(int(words[y, x]), int(x == 0 and y == 0), int(x == n - 1)) for x in range(n)]
+    return out[:700] if fault == "cut" else out
+
+
 def expected_multi(frames, commands: dict[int, list[tuple]], tp: TrackerParams | None = None,
-                   fp: FixedParams | None = None, max_targets: int = 2, max_frame_w: int = 2048) -> CoreModelMulti:
+                   fp: FixedParams | None = None, max_targets: int = 2, max_frame_w: int = 2048,
+                   faults: dict[int, str] | None = None) -> CoreModelMulti:
     """The model fed as :func:`mstrack.hw.fastsim.simulate_multi` feeds the core: *commands* (``{frame:
     [("add", (x, y, w, h)) | ("remove", id), ...]}``) before the frames they are keyed by, every frame
-    (BGR arrays) whole.  Returns the model (``frames``, ``results``, ``outcomes``)."""
+    (BGR arrays) as :func:`frame_beats` streams it with its fault in *faults*.  Returns the model
+    (``frames``, ``results``, ``outcomes``)."""
     from .cosim import frame_words
     m = CoreModelMulti(tp, fp, max_frame_w, max_targets)
     n = 0
@@ -153,13 +167,12 @@ def expected_multi(frames, commands: dict[int, list[tuple]], tp: TrackerParams |
         h, w = words.shape
         for op, arg in commands.get(i, []):
             m.add(arg, w, h) if op == "add" else m.remove(arg)
-        for y in range(h):
-            for x in range(w):
-                m.beat(int(words[y, x]), int(x == 0 and y == 0), int(x == w - 1), w, h)
+        for b in frame_beats(words, (faults or {}).get(i)):
+            m.beat(*b, w, h)
         n = i + 1
     for op, arg in commands.get(n, []):
         m.add(arg, w, h) if op == "add" else m.remove(arg)
     return m
 
 
-__all__ = ["CoreModelMulti", "expected_multi", "Outcome", "CMD_OK", "CMD_REFUSED", "CMD_BOX"]
+__all__ = ["CoreModelMulti", "expected_multi", "frame_beats", "Outcome", "CMD_OK", "CMD_REFUSED", "CMD_BOX"]

@@ -418,10 +418,11 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
                    fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int = 4, max_frame_w: int = 2048,
                    hblank: int = 0, vblank: int = 0, out_pause_pct: int = 0, seed: int = 1,
                    words: int | None = None, watchdog: int = 4_000_000, workdir: Path | str | None = None,
-                   check: bool = True) -> MultiRun:
+                   check: bool = True, faults: dict[int, str] | None = None) -> MultiRun:
     """Stream *frames* through the verilated ms_tracker_multi, with *commands* given before the frames
     they are keyed by: ``{frame: [("add", (x, y, w, h)) | ("remove", id), ...]}`` (a key of len(frames):
     after the last frame).  *words*: result words to wait for (default: one per frame at least).
+    *faults*: ``{frame: "short_line" | "cut"}`` stream faults (as :func:`mstrack.hw.cosim_multi.frame_beats`).
     Raise :class:`FastsimError` when the harness stops early (unless ``check`` is false)."""
     from ..fixed.vhdl_pkg import unpack_result_multi
     cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes, max_frame_w=max_frame_w)
@@ -436,6 +437,10 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
         lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", f"hblank {hblank}",
                  f"vblank {vblank}", f"out_pause_pct {out_pause_pct}", f"seed {seed}",
                  f"words {words if words is not None else n}", f"watchdog {watchdog}"]
+        for fr, kind in sorted((faults or {}).items()):
+            if kind not in ("short_line", "cut"):
+                raise ValueError(f"fault {kind!r}: short_line or cut")
+            lines.append(f"fault {fr} {kind}")
         for fr in sorted(commands):
             for op, arg in commands[fr]:
                 if op == "add":

@@ -20,6 +20,9 @@
 //   cmd F OP ID X Y W H             a command given before frame F's first pixel (several lines in
 //                                   order): OP 0 add (box X, Y, W, H; X, Y already masked to the port
 //                                   width), 1 remove (ID)
+//   fault F KIND                    a stream fault in frame F: short_line (row 5 three pixels short,
+//                                   tlast on its last), cut (the frame ends after its first 700 beats;
+//                                   the next frame's start of frame cuts it)
 //
 // out.txt, one record per line:
 //   W <index> <word, hex, MSB first> <last> <cycle>    a result word taken
@@ -65,6 +68,7 @@ int main(int argc, char** argv) {
     }
     std::map<std::string, std::string> job;
     std::vector<Cmd> cmds;
+    std::map<long long, std::string> faults;
     {
         std::ifstream jf(argv[1]);
         if (!jf) {
@@ -77,7 +81,12 @@ int main(int argc, char** argv) {
             std::istringstream ls(line);
             std::string k;
             if (!(ls >> k)) continue;
-            if (k == "cmd") {
+            if (k == "fault") {
+                long long fr = 0;
+                std::string kind;
+                ls >> fr >> kind;
+                faults[fr] = kind;
+            } else if (k == "cmd") {
                 Cmd c{};
                 ls >> c.frame >> c.op >> c.id >> c.x >> c.y >> c.w >> c.h;
                 cmds.push_back(c);
@@ -128,7 +137,13 @@ int main(int argc, char** argv) {
     }
     top.rst = 0;
 
-    long long f = 0, x = 0, y = 0, blank = 0, n_got = 0, last_event = 0, done_at = -1;
+    long long f = 0, x = 0, y = 0, blank = 0, n_got = 0, last_event = 0, done_at = -1, frame_beats = 0;
+    auto fault_of = [&](long long fr) -> std::string {
+        auto it = faults.find(fr);
+        return it == faults.end() ? std::string() : it->second;
+    };
+    // the width of the current row: three pixels short on row 5 of a short_line frame
+    auto row_w = [&]() -> long long { return (y == 5 && fault_of(f) == "short_line") ? W - 3 : W; };
     std::size_t next_cmd = 0;
     bool frame_loaded = false;
     std::string status = "done", detail;
@@ -161,7 +176,7 @@ int main(int argc, char** argv) {
             s_valid = true;
             top.s_axis_tdata = pix[static_cast<std::size_t>(y * W + x)] & 0xFFFFFFu;
             top.s_axis_tuser = at_frame_start;
-            top.s_axis_tlast = (x == W - 1);
+            top.s_axis_tlast = (x == row_w() - 1);
         }
         top.s_cmd_tvalid = cmd_valid;
         top.s_axis_tvalid = s_valid;
@@ -188,7 +203,15 @@ int main(int argc, char** argv) {
         }
         if (s_fire) {
             last_event = cycle;
-            if (x == W - 1) {
+            ++frame_beats;
+            if (fault_of(f) == "cut" && frame_beats == 700) {
+                x = 0;
+                y = 0;
+                ++f;
+                frame_loaded = false;
+                frame_beats = 0;
+                blank += vblank;
+            } else if (x == row_w() - 1) {
                 blank = hblank;
                 x = 0;
                 if (++y == H) {
@@ -196,6 +219,7 @@ int main(int argc, char** argv) {
                     y = 0;
                     ++f;
                     frame_loaded = false;
+                    frame_beats = 0;
                 }
             } else {
                 ++x;

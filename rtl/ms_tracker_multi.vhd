@@ -14,7 +14,8 @@
 -- with no free slot it is refused (code 1, flag `rejected` on the next frame's first word).  A remove
 -- resets the slot's engine (code 0; an id that is not live: code 1, nothing changes).  Each command
 -- reports its outcome on cmd_done / cmd_code / cmd_id (add: 0 ok, 1 full; a rejected box later reports
--- code 3 with its id when the engine's word shows the rejection).
+-- code 3 with its id when the engine's word shows the rejection; several in one frame: one per clock,
+-- lowest slot first).
 -- Results: when every engine has its word of a frame, the merger takes them all in one clock and sends,
 -- in ascending slot order, the words without the flag no_target (live targets), each with its id at
 -- bits RESULT_W + 3 .. RESULT_W and frame_count replaced by the frames merged since reset; a frame with
@@ -178,6 +179,7 @@ architecture rtl of ms_tracker_multi is
   signal c_w, c_h : unsigned(COORD_W downto 0) := (others => '0');
   signal alloc, pend : std_logic_vector(N - 1 downto 0) := (others => '0');
   signal rej_flag : std_logic := '0';
+  signal box_rep  : std_logic_vector(N - 1 downto 0) := (others => '0');   -- rejected boxes still to report
   -- merger
   signal m_busy   : std_logic := '0';                  -- words latched, being sent
   signal m_emit   : std_logic_vector(N - 1 downto 0) := (others => '0');
@@ -314,7 +316,7 @@ begin
   -- a command is taken between frames: every engine idle (no frame in progress, its word taken), the
   -- merger done with the previous frame's words (so a refusal's flag goes to the next frame)
   cmd_take <= s_cmd_tvalid and not cmd_busy and all_idle and not any_rvalid and not m_busy and not b_valid
-              and not rst;
+              and not rst when box_rep = (box_rep'range => '0') else '0';
   s_cmd_tready <= cmd_take;
   -- no beat while a command is taken or carried out
   v_open  <= not cmd_take and not cmd_busy;
@@ -396,6 +398,15 @@ begin
         end if;
       end if;
 
+      -- the rejected boxes of the last merged frame, lowest slot first, one report per clock
+      if box_rep /= (box_rep'range => '0') then
+        k := next_set(box_rep, 0);
+        done_r <= '1';
+        code_r <= "11";
+        id_r <= to_unsigned(k, 4);
+        box_rep(k) <= '0';
+      end if;
+
       -- merger: latch every engine's word of the frame, then send the live ones
       if m_take = '1' then
         w_reg <= e_word;
@@ -409,9 +420,7 @@ begin
             if fl(F_REJ) = '1' then                    -- the box was rejected: the slot is free again
               alloc(i) <= '0';
               pend(i) <= '0';
-              done_r <= '1';
-              code_r <= "11";
-              id_r <= to_unsigned(i, 4);
+              box_rep(i) <= '1';                       -- reported below, one slot per clock
             elsif fl(F_NOT) = '0' then
               pend(i) <= '0';                          -- the target exists
             end if;
@@ -458,6 +467,7 @@ begin
         e_init_v <= (others => '0');
         alloc <= (others => '0');
         pend <= (others => '0');
+        box_rep <= (others => '0');
         rej_flag <= '0';
         m_busy <= '0';
         o_valid <= '0';

@@ -348,7 +348,8 @@ begin
   m_take  <= all_rvalid and not m_busy and not rst;
 
   p_ctl : process(clk)
-    variable k : natural;
+    variable k : natural range 0 to 16;
+    variable wsel : std_logic_vector(RESULT_W - 1 downto 0);
     variable fl : std_logic_vector(7 downto 0);
     variable emit : std_logic_vector(N - 1 downto 0);
     variable rj : std_logic;
@@ -363,15 +364,16 @@ begin
         if s_cmd_op = '1' then                         -- remove
           done_r <= '1';
           id_r <= s_cmd_id;
-          if to_integer(s_cmd_id) < N and alloc(to_integer(s_cmd_id) mod N) = '1' then
-            e_rst(to_integer(s_cmd_id) mod N) <= '1';
-            alloc(to_integer(s_cmd_id) mod N) <= '0';
-            pend(to_integer(s_cmd_id) mod N) <= '0';
-            code_r <= "00";
-            cmd_busy <= '1';                           -- the reset clock: no beat
-          else
-            code_r <= "01";
-          end if;
+          code_r <= "01";
+          for i in 0 to N - 1 loop                     -- (loops, not variable indices: GHDL's Verilog
+            if to_integer(s_cmd_id) = i and alloc(i) = '1' then   -- writer breaks those at N = 1)
+              e_rst(i) <= '1';
+              alloc(i) <= '0';
+              pend(i) <= '0';
+              code_r <= "00";
+              cmd_busy <= '1';                         -- the reset clock: no beat
+            end if;
+          end loop;
         else                                           -- add
           k := lowest(alloc);
           if k = N then
@@ -380,9 +382,13 @@ begin
             id_r <= (others => '0');
             rej_flag <= '1';
           else
-            alloc(k) <= '1';
-            pend(k) <= '1';
-            e_init_v(k) <= '1';
+            for i in 0 to N - 1 loop
+              if i = k then
+                alloc(i) <= '1';
+                pend(i) <= '1';
+                e_init_v(i) <= '1';
+              end if;
+            end loop;
             id_r <= to_unsigned(k, 4);
             cmd_busy <= '1';
           end if;
@@ -404,7 +410,11 @@ begin
         done_r <= '1';
         code_r <= "11";
         id_r <= to_unsigned(k, 4);
-        box_rep(k) <= '0';
+        for i in 0 to N - 1 loop
+          if i = k then
+            box_rep(i) <= '0';
+          end if;
+        end loop;
       end if;
 
       -- merger: latch every engine's word of the frame, then send the live ones
@@ -441,10 +451,16 @@ begin
           else
             k := next_set(m_emit, m_idx);
           end if;
+          wsel := w_reg(0);
+          for i in 1 to N - 1 loop
+            if i = k then
+              wsel := w_reg(i);
+            end if;
+          end loop;
           o_data <= (others => '0');
-          o_data(RESULT_W - 1 downto 0) <= w_reg(k);
+          o_data(RESULT_W - 1 downto 0) <= wsel;
           o_data(V_FC + 15 downto V_FC) <= std_logic_vector(fcount);
-          o_data(V_FL + F_REJ) <= w_reg(k)(V_FL + F_REJ) or (m_rej and m_first);
+          o_data(V_FL + F_REJ) <= wsel(V_FL + F_REJ) or (m_rej and m_first);
           o_data(RESULT_W + 3 downto RESULT_W) <= std_logic_vector(to_unsigned(k, 4));
           o_valid <= '1';
           m_first <= '0';

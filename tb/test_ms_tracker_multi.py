@@ -3,8 +3,8 @@ netlist (mstrack.hw.fastsim.simulate_multi, harness tools/hdl/multi_main.cpp): e
 in order, with its id and tlast, and every cmd_done report, against mstrack.hw.cosim_multi.CoreModelMulti
 (expected_multi).
 
-One build for both tests: 3 slots of the colour core v2 engine (mstrack-v2-colour's generics,
-MAX_FRAME_W 1024).  Stream faults are core v2's (each engine is ms_tracker_v2: tb/test_ms_tracker_v2_faults.py)
+One build for the three-slot tests: 3 slots of the colour core v2 engine (mstrack-v2-colour's generics,
+MAX_FRAME_W 1024); one more with 1 slot (test_multi_one_slot_is_core_v2).  Stream faults are core v2's (each engine is ms_tracker_v2: tb/test_ms_tracker_v2_faults.py)
 and the merger's handling of their words is in the model's tests (tests/test_core_model_multi.py).
 Marker ``long``: the netlist half of `make test`.
 """
@@ -83,6 +83,30 @@ def test_multi_real_people():
             8: [("remove", 1), ("add", round_box(*b8[8].as_tuple()))]}
     m = _run(frames, cmds)
     assert all(len(fr) == 3 for fr in m.frames)
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_multi_one_slot_is_core_v2():
+    """MAX_TARGETS 1 (colour engine): 30 frames of Girl (128 x 96) with the ground-truth box added before
+    the first; every word equals core v2's result word (expected_results_v2, the model of ms_tracker with
+    PRESET 1), field by field, with id 0 and tlast on each."""
+    from mstrack.hw import fastsim
+    from mstrack.hw.cosim import expected_results_v2
+    from mstrack.io.data import load_sequence
+    seq_dir = MULTI.parent / "sequences" / "Girl"
+    if not seq_dir.is_dir():
+        pytest.skip(f"{seq_dir} not found: the real-frame run needs ../shared/data/sequences")
+    seq = load_sequence(seq_dir)
+    frames = [seq.frame(i) for i in range(30)]
+    box = round_box(*map(float, seq.gt[0]))
+    exp = expected_results_v2(frames, box, TP)
+    run = fastsim.simulate_multi(frames, {0: [("add", box)]}, TP, FixedParams(), max_targets=1, max_frame_w=MAX_W,
+                                 words=len(exp))
+    assert len(run.words) == len(exp) and all(w["target_id"] == 0 and w["last"] for w in run.words)
+    diffs = [f"frame {i}: " + "; ".join(f"{k}: dut={w[k]} model={e[k]}" for k in COMPARED_FIELDS_V2 if w[k] != e[k])
+             for i, (w, e) in enumerate(zip(run.words, exp)) if any(w[k] != e[k] for k in COMPARED_FIELDS_V2)]
+    assert not diffs, "\n".join(diffs[:10])
 
 
 def fuzz_case(seed: int) -> tuple:

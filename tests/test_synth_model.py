@@ -243,6 +243,12 @@ def test_multi4_colour_config_is_four_colour_engines():
     synth.add_arguments(ap)
     assert ap.parse_args([]).config == list(synth.DEFAULT_CONFIGS)
     assert ap.parse_args(["--config", "multi4-colour"]).config == ["multi4-colour"]
+    # the Vitis comparison counts its MAX_TARGETS targets (a single-target core: 1, figures as before)
+    x = {"LUT": 40000, "FF": 50000, "BRAM36": 92.0, "DSP48E1": 8}
+    rows = synth.vitis_table([{"config": "multi4-colour", "xc7": x, "generics": g},
+                              {"config": "v2-colour", "xc7": x, "generics": synth.CONFIGS["v2-colour"].generics()}])
+    assert "| mstrack multi4-colour (xc7, yosys) | 4 | 40,000 | 50,000 | 92 | 8 | 10,000 / 12,500 / 23.0 / 2.0 |" in rows
+    assert "| mstrack v2-colour (xc7, yosys) | 1 | 40,000 | 50,000 | 92 | 8 | 40,000 / 50,000 / 92 / 8 |" in rows
 
 
 def test_write_section_keeps_rows_of_other_configs(tmp_path):

@@ -957,8 +957,11 @@ def vitis_table(rows: Iterable[dict]) -> str:
            f"{v['DSP']} | {v['LUT'] / n:,.0f} / {v['FF'] / n:,.0f} / {v['BRAM36'] / n:.1f} / {v['DSP'] / n:.1f} |"]
     for s in rows:
         x = s["xc7"]
-        out.append(f"| mstrack {s['config']} (xc7, yosys) | 1 | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
-                   f"{x['DSP48E1']} | {x['LUT']:,} / {x['FF']:,} / {x['BRAM36']:g} / {x['DSP48E1']} |")
+        t = s.get("generics", {}).get("MAX_TARGETS", 1)        # ms_tracker_multi: its slots
+        per = (f"{x['LUT']:,} / {x['FF']:,} / {x['BRAM36']:g} / {x['DSP48E1']}" if t == 1 else
+               f"{x['LUT'] / t:,.0f} / {x['FF'] / t:,.0f} / {x['BRAM36'] / t:.1f} / {x['DSP48E1'] / t:.1f}")
+        out.append(f"| mstrack {s['config']} (xc7, yosys) | {t} | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
+                   f"{x['DSP48E1']} | {per} |")
     return "\n".join(out)
 
 

@@ -21,6 +21,9 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * core v2 (configurations ``v2``, ``v2-colour``): the same flow on ``ms_tracker_v2`` (generics from
   :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` with
   PRESET 1 (160-bit result word v2); the cycle table is the paper core's only.
+* the multi-target core (configuration ``multi4-colour``, only when named with ``--config``):
+  ``ms_tracker_multi`` with MAX_TARGETS 4 engines of ``v2-colour``, yosys resources only (no pin
+  wrapper, so no nextpnr).
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
@@ -54,6 +57,8 @@ PINS_TOP = "ms_tracker_pins"
 PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_pins.vhd"
 #: core v2's engine, synthesised alone for its resources (placed through PINS_TOP with PRESET 1)
 TOP_V2 = "ms_tracker_v2"
+#: the multi-target core: MAX_TARGETS core v2 engines + the merger (resources only, no pin wrapper)
+TOP_MULTI = "ms_tracker_multi"
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
@@ -87,7 +92,11 @@ class Config:
 
     ``core``: the top synthesised, ``ms_tracker`` (the paper core) or ``ms_tracker_v2`` (core v2:
     tracker preset "v2", generics from :class:`mstrack.hw.cosim.CoreConfigV2`); both are placed through
-    rtl/wrappers/ms_tracker_pins.vhd (:meth:`pins_generics`)."""
+    rtl/wrappers/ms_tracker_pins.vhd (:meth:`pins_generics`).
+
+    ``top``: the entity synthesised, ``core`` unless named (``""``); ``ms_tracker_multi`` takes
+    ``MAX_TARGETS`` (``max_targets``) ahead of the generics of its ``core`` engine (core v2). Such a
+    configuration has no pin wrapper: resources only (no nextpnr)."""
 
     name: str
     note: str
@@ -97,10 +106,23 @@ class Config:
     max_frame_w: int = 2048
     ppc: int = 1
     core: str = "ms_tracker"
+    top: str = ""
+    max_targets: int = 0
+
+    def __post_init__(self) -> None:
+        if not self.top:
+            object.__setattr__(self, "top", self.core)
+        assert (self.top == TOP_MULTI) == (self.max_targets > 0), "MAX_TARGETS is ms_tracker_multi's generic"
+        assert self.top == self.core or (self.top == TOP_MULTI and self.core == TOP_V2)
 
     @property
     def v2(self) -> bool:
         return self.core == TOP_V2
+
+    @property
+    def placeable(self) -> bool:
+        """True when nextpnr can place it (the pin wrapper holds this top)."""
+        return self.top == self.core
 
     @property
     def pins_top(self) -> str:
@@ -116,7 +138,8 @@ class Config:
         if self.v2:
             from .cosim import CoreConfigV2
             assert self.ppc == 1, "core v2 takes one pixel per clock"
-            return CoreConfigV2(tp, fp, self.lanes, self.max_frame_w).generics()
+            g = CoreConfigV2(tp, fp, self.lanes, self.max_frame_w).generics()
+            return {"MAX_TARGETS": self.max_targets, **g} if self.max_targets else g
         g = core_generics(tp, fp, self.lanes)
         g["MAX_FRAME_W"] = self.max_frame_w
         if self.ppc != 1:
@@ -142,7 +165,12 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
            core=TOP_V2),
     Config("v2-colour", "core v2 of tracker mstrack-v2-colour (mstrack.track.params.V2_COLOUR: colour bins alone, "
                         "ORIENT_T -1, no scale test, loss_rho 0.88, loss_contrast 0.19)", core=TOP_V2, tp=dict(V2_COLOUR)),
+    Config("multi4-colour", "ms_tracker_multi with MAX_TARGETS 4 and the v2-colour engine's generics: four colour "
+                            "engines + the merger (resources only: no pin wrapper, no nextpnr)",
+           core=TOP_V2, top=TOP_MULTI, max_targets=4, tp=dict(V2_COLOUR)),
 )}
+#: the configurations of a plain `mstrack synth` (the multi-target core only when named with --config)
+DEFAULT_CONFIGS = tuple(n for n, c in CONFIGS.items() if c.top != TOP_MULTI)
 
 
 # ----------------------------------------------------------------------------- sources
@@ -372,13 +400,15 @@ def _synth_ecp5_part(cfg: Config, g: dict[str, int], out: dict[str, Any], seeds:
     """The ECP5 part of :func:`synth_config`: yosys counts of the core, nextpnr-ecp5 of the pins wrapper."""
     secs = out["seconds"]
     t0 = time.monotonic()
-    r = yosys_cached("ecp5", cfg.core, g, None, f"ecp5_{cfg.name}")
+    r = yosys_cached("ecp5", cfg.top, g, None, f"ecp5_{cfg.name}")
     secs["ecp5_core"] = round(time.monotonic() - t0, 1)
     out["ecp5"] = {k: r[k] for k in ("LUT4", "TRELLIS_FF", "CCU2C", "DP16KD", "MULT18X18D", "TRELLIS_DPR16X4")}
     out["ecp5"]["dir"] = r["dir"]
     log(f"[{cfg.name}] ecp5 core: {out['ecp5']} ({secs['ecp5_core']} s)")
 
-    if pnr:
+    if pnr and not cfg.placeable:
+        log(f"[{cfg.name}] no nextpnr: {cfg.top} has no pin wrapper")
+    elif pnr:
         t0 = time.monotonic()
         rp = yosys_cached("ecp5", cfg.pins_top, cfg.pins_generics(), pins_sources(cfg.pins_top),
                           f"ecp5pnr_{cfg.name}")
@@ -416,7 +446,8 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
     from . import hdl
     cfg = CONFIGS[cfg] if isinstance(cfg, str) else cfg
     g = cfg.generics()
-    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "core": cfg.core, "generics": g, "seconds": {},
+    out: dict[str, Any] = {"config": cfg.name, "note": cfg.note, "core": cfg.core,
+                           **({"top": cfg.top} if cfg.top != cfg.core else {}), "generics": g, "seconds": {},
                            "rtl": _RTL_DESC}
     secs = out["seconds"]
 
@@ -424,11 +455,11 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         _synth_ecp5_part(cfg, g, out, seeds, freq_mhz, pnr, log, speed)
     if nexus:
         t0 = time.monotonic()
-        n = yosys_cached("nexus", cfg.core, g, None, f"nexus_{cfg.name}")
+        n = yosys_cached("nexus", cfg.top, g, None, f"nexus_{cfg.name}")
         secs["nexus_core"] = round(time.monotonic() - t0, 1)
         out["nexus"] = {k: n[k] for k in NEXUS_KEYS}
         log(f"[{cfg.name}] nexus core: {out['nexus']} ({secs['nexus_core']} s)")
-        if pnr:
+        if pnr and cfg.placeable:
             t0 = time.monotonic()
             npins = yosys_cached("nexus", cfg.pins_top, cfg.pins_generics(), pins_sources(cfg.pins_top),
                                  f"nexuspnr_{cfg.name}")
@@ -449,7 +480,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
 
     if xilinx:
         t0 = time.monotonic()
-        x = yosys_cached("xc7", cfg.core, g, None, f"xc7_{cfg.name}")
+        x = yosys_cached("xc7", cfg.top, g, None, f"xc7_{cfg.name}")
         secs["xc7"] = round(time.monotonic() - t0, 1)
         out["xc7"] = {k: x[k] for k in ("LUT", "FF", "BRAM36", "RAMB36E1", "RAMB18E1", "DSP48E1", "CARRY4",
                                         "LUTRAM", "SRL")}
@@ -926,8 +957,11 @@ def vitis_table(rows: Iterable[dict]) -> str:
            f"{v['DSP']} | {v['LUT'] / n:,.0f} / {v['FF'] / n:,.0f} / {v['BRAM36'] / n:.1f} / {v['DSP'] / n:.1f} |"]
     for s in rows:
         x = s["xc7"]
-        out.append(f"| mstrack {s['config']} (xc7, yosys) | 1 | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
-                   f"{x['DSP48E1']} | {x['LUT']:,} / {x['FF']:,} / {x['BRAM36']:g} / {x['DSP48E1']} |")
+        t = s.get("generics", {}).get("MAX_TARGETS", 1)        # ms_tracker_multi: its slots
+        per = (f"{x['LUT']:,} / {x['FF']:,} / {x['BRAM36']:g} / {x['DSP48E1']}" if t == 1 else
+               f"{x['LUT'] / t:,.0f} / {x['FF'] / t:,.0f} / {x['BRAM36'] / t:.1f} / {x['DSP48E1'] / t:.1f}")
+        out.append(f"| mstrack {s['config']} (xc7, yosys) | {t} | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
+                   f"{x['DSP48E1']} | {per} |")
     return "\n".join(out)
 
 
@@ -1020,8 +1054,8 @@ def write_section(md: str, section: str, command: str, path: Path = PERF_MD, too
 
 # ----------------------------------------------------------------------------- CLI
 def add_arguments(ap: argparse.ArgumentParser) -> None:
-    ap.add_argument("--config", nargs="+", default=list(CONFIGS), choices=list(CONFIGS),
-                    help="configurations (default: all)")
+    ap.add_argument("--config", nargs="+", default=list(DEFAULT_CONFIGS), choices=list(CONFIGS),
+                    help=f"configurations (default: all but {', '.join(n for n in CONFIGS if n not in DEFAULT_CONFIGS)})")
     ap.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS), help="nextpnr seeds")
     ap.add_argument("--freq", type=float, default=FREQ_MHZ, help="nextpnr target MHz")
     ap.add_argument("--speed", type=int, default=SPEED, choices=SPEEDS,
@@ -1058,7 +1092,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"wrote {doc}")
         return 0
     cmd = "mstrack synth " + " ".join(
-        ([f"--config {' '.join(args.config)}"] if args.config != list(CONFIGS) else [])
+        ([f"--config {' '.join(args.config)}"] if args.config != list(DEFAULT_CONFIGS) else [])
         + ([f"--seeds {' '.join(map(str, args.seeds))}"] if list(args.seeds) != list(SEEDS) else [])
         + ([f"--freq {args.freq:g}"] if args.freq != FREQ_MHZ else [])
         + ([f"--speed {args.speed}"] if args.speed != SPEED else [])

@@ -94,7 +94,8 @@ def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False) -> tuple
     with fastsim._lock(net_dir.with_suffix(".lock")):
         vfile = hdl.ghdl_to_verilog(TOP, vg, out_path=net_dir / f"{TOP}.v")
     exe, built = fastsim.verilate(vfile.read_text(), g, TOP, [DRV_CPP, SW_DIR / "mstrack_drv.c"],
-                                  include_dirs=[SW_DIR], defines=["MSTRACK_IO_EXTERN"], exe_name="Vdrv",
+                                  include_dirs=[SW_DIR, hdl.TOOLS_HDL_DIR], defines=["MSTRACK_IO_EXTERN"],
+                                  exe_name="Vdrv",
                                   verbose=verbose)
     return exe, (time.monotonic() - t0) if built else 0.0
 

@@ -177,7 +177,7 @@ def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = 
     if top != TOP:
         import re
         vtext = re.sub(rf"\bmodule\s+{top}\b", f"module {TOP}", vtext)
-    exe = verilate(vtext, g, TOP, [HARNESS_CPP], cxx_opt, verbose=verbose)
+    exe = verilate(vtext, g, TOP, [HARNESS_CPP], cxx_opt, include_dirs=[hdl.TOOLS_HDL_DIR], verbose=verbose)
     return exe[0], (time.monotonic() - t0) if exe[1] else 0.0
 
 
@@ -410,7 +410,8 @@ def build_multi(cfg: CoreConfigV2, max_targets: int, verbose: bool = False) -> t
     net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}_{MULTI_TOP}"
     with _lock(net_dir.with_suffix(".lock")):
         vfile = hdl.ghdl_to_verilog(MULTI_TOP, g, out_path=net_dir / f"{MULTI_TOP}.v")
-    exe, built = verilate(vfile.read_text(), g, MULTI_TOP, [MULTI_CPP], exe_name="Vmulti", verbose=verbose)
+    exe, built = verilate(vfile.read_text(), g, MULTI_TOP, [MULTI_CPP], include_dirs=[hdl.TOOLS_HDL_DIR],
+                          exe_name="Vmulti", verbose=verbose)
     return exe, (time.monotonic() - t0) if built else 0.0
 
 

@@ -46,6 +46,7 @@
 // stdout; exit code 0 when done, 3 on a watchdog or the cycle limit, 2 on bad arguments.
 #include "Vms_tracker.h"
 #include "verilated.h"
+#include "harness_job.h"
 
 #include <chrono>
 #include <ctime>
@@ -61,17 +62,7 @@
 
 namespace {
 
-// Hex of a port value, MSB first, zero-padded to whole 32-bit words (wide ports are VlWide).
-template <std::size_t N>
-std::string hex_of(const VlWide<N>& w) {
-    std::string s;
-    char buf[9];
-    for (std::size_t i = N; i-- > 0;) {
-        std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(w[i]));
-        s += buf;
-    }
-    return s;
-}
+using harness::hex_of;
 
 // Drive a tdata port with ppc 24-bit pixels, pixel k at bits 24k+23 .. 24k: a scalar port
 // (PPC 1, 2: up to 48 bits) or a VlWide (PPC 4: 96 bits in 32-bit words, LSB first).
@@ -120,31 +111,12 @@ int main(int argc, char** argv) {
         return 2;
     }
     // ------------------------------------------------------------------ job
-    std::map<std::string, std::string> job;
-    {
-        std::ifstream f(argv[1]);
-        if (!f) {
-            std::fprintf(stderr, "cannot read %s\n", argv[1]);
-            return 2;
-        }
-        std::string line;
-        while (std::getline(f, line)) {
-            if (line.empty() || line[0] == '#') continue;
-            std::istringstream ls(line);
-            std::string k, v;
-            if (ls >> k) {
-                std::getline(ls >> std::ws, v);
-                job[k] = v;
-            }
-        }
-    }
-    auto num = [&](const char* k, long long d) -> long long {
-        auto it = job.find(k);
-        return it == job.end() ? d : std::stoll(it->second, nullptr, 0);
-    };
+    harness::Job job;
+    if (!harness::read_job(argv[1], job)) return 2;
+    auto num = [&](const char* k, long long d) -> long long { return job.num(k, d); };
     const long long W = num("width", 0), H = num("height", 0), n_frames = num("frames", 0);
     const long long ppc = num("ppc", 1);
-    if (W < 3 || H < 3 || n_frames < 0 || !job.count("pixels") || !(ppc == 1 || ppc == 2 || ppc == 4) ||
+    if (W < 3 || H < 3 || n_frames < 0 || !job.has("pixels") || !(ppc == 1 || ppc == 2 || ppc == 4) ||
         W % ppc != 0) {
         std::fprintf(stderr, "job needs width, height (>= 3), frames and pixels; ppc 1, 2, 4 dividing width\n");
         return 2;
@@ -158,9 +130,9 @@ int main(int argc, char** argv) {
     const long long max_cycles = num("max_cycles", -1);
     const bool do_init = num("init", 1) != 0;
 
-    std::FILE* pix_f = std::fopen(job["pixels"].c_str(), "rb");
+    std::FILE* pix_f = std::fopen(job.str("pixels").c_str(), "rb");
     if (!pix_f) {
-        std::fprintf(stderr, "cannot read pixels %s\n", job["pixels"].c_str());
+        std::fprintf(stderr, "cannot read pixels %s\n", job.str("pixels").c_str());
         return 2;
     }
     std::vector<uint32_t> pix(static_cast<std::size_t>(W * H));

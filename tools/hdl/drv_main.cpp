@@ -42,6 +42,7 @@
 // Exit code 0 when done, 3 otherwise, 2 on bad arguments.
 #include "Vms_tracker_axi.h"
 #include "verilated.h"
+#include "harness_job.h"
 
 extern "C" {
 #include "mstrack_drv.h"
@@ -213,34 +214,15 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "usage: %s job.txt out.txt\n", argv[0]);
         return 2;
     }
-    std::map<std::string, std::string> job;
-    {
-        std::ifstream jf(argv[1]);
-        if (!jf) {
-            std::fprintf(stderr, "cannot read %s\n", argv[1]);
-            return 2;
-        }
-        std::string line;
-        while (std::getline(jf, line)) {
-            if (line.empty() || line[0] == '#') continue;
-            std::istringstream ls(line);
-            std::string k, v;
-            if (ls >> k) {
-                std::getline(ls >> std::ws, v);
-                job[k] = v;
-            }
-        }
-    }
-    auto num = [&](const char* k, long long d) -> long long {
-        auto it = job.find(k);
-        return it == job.end() ? d : std::stoll(it->second, nullptr, 0);
-    };
+    harness::Job job;
+    if (!harness::read_job(argv[1], job)) return 2;
+    auto num = [&](const char* k, long long d) -> long long { return job.num(k, d); };
     Sim s;
     sim = &s;
     s.W = num("width", 0);
     s.H = num("height", 0);
     s.n_frames = num("frames", 0);
-    if (s.W < 1 || s.H < 1 || s.n_frames < 0 || !job.count("pixels")) {
+    if (s.W < 1 || s.H < 1 || s.n_frames < 0 || !job.has("pixels")) {
         std::fprintf(stderr, "job needs width, height, frames and pixels\n");
         return 2;
     }
@@ -250,9 +232,9 @@ int main(int argc, char** argv) {
     const long long n_results = num("results", s.n_frames);
     const long long watchdog = num("watchdog", 4000000);
     const long long tail = num("tail", 200);
-    s.pix_f = std::fopen(job["pixels"].c_str(), "rb");
+    s.pix_f = std::fopen(job.str("pixels").c_str(), "rb");
     if (!s.pix_f) {
-        std::fprintf(stderr, "cannot read pixels %s\n", job["pixels"].c_str());
+        std::fprintf(stderr, "cannot read pixels %s\n", job.str("pixels").c_str());
         return 2;
     }
     s.pix.resize(static_cast<std::size_t>(s.W * s.H));

@@ -31,6 +31,7 @@
 //   E <status: done | watchdog> <cycles> <seconds> <detail>
 #include "Vms_tracker_multi.h"
 #include "verilated.h"
+#include "harness_job.h"
 
 #include <chrono>
 #include <cstdint>
@@ -44,17 +45,6 @@
 
 namespace {
 
-template <std::size_t N>
-std::string hex_of(const VlWide<N>& w) {
-    std::string s;
-    char buf[9];
-    for (std::size_t i = N; i-- > 0;) {
-        std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(w[i]));
-        s += buf;
-    }
-    return s;
-}
-
 struct Cmd {
     long long frame, op, id, x, y, w, h;
 };
@@ -66,50 +56,33 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "usage: %s job.txt out.txt\n", argv[0]);
         return 2;
     }
-    std::map<std::string, std::string> job;
+    harness::Job job;
+    if (!harness::read_job(argv[1], job, {"cmd", "fault"})) return 2;
     std::vector<Cmd> cmds;
     std::map<long long, std::string> faults;
-    {
-        std::ifstream jf(argv[1]);
-        if (!jf) {
-            std::fprintf(stderr, "cannot read %s\n", argv[1]);
-            return 2;
-        }
-        std::string line;
-        while (std::getline(jf, line)) {
-            if (line.empty() || line[0] == '#') continue;
-            std::istringstream ls(line);
-            std::string k;
-            if (!(ls >> k)) continue;
-            if (k == "fault") {
-                long long fr = 0;
-                std::string kind;
-                ls >> fr >> kind;
-                faults[fr] = kind;
-            } else if (k == "cmd") {
-                Cmd c{};
-                ls >> c.frame >> c.op >> c.id >> c.x >> c.y >> c.w >> c.h;
-                cmds.push_back(c);
-            } else {
-                std::string v;
-                std::getline(ls >> std::ws, v);
-                job[k] = v;
-            }
+    for (const auto& [k, v] : job.lines) {
+        std::istringstream ls(v);
+        if (k == "fault") {
+            long long fr = 0;
+            std::string kind;
+            ls >> fr >> kind;
+            faults[fr] = kind;
+        } else {
+            Cmd c{};
+            ls >> c.frame >> c.op >> c.id >> c.x >> c.y >> c.w >> c.h;
+            cmds.push_back(c);
         }
     }
-    auto num = [&](const char* k, long long d) -> long long {
-        auto it = job.find(k);
-        return it == job.end() ? d : std::stoll(it->second, nullptr, 0);
-    };
+    auto num = [&](const char* k, long long d) -> long long { return job.num(k, d); };
     const long long W = num("width", 0), H = num("height", 0), n_frames = num("frames", 0);
-    if (W < 1 || H < 1 || n_frames < 0 || !job.count("pixels")) {
+    if (W < 1 || H < 1 || n_frames < 0 || !job.has("pixels")) {
         std::fprintf(stderr, "job needs width, height, frames and pixels\n");
         return 2;
     }
     const long long hblank = num("hblank", 0), vblank = num("vblank", 0);
     const int out_pause = static_cast<int>(num("out_pause_pct", 0));
     const long long n_words = num("words", 0), watchdog = num("watchdog", 4000000), tail = num("tail", 200);
-    std::FILE* pix_f = std::fopen(job["pixels"].c_str(), "rb");
+    std::FILE* pix_f = std::fopen(job.str("pixels").c_str(), "rb");
     std::FILE* o = std::fopen(argv[2], "w");
     if (!pix_f || !o) {
         std::fprintf(stderr, "cannot open the pixel or the output file\n");
@@ -186,7 +159,7 @@ int main(int argc, char** argv) {
         const bool cmd_fire = cmd_valid && top.s_cmd_tready;
         const bool s_fire = s_valid && top.s_axis_tready;
         if (top.m_axis_result_tvalid && top.m_axis_result_tready) {
-            std::fprintf(o, "W %lld %s %d %lld\n", n_got, hex_of(top.m_axis_result_tdata).c_str(),
+            std::fprintf(o, "W %lld %s %d %lld\n", n_got, harness::hex_of(top.m_axis_result_tdata).c_str(),
                          static_cast<int>(top.m_axis_result_tlast), cycle);
             ++n_got;
             last_event = cycle;

@@ -309,6 +309,22 @@ ModelFn = Callable[[Iterator[np.ndarray], tuple[int, int, int, int], TrackerPara
                    list[dict[str, int]]]
 
 
+def write_overlay(path: Path, fps: float, images: Iterator[np.ndarray]) -> Path | None:
+    """Write *images* as the overlay video at *path* (``open_video_writer``: .avi where mp4 cannot be
+    written); returns the file written, None when there was no image."""
+    from .io.data import open_video_writer
+    writer, video = None, None
+    try:
+        for img in images:
+            if writer is None:
+                writer, video = open_video_writer(path, fps, (img.shape[1], img.shape[0]))
+            writer.write(img)
+    finally:
+        if writer is not None:
+            writer.release()
+    return video
+
+
 def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool = False,
             command: str = "") -> dict[str, Any]:
     """Simulate ``job`` and write results.csv, the overlay video and bitexact.json to ``out``.
@@ -317,7 +333,6 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
     from .hw import fastsim
     from .cli import draw_overlay
     from .hw.cosim import expected_results, expected_results_v2
-    from .io.data import open_video_writer
 
     v2 = isinstance(job.cfg, CoreConfigV2)
     model = model or (expected_results_v2 if v2 else expected_results)
@@ -349,21 +364,15 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
         w.writerows(rows)
     video = None
     if rows:
-        writer = None
-        try:
+        def images() -> Iterator[np.ndarray]:
             for i, frame in enumerate(job.frames()):
                 if i >= len(rows):
                     break
                 gt = None if job.gt is None or i >= len(job.gt) else job.gt[i]
                 # core v2: one feature (colour), its rho as rho_c and the confidence in the banner
                 row = {**rows[i], "rho_c": rows[i]["rho"], "alpha_c": 1.0} if v2 else rows[i]
-                img = draw_overlay(frame, row, gt)
-                if writer is None:
-                    writer, video = open_video_writer(out / "overlay.mp4", job.source.fps, (img.shape[1], img.shape[0]))
-                writer.write(img)
-        finally:
-            if writer is not None:
-                writer.release()
+                yield draw_overlay(frame, row, gt)
+        video = write_overlay(out / "overlay.mp4", job.source.fps, images())
     lat = [r["latency"] for r in run.results if "latency" in r]
     listed = rep.pop("listed")
     rep = {**rep, "command": command, "source": str(job.source.path), "kind": job.source.kind,
@@ -395,7 +404,6 @@ def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path
     (:data:`SIM_CSV_FIELDS_MULTI`, one row per word), overlay.mp4 and bitexact.json to ``out``."""
     from .hw import fastsim
     from .hw.cosim_multi import expected_multi
-    from .io.data import open_video_writer
     from .multicli import draw_multi_overlay
 
     assert isinstance(job.cfg, CoreConfigV2)
@@ -432,18 +440,10 @@ def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path
         wr = csv.DictWriter(fh, fieldnames=SIM_CSV_FIELDS_MULTI, extrasaction="ignore")
         wr.writeheader()
         wr.writerows(rows)
-    video = None
-    writer = None
-    try:
-        for i, frame in enumerate(frames):
-            here = [{**r, "id": r["target_id"]} for r in rows if r["frame"] == job.first + i]
-            img = draw_multi_overlay(frame, job.first + i, here)
-            if writer is None:
-                writer, video = open_video_writer(out / "overlay.mp4", job.source.fps, (img.shape[1], img.shape[0]))
-            writer.write(img)
-    finally:
-        if writer is not None:
-            writer.release()
+    video = write_overlay(out / "overlay.mp4", job.source.fps,
+                          (draw_multi_overlay(frame, job.first + i,
+                                              [{**r, "id": r["target_id"]} for r in rows if r["frame"] == job.first + i])
+                           for i, frame in enumerate(frames)))
     rep = {"bit_exact": not mism and run.status == "done", "words": len(run.words), "expected_words": len(m.results),
            "mismatches": len(mism), "compared_fields": keys, "model": "mstrack.hw.cosim_multi.expected_multi",
            "command": command, "source": str(job.source.path), "kind": job.source.kind, "first_frame": job.first,

@@ -44,11 +44,11 @@ test-synth: setup
 
 # the halves without setup (setup must not run twice at once)
 test-sim-only:
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long and not extra" $(ARGS)
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long and not extra" --durations=15 $(ARGS)
 
 test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "synth and not extra" -s -p no:cacheprovider $(ARGS); a=$$?; \
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" -p no:cacheprovider $(ARGS); b=$$?; \
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" --durations=15 -p no:cacheprovider $(ARGS); b=$$?; \
 	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
 
 # the long co-simulations alone (core v2 on 1,545 real frames, the paper core on 760, the real-time checks,

@@ -35,9 +35,21 @@
 -- Throughput : the core's: PPC pixels per clock while a frame streams in.
 -- Reset      : rst synchronous, active high (core and registers; every register to its reset value).
 -- Cost       : over the core, logic only (no RAM, no multiplier): docs/blocks/ms_tracker_axi.md, Resources.
+-- Multi-target cores (MAX_TARGETS >= 1; PRESET 1, PPC 1): ms_tracker_multi with MAX_TARGETS slots in place
+-- of ms_tracker (docs/blocks/ms_tracker_multi.md): CMD.add (box INIT_POS / INIT_SIZE; CMD.init does the
+-- same) and CMD.remove (TARGET.id) are copied at the write and offered to the core's command port until
+-- taken (between frames); CMD_STATUS shows pending and the last report (code, id), INT_STATUS.command
+-- fires on each report; MULTI shows MAX_TARGETS and the live slots.  The words of a frame (one per live
+-- target, id at RESULT_W + 3 .. RESULT_W on m_axis_result) are latched by id as they come into a
+-- collecting bank and copied, in the clock the frame's last word (tlast) comes, into the bank the registers
+-- show (2 x MAX_TARGETS x 160 flip-flops), with RES_MASK (the ids with a word without flag no_target) and
+-- its frame_count: RES_SEL.id chooses the target whose word RES_HEAD returns and snapshots, so every
+-- target's word of one frame is read without tearing while the next frame's words come.
+-- INT_STATUS.result fires once per frame (its last word); lost / error / reacquired on any word of it;
+-- RESULT_COUNT counts frames, LOST / ERROR / REJECT_COUNT words.
 -- Generics: those of ms_tracker (passed through; the derived widths come from
 -- mstrack.fixed.vhdl_pkg.core_generics, core v2's from mstrack.hw.cosim.CoreConfigV2.tracker_generics)
--- and RESULT_STREAM.
+-- MAX_TARGETS (0: single target) and RESULT_STREAM.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -124,6 +136,7 @@ entity ms_tracker_axi is
     MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
     SCALE_TEST_D256: natural range 0 to 255 := 13; -- PRESET 1: the gated scale test: round(256 scale_test); 0 = off (mstrack-v2-colour)
     ORIENT_T       : integer range -1 to 2047 := 64; -- PRESET 1: the joint colour x orientation bins: orient_T; -1 = off (mstrack-v2-colour)
+    MAX_TARGETS    : natural range 0 to 16 := 0;  -- 0: one target (ms_tracker); 1 .. 16: ms_tracker_multi's slots (PRESET 1)
     RESULT_STREAM  : boolean := true              -- true: m_axis_result_* carries each result word
   );
   port (
@@ -156,10 +169,11 @@ entity ms_tracker_axi is
     s_axis_tlast         : in  std_logic;                                -- last pixel of a line
     s_axis_tuser         : in  std_logic;                                -- first pixel of a frame
     -- result stream (RESULT_STREAM = true)
-    m_axis_result_tdata  : out std_logic_vector(RESULT_W - 1 downto 0);  -- result word (result_layout / _v2)
+    m_axis_result_tdata  : out std_logic_vector(RESULT_W + 4 * minimum(MAX_TARGETS, 1) - 1 downto 0);  -- result word
+                                                                         -- (result_layout / _v2; MAX_TARGETS >= 1: _multi)
     m_axis_result_tvalid : out std_logic;                                -- result valid
     m_axis_result_tready : in  std_logic;                                -- result taken
-    m_axis_result_tlast  : out std_logic;                                -- always 1
+    m_axis_result_tlast  : out std_logic;                                -- 1 on a frame's last word (single target: always)
     -- interrupt
     irq                  : out std_logic                                 -- level, active high
   );
@@ -226,13 +240,31 @@ architecture rtl of ms_tracker_axi is
   signal ib_x, ib_y : signed(COORD_W + 1 downto 0) := (others => '0');
   signal ib_w, ib_h : unsigned(COORD_W downto 0) := (others => '0');
   -- results
-  signal r_data   : std_logic_vector(RESULT_W - 1 downto 0);
-  signal r_valid, r_ready, r_take : std_logic;
+  constant MULTI_W : natural := RESULT_W + 4 * minimum(MAX_TARGETS, 1);
+  signal r_data   : std_logic_vector(MULTI_W - 1 downto 0);                   -- the core's word (multi: with id)
+  signal r_valid, r_ready, r_take, r_last : std_logic;
+  signal r_id     : natural range 0 to 15;                                     -- target id of r_data (multi)
   signal r_word   : std_logic_vector(RAW_W - 1 downto 0);                      -- r_data, zero-extended
   signal c_lost, c_err, c_rej, c_reacq : std_logic;                           -- events of r_word
-  signal lat      : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- L
+  signal lat      : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- L (multi: RES_SEL's word)
   signal snap     : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- S
   signal lat_ok   : std_logic := '0';
+  signal head_id  : std_logic_vector(3 downto 0);                              -- target id of L (multi)
+  -- commands (multi)
+  signal cmd_v    : std_logic := '0';                  -- a command offered to the core
+  signal cmd_wait : std_logic := '0';                  -- taken, its report not yet come
+  signal cmd_op   : std_logic := '0';                  -- 0 add, 1 remove
+  signal cmd_tid  : unsigned(3 downto 0) := (others => '0');
+  signal cmd_rdy, cmd_done : std_logic;
+  signal cmd_code : unsigned(1 downto 0);
+  signal cmd_rid  : unsigned(3 downto 0);
+  signal ev_cmd   : std_logic := '0';
+  signal st_code  : std_logic_vector(1 downto 0) := (others => '0');
+  signal st_id    : std_logic_vector(3 downto 0) := (others => '0');
+  signal st_count : unsigned(15 downto 0) := (others => '0');
+  signal live     : std_logic_vector(15 downto 0) := (others => '0');
+  signal vis_mask : std_logic_vector(15 downto 0) := (others => '0');
+  signal vis_fc   : std_logic_vector(15 downto 0) := (others => '0');
   signal ev_res, ev_lost, ev_err, ev_rej, ev_reacq : std_logic := '0';
   signal busy     : std_logic;
   signal fw, fh   : unsigned(COORD_W - 1 downto 0);
@@ -268,6 +300,8 @@ begin
   assert PRESET = 0 or (V_FC + 16 <= RESULT_W and SIZE_W <= 32)
     report "ms_tracker_axi: result layout v2 and RESULT_W disagree" severity failure;
   assert COORD_W + 2 <= 16 report "ms_tracker_axi: init box registers are 16 bits" severity failure;
+  assert MAX_TARGETS = 0 or (PRESET = 1 and PPC = 1)
+    report "ms_tracker_axi: MAX_TARGETS >= 1 (ms_tracker_multi) needs PRESET 1 and PPC 1" severity failure;
 
   ---------------------------------------------------------------------------- registers
   u_regs : entity work.ms_tracker_regs
@@ -312,6 +346,7 @@ begin
   hw_in.INT_STATUS.lost.next_q   <= ev_lost;
   hw_in.INT_STATUS.error.next_q  <= ev_err or ev_rej;
   hw_in.INT_STATUS.reacquired.next_q <= ev_reacq;
+  hw_in.INT_STATUS.command.next_q <= ev_cmd;
   irq <= hw_out.INT_STATUS.intr;
   hw_in.RESULT_COUNT.count.incr <= ev_res;
   hw_in.LOST_COUNT.count.incr   <= ev_lost;
@@ -392,6 +427,16 @@ begin
     hw_in.RES_STATE.searched.next_q   <= fld(snap, V_SR, 4, 4);
   end generate;
   hw_in.RES_HEAD.valid.next_q       <= lat_ok;
+  hw_in.RES_HEAD.target_id.next_q   <= head_id;
+  -- multi-target registers (single target: 0)
+  hw_in.MULTI.max_targets.next_q    <= std_logic_vector(to_unsigned(MAX_TARGETS, 5));
+  hw_in.MULTI.live.next_q           <= live;
+  hw_in.CMD_STATUS.pending.next_q   <= cmd_v or cmd_wait;
+  hw_in.CMD_STATUS.code.next_q      <= st_code;
+  hw_in.CMD_STATUS.id.next_q        <= st_id;
+  hw_in.CMD_STATUS.reports.next_q   <= std_logic_vector(st_count);
+  hw_in.RES_MASK.mask.next_q        <= vis_mask;
+  hw_in.RES_MASK.frame_count.next_q <= vis_fc;
   hw_in.RES_RAW0.value.next_q       <= snap(31 downto 0);
   hw_in.RES_RAW1.value.next_q       <= snap(63 downto 32);
   hw_in.RES_RAW2.value.next_q       <= snap(95 downto 64);
@@ -437,12 +482,13 @@ begin
       if init_v = '1' and init_rdy = '1' then
         init_v <= '0';
       end if;
-      if hw_out.CMD.init.value = '1' then            -- copy the box; the latest command wins
+      -- copy the box; the latest command wins (multi-target: CMD.add too)
+      if hw_out.CMD.init.value = '1' or (MAX_TARGETS > 0 and hw_out.CMD.add.value = '1') then
         ib_x   <= sat_s(hw_out.INIT_POS.x.value, COORD_W + 2);
         ib_y   <= sat_s(hw_out.INIT_POS.y.value, COORD_W + 2);
         ib_w   <= sat_u(hw_out.INIT_SIZE.width.value, COORD_W + 1);
         ib_h   <= sat_u(hw_out.INIT_SIZE.height.value, COORD_W + 1);
-        init_v <= '1';
+        init_v <= '1' when MAX_TARGETS = 0 else '0';
       end if;
       if rst = '1' then
         init_v <= '0';
@@ -451,122 +497,335 @@ begin
   end process;
 
   ---------------------------------------------------------------------------- core
-  u_core : entity work.ms_tracker
-    generic map (
-      PRESET         => PRESET,
-      MAX_FRAME_W    => MAX_FRAME_W,
-      RGB_PACKING    => RGB_PACKING,
-      PPC            => PPC,
-      LANES          => LANES,
-      COLOUR_BITS    => COLOUR_BITS,
-      EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
-      EDGE_SHIFT     => EDGE_SHIFT,
-      FEATURES       => FEATURES,
-      KERNEL_EPAN    => KERNEL_EPAN,
-      KERNEL_BITS    => KERNEL_BITS,
-      MAX_HALF       => MAX_HALF,
-      MARGIN         => MARGIN,
-      COORD_W        => COORD_W,
-      CF             => CF,
-      WI             => WI,
-      WF             => WF,
-      RF             => RF,
-      AF             => AF,
-      RHO_OUT_FRAC   => RHO_OUT_FRAC,
-      MAX_ITER       => MAX_ITER,
-      EPS2           => EPS2,
-      HALF_W         => HALF_W,
-      REGION_MAX     => REGION_MAX,
-      REGION_W       => REGION_W,
-      STRIDE         => STRIDE,
-      ADDR_W         => ADDR_W,
-      KVAL_W         => KVAL_W,
-      HIST_W         => HIST_W,
-      COUNT_W        => COUNT_W,
-      POSSUM_W       => POSSUM_W,
-      KD_W           => KD_W,
-      SQRT_IN_W      => SQRT_IN_W,
-      RHO_SUM_W      => RHO_SUM_W,
-      RATIO_Q_W      => RATIO_Q_W,
-      WEIGHT_W       => WEIGHT_W,
-      SW_W           => SW_W,
-      SWX_W          => SWX_W,
-      SHIFT_Q_W      => SHIFT_Q_W,
-      CENTRE_W       => CENTRE_W,
-      CENTRE_ABS_W   => CENTRE_ABS_W,
-      ITER_W         => ITER_W,
-      RHO_OUT_W      => RHO_OUT_W,
-      ALPHA_W        => ALPHA_W,
-      WIN_W          => WIN_W,
-      RESULT_W       => RESULT_W,
-      PAD16          => PAD16,
-      RING16         => RING16,
-      MAX_WINDOW     => MAX_WINDOW,
-      KT_W           => KT_W,
-      ST2_W          => ST2_W,
-      SHARE_W        => SHARE_W,
-      SPREAD_W       => SPREAD_W,
-      SIZE_W         => SIZE_W,
-      SCALE_W        => SCALE_W,
-      SCALE_GAIN     => SCALE_GAIN,
-      SCALE_REG      => SCALE_REG,
-      SCALE_STEP     => SCALE_STEP,
-      SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
-      WR_Q_W         => WR_Q_W,
-      CON_W          => CON_W,
-      LOSS_K         => LOSS_K,
-      REF_K          => REF_K,
-      LOSS_RHO       => LOSS_RHO,
-      LOSS_CONTRAST  => LOSS_CONTRAST,
-      CONF_LOST      => CONF_LOST,
-      CONF_UNCERTAIN => CONF_UNCERTAIN,
-      CONF_REACQUIRE => CONF_REACQUIRE,
-      SPREAD_DEFAULT => SPREAD_DEFAULT,
-      BG_Q_W         => BG_Q_W,
-      BG_O_W         => BG_O_W,
-      SEARCH_ITER    => SEARCH_ITER,
-      STEP16         => STEP16,
-      MARGIN_MAX     => MARGIN_MAX,
-      SCALE_TEST_D256=> SCALE_TEST_D256,
-      ORIENT_T       => ORIENT_T
-    )
-    port map (
-      clk => clk, rst => rst, frame_width => fw, frame_height => fh,
-      s_init_tvalid => init_v, s_init_tready => init_rdy,
-      s_init_x => ib_x, s_init_y => ib_y, s_init_w => ib_w, s_init_h => ib_h,
-      s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
-      s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
-      m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
-      m_axis_result_tready => r_ready, m_axis_result_tlast => open,
-      busy => busy);
+  g_core1 : if MAX_TARGETS = 0 generate
+    u_core : entity work.ms_tracker
+      generic map (
+        PRESET         => PRESET,
+        MAX_FRAME_W    => MAX_FRAME_W,
+        RGB_PACKING    => RGB_PACKING,
+        PPC            => PPC,
+        LANES          => LANES,
+        COLOUR_BITS    => COLOUR_BITS,
+        EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
+        EDGE_SHIFT     => EDGE_SHIFT,
+        FEATURES       => FEATURES,
+        KERNEL_EPAN    => KERNEL_EPAN,
+        KERNEL_BITS    => KERNEL_BITS,
+        MAX_HALF       => MAX_HALF,
+        MARGIN         => MARGIN,
+        COORD_W        => COORD_W,
+        CF             => CF,
+        WI             => WI,
+        WF             => WF,
+        RF             => RF,
+        AF             => AF,
+        RHO_OUT_FRAC   => RHO_OUT_FRAC,
+        MAX_ITER       => MAX_ITER,
+        EPS2           => EPS2,
+        HALF_W         => HALF_W,
+        REGION_MAX     => REGION_MAX,
+        REGION_W       => REGION_W,
+        STRIDE         => STRIDE,
+        ADDR_W         => ADDR_W,
+        KVAL_W         => KVAL_W,
+        HIST_W         => HIST_W,
+        COUNT_W        => COUNT_W,
+        POSSUM_W       => POSSUM_W,
+        KD_W           => KD_W,
+        SQRT_IN_W      => SQRT_IN_W,
+        RHO_SUM_W      => RHO_SUM_W,
+        RATIO_Q_W      => RATIO_Q_W,
+        WEIGHT_W       => WEIGHT_W,
+        SW_W           => SW_W,
+        SWX_W          => SWX_W,
+        SHIFT_Q_W      => SHIFT_Q_W,
+        CENTRE_W       => CENTRE_W,
+        CENTRE_ABS_W   => CENTRE_ABS_W,
+        ITER_W         => ITER_W,
+        RHO_OUT_W      => RHO_OUT_W,
+        ALPHA_W        => ALPHA_W,
+        WIN_W          => WIN_W,
+        RESULT_W       => RESULT_W,
+        PAD16          => PAD16,
+        RING16         => RING16,
+        MAX_WINDOW     => MAX_WINDOW,
+        KT_W           => KT_W,
+        ST2_W          => ST2_W,
+        SHARE_W        => SHARE_W,
+        SPREAD_W       => SPREAD_W,
+        SIZE_W         => SIZE_W,
+        SCALE_W        => SCALE_W,
+        SCALE_GAIN     => SCALE_GAIN,
+        SCALE_REG      => SCALE_REG,
+        SCALE_STEP     => SCALE_STEP,
+        SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
+        WR_Q_W         => WR_Q_W,
+        CON_W          => CON_W,
+        LOSS_K         => LOSS_K,
+        REF_K          => REF_K,
+        LOSS_RHO       => LOSS_RHO,
+        LOSS_CONTRAST  => LOSS_CONTRAST,
+        CONF_LOST      => CONF_LOST,
+        CONF_UNCERTAIN => CONF_UNCERTAIN,
+        CONF_REACQUIRE => CONF_REACQUIRE,
+        SPREAD_DEFAULT => SPREAD_DEFAULT,
+        BG_Q_W         => BG_Q_W,
+        BG_O_W         => BG_O_W,
+        SEARCH_ITER    => SEARCH_ITER,
+        STEP16         => STEP16,
+        MARGIN_MAX     => MARGIN_MAX,
+        SCALE_TEST_D256=> SCALE_TEST_D256,
+        ORIENT_T       => ORIENT_T
+      )
+      port map (
+        clk => clk, rst => rst, frame_width => fw, frame_height => fh,
+        s_init_tvalid => init_v, s_init_tready => init_rdy,
+        s_init_x => ib_x, s_init_y => ib_y, s_init_w => ib_w, s_init_h => ib_h,
+        s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
+        s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+        m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+        m_axis_result_tready => r_ready, m_axis_result_tlast => open,
+        busy => busy);
+    r_id   <= 0;
+    r_last <= '1';
+    cmd_rdy  <= '0';
+    cmd_done <= '0';
+    cmd_code <= (others => '0');
+    cmd_rid  <= (others => '0');
+    cmd_v    <= '0';
+    cmd_wait <= '0';
+    cmd_op   <= '0';
+    cmd_tid  <= (others => '0');
+    ev_cmd   <= '0';
+    st_code  <= (others => '0');
+    st_id    <= (others => '0');
+    st_count <= (others => '0');
+    live     <= (others => '0');
+    vis_mask <= (others => '0');
+    vis_fc   <= (others => '0');
+    head_id  <= (others => '0');
+
+    p_lat : process(clk)
+    begin
+      if rising_edge(clk) then
+        if r_take = '1' then                         -- L: the whole word in one clock
+          lat    <= r_word;
+          lat_ok <= '1';
+        end if;
+        if rst = '1' then
+          lat    <= (others => '0');
+          lat_ok <= '0';
+        end if;
+      end if;
+    end process;
+  end generate;
+
+  g_coreN : if MAX_TARGETS > 0 generate
+    type bank_t is array (0 to MAX_TARGETS - 1) of std_logic_vector(RAW_W - 1 downto 0);
+    signal coll, vis : bank_t := (others => (others => '0'));   -- the frame's words as they come / shown
+    signal coll_m    : std_logic_vector(MAX_TARGETS - 1 downto 0) := (others => '0');
+    signal vis_ok    : std_logic := '0';                         -- a frame has completed since reset
+    signal live_n    : std_logic_vector(MAX_TARGETS - 1 downto 0);
+    signal sel       : natural range 0 to 15;
+  begin
+    u_core : entity work.ms_tracker_multi
+      generic map (
+        MAX_TARGETS    => MAX_TARGETS,
+        MAX_FRAME_W    => MAX_FRAME_W,
+        RGB_PACKING    => RGB_PACKING,
+        LANES          => LANES,
+        COLOUR_BITS    => COLOUR_BITS,
+        EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
+        EDGE_SHIFT     => EDGE_SHIFT,
+        FEATURES       => FEATURES,
+        KERNEL_EPAN    => KERNEL_EPAN,
+        KERNEL_BITS    => KERNEL_BITS,
+        MAX_HALF       => MAX_HALF,
+        MARGIN         => MARGIN,
+        COORD_W        => COORD_W,
+        CF             => CF,
+        WI             => WI,
+        WF             => WF,
+        RF             => RF,
+        AF             => AF,
+        RHO_OUT_FRAC   => RHO_OUT_FRAC,
+        MAX_ITER       => MAX_ITER,
+        EPS2           => EPS2,
+        HALF_W         => HALF_W,
+        REGION_MAX     => REGION_MAX,
+        REGION_W       => REGION_W,
+        STRIDE         => STRIDE,
+        ADDR_W         => ADDR_W,
+        KVAL_W         => KVAL_W,
+        HIST_W         => HIST_W,
+        COUNT_W        => COUNT_W,
+        POSSUM_W       => POSSUM_W,
+        KD_W           => KD_W,
+        SQRT_IN_W      => SQRT_IN_W,
+        RHO_SUM_W      => RHO_SUM_W,
+        RATIO_Q_W      => RATIO_Q_W,
+        WEIGHT_W       => WEIGHT_W,
+        SW_W           => SW_W,
+        SWX_W          => SWX_W,
+        SHIFT_Q_W      => SHIFT_Q_W,
+        CENTRE_W       => CENTRE_W,
+        CENTRE_ABS_W   => CENTRE_ABS_W,
+        ITER_W         => ITER_W,
+        RHO_OUT_W      => RHO_OUT_W,
+        ALPHA_W        => ALPHA_W,
+        WIN_W          => WIN_W,
+        RESULT_W       => RESULT_W,
+        PAD16          => PAD16,
+        RING16         => RING16,
+        MAX_WINDOW     => MAX_WINDOW,
+        KT_W           => KT_W,
+        ST2_W          => ST2_W,
+        SHARE_W        => SHARE_W,
+        SPREAD_W       => SPREAD_W,
+        SIZE_W         => SIZE_W,
+        SCALE_W        => SCALE_W,
+        SCALE_GAIN     => SCALE_GAIN,
+        SCALE_REG      => SCALE_REG,
+        SCALE_STEP     => SCALE_STEP,
+        SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
+        WR_Q_W         => WR_Q_W,
+        CON_W          => CON_W,
+        LOSS_K         => LOSS_K,
+        REF_K          => REF_K,
+        LOSS_RHO       => LOSS_RHO,
+        LOSS_CONTRAST  => LOSS_CONTRAST,
+        CONF_LOST      => CONF_LOST,
+        CONF_UNCERTAIN => CONF_UNCERTAIN,
+        CONF_REACQUIRE => CONF_REACQUIRE,
+        SPREAD_DEFAULT => SPREAD_DEFAULT,
+        BG_Q_W         => BG_Q_W,
+        BG_O_W         => BG_O_W,
+        SEARCH_ITER    => SEARCH_ITER,
+        STEP16         => STEP16,
+        MARGIN_MAX     => MARGIN_MAX,
+        SCALE_TEST_D256=> SCALE_TEST_D256,
+        ORIENT_T       => ORIENT_T
+      )
+      port map (
+        clk => clk, rst => rst, frame_width => fw, frame_height => fh,
+        s_cmd_tvalid => cmd_v, s_cmd_tready => cmd_rdy, s_cmd_op => cmd_op, s_cmd_id => cmd_tid,
+        s_cmd_x => ib_x, s_cmd_y => ib_y, s_cmd_w => ib_w, s_cmd_h => ib_h,
+        cmd_done => cmd_done, cmd_code => cmd_code, cmd_id => cmd_rid,
+        s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
+        s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+        m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+        m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
+        live => live_n, busy => busy);
+    r_id <= to_integer(unsigned(r_data(MULTI_W - 1 downto RESULT_W)));
+    init_rdy <= '1';                                   -- (CMD.init is an add here: init_v stays 0)
+    live <= std_logic_vector(resize(unsigned(live_n), 16));
+
+    -- commands: copied at the write of CMD (add / init: the box of p_init; remove: TARGET.id), offered
+    -- until the core takes it; the latest write wins while not taken
+    p_cmd : process(clk)
+    begin
+      if rising_edge(clk) then
+        ev_cmd <= cmd_done;
+        if cmd_v = '1' and cmd_rdy = '1' then
+          cmd_v    <= '0';
+          cmd_wait <= '1';
+        end if;
+        if cmd_done = '1' then
+          cmd_wait <= '0';
+          st_code  <= std_logic_vector(cmd_code);
+          st_id    <= std_logic_vector(cmd_rid);
+          st_count <= st_count + 1;
+        end if;
+        if hw_out.CMD.remove.value = '1' then
+          cmd_v   <= '1';
+          cmd_op  <= '1';
+          cmd_tid <= unsigned(hw_out.TARGET.id.value);
+        elsif hw_out.CMD.add.value = '1' or hw_out.CMD.init.value = '1' then
+          cmd_v  <= '1';
+          cmd_op <= '0';
+        end if;
+        if rst = '1' then
+          cmd_v    <= '0';
+          cmd_wait <= '0';
+          ev_cmd   <= '0';
+          st_code  <= (others => '0');
+          st_id    <= (others => '0');
+          st_count <= (others => '0');
+        end if;
+      end if;
+    end process;
+
+    -- the frame's words by id into coll; at its last word coll (with that word) is shown in vis
+    p_bank : process(clk)
+      variable m : std_logic_vector(MAX_TARGETS - 1 downto 0);
+    begin
+      if rising_edge(clk) then
+        if r_take = '1' then
+          m := coll_m;
+          for i in 0 to MAX_TARGETS - 1 loop           -- loops, not variable indices (docs/hdl_flow.md)
+            if r_id = i then
+              coll(i) <= r_word;
+              m(i) := not r_word(V_FL + F_NOT);
+            end if;
+            if r_last = '1' then
+              vis(i) <= r_word when r_id = i else coll(i);
+            end if;
+          end loop;
+          if r_last = '1' then
+            vis_mask <= std_logic_vector(resize(unsigned(m), 16));
+            vis_fc   <= r_word(V_FC + 15 downto V_FC);
+            vis_ok   <= '1';
+            coll_m   <= (others => '0');
+          else
+            coll_m   <= m;
+          end if;
+        end if;
+        if rst = '1' then
+          coll_m   <= (others => '0');
+          vis_mask <= (others => '0');
+          vis_fc   <= (others => '0');
+          vis_ok   <= '0';
+        end if;
+      end if;
+    end process;
+
+    -- L: the word of target RES_SEL.id (an id >= MAX_TARGETS reads as no result)
+    sel <= to_integer(unsigned(hw_out.RES_SEL.id.value));
+    p_sel : process(all)
+    begin
+      lat    <= (others => '0');
+      lat_ok <= '0';
+      for i in 0 to MAX_TARGETS - 1 loop
+        if sel = i then
+          lat    <= vis(i);
+          lat_ok <= vis_ok;
+        end if;
+      end loop;
+    end process;
+    head_id <= hw_out.RES_SEL.id.value when sel < MAX_TARGETS else (others => '0');
+  end generate;
 
   ---------------------------------------------------------------------------- results
   r_ready <= m_axis_result_tready when RESULT_STREAM else '1';
   r_take  <= r_valid and r_ready;
   m_axis_result_tdata  <= r_data;
   m_axis_result_tvalid <= r_valid when RESULT_STREAM else '0';
-  m_axis_result_tlast  <= '1';
-  r_word <= std_logic_vector(resize(unsigned(r_data), RAW_W));
+  m_axis_result_tlast  <= r_last;
+  r_word <= std_logic_vector(resize(unsigned(r_data(RESULT_W - 1 downto 0)), RAW_W));
 
   p_result : process(clk)
   begin
     if rising_edge(clk) then
-      ev_res  <= r_take;
+      ev_res  <= r_take and r_last;                  -- once per frame
       ev_lost <= r_take and c_lost;
       ev_err  <= r_take and c_err;
       ev_rej  <= r_take and c_rej;
       ev_reacq <= r_take and c_reacq;
-      if r_take = '1' then                           -- L: the whole word in one clock
-        lat    <= r_word;
-        lat_ok <= '1';
-      end if;
       if hw_out.RES_HEAD.frame_count.swacc = '1' then  -- read of RES_HEAD: S <= L, same clock
         snap <= lat;
       end if;
       if rst = '1' then
-        lat    <= (others => '0');
         snap   <= (others => '0');
-        lat_ok <= '0';
         ev_res <= '0';
         ev_lost <= '0';
         ev_err <= '0';

@@ -147,7 +147,8 @@ entity ms_tracker_multi is
     m_axis_result_tvalid : out std_logic;
     m_axis_result_tready : in  std_logic;
     m_axis_result_tlast  : out std_logic;
-    live                 : out std_logic_vector(MAX_TARGETS - 1 downto 0)   -- slots holding a target (or its add)
+    live                 : out std_logic_vector(MAX_TARGETS - 1 downto 0);  -- slots holding a target (or its add)
+    busy                 : out std_logic                                    -- an engine's mean shift is running
   );
 end entity;
 
@@ -162,7 +163,7 @@ architecture rtl of ms_tracker_multi is
   constant F_NOT  : natural := 5;
 
   type words_t is array (0 to N - 1) of std_logic_vector(RESULT_W - 1 downto 0);
-  signal e_init_v, e_init_r, e_ready, e_rvalid, e_rst : std_logic_vector(N - 1 downto 0) := (others => '0');
+  signal e_init_v, e_init_r, e_ready, e_rvalid, e_rst, e_busy : std_logic_vector(N - 1 downto 0) := (others => '0');
   signal e_word   : words_t;
   signal w_reg    : words_t := (others => (others => '0'));
   signal all_idle, all_rvalid, any_rvalid, v_open, cmd_take, m_take : std_logic;
@@ -302,7 +303,7 @@ begin
         s_axis_tdata => b_data, s_axis_tvalid => e_valid(k), s_axis_tready => e_ready(k),
         s_axis_tlast => b_last, s_axis_tuser => b_user,
         m_axis_result_tdata => e_word(k), m_axis_result_tvalid => e_rvalid(k),
-        m_axis_result_tready => m_take, m_axis_result_tlast => open, busy => open);
+        m_axis_result_tready => m_take, m_axis_result_tlast => open, busy => e_busy(k));
   end generate;
 
   -- the beat register is free when empty or when every engine that has not taken its beat takes it now;
@@ -501,4 +502,5 @@ begin
   cmd_code <= code_r;
   cmd_id   <= id_r;
   live     <= alloc;
+  busy     <= '0' when e_busy = (e_busy'range => '0') else '1';
 end architecture;

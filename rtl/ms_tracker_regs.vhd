@@ -103,6 +103,8 @@ architecture rtl of ms_tracker_regs is
         REJECT_COUNT : std_logic;
         DROP_COUNT : std_logic;
         CONFIG_V2 : std_logic;
+        TARGET : std_logic;
+        MULTI : std_logic;
         RES_HEAD : std_logic;
         RES_CX : std_logic;
         RES_CY : std_logic;
@@ -120,6 +122,9 @@ architecture rtl of ms_tracker_regs is
         RES_RAW2 : std_logic;
         RES_RAW3 : std_logic;
         RES_RAW4 : std_logic;
+        CMD_STATUS : std_logic;
+        RES_SEL : std_logic;
+        RES_MASK : std_logic;
     end record;
     signal decoded_reg_strb : decoded_reg_strb_t;
     signal decoded_err : std_logic;
@@ -197,9 +202,21 @@ architecture rtl of ms_tracker_regs is
         load_next : std_logic;
     end record;
 
+    type \ms_tracker_regs.CMD.add_combo_t\ is record
+        next_q : std_logic;
+        load_next : std_logic;
+    end record;
+
+    type \ms_tracker_regs.CMD.remove_combo_t\ is record
+        next_q : std_logic;
+        load_next : std_logic;
+    end record;
+
     type \ms_tracker_regs.CMD_combo_t\ is record
         init : \ms_tracker_regs.CMD.init_combo_t\;
         clear_counters : \ms_tracker_regs.CMD.clear_counters_combo_t\;
+        add : \ms_tracker_regs.CMD.add_combo_t\;
+        remove : \ms_tracker_regs.CMD.remove_combo_t\;
     end record;
 
     type \ms_tracker_regs.INT_STATUS.result_combo_t\ is record
@@ -222,11 +239,17 @@ architecture rtl of ms_tracker_regs is
         load_next : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_STATUS.command_combo_t\ is record
+        next_q : std_logic;
+        load_next : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_STATUS_combo_t\ is record
         result : \ms_tracker_regs.INT_STATUS.result_combo_t\;
         lost : \ms_tracker_regs.INT_STATUS.lost_combo_t\;
         error : \ms_tracker_regs.INT_STATUS.error_combo_t\;
         reacquired : \ms_tracker_regs.INT_STATUS.reacquired_combo_t\;
+        command : \ms_tracker_regs.INT_STATUS.command_combo_t\;
     end record;
 
     type \ms_tracker_regs.INT_ENABLE.result_combo_t\ is record
@@ -249,11 +272,17 @@ architecture rtl of ms_tracker_regs is
         load_next : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_ENABLE.command_combo_t\ is record
+        next_q : std_logic;
+        load_next : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_ENABLE_combo_t\ is record
         result : \ms_tracker_regs.INT_ENABLE.result_combo_t\;
         lost : \ms_tracker_regs.INT_ENABLE.lost_combo_t\;
         error : \ms_tracker_regs.INT_ENABLE.error_combo_t\;
         reacquired : \ms_tracker_regs.INT_ENABLE.reacquired_combo_t\;
+        command : \ms_tracker_regs.INT_ENABLE.command_combo_t\;
     end record;
 
     type \ms_tracker_regs.RESULT_COUNT.count_combo_t\ is record
@@ -311,6 +340,24 @@ architecture rtl of ms_tracker_regs is
         count : \ms_tracker_regs.DROP_COUNT.count_combo_t\;
     end record;
 
+    type \ms_tracker_regs.TARGET.id_combo_t\ is record
+        next_q : std_logic_vector(3 downto 0);
+        load_next : std_logic;
+    end record;
+
+    type \ms_tracker_regs.TARGET_combo_t\ is record
+        id : \ms_tracker_regs.TARGET.id_combo_t\;
+    end record;
+
+    type \ms_tracker_regs.RES_SEL.id_combo_t\ is record
+        next_q : std_logic_vector(3 downto 0);
+        load_next : std_logic;
+    end record;
+
+    type \ms_tracker_regs.RES_SEL_combo_t\ is record
+        id : \ms_tracker_regs.RES_SEL.id_combo_t\;
+    end record;
+
     type field_combo_t is record
         CTRL : \ms_tracker_regs.CTRL_combo_t\;
         FRAME_SIZE : \ms_tracker_regs.FRAME_SIZE_combo_t\;
@@ -324,6 +371,8 @@ architecture rtl of ms_tracker_regs is
         ERROR_COUNT : \ms_tracker_regs.ERROR_COUNT_combo_t\;
         REJECT_COUNT : \ms_tracker_regs.REJECT_COUNT_combo_t\;
         DROP_COUNT : \ms_tracker_regs.DROP_COUNT_combo_t\;
+        TARGET : \ms_tracker_regs.TARGET_combo_t\;
+        RES_SEL : \ms_tracker_regs.RES_SEL_combo_t\;
     end record;
     signal field_combo : field_combo_t;
 
@@ -383,9 +432,19 @@ architecture rtl of ms_tracker_regs is
         value : std_logic;
     end record;
 
+    type \ms_tracker_regs.CMD.add_storage_t\ is record
+        value : std_logic;
+    end record;
+
+    type \ms_tracker_regs.CMD.remove_storage_t\ is record
+        value : std_logic;
+    end record;
+
     type \ms_tracker_regs.CMD_storage_t\ is record
         init : \ms_tracker_regs.CMD.init_storage_t\;
         clear_counters : \ms_tracker_regs.CMD.clear_counters_storage_t\;
+        add : \ms_tracker_regs.CMD.add_storage_t\;
+        remove : \ms_tracker_regs.CMD.remove_storage_t\;
     end record;
 
     type \ms_tracker_regs.INT_STATUS.result_storage_t\ is record
@@ -404,11 +463,16 @@ architecture rtl of ms_tracker_regs is
         value : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_STATUS.command_storage_t\ is record
+        value : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_STATUS_storage_t\ is record
         result : \ms_tracker_regs.INT_STATUS.result_storage_t\;
         lost : \ms_tracker_regs.INT_STATUS.lost_storage_t\;
         error : \ms_tracker_regs.INT_STATUS.error_storage_t\;
         reacquired : \ms_tracker_regs.INT_STATUS.reacquired_storage_t\;
+        command : \ms_tracker_regs.INT_STATUS.command_storage_t\;
     end record;
 
     type \ms_tracker_regs.INT_ENABLE.result_storage_t\ is record
@@ -427,11 +491,16 @@ architecture rtl of ms_tracker_regs is
         value : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_ENABLE.command_storage_t\ is record
+        value : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_ENABLE_storage_t\ is record
         result : \ms_tracker_regs.INT_ENABLE.result_storage_t\;
         lost : \ms_tracker_regs.INT_ENABLE.lost_storage_t\;
         error : \ms_tracker_regs.INT_ENABLE.error_storage_t\;
         reacquired : \ms_tracker_regs.INT_ENABLE.reacquired_storage_t\;
+        command : \ms_tracker_regs.INT_ENABLE.command_storage_t\;
     end record;
 
     type \ms_tracker_regs.RESULT_COUNT.count_storage_t\ is record
@@ -474,6 +543,22 @@ architecture rtl of ms_tracker_regs is
         count : \ms_tracker_regs.DROP_COUNT.count_storage_t\;
     end record;
 
+    type \ms_tracker_regs.TARGET.id_storage_t\ is record
+        value : std_logic_vector(3 downto 0);
+    end record;
+
+    type \ms_tracker_regs.TARGET_storage_t\ is record
+        id : \ms_tracker_regs.TARGET.id_storage_t\;
+    end record;
+
+    type \ms_tracker_regs.RES_SEL.id_storage_t\ is record
+        value : std_logic_vector(3 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_SEL_storage_t\ is record
+        id : \ms_tracker_regs.RES_SEL.id_storage_t\;
+    end record;
+
     type field_storage_t is record
         CTRL : \ms_tracker_regs.CTRL_storage_t\;
         FRAME_SIZE : \ms_tracker_regs.FRAME_SIZE_storage_t\;
@@ -487,6 +572,8 @@ architecture rtl of ms_tracker_regs is
         ERROR_COUNT : \ms_tracker_regs.ERROR_COUNT_storage_t\;
         REJECT_COUNT : \ms_tracker_regs.REJECT_COUNT_storage_t\;
         DROP_COUNT : \ms_tracker_regs.DROP_COUNT_storage_t\;
+        TARGET : \ms_tracker_regs.TARGET_storage_t\;
+        RES_SEL : \ms_tracker_regs.RES_SEL_storage_t\;
     end record;
     signal field_storage : field_storage_t;
 
@@ -757,6 +844,12 @@ begin
         decoded_reg_strb.CONFIG_V2 <= cpuif_req_masked and (cpuif_addr = 16#44#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#44#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#44#) and not cpuif_req_is_wr);
+        decoded_reg_strb.TARGET <= cpuif_req_masked and (cpuif_addr = 16#48#);
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#48#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#48#));
+        decoded_reg_strb.MULTI <= cpuif_req_masked and (cpuif_addr = 16#4C#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#4C#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#4C#) and not cpuif_req_is_wr);
         decoded_reg_strb.RES_HEAD <= cpuif_req_masked and (cpuif_addr = 16#50#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#50#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#50#) and not cpuif_req_is_wr);
@@ -808,6 +901,15 @@ begin
         decoded_reg_strb.RES_RAW4 <= cpuif_req_masked and (cpuif_addr = 16#90#) and not cpuif_req_is_wr;
         is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#90#));
         is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#90#) and not cpuif_req_is_wr);
+        decoded_reg_strb.CMD_STATUS <= cpuif_req_masked and (cpuif_addr = 16#94#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#94#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#94#) and not cpuif_req_is_wr);
+        decoded_reg_strb.RES_SEL <= cpuif_req_masked and (cpuif_addr = 16#98#);
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#98#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#98#));
+        decoded_reg_strb.RES_MASK <= cpuif_req_masked and (cpuif_addr = 16#9C#) and not cpuif_req_is_wr;
+        is_valid_addr := is_valid_addr or (cpuif_req_masked and (cpuif_addr = 16#9C#));
+        is_valid_rw := is_valid_rw or (cpuif_req_masked and (cpuif_addr = 16#9C#) and not cpuif_req_is_wr);
         decoded_err <= (not is_valid_addr or (is_valid_addr and not is_valid_rw)) and decoded_req;
     end process;
 
@@ -1091,6 +1193,70 @@ begin
     end process;
     hwif_out.CMD.clear_counters.value <= field_storage.CMD.clear_counters.value;
 
+    -- Field: ms_tracker_regs.CMD.add
+    process(all)
+        variable next_c: std_logic;
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.CMD.add.value;
+        load_next_c := '0';
+        if decoded_reg_strb.CMD and decoded_req_is_wr then -- SW write
+            next_c := (field_storage.CMD.add.value and not decoded_wr_biten(2)) or (decoded_wr_data(2) and decoded_wr_biten(2));
+            load_next_c := '1';
+        else -- singlepulse clears back to 0
+            next_c := '0';
+            load_next_c := '1';
+        end if;
+        field_combo.CMD.add.next_q <= next_c;
+        field_combo.CMD.add.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.CMD.add.value <= '0';
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.CMD.add.value <= '0';
+            else
+                if field_combo.CMD.add.load_next then
+                    field_storage.CMD.add.value <= field_combo.CMD.add.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
+    hwif_out.CMD.add.value <= field_storage.CMD.add.value;
+
+    -- Field: ms_tracker_regs.CMD.remove
+    process(all)
+        variable next_c: std_logic;
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.CMD.remove.value;
+        load_next_c := '0';
+        if decoded_reg_strb.CMD and decoded_req_is_wr then -- SW write
+            next_c := (field_storage.CMD.remove.value and not decoded_wr_biten(3)) or (decoded_wr_data(3) and decoded_wr_biten(3));
+            load_next_c := '1';
+        else -- singlepulse clears back to 0
+            next_c := '0';
+            load_next_c := '1';
+        end if;
+        field_combo.CMD.remove.next_q <= next_c;
+        field_combo.CMD.remove.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.CMD.remove.value <= '0';
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.CMD.remove.value <= '0';
+            else
+                if field_combo.CMD.remove.load_next then
+                    field_storage.CMD.remove.value <= field_combo.CMD.remove.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
+    hwif_out.CMD.remove.value <= field_storage.CMD.remove.value;
+
     -- Field: ms_tracker_regs.INT_STATUS.result
     process(all)
         variable next_c: std_logic;
@@ -1214,11 +1380,43 @@ begin
             end if;
         end if;
     end process;
+
+    -- Field: ms_tracker_regs.INT_STATUS.command
+    process(all)
+        variable next_c: std_logic;
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.INT_STATUS.command.value;
+        load_next_c := '0';
+        if decoded_reg_strb.INT_STATUS and decoded_req_is_wr then -- SW write 1 clear
+            next_c := field_storage.INT_STATUS.command.value and not (decoded_wr_data(4) and decoded_wr_biten(4));
+            load_next_c := '1';
+        elsif hwif_in.INT_STATUS.command.next_q then -- stickybit
+            next_c := '1';
+            load_next_c := '1';
+        end if;
+        field_combo.INT_STATUS.command.next_q <= next_c;
+        field_combo.INT_STATUS.command.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.INT_STATUS.command.value <= '0';
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.INT_STATUS.command.value <= '0';
+            else
+                if field_combo.INT_STATUS.command.load_next then
+                    field_storage.INT_STATUS.command.value <= field_combo.INT_STATUS.command.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
     hwif_out.INT_STATUS.intr <=
         (field_storage.INT_STATUS.result.value and field_storage.INT_ENABLE.result.value)
         or (field_storage.INT_STATUS.lost.value and field_storage.INT_ENABLE.lost.value)
         or (field_storage.INT_STATUS.error.value and field_storage.INT_ENABLE.error.value)
-        or (field_storage.INT_STATUS.reacquired.value and field_storage.INT_ENABLE.reacquired.value);
+        or (field_storage.INT_STATUS.reacquired.value and field_storage.INT_ENABLE.reacquired.value)
+        or (field_storage.INT_STATUS.command.value and field_storage.INT_ENABLE.command.value);
 
     -- Field: ms_tracker_regs.INT_ENABLE.result
     process(all)
@@ -1327,6 +1525,34 @@ begin
             else
                 if field_combo.INT_ENABLE.reacquired.load_next then
                     field_storage.INT_ENABLE.reacquired.value <= field_combo.INT_ENABLE.reacquired.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
+
+    -- Field: ms_tracker_regs.INT_ENABLE.command
+    process(all)
+        variable next_c: std_logic;
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.INT_ENABLE.command.value;
+        load_next_c := '0';
+        if decoded_reg_strb.INT_ENABLE and decoded_req_is_wr then -- SW write
+            next_c := (field_storage.INT_ENABLE.command.value and not decoded_wr_biten(4)) or (decoded_wr_data(4) and decoded_wr_biten(4));
+            load_next_c := '1';
+        end if;
+        field_combo.INT_ENABLE.command.next_q <= next_c;
+        field_combo.INT_ENABLE.command.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.INT_ENABLE.command.value <= '0';
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.INT_ENABLE.command.value <= '0';
+            else
+                if field_combo.INT_ENABLE.command.load_next then
+                    field_storage.INT_ENABLE.command.value <= field_combo.INT_ENABLE.command.next_q;
                 end if;
             end if;
         end if;
@@ -1521,7 +1747,65 @@ begin
             end if;
         end if;
     end process;
+
+    -- Field: ms_tracker_regs.TARGET.id
+    process(all)
+        variable next_c: std_logic_vector(3 downto 0);
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.TARGET.id.value;
+        load_next_c := '0';
+        if decoded_reg_strb.TARGET and decoded_req_is_wr then -- SW write
+            next_c := (field_storage.TARGET.id.value and not decoded_wr_biten(3 downto 0)) or (decoded_wr_data(3 downto 0) and decoded_wr_biten(3 downto 0));
+            load_next_c := '1';
+        end if;
+        field_combo.TARGET.id.next_q <= next_c;
+        field_combo.TARGET.id.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.TARGET.id.value <= 4x"0";
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.TARGET.id.value <= 4x"0";
+            else
+                if field_combo.TARGET.id.load_next then
+                    field_storage.TARGET.id.value <= field_combo.TARGET.id.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
+    hwif_out.TARGET.id.value <= field_storage.TARGET.id.value;
     hwif_out.RES_HEAD.frame_count.swacc <= decoded_reg_strb.RES_HEAD;
+
+    -- Field: ms_tracker_regs.RES_SEL.id
+    process(all)
+        variable next_c: std_logic_vector(3 downto 0);
+        variable load_next_c: std_logic;
+    begin
+        next_c := field_storage.RES_SEL.id.value;
+        load_next_c := '0';
+        if decoded_reg_strb.RES_SEL and decoded_req_is_wr then -- SW write
+            next_c := (field_storage.RES_SEL.id.value and not decoded_wr_biten(3 downto 0)) or (decoded_wr_data(3 downto 0) and decoded_wr_biten(3 downto 0));
+            load_next_c := '1';
+        end if;
+        field_combo.RES_SEL.id.next_q <= next_c;
+        field_combo.RES_SEL.id.load_next <= load_next_c;
+    end process;
+    process(clk) begin
+        if false then -- async reset
+            field_storage.RES_SEL.id.value <= 4x"0";
+        elsif rising_edge(clk) then
+            if rst then -- sync reset
+                field_storage.RES_SEL.id.value <= 4x"0";
+            else
+                if field_combo.RES_SEL.id.load_next then
+                    field_storage.RES_SEL.id.value <= field_combo.RES_SEL.id.next_q;
+                end if;
+            end if;
+        end if;
+    end process;
+    hwif_out.RES_SEL.id.value <= field_storage.RES_SEL.id.value;
 
     ----------------------------------------------------------------------------
     -- Write response
@@ -1542,7 +1826,7 @@ begin
             readback_data_var(31 downto 0) := 32x"4D53544B";
         end if;
         if rd_mux_addr = 16#4# then
-            readback_data_var(7 downto 0) := 8x"2";
+            readback_data_var(7 downto 0) := 8x"3";
             readback_data_var(15 downto 8) := 8x"1";
             readback_data_var(19 downto 16) := hwif_in.VERSION.result_version.next_q;
             readback_data_var(31 downto 24) := hwif_in.VERSION.result_width.next_q;
@@ -1588,12 +1872,14 @@ begin
             readback_data_var(1) := field_storage.INT_STATUS.lost.value;
             readback_data_var(2) := field_storage.INT_STATUS.error.value;
             readback_data_var(3) := field_storage.INT_STATUS.reacquired.value;
+            readback_data_var(4) := field_storage.INT_STATUS.command.value;
         end if;
         if rd_mux_addr = 16#2C# then
             readback_data_var(0) := field_storage.INT_ENABLE.result.value;
             readback_data_var(1) := field_storage.INT_ENABLE.lost.value;
             readback_data_var(2) := field_storage.INT_ENABLE.error.value;
             readback_data_var(3) := field_storage.INT_ENABLE.reacquired.value;
+            readback_data_var(4) := field_storage.INT_ENABLE.command.value;
         end if;
         if rd_mux_addr = 16#30# then
             readback_data_var(31 downto 0) := field_storage.RESULT_COUNT.count.value;
@@ -1615,10 +1901,18 @@ begin
             readback_data_var(18 downto 8) := hwif_in.CONFIG_V2.orient_t.next_q;
             readback_data_var(31 downto 24) := hwif_in.CONFIG_V2.scale_test_d256.next_q;
         end if;
+        if rd_mux_addr = 16#48# then
+            readback_data_var(3 downto 0) := field_storage.TARGET.id.value;
+        end if;
+        if rd_mux_addr = 16#4C# then
+            readback_data_var(4 downto 0) := hwif_in.MULTI.max_targets.next_q;
+            readback_data_var(31 downto 16) := hwif_in.MULTI.live.next_q;
+        end if;
         if rd_mux_addr = 16#50# then
             readback_data_var(15 downto 0) := hwif_in.RES_HEAD.frame_count.next_q;
             readback_data_var(23 downto 16) := hwif_in.RES_HEAD.flags.next_q;
             readback_data_var(26 downto 24) := hwif_in.RES_HEAD.err_code.next_q;
+            readback_data_var(30 downto 27) := hwif_in.RES_HEAD.target_id.next_q;
             readback_data_var(31) := hwif_in.RES_HEAD.valid.next_q;
         end if;
         if rd_mux_addr = 16#54# then
@@ -1676,6 +1970,19 @@ begin
         end if;
         if rd_mux_addr = 16#90# then
             readback_data_var(31 downto 0) := hwif_in.RES_RAW4.value.next_q;
+        end if;
+        if rd_mux_addr = 16#94# then
+            readback_data_var(0) := hwif_in.CMD_STATUS.pending.next_q;
+            readback_data_var(5 downto 4) := hwif_in.CMD_STATUS.code.next_q;
+            readback_data_var(11 downto 8) := hwif_in.CMD_STATUS.id.next_q;
+            readback_data_var(31 downto 16) := hwif_in.CMD_STATUS.reports.next_q;
+        end if;
+        if rd_mux_addr = 16#98# then
+            readback_data_var(3 downto 0) := field_storage.RES_SEL.id.value;
+        end if;
+        if rd_mux_addr = 16#9C# then
+            readback_data_var(15 downto 0) := hwif_in.RES_MASK.mask.next_q;
+            readback_data_var(31 downto 16) := hwif_in.RES_MASK.frame_count.next_q;
         end if;
         readback_data <= readback_data_var;
         readback_done <= decoded_req and not decoded_req_is_wr;

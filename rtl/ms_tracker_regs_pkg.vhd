@@ -10,7 +10,7 @@ package ms_tracker_regs_pkg is
 
     constant MS_TRACKER_REGS_DATA_WIDTH : positive := 32;
     constant MS_TRACKER_REGS_MIN_ADDR_WIDTH : positive := 12;
-    constant MS_TRACKER_REGS_SIZE : positive := 148;
+    constant MS_TRACKER_REGS_SIZE : positive := 160;
 
     type \ms_tracker_regs.VERSION.result_version_in_t\ is record
         next_q : std_logic_vector(3 downto 0);
@@ -125,11 +125,16 @@ package ms_tracker_regs_pkg is
         next_q : std_logic;
     end record;
 
+    type \ms_tracker_regs.INT_STATUS.command_in_t\ is record
+        next_q : std_logic;
+    end record;
+
     type \ms_tracker_regs.INT_STATUS_in_t\ is record
         result : \ms_tracker_regs.INT_STATUS.result_in_t\;
         lost : \ms_tracker_regs.INT_STATUS.lost_in_t\;
         error : \ms_tracker_regs.INT_STATUS.error_in_t\;
         reacquired : \ms_tracker_regs.INT_STATUS.reacquired_in_t\;
+        command : \ms_tracker_regs.INT_STATUS.command_in_t\;
     end record;
 
     type \ms_tracker_regs.RESULT_COUNT.count_in_t\ is record
@@ -190,6 +195,19 @@ package ms_tracker_regs_pkg is
         scale_test_d256 : \ms_tracker_regs.CONFIG_V2.scale_test_d256_in_t\;
     end record;
 
+    type \ms_tracker_regs.MULTI.max_targets_in_t\ is record
+        next_q : std_logic_vector(4 downto 0);
+    end record;
+
+    type \ms_tracker_regs.MULTI.live_in_t\ is record
+        next_q : std_logic_vector(15 downto 0);
+    end record;
+
+    type \ms_tracker_regs.MULTI_in_t\ is record
+        max_targets : \ms_tracker_regs.MULTI.max_targets_in_t\;
+        live : \ms_tracker_regs.MULTI.live_in_t\;
+    end record;
+
     type \ms_tracker_regs.RES_HEAD.frame_count_in_t\ is record
         next_q : std_logic_vector(15 downto 0);
     end record;
@@ -202,6 +220,10 @@ package ms_tracker_regs_pkg is
         next_q : std_logic_vector(2 downto 0);
     end record;
 
+    type \ms_tracker_regs.RES_HEAD.target_id_in_t\ is record
+        next_q : std_logic_vector(3 downto 0);
+    end record;
+
     type \ms_tracker_regs.RES_HEAD.valid_in_t\ is record
         next_q : std_logic;
     end record;
@@ -210,6 +232,7 @@ package ms_tracker_regs_pkg is
         frame_count : \ms_tracker_regs.RES_HEAD.frame_count_in_t\;
         flags : \ms_tracker_regs.RES_HEAD.flags_in_t\;
         err_code : \ms_tracker_regs.RES_HEAD.err_code_in_t\;
+        target_id : \ms_tracker_regs.RES_HEAD.target_id_in_t\;
         valid : \ms_tracker_regs.RES_HEAD.valid_in_t\;
     end record;
 
@@ -381,6 +404,42 @@ package ms_tracker_regs_pkg is
         value : \ms_tracker_regs.RES_RAW4.value_in_t\;
     end record;
 
+    type \ms_tracker_regs.CMD_STATUS.pending_in_t\ is record
+        next_q : std_logic;
+    end record;
+
+    type \ms_tracker_regs.CMD_STATUS.code_in_t\ is record
+        next_q : std_logic_vector(1 downto 0);
+    end record;
+
+    type \ms_tracker_regs.CMD_STATUS.id_in_t\ is record
+        next_q : std_logic_vector(3 downto 0);
+    end record;
+
+    type \ms_tracker_regs.CMD_STATUS.reports_in_t\ is record
+        next_q : std_logic_vector(15 downto 0);
+    end record;
+
+    type \ms_tracker_regs.CMD_STATUS_in_t\ is record
+        pending : \ms_tracker_regs.CMD_STATUS.pending_in_t\;
+        code : \ms_tracker_regs.CMD_STATUS.code_in_t\;
+        id : \ms_tracker_regs.CMD_STATUS.id_in_t\;
+        reports : \ms_tracker_regs.CMD_STATUS.reports_in_t\;
+    end record;
+
+    type \ms_tracker_regs.RES_MASK.mask_in_t\ is record
+        next_q : std_logic_vector(15 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_MASK.frame_count_in_t\ is record
+        next_q : std_logic_vector(15 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_MASK_in_t\ is record
+        mask : \ms_tracker_regs.RES_MASK.mask_in_t\;
+        frame_count : \ms_tracker_regs.RES_MASK.frame_count_in_t\;
+    end record;
+
     type ms_tracker_regs_in_t is record
         VERSION : \ms_tracker_regs.VERSION_in_t\;
         CONFIG : \ms_tracker_regs.CONFIG_in_t\;
@@ -393,6 +452,7 @@ package ms_tracker_regs_pkg is
         REJECT_COUNT : \ms_tracker_regs.REJECT_COUNT_in_t\;
         DROP_COUNT : \ms_tracker_regs.DROP_COUNT_in_t\;
         CONFIG_V2 : \ms_tracker_regs.CONFIG_V2_in_t\;
+        MULTI : \ms_tracker_regs.MULTI_in_t\;
         RES_HEAD : \ms_tracker_regs.RES_HEAD_in_t\;
         RES_CX : \ms_tracker_regs.RES_CX_in_t\;
         RES_CY : \ms_tracker_regs.RES_CY_in_t\;
@@ -410,6 +470,8 @@ package ms_tracker_regs_pkg is
         RES_RAW2 : \ms_tracker_regs.RES_RAW2_in_t\;
         RES_RAW3 : \ms_tracker_regs.RES_RAW3_in_t\;
         RES_RAW4 : \ms_tracker_regs.RES_RAW4_in_t\;
+        CMD_STATUS : \ms_tracker_regs.CMD_STATUS_in_t\;
+        RES_MASK : \ms_tracker_regs.RES_MASK_in_t\;
     end record;
 
     type \ms_tracker_regs.CTRL.enable_out_t\ is record
@@ -467,13 +529,31 @@ package ms_tracker_regs_pkg is
         value : std_logic;
     end record;
 
+    type \ms_tracker_regs.CMD.add_out_t\ is record
+        value : std_logic;
+    end record;
+
+    type \ms_tracker_regs.CMD.remove_out_t\ is record
+        value : std_logic;
+    end record;
+
     type \ms_tracker_regs.CMD_out_t\ is record
         init : \ms_tracker_regs.CMD.init_out_t\;
         clear_counters : \ms_tracker_regs.CMD.clear_counters_out_t\;
+        add : \ms_tracker_regs.CMD.add_out_t\;
+        remove : \ms_tracker_regs.CMD.remove_out_t\;
     end record;
 
     type \ms_tracker_regs.INT_STATUS_out_t\ is record
         intr : std_logic;
+    end record;
+
+    type \ms_tracker_regs.TARGET.id_out_t\ is record
+        value : std_logic_vector(3 downto 0);
+    end record;
+
+    type \ms_tracker_regs.TARGET_out_t\ is record
+        id : \ms_tracker_regs.TARGET.id_out_t\;
     end record;
 
     type \ms_tracker_regs.RES_HEAD.frame_count_out_t\ is record
@@ -484,6 +564,14 @@ package ms_tracker_regs_pkg is
         frame_count : \ms_tracker_regs.RES_HEAD.frame_count_out_t\;
     end record;
 
+    type \ms_tracker_regs.RES_SEL.id_out_t\ is record
+        value : std_logic_vector(3 downto 0);
+    end record;
+
+    type \ms_tracker_regs.RES_SEL_out_t\ is record
+        id : \ms_tracker_regs.RES_SEL.id_out_t\;
+    end record;
+
     type ms_tracker_regs_out_t is record
         CTRL : \ms_tracker_regs.CTRL_out_t\;
         FRAME_SIZE : \ms_tracker_regs.FRAME_SIZE_out_t\;
@@ -491,6 +579,8 @@ package ms_tracker_regs_pkg is
         INIT_SIZE : \ms_tracker_regs.INIT_SIZE_out_t\;
         CMD : \ms_tracker_regs.CMD_out_t\;
         INT_STATUS : \ms_tracker_regs.INT_STATUS_out_t\;
+        TARGET : \ms_tracker_regs.TARGET_out_t\;
         RES_HEAD : \ms_tracker_regs.RES_HEAD_out_t\;
+        RES_SEL : \ms_tracker_regs.RES_SEL_out_t\;
     end record;
 end package;

@@ -20,7 +20,7 @@ extern "C" {
 #define MS_TRACKER_REGS__VERSION__MAP_MINOR_bm 0xff
 #define MS_TRACKER_REGS__VERSION__MAP_MINOR_bp 0
 #define MS_TRACKER_REGS__VERSION__MAP_MINOR_bw 8
-#define MS_TRACKER_REGS__VERSION__MAP_MINOR_reset 0x2
+#define MS_TRACKER_REGS__VERSION__MAP_MINOR_reset 0x3
 #define MS_TRACKER_REGS__VERSION__MAP_MAJOR_bm 0xff00
 #define MS_TRACKER_REGS__VERSION__MAP_MAJOR_bp 8
 #define MS_TRACKER_REGS__VERSION__MAP_MAJOR_bw 8
@@ -111,6 +111,14 @@ extern "C" {
 #define MS_TRACKER_REGS__CMD__CLEAR_COUNTERS_bp 1
 #define MS_TRACKER_REGS__CMD__CLEAR_COUNTERS_bw 1
 #define MS_TRACKER_REGS__CMD__CLEAR_COUNTERS_reset 0x0
+#define MS_TRACKER_REGS__CMD__ADD_bm 0x4
+#define MS_TRACKER_REGS__CMD__ADD_bp 2
+#define MS_TRACKER_REGS__CMD__ADD_bw 1
+#define MS_TRACKER_REGS__CMD__ADD_reset 0x0
+#define MS_TRACKER_REGS__CMD__REMOVE_bm 0x8
+#define MS_TRACKER_REGS__CMD__REMOVE_bp 3
+#define MS_TRACKER_REGS__CMD__REMOVE_bw 1
+#define MS_TRACKER_REGS__CMD__REMOVE_reset 0x0
 
 // reg - ms_tracker_regs.STATUS
 #define MS_TRACKER_REGS__STATUS__INIT_PENDING_bm 0x1
@@ -146,6 +154,10 @@ extern "C" {
 #define MS_TRACKER_REGS__INT_STATUS__REACQUIRED_bp 3
 #define MS_TRACKER_REGS__INT_STATUS__REACQUIRED_bw 1
 #define MS_TRACKER_REGS__INT_STATUS__REACQUIRED_reset 0x0
+#define MS_TRACKER_REGS__INT_STATUS__COMMAND_bm 0x10
+#define MS_TRACKER_REGS__INT_STATUS__COMMAND_bp 4
+#define MS_TRACKER_REGS__INT_STATUS__COMMAND_bw 1
+#define MS_TRACKER_REGS__INT_STATUS__COMMAND_reset 0x0
 
 // reg - ms_tracker_regs.INT_ENABLE
 #define MS_TRACKER_REGS__INT_ENABLE__RESULT_bm 0x1
@@ -164,6 +176,10 @@ extern "C" {
 #define MS_TRACKER_REGS__INT_ENABLE__REACQUIRED_bp 3
 #define MS_TRACKER_REGS__INT_ENABLE__REACQUIRED_bw 1
 #define MS_TRACKER_REGS__INT_ENABLE__REACQUIRED_reset 0x0
+#define MS_TRACKER_REGS__INT_ENABLE__COMMAND_bm 0x10
+#define MS_TRACKER_REGS__INT_ENABLE__COMMAND_bp 4
+#define MS_TRACKER_REGS__INT_ENABLE__COMMAND_bw 1
+#define MS_TRACKER_REGS__INT_ENABLE__COMMAND_reset 0x0
 
 // reg - ms_tracker_regs.RESULT_COUNT
 #define MS_TRACKER_REGS__RESULT_COUNT__COUNT_bm 0xffffffff
@@ -206,6 +222,20 @@ extern "C" {
 #define MS_TRACKER_REGS__CONFIG_V2__SCALE_TEST_D256_bp 24
 #define MS_TRACKER_REGS__CONFIG_V2__SCALE_TEST_D256_bw 8
 
+// reg - ms_tracker_regs.TARGET
+#define MS_TRACKER_REGS__TARGET__ID_bm 0xf
+#define MS_TRACKER_REGS__TARGET__ID_bp 0
+#define MS_TRACKER_REGS__TARGET__ID_bw 4
+#define MS_TRACKER_REGS__TARGET__ID_reset 0x0
+
+// reg - ms_tracker_regs.MULTI
+#define MS_TRACKER_REGS__MULTI__MAX_TARGETS_bm 0x1f
+#define MS_TRACKER_REGS__MULTI__MAX_TARGETS_bp 0
+#define MS_TRACKER_REGS__MULTI__MAX_TARGETS_bw 5
+#define MS_TRACKER_REGS__MULTI__LIVE_bm 0xffff0000
+#define MS_TRACKER_REGS__MULTI__LIVE_bp 16
+#define MS_TRACKER_REGS__MULTI__LIVE_bw 16
+
 // reg - ms_tracker_regs.RES_HEAD
 #define MS_TRACKER_REGS__RES_HEAD__FRAME_COUNT_bm 0xffff
 #define MS_TRACKER_REGS__RES_HEAD__FRAME_COUNT_bp 0
@@ -216,6 +246,9 @@ extern "C" {
 #define MS_TRACKER_REGS__RES_HEAD__ERR_CODE_bm 0x7000000
 #define MS_TRACKER_REGS__RES_HEAD__ERR_CODE_bp 24
 #define MS_TRACKER_REGS__RES_HEAD__ERR_CODE_bw 3
+#define MS_TRACKER_REGS__RES_HEAD__TARGET_ID_bm 0x78000000
+#define MS_TRACKER_REGS__RES_HEAD__TARGET_ID_bp 27
+#define MS_TRACKER_REGS__RES_HEAD__TARGET_ID_bw 4
 #define MS_TRACKER_REGS__RES_HEAD__VALID_bm 0x80000000
 #define MS_TRACKER_REGS__RES_HEAD__VALID_bp 31
 #define MS_TRACKER_REGS__RES_HEAD__VALID_bw 1
@@ -324,6 +357,34 @@ extern "C" {
 #define MS_TRACKER_REGS__RES_RAW4__VALUE_bp 0
 #define MS_TRACKER_REGS__RES_RAW4__VALUE_bw 32
 
+// reg - ms_tracker_regs.CMD_STATUS
+#define MS_TRACKER_REGS__CMD_STATUS__PENDING_bm 0x1
+#define MS_TRACKER_REGS__CMD_STATUS__PENDING_bp 0
+#define MS_TRACKER_REGS__CMD_STATUS__PENDING_bw 1
+#define MS_TRACKER_REGS__CMD_STATUS__CODE_bm 0x30
+#define MS_TRACKER_REGS__CMD_STATUS__CODE_bp 4
+#define MS_TRACKER_REGS__CMD_STATUS__CODE_bw 2
+#define MS_TRACKER_REGS__CMD_STATUS__ID_bm 0xf00
+#define MS_TRACKER_REGS__CMD_STATUS__ID_bp 8
+#define MS_TRACKER_REGS__CMD_STATUS__ID_bw 4
+#define MS_TRACKER_REGS__CMD_STATUS__REPORTS_bm 0xffff0000
+#define MS_TRACKER_REGS__CMD_STATUS__REPORTS_bp 16
+#define MS_TRACKER_REGS__CMD_STATUS__REPORTS_bw 16
+
+// reg - ms_tracker_regs.RES_SEL
+#define MS_TRACKER_REGS__RES_SEL__ID_bm 0xf
+#define MS_TRACKER_REGS__RES_SEL__ID_bp 0
+#define MS_TRACKER_REGS__RES_SEL__ID_bw 4
+#define MS_TRACKER_REGS__RES_SEL__ID_reset 0x0
+
+// reg - ms_tracker_regs.RES_MASK
+#define MS_TRACKER_REGS__RES_MASK__MASK_bm 0xffff
+#define MS_TRACKER_REGS__RES_MASK__MASK_bp 0
+#define MS_TRACKER_REGS__RES_MASK__MASK_bw 16
+#define MS_TRACKER_REGS__RES_MASK__FRAME_COUNT_bm 0xffff0000
+#define MS_TRACKER_REGS__RES_MASK__FRAME_COUNT_bp 16
+#define MS_TRACKER_REGS__RES_MASK__FRAME_COUNT_bw 16
+
 // addrmap - ms_tracker_regs
 typedef struct __attribute__ ((__packed__)) {
     uint32_t ID;
@@ -344,7 +405,8 @@ typedef struct __attribute__ ((__packed__)) {
     uint32_t REJECT_COUNT;
     uint32_t DROP_COUNT;
     uint32_t CONFIG_V2;
-    uint8_t RESERVED_48_4f[0x8];
+    uint32_t TARGET;
+    uint32_t MULTI;
     uint32_t RES_HEAD;
     uint32_t RES_CX;
     uint32_t RES_CY;
@@ -362,6 +424,9 @@ typedef struct __attribute__ ((__packed__)) {
     uint32_t RES_RAW2;
     uint32_t RES_RAW3;
     uint32_t RES_RAW4;
+    uint32_t CMD_STATUS;
+    uint32_t RES_SEL;
+    uint32_t RES_MASK;
 } ms_tracker_regs_t;
 
 

@@ -37,6 +37,9 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
     dev->result_version = 0;
     dev->last.valid = 0;
     dev->last_v2.valid = 0;
+    dev->max_targets = 0;
+    dev->target_mask = 0;
+    dev->box_rejected = 0;
     if (RD(dev, ID) != MSTRACK_MAGIC) {
         return MSTRACK_ERR_ID;
     }
@@ -46,6 +49,9 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
         return MSTRACK_ERR_VERSION;
     }
     dev->result_version = FIELD(v, VERSION, RESULT_VERSION);
+    if (FIELD(v, VERSION, MAP_MINOR) >= 3u) {
+        dev->max_targets = FIELD(RD(dev, MULTI), MULTI, MAX_TARGETS);
+    }
     if (width < 3u || height < 3u || width > FIELD(RD(dev, FORMAT), FORMAT, MAX_FRAME_W) || height > 0xFFFFu) {
         return MSTRACK_ERR_ARG;
     }
@@ -65,10 +71,81 @@ int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t
     WR(dev, INIT_POS, PUT(INIT_POS, X, (uint32_t)x & 0xFFFFu) | PUT(INIT_POS, Y, (uint32_t)y & 0xFFFFu));
     WR(dev, INIT_SIZE, PUT(INIT_SIZE, WIDTH, w) | PUT(INIT_SIZE, HEIGHT, h));
     WR(dev, CMD, PUT(CMD, INIT, 1u));                      /* box copied now, taken between frames */
+    mstrack_enable(dev, irq_mask);
+    return MSTRACK_OK;
+}
+
+void mstrack_enable(mstrack_dev_t *dev, uint32_t irq_mask)
+{
     dev->irq_mask = irq_mask & MSTRACK_IRQ_ALL;
     WR(dev, INT_ENABLE, dev->irq_mask);
     WR(dev, CTRL, PUT(CTRL, ENABLE, 1u));
+}
+
+/* wait for the report of the command just written: CMD_STATUS.pending falls */
+static int wait_command(const mstrack_dev_t *dev, uint32_t *code, uint32_t *id)
+{
+    uint32_t n, v;
+    for (n = 0; n < MSTRACK_CMD_POLLS; ++n) {
+        v = RD(dev, CMD_STATUS);
+        if (!FIELD(v, CMD_STATUS, PENDING)) {
+            *code = FIELD(v, CMD_STATUS, CODE);
+            *id = FIELD(v, CMD_STATUS, ID);
+            return MSTRACK_OK;
+        }
+    }
+    return MSTRACK_ERR_TIMEOUT;
+}
+
+int mstrack_add(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h, uint32_t *id)
+{
+    uint32_t code = 0u, slot = 0u;
+    int rc;
+    if (dev->max_targets == 0u) {
+        return MSTRACK_ERR_SINGLE;
+    }
+    if (x < -32768 || x > 32767 || y < -32768 || y > 32767 || w > 0xFFFFu || h > 0xFFFFu) {
+        return MSTRACK_ERR_ARG;
+    }
+    WR(dev, INIT_POS, PUT(INIT_POS, X, (uint32_t)x & 0xFFFFu) | PUT(INIT_POS, Y, (uint32_t)y & 0xFFFFu));
+    WR(dev, INIT_SIZE, PUT(INIT_SIZE, WIDTH, w) | PUT(INIT_SIZE, HEIGHT, h));
+    WR(dev, CMD, PUT(CMD, ADD, 1u));
+    rc = wait_command(dev, &code, &slot);
+    if (rc != MSTRACK_OK) {
+        return rc;
+    }
+    if (code != 0u) {
+        return MSTRACK_ERR_FULL;
+    }
+    dev->box_rejected &= ~(1u << slot);
+    if (id != NULL) {
+        *id = slot;
+    }
     return MSTRACK_OK;
+}
+
+int mstrack_remove(mstrack_dev_t *dev, uint32_t id)
+{
+    uint32_t code = 0u, slot = 0u;
+    int rc;
+    if (dev->max_targets == 0u) {
+        return MSTRACK_ERR_SINGLE;
+    }
+    if (id >= dev->max_targets) {
+        return MSTRACK_ERR_ARG;
+    }
+    WR(dev, TARGET, PUT(TARGET, ID, id));
+    WR(dev, CMD, PUT(CMD, REMOVE, 1u));
+    rc = wait_command(dev, &code, &slot);
+    if (rc != MSTRACK_OK) {
+        return rc;
+    }
+    return code == 0u ? MSTRACK_OK : MSTRACK_ERR_ARG;
+}
+
+uint32_t mstrack_live(const mstrack_dev_t *dev)
+{
+    return FIELD(RD(dev, MULTI), MULTI, LIVE);
 }
 
 void mstrack_stop(mstrack_dev_t *dev)
@@ -113,6 +190,7 @@ int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r)
 {
     uint32_t v;
     READ_HEAD(dev, r, v);
+    r->target_id = FIELD(v, RES_HEAD, TARGET_ID);
     r->rho = RD(dev, RES_RHO_C);
     r->w8 = RD(dev, RES_W8);
     r->h8 = RD(dev, RES_H8);
@@ -124,6 +202,40 @@ int mstrack_read_result_v2(const mstrack_dev_t *dev, mstrack_result_v2_t *r)
     r->decim_log2 = FIELD(v, RES_STATE, DECIM_LOG2);
     r->searched = FIELD(v, RES_STATE, SEARCHED);
     return r->valid ? MSTRACK_OK : MSTRACK_NO_RESULT;
+}
+
+int mstrack_read_target(const mstrack_dev_t *dev, uint32_t id, mstrack_result_v2_t *r)
+{
+    WR(dev, RES_SEL, PUT(RES_SEL, ID, id));
+    return mstrack_read_result_v2(dev, r);
+}
+
+int mstrack_read_frame(mstrack_dev_t *dev)
+{
+    unsigned tries, id;
+    uint32_t v, mask, fc;
+    int torn;
+    if (dev->max_targets == 0u) {
+        return MSTRACK_ERR_SINGLE;
+    }
+    for (tries = 0; tries < 3u; ++tries) {
+        v = RD(dev, RES_MASK);
+        mask = FIELD(v, RES_MASK, MASK);
+        fc = FIELD(v, RES_MASK, FRAME_COUNT);
+        torn = 0;
+        for (id = 0; id < MSTRACK_MAX_TARGETS && !torn; ++id) {
+            if (mask & (1u << id)) {
+                (void)mstrack_read_target(dev, id, &dev->target[id]);
+                torn = dev->target[id].frame_count != fc;
+            }
+        }
+        if (!torn && FIELD(RD(dev, RES_MASK), RES_MASK, FRAME_COUNT) == fc) {
+            dev->target_mask = mask;
+            return MSTRACK_OK;
+        }
+    }
+    dev->target_mask = 0u;
+    return MSTRACK_ERR_TORN;
 }
 
 void mstrack_read_raw(const mstrack_dev_t *dev, uint32_t words[5])
@@ -171,6 +283,7 @@ void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r)
     r->err_code = bits(words, MSTRACK_RES2_ERR_CODE_OFF, MSTRACK_RES2_ERR_CODE_W);
     r->frame_count = bits(words, MSTRACK_RES2_FRAME_COUNT_OFF, MSTRACK_RES2_FRAME_COUNT_W);
     r->valid = 1u;
+    r->target_id = 0u;
 }
 
 uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
@@ -180,7 +293,15 @@ uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
         return 0u;
     }
     dev->irq_count++;
-    if (st & MSTRACK_IRQ_RESULT) {
+    if (st & MSTRACK_IRQ_COMMAND) {
+        uint32_t v = RD(dev, CMD_STATUS);
+        if (FIELD(v, CMD_STATUS, CODE) == 3u) {
+            dev->box_rejected |= 1u << FIELD(v, CMD_STATUS, ID);
+        }
+    }
+    if ((st & MSTRACK_IRQ_RESULT) && dev->max_targets != 0u) {
+        (void)mstrack_read_frame(dev);
+    } else if (st & MSTRACK_IRQ_RESULT) {
         if (dev->result_version == 2u) {
             const mstrack_result_v2_t *v2 = &dev->last_v2;
             (void)mstrack_read_result_v2(dev, &dev->last_v2);

@@ -18,6 +18,13 @@
  *     if (mstrack_init(&dev, 0x43C00000u, 640, 480) != MSTRACK_OK) ... ;
  *     mstrack_start(&dev, x, y, w, h, MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST);
  *     ... in the interrupt: mstrack_irq_handler(&dev, &res);
+ *
+ * A multi-target core (MAX_TARGETS >= 1: dev->max_targets after mstrack_init):
+ *     mstrack_enable(&dev, MSTRACK_IRQ_ALL);
+ *     mstrack_add(&dev, x, y, w, h, &id);     ... at any frame, as targets appear
+ *     mstrack_remove(&dev, id);               ... as they leave
+ *     ... in the interrupt: mstrack_irq_handler(&dev, NULL) reads every target's word of the frame
+ *         into dev->target[id] for the ids in dev->target_mask.
  */
 #ifndef MSTRACK_DRV_H
 #define MSTRACK_DRV_H
@@ -47,13 +54,24 @@ void mstrack_io_write32(uintptr_t addr, uint32_t value);
 #define MSTRACK_ERR_VERSION (-2)           /* register map or result word version unknown */
 #define MSTRACK_ERR_ARG (-3)               /* argument out of range */
 #define MSTRACK_NO_RESULT (-4)             /* no result since reset */
+#define MSTRACK_ERR_FULL (-5)              /* multi-target: add refused, no free target slot */
+#define MSTRACK_ERR_TIMEOUT (-6)           /* multi-target: a command not reported in MSTRACK_CMD_POLLS reads */
+#define MSTRACK_ERR_SINGLE (-7)            /* a multi-target call on a single-target core */
+#define MSTRACK_ERR_TORN (-8)              /* frames completed during every try of mstrack_read_frame */
+
+#define MSTRACK_MAX_TARGETS 16u            /* target ids 0 .. 15 (MULTI.max_targets of the core: fewer) */
+#ifndef MSTRACK_CMD_POLLS
+#define MSTRACK_CMD_POLLS 100000u          /* CMD_STATUS reads before a command is given up */
+#endif
 
 /* interrupt bits (INT_STATUS / INT_ENABLE) */
 #define MSTRACK_IRQ_RESULT MS_TRACKER_REGS__INT_STATUS__RESULT_bm
 #define MSTRACK_IRQ_LOST MS_TRACKER_REGS__INT_STATUS__LOST_bm
 #define MSTRACK_IRQ_ERROR MS_TRACKER_REGS__INT_STATUS__ERROR_bm
 #define MSTRACK_IRQ_REACQUIRED MS_TRACKER_REGS__INT_STATUS__REACQUIRED_bm   /* core v2 only */
-#define MSTRACK_IRQ_ALL (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR | MSTRACK_IRQ_REACQUIRED)
+#define MSTRACK_IRQ_COMMAND MS_TRACKER_REGS__INT_STATUS__COMMAND_bm         /* multi-target only */
+#define MSTRACK_IRQ_ALL (MSTRACK_IRQ_RESULT | MSTRACK_IRQ_LOST | MSTRACK_IRQ_ERROR | MSTRACK_IRQ_REACQUIRED | \
+                         MSTRACK_IRQ_COMMAND)
 
 /* status of result word v2 (RES_STATE.status): MSTRACK_STATUS_* in the generated ms_tracker_result.h */
 
@@ -80,6 +98,7 @@ typedef struct {
     uint32_t cx, cy, w8, h8, rho, confidence, status, iter, stop, decim_log2, searched;
     uint32_t flags, err_code, frame_count;
     uint32_t valid;
+    uint32_t target_id;    /* multi-target cores: the target (RES_HEAD.target_id); else 0 */
 } mstrack_result_v2_t;
 
 typedef struct {
@@ -89,6 +108,11 @@ typedef struct {
     uint32_t result_version; /* 1 paper core (result word v1), 2 core v2 (mstrack_init sets it) */
     mstrack_result_t last; /* filled by mstrack_irq_handler on a result interrupt (v2: the common fields) */
     mstrack_result_v2_t last_v2; /* v2: filled by mstrack_irq_handler on a result interrupt */
+    /* multi-target cores (max_targets >= 1) */
+    uint32_t max_targets;  /* MULTI.max_targets: target slots; 0 a single-target core */
+    uint32_t target_mask;  /* ids with a word in the last frame read (mstrack_read_frame) */
+    uint32_t box_rejected; /* ids whose add box the core rejected (CMD_STATUS code 3 seen by the handler) */
+    mstrack_result_v2_t target[MSTRACK_MAX_TARGETS]; /* the last frame's word of each id in target_mask */
 } mstrack_dev_t;
 
 /* Check ID and versions (map major 1, result word 1 or 2: dev->result_version), disable the core,
@@ -100,6 +124,34 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
 /* Give the init box (0-based px; x, y may be negative), enable the interrupts in irq_mask
  * (MSTRACK_IRQ_*) and the core.  The box applies from the next frame. */
 int mstrack_start(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h, uint32_t irq_mask);
+
+/* Enable the interrupts in irq_mask and the core, without an init box (a multi-target core gets its
+ * targets from mstrack_add). */
+void mstrack_enable(mstrack_dev_t *dev, uint32_t irq_mask);
+
+/* Multi-target cores: add a target with the box (0-based px; x, y may be negative).  The core takes it
+ * between frames (from the next frame); waits for the report (polling CMD_STATUS) and gives the
+ * target's id.  Returns MSTRACK_OK, MSTRACK_ERR_FULL (no free slot), MSTRACK_ERR_ARG,
+ * MSTRACK_ERR_TIMEOUT or MSTRACK_ERR_SINGLE.  A box the core rejects later (it does not clip into the
+ * frame) is reported by the handler in dev->box_rejected, and its id is free again. */
+int mstrack_add(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h, uint32_t *id);
+
+/* Multi-target cores: remove target id (between frames).  Returns MSTRACK_OK, MSTRACK_ERR_ARG (id not
+ * live), MSTRACK_ERR_TIMEOUT or MSTRACK_ERR_SINGLE. */
+int mstrack_remove(mstrack_dev_t *dev, uint32_t id);
+
+/* Multi-target cores: the slots holding a target (MULTI.live, bit k: id k). */
+uint32_t mstrack_live(const mstrack_dev_t *dev);
+
+/* Multi-target cores: read target id's word of the last complete frame (RES_SEL, then RES_HEAD first,
+ * then every field).  Returns MSTRACK_OK or MSTRACK_NO_RESULT. */
+int mstrack_read_target(const mstrack_dev_t *dev, uint32_t id, mstrack_result_v2_t *r);
+
+/* Multi-target cores: read the last complete frame: RES_MASK into dev->target_mask and each of its
+ * targets' words into dev->target[id].  Every word must carry RES_MASK's frame_count, else (a frame
+ * completed meanwhile) it reads again, 3 tries.  Returns MSTRACK_OK, MSTRACK_ERR_TORN or
+ * MSTRACK_ERR_SINGLE. */
+int mstrack_read_frame(mstrack_dev_t *dev);
 
 /* Stop feeding frames to the core (the frame in progress completes); interrupts off. */
 void mstrack_stop(mstrack_dev_t *dev);
@@ -124,6 +176,8 @@ void mstrack_decode_word(const uint32_t *words, mstrack_result_t *r);
 void mstrack_decode_word_v2(const uint32_t *words, mstrack_result_v2_t *r);
 
 /* Interrupt handler: reads INT_STATUS, on a result reads it into dev->last (and *r if not NULL),
+ * (a multi-target core: mstrack_read_frame, every target's word; dev->last is not touched; on a
+ * command report with code 3 the id goes into dev->box_rejected),
  * clears the bits it saw (W1C) and returns them (0: not ours).  Core v2 (dev->result_version 2):
  * the result is read with mstrack_read_result_v2 into dev->last_v2, and dev->last (*r) gets the
  * fields common to both words (valid, frame_count, flags, err_code, cx, cy; rho_c = rho; the rest 0). */

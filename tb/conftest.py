@@ -89,6 +89,11 @@ CI_EXTRA: dict[str, str] = {
         "tests/test_core_model_multi.py (the multi-target model with one slot equals core v2's model, stream "
         "faults included) and the 3-slot netlist's tests, whose engines are ms_tracker_v2; this case: the "
         "MAX_TARGETS 1 netlist (its own Verilator build) against core v2's words on 30 Girl frames",
+    "tb/test_ms_tracker_multi.py::test_multi_real_people":
+        "tb/test_mstrack_drv.py::test_driver_against_multi_target_core (the same engines behind ms_tracker_axi on "
+        "12 TUD-Stadtmitte frames: people added, removed and added in a freed slot, every word of every target "
+        "bit-exact) and test_multi_generated_scene / test_multi_fuzz (the core's own ports); this case: 16 TUD "
+        "frames, 3 slots",
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",

@@ -264,7 +264,7 @@ async def check_identification(tb: TB, check) -> None:
     """ID, VERSION, CONFIG, CONFIG_V2 and FORMAT against the job's generics."""
     g, v2 = tb.g, tb.v2
     check("ID", await tb.rd("ID"), {"magic": 0x4D53544B})
-    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 2, "result_version": 2 if v2 else 1,
+    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 3, "result_version": 2 if v2 else 1,
                                               "result_width": g["RESULT_W"]})
     check("CONFIG", await tb.rd("CONFIG"), {"preset": int(v2), "features": g["FEATURES"], "kernel_epan": g["KERNEL_EPAN"],
                                             "result_stream": int(tb.job["result_stream"]), "lanes": g["LANES"],
@@ -317,26 +317,28 @@ async def run_axi(dut):
 
     # -- identification, configuration, reset values
     await check_identification(tb, check)
-    for name in ("CTRL", "INT_STATUS", "INT_ENABLE", "RESULT_COUNT", "DROP_COUNT", "RES_HEAD", "RES_CX", *V2_ONLY):
+    # (a single-target core: the multi-target registers MULTI, CMD_STATUS, RES_MASK read 0)
+    for name in ("CTRL", "INT_STATUS", "INT_ENABLE", "RESULT_COUNT", "DROP_COUNT", "RES_HEAD", "RES_CX", *V2_ONLY,
+                 "MULTI", "CMD_STATUS", "RES_MASK"):
         v = await tb.rd(name)
         if v["_raw"]:
             errors.append(f"{name} after reset: 0x{v['_raw']:08x}")
 
     # -- bad accesses: SLVERR, data 0, no effect
-    for addr in (0x048, 0x04C, 0x094, 0x0FC, 0xFFC):
+    for addr in (0x0A0, 0x0A4, 0x0FC, 0xFFC):
         v, resp = await tb.read_at(addr)
         if resp != AxiResp.SLVERR or v:
             errors.append(f"read of unmapped 0x{addr:03x}: {resp} 0x{v:08x}")
     v, resp = await tb.read_at(REGS["CMD"].offset)
     if resp != AxiResp.SLVERR:
         errors.append(f"read of write-only CMD: {resp}")
-    for name in ("ID", "CONFIG", "CONFIG_V2", "STATUS", "RESULT_COUNT", "RES_CX"):
+    for name in ("ID", "CONFIG", "CONFIG_V2", "STATUS", "RESULT_COUNT", "RES_CX", "MULTI", "CMD_STATUS"):
         before = (await tb.rd(name))["_raw"]
         resp = await tb.write_at(REGS[name].offset, 0xFFFFFFFF)
         after = (await tb.rd(name))["_raw"]
         if resp != AxiResp.SLVERR or after != before:
             errors.append(f"write to read-only {name}: {resp}, 0x{before:08x} -> 0x{after:08x}")
-    for addr in (0x048, 0x100, 0xFFC):
+    for addr in (0x0A0, 0x100, 0xFFC):
         resp = await tb.write_at(addr, 0xFFFFFFFF)
         if resp != AxiResp.SLVERR:
             errors.append(f"write to unmapped 0x{addr:03x}: {resp}")

@@ -1,16 +1,18 @@
-"""The C driver sw/mstrack_drv.c against the RTL: ms_tracker_axi (core v2 with the default generics, and
-the paper core) under Verilator, every register access of the driver an AXI4-Lite transaction (mstrack.hw.drvsim,
-tools/hdl/drv_main.cpp).
+"""The C driver sw/mstrack_drv.c against the RTL: ms_tracker_axi (core v2 with the default generics, the
+paper core, and the multi-target core: MAX_TARGETS 2) under Verilator, every register access of the driver an
+AXI4-Lite transaction (mstrack.hw.drvsim, tools/hdl/drv_main.cpp).
 
 The driver initialises the core, gives the init box, enables the interrupts, and its interrupt
 handler reads every result through the registers while the video streams with 1080p60 blanking.
 Each result is compared with the fixed-point model field by field, frame by frame (the raw word and
 the driver's decode of the RES_* registers), with the interrupt bits the handler saw and the
 counters at the end (:func:`mstrack.hw.drvsim.check_run`).  In the simulation half of `make test`
-(no marker ``long``: the netlist half is the longer one).  tests/test_sw_driver.py checks the same
-driver's decoder on the host without RTL.
+(no marker ``long``), the multi-target run in the netlist half (marker ``long``).  tests/test_sw_driver.py
+checks the same driver's decoder on the host without RTL.
 """
 from __future__ import annotations
+
+from pathlib import Path
 
 import pytest
 
@@ -51,6 +53,54 @@ def test_driver_against_paper_core():
     assert {"rho_e", "alpha_c", "box_w"} <= set(run.results[0]["driver"])   # the v1 fields, read by the driver
 
 
+@pytest.mark.long
+@pytest.mark.verilator
+def test_driver_against_multi_target_core():
+    """ms_tracker_axi with MAX_TARGETS 2 (two colour core v2 engines, MAX_FRAME_W 1024) on TUD-Stadtmitte
+    (640 x 480), 12 frames, 1080p60 blanking, a CPU 8 idle clocks per access slower than the bus.  The
+    driver (mstrack_enable, then mstrack_add / mstrack_remove between frames, as the people appear and
+    leave): three people added before frame 0 (the third refused: both slots taken, flag rejected on
+    frame 0's word); before frame 5 the first removed and another person added in its slot; before frame 7
+    the second removed and a box outside the frame added (taken, then rejected by its engine: the command
+    report code 3, the slot free again); before frame 9 a person added in that slot; before frame 10 a
+    remove of the refused person (the driver refuses it: no id).  Every target's word of every frame, read
+    by the handler through RES_SEL / RES_HEAD, against CoreModelMulti fed the commands where they landed."""
+    from mstrack.fixed import FixedParams
+    from mstrack.fixed.blocks import round_box
+    from mstrack.hw import drvsim, fastsim
+    from mstrack.hw.cosim_multi import CMD_BOX, expected_multi
+    from mstrack.io.mot import load_mot_sequence
+    from mstrack.track.params import V2_COLOUR
+    seq_dir = Path(__file__).resolve().parents[2] / "shared" / "data" / "multi" / "TUD-Stadtmitte"
+    if not seq_dir.is_dir():
+        pytest.skip(f"{seq_dir} not found: the multi-target driver run needs ../shared/data/multi")
+    seq = load_mot_sequence(seq_dir)
+    tp = TrackerParams(preset="v2", **V2_COLOUR)
+    frames = [seq.frame(i) for i in range(12)]
+
+    def box(frame, pid):
+        return round_box(*seq.boxes_at(frame)[pid].as_tuple())
+    ops = [(0, "add", "p1", box(0, 1)), (0, "add", "p4", box(0, 4)), (0, "add", "p7", box(0, 7)),
+           (5, "remove", "p1"), (5, "add", "p8", box(5, 8)),
+           (7, "remove", "p4"), (7, "add", "off", (2000, -500, 10, 10)),
+           (9, "add", "p7b", box(9, 7)), (10, "remove", "p7")]
+    run = drvsim.simulate_driver_multi(frames, ops, tp, FixedParams(), max_targets=2, max_frame_w=1024, io_gap=8,
+                                       **fastsim.HD1080P60)
+    cmds = run.commands(2)                   # where each command landed: the frame planned (the result of
+    assert sorted(cmds) == [0, 5, 7, 9]      # the frame before is read well inside the vertical blanking)
+    model = expected_multi(frames, cmds, tp, FixedParams(), 2, 1024)
+    diffs = drvsim.check_run_multi(run, model, 2)
+    assert not diffs, "\n".join(diffs[:10])
+    assert [o["rc"] for o in run.ops] == [0, 0, -5, 0, 0, 0, 0, 0, -3]   # MSTRACK_ERR_FULL, MSTRACK_ERR_ARG
+    # the rejected box: reported (command interrupt) with the frame whose word shows it; its slot given
+    # again before frame 9, which clears the driver's bit
+    assert [o.code for o in model.outcomes].count(CMD_BOX) == 1
+    assert [f["box_rejected"] for f in run.frames] == [0] * 7 + [0b10] * 2 + [0] * 3
+    assert run.frames[7]["irq"] & drvsim.irq_bits()["command"]
+    assert [f["mask"] for f in run.frames] == [0b11] * 7 + [0b01] * 2 + [0b11] * 3
+    assert max(run.handler_clocks()) < 2000
+
+
 def test_check_run_finds_differences():
     """check_run reports a changed field, a driver decode that differs from the raw word, a missing
     interrupt bit and wrong counters (on a run assembled by hand, no RTL)."""
@@ -76,3 +126,45 @@ def test_check_run_finds_differences():
     msgs = "\n".join(drvsim.check_run(bad, [{**exp[0], "cx": 101}]))
     for what in ("cx: dut=100 model=101", "cy: driver=51", "interrupt bits", "counters"):
         assert what in msgs
+
+
+def test_check_run_multi_finds_differences():
+    """check_run_multi reports a changed field, a wrong target mask, a driver decode that differs from the
+    raw word, an add whose id differs from the model's and wrong counters (a run assembled by hand, no RTL)."""
+    from mstrack.fixed.vhdl_pkg import pack_result_v2, unpack_result_v2
+    from mstrack.hw import drvsim
+    from mstrack.hw.cosim_multi import CMD_OK, Outcome
+
+    class Model:                             # the two attributes check_run_multi reads, and live
+        def __init__(self, frames, outcomes):
+            self.frames, self.outcomes, self.live = frames, outcomes, [0]
+
+        @property
+        def results(self):
+            return [w for f in self.frames for w in f]
+    base = {"cx": 100, "cy": 50, "w8": 256, "h8": 512, "rho": 1000, "confidence": 200, "status": 0, "iter": 1,
+            "stop": 0, "decim_log2": 1, "searched": 0, "flags": 0, "err_code": 0, "frame_count": 0}
+    f = {k: v for k, v in unpack_result_v2(pack_result_v2(base)).items() if k in COMPARED_FIELDS_V2}
+    word = pack_result_v2(f)
+    irq = drvsim.irq_bits()
+    good = drvsim.DriverMultiRun(
+        frames=[{"mask": 1, "irq": irq["result"], "irq_cycle": 0, "handled_cycle": 90, "frame_count": 0, "box_rejected": 0,
+                 "words": {0: {"word": word, "fields": unpack_result_v2(word),
+                               "driver": {**f, "valid": 1, "target_id": 0, "again_frame_count": 0}}}}],
+        ops=[{"op": "add", "label": "a", "rc": 0, "id": 0, "before": 0, "after": 0, "box": (1, 2, 3, 4)}],
+        calls={"init": 0, "start": 0}, counters={"results": 1, "lost": 0, "errors": 0, "rejected": 0, "dropped": 0},
+        live=1, status="done")
+    model = Model([[{**f, "target_id": 0}]], [Outcome(CMD_OK, 0)])
+    assert drvsim.check_run_multi(good, model, 2) == []
+    assert good.commands(2) == {0: [("add", (1, 2, 3, 4))]}
+    bad = drvsim.DriverMultiRun(**{**good.__dict__})
+    bad.frames = [{**good.frames[0], "mask": 3, "words": {0: {**good.frames[0]["words"][0],
+                                                              "driver": {**good.frames[0]["words"][0]["driver"],
+                                                                         "cy": 51}}}}]
+    bad.ops = [{**good.ops[0], "id": 1}]
+    bad.counters = {**good.counters, "results": 2}
+    msgs = "\n".join(drvsim.check_run_multi(bad, Model([[{**f, "cx": 101, "target_id": 0}]], [Outcome(CMD_OK, 0)]), 2))
+    for what in ("cx: dut=100 model=101", "targets 0x3", "cy: driver=51", "add a: driver rc=0 id=1", "counters"):
+        assert what in msgs, what
+    with pytest.raises(ValueError, match="started during the call"):
+        drvsim.DriverMultiRun(ops=[{**good.ops[0], "after": 1}]).commands(2)

@@ -32,7 +32,7 @@ def test_register_map():
     assert m["RES_HEAD"].offset < m["RES_CX"].offset
     v2_space = range(0x70, 0x80)
     assert [r.name for r in m.values() if r.offset in v2_space] == ["RES_W8", "RES_H8", "RES_CONF", "RES_STATE"]
-    assert m["VERSION"].fields["map_minor"].reset == 2 and m["VERSION"].fields["map_major"].reset == 1
+    assert m["VERSION"].fields["map_minor"].reset == 3 and m["VERSION"].fields["map_major"].reset == 1
     raw = [m[f"RES_RAW{i}"].offset for i in range(5)]
     assert raw == list(range(raw[0], raw[0] + 20, 4))
     assert 5 * 32 >= max(result_width(), result_width_v2())
@@ -44,7 +44,24 @@ def test_register_map():
             bits |= mask
         assert bits < 1 << 32
     # the interrupt bits the wrapper sets and the flags they follow
-    assert set(m["INT_STATUS"].fields) == set(m["INT_ENABLE"].fields) == {"result", "lost", "error", "reacquired"}
+    assert set(m["INT_STATUS"].fields) == set(m["INT_ENABLE"].fields) == {"result", "lost", "error", "reacquired",
+                                                                        "command"}
+
+
+def test_multi_target_registers():
+    """Map minor 3: the multi-target registers sit in holes of the minor-2 map (every older offset keeps
+    its register), CMD gains add / remove beside init and clear_counters, ids are 4 bits (16 slots), and
+    the live / result masks have a bit per id."""
+    m = regs.register_map()
+    assert {n: m[n].offset for n in ("TARGET", "MULTI", "CMD_STATUS", "RES_SEL", "RES_MASK")} == \
+        {"TARGET": 0x048, "MULTI": 0x04C, "CMD_STATUS": 0x094, "RES_SEL": 0x098, "RES_MASK": 0x09C}
+    assert {n: f.lsb for n, f in m["CMD"].fields.items()} == {"init": 0, "clear_counters": 1, "add": 2, "remove": 3}
+    assert m["TARGET"].fields["id"].width == m["RES_SEL"].fields["id"].width == m["CMD_STATUS"].fields["id"].width \
+        == m["RES_HEAD"].fields["target_id"].width == 4
+    assert m["MULTI"].fields["live"].width == m["RES_MASK"].fields["mask"].width == 16
+    assert m["MULTI"].fields["max_targets"].width == 5                       # 0 .. 16
+    assert not m["MULTI"].writable and not m["CMD_STATUS"].writable and not m["RES_MASK"].writable
+    assert m["TARGET"].writable and m["RES_SEL"].writable
 
 
 def test_config_v2_holds_the_tracker_generics():
@@ -102,14 +119,16 @@ def test_register_fields_hold_result_fields_v2():
 
 def test_wrapper_takes_every_core_generic():
     """ms_tracker_axi has every generic of ms_tracker (so `mstrack hdl config`'s generic map fits it too)
-    and passes each to the core under the same name."""
+    and passes each to the core under the same name; its own: MAX_TARGETS (ms_tracker_multi's slots, passed
+    to that core) and RESULT_STREAM."""
     from mstrack.hw.hdl_config import entity_generics
     text = re.sub(r"--[^\n]*", "", (regs.REPO / "rtl" / "ms_tracker_axi.vhd").read_text())
     decl = re.search(r"entity\s+ms_tracker_axi\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
     assert decl
     names = re.findall(r"(\w+)\s*:\s*(?:natural|integer|boolean)\b", decl.group(1), re.I)
     core = entity_generics()
-    assert [n for n in names if n != "RESULT_STREAM"] == core
+    assert [n for n in names if n not in ("RESULT_STREAM", "MAX_TARGETS")] == core
+    assert re.search(r"\bMAX_TARGETS\s*=>\s*MAX_TARGETS\b", text)
     for n in core:
         assert re.search(rf"\b{n}\s*=>\s*{n}\b", text), f"{n} not passed to ms_tracker"
 

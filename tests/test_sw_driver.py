@@ -176,7 +176,7 @@ def test_init_and_start(drv):
     c = got[3]
     assert c["rc"] == 0 and c["FRAME_SIZE"] == m["FRAME_SIZE"].encode(width=640, height=480)
     assert c["CTRL"] == 0 and c["CMD"] == m["CMD"].encode(clear_counters=1)
-    assert c["INT_STATUS"] == m["INT_STATUS"].encode(result=1, lost=1, error=1, reacquired=1)
+    assert c["INT_STATUS"] == m["INT_STATUS"].encode(result=1, lost=1, error=1, reacquired=1, command=1)
     assert c["RV"] == 1
     assert got[4]["rc"] == -3                                         # wider than max_frame_w
     s = got[7]
@@ -241,3 +241,42 @@ def test_read_result_v2_and_irq(drv):
     # result word 3 is refused
     bad = m["VERSION"].encode(map_major=1, result_version=3)
     assert _run(drv, [setup, f"regs {m['VERSION'].offset:x}={bad:x}", "init 320 240"])[2]["rc"] == -2
+
+
+# ----------------------------------------------------------------------------- multi-target cores
+def test_multi_target_calls(drv):
+    """mstrack_add / mstrack_remove / mstrack_read_frame / the handler of a multi-target core on a fake
+    register file: the registers written, the report read from CMD_STATUS (id, refused, never answered),
+    the calls refused on a single-target core and for an id out of range, a frame read whole or found
+    torn (a word's frame_count differs from RES_MASK's), a rejected box seen by the handler."""
+    m = register_map()
+    cs, head, mask, st = m["CMD_STATUS"], m["RES_HEAD"], m["RES_MASK"], m["INT_STATUS"]
+
+    def regs(**kv):
+        return "regs " + " ".join(f"{m[k].offset:x}={v:x}" for k, v in kv.items())
+    got = _run(drv, [
+        "slots 0", "add 1 2 3 4", "remove 0",                                        # single-target core
+        "slots 4", regs(CMD_STATUS=cs.encode(pending=0, code=0, id=2), CMD=0), "add -5 7 30 40",
+        regs(CMD_STATUS=cs.encode(pending=0, code=1, id=0), CMD=0), "add 1 1 8 8",  # no free slot
+        regs(CMD_STATUS=cs.encode(pending=1), CMD=0), "add 1 1 8 8",                # never reported
+        regs(CMD_STATUS=cs.encode(pending=0, code=0, id=1), CMD=0), "remove 1", "remove 4",
+        regs(CMD_STATUS=cs.encode(pending=0, code=1, id=3)), "remove 3",            # not live
+        regs(RES_MASK=mask.encode(mask=0b101, frame_count=7), RES_HEAD=head.encode(frame_count=7, valid=1, target_id=2),
+             RES_CX=1234), "frame",
+        regs(RES_HEAD=head.encode(frame_count=6, valid=1)), "frame",                # a frame completed meanwhile
+        regs(INT_STATUS=st.encode(command=1), CMD_STATUS=cs.encode(code=3, id=2)), "irqm",
+        regs(INT_STATUS=st.encode(result=1), RES_HEAD=head.encode(frame_count=7, valid=1)), "irqm"])
+    assert got[1]["rc"] == got[2]["rc"] == -7                                  # MSTRACK_ERR_SINGLE
+    a = got[5]
+    assert a["rc"] == 0 and a["id"] == 2 and a["CMD"] == m["CMD"].encode(add=1)
+    assert a["INIT_POS"] == m["INIT_POS"].encode(x=(-5) & 0xFFFF, y=7) and a["INIT_SIZE"] == m["INIT_SIZE"].encode(width=30, height=40)
+    assert got[7]["rc"] == -5 and got[9]["rc"] == -6                           # FULL, TIMEOUT
+    r = got[11]
+    assert r["rc"] == 0 and r["TARGET"] == 1 and r["CMD"] == m["CMD"].encode(remove=1)
+    assert got[12]["rc"] == -3 and got[14]["rc"] == -3                          # id >= slots; not live
+    f = got[16]
+    assert f["rc"] == 0 and f["mask"] == 0b101 and f["RES_SEL"] == 2 and f["t0"] == f["t2"] == 1234
+    assert f["i0"] == f["i2"] == 2                                             # (the fake RES_HEAD's target_id)
+    assert got[18]["rc"] == -8 and got[18]["mask"] == 0                        # MSTRACK_ERR_TORN
+    assert got[20]["st"] == st.encode(command=1) and got[20]["box_rejected"] == 0b100
+    assert got[22]["st"] == st.encode(result=1) and got[22]["mask"] == 0b101

@@ -76,18 +76,24 @@ class DriverRun:
         return [r["handled_cycle"] - r["irq_cycle"] for r in self.results]
 
 
-def axi_generics(cfg: CoreConfig | CoreConfigV2) -> dict[str, int]:
+def axi_generics(cfg: CoreConfig | CoreConfigV2, max_targets: int = 0) -> dict[str, int]:
     """The generics of ms_tracker_axi for *cfg*: those of ms_tracker, results through the registers
-    only (RESULT_STREAM false, as a CPU-only integration builds it)."""
+    only (RESULT_STREAM false, as a CPU-only integration builds it); *max_targets* >= 1: the
+    multi-target core with that many slots (core v2)."""
     g: dict[str, int] = dict(cfg.tracker_generics() if isinstance(cfg, CoreConfigV2) else cfg.generics())
     g["RESULT_STREAM"] = 0
+    if max_targets:
+        if not isinstance(cfg, CoreConfigV2) or not 1 <= max_targets <= 16:
+            raise ValueError("a multi-target core is core v2 with 1 .. 16 slots")
+        g["MAX_TARGETS"] = max_targets
     return g
 
 
-def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False) -> tuple[Path, float]:
-    """Build (or find in the cache) the driver harness for *cfg*: (executable, seconds spent building)."""
+def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, max_targets: int = 0) -> tuple[Path, float]:
+    """Build (or find in the cache) the driver harness for *cfg* (*max_targets* as :func:`axi_generics`):
+    (executable, seconds spent building)."""
     import time
-    g = axi_generics(cfg)
+    g = axi_generics(cfg, max_targets)
     vg = {k: (v != 0) if k == "RESULT_STREAM" else v for k, v in g.items()}
     t0 = time.monotonic()
     net_dir = fastsim.FASTSIM_DIR / f"netlist_{fastsim._generics_hash(g)}_{TOP}"
@@ -229,4 +235,237 @@ def check_run(run: DriverRun, expected: Sequence[dict[str, int]], v2: bool = Tru
     return out
 
 
-__all__ = ["DriverRun", "DriverSimError", "build_driver", "simulate_driver", "check_run", "axi_generics"]
+# ----------------------------------------------------------------------------- multi-target cores
+@dataclass
+class DriverMultiRun:
+    """Outcome of a driver co-simulation of a multi-target core (:func:`simulate_driver_multi`).
+
+    ``frames``: one dict per result interrupt: ``mask`` (the driver's ``target_mask``), ``irq``,
+    ``irq_cycle``, ``handled_cycle``, ``frame_count`` (RES_MASK's), ``box_rejected`` (the driver's
+    ``dev.box_rejected`` after the handler) and ``words``: ``{id: {"word", "fields",
+    "driver"}}`` (the raw word read again, Python's decode of it, the driver's ``target[id]``).
+    ``ops``: each ``mstrack_add`` / ``mstrack_remove`` the harness called: ``label``, ``op``, ``rc``, ``id``
+    (add), ``before`` / ``after`` (frames whose first pixel had been taken before the call / at its
+    return).  ``box_rejected``, ``live``: the driver's ``dev.box_rejected`` and ``mstrack_live`` at the end.
+    """
+    frames: list[dict] = field(default_factory=list)
+    ops: list[dict] = field(default_factory=list)
+    calls: dict[str, int] = field(default_factory=dict)
+    counters: dict[str, int] = field(default_factory=dict)
+    other_irqs: list[tuple[int, int]] = field(default_factory=list)
+    box_rejected: int = 0
+    live: int = 0
+    bus_errors: int = 0
+    cycles: int = 0
+    seconds: float = 0.0
+    status: str = "missing"
+    detail: str = ""
+    build_seconds: float = 0.0
+
+    def handler_clocks(self) -> list[int]:
+        """Clocks from irq high to the handler's return (every target's word read), per frame."""
+        return [f["handled_cycle"] - f["irq_cycle"] for f in self.frames]
+
+    def commands(self, max_targets: int) -> dict[int, list[tuple]]:
+        """The commands the core was given, keyed by the frame they apply to (:func:`mstrack.hw.cosim_multi.expected_multi`):
+        each op at the frame whose first pixel had not been taken when it was called (ValueError when a
+        frame started during the call: the frame it applies to is then not known).  A remove of a label
+        whose add failed was never given to the core (the driver refuses the id itself)."""
+        ids: dict[str, int] = {}
+        out: dict[int, list[tuple]] = {}
+        for op in self.ops:
+            if op["before"] != op["after"]:
+                raise ValueError(f"{op['op']} {op['label']}: frame {op['before']} started during the call")
+            if op["op"] == "add":
+                out.setdefault(op["before"], []).append(("add", op["box"]))
+                if op["rc"] == 0:
+                    ids[op["label"]] = op["id"]
+            elif op["label"] in ids and ids[op["label"]] < max_targets:
+                out.setdefault(op["before"], []).append(("remove", ids[op["label"]]))
+        return out
+
+
+def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMultiRun:
+    run = DriverMultiRun()
+    boxes = {op[2]: tuple(op[3]) for op in ops if op[1] == "add"}
+    for line in out.read_text().splitlines():
+        p = line.split()
+        if not p:
+            continue
+        if p[0] == "D":
+            run.calls[p[1]] = int(p[2])
+        elif p[0] == "M":
+            run.frames.append({"mask": int(p[2]), "irq": int(p[3]), "irq_cycle": int(p[4]),
+                               "handled_cycle": int(p[5]), "frame_count": int(p[6]), "box_rejected": int(p[7]),
+                               "words": {}})
+        elif p[0] == "W":
+            word = int(p[3], 16)
+            drv = {k: int(v) for k, v in (kv.split("=", 1) for kv in p[4:])}
+            run.frames[int(p[1])]["words"][int(p[2])] = {"word": word, "fields": unpack_result_v2(word, g),
+                                                         "driver": drv}
+        elif p[0] == "A":
+            run.ops.append({"op": "add", "label": p[1], "rc": int(p[2]), "id": int(p[3]), "before": int(p[4]),
+                            "after": int(p[5]), "box": boxes[p[1]]})
+        elif p[0] == "X":
+            run.ops.append({"op": "remove", "label": p[1], "rc": int(p[2]), "before": int(p[3]), "after": int(p[4])})
+        elif p[0] == "J":
+            run.box_rejected, run.live = int(p[1]), int(p[2])
+        elif p[0] == "Q":
+            run.other_irqs.append((int(p[1]), int(p[2])))
+        elif p[0] == "C":
+            run.counters = dict(zip(("results", "lost", "errors", "rejected", "dropped"), map(int, p[1:6])))
+        elif p[0] == "B":
+            run.bus_errors = int(p[1])
+        elif p[0] == "E":
+            run.status, run.cycles, run.seconds, run.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
+    return run
+
+
+def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp: TrackerParams | None = None,
+                          fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int | None = None,
+                          max_frame_w: int = 2048, hblank: int = 0, vblank: int = 0, io_gap: int = 0,
+                          irq_mask: int | None = None, watchdog: int = 4_000_000, tail: int = 200,
+                          workdir: Path | str | None = None, check: bool = True) -> DriverMultiRun:
+    """Run the driver against ms_tracker_axi with ``MAX_TARGETS`` = *max_targets* (core v2 engines, the
+    parameters *tp*, default tracker v2) on *frames*.  *ops*: ``(frame, "add", label, (x, y, w, h))`` or
+    ``(frame, "remove", label)``, in order: the harness calls ``mstrack_add`` / ``mstrack_remove`` (the id
+    its add of *label* returned) once the result of frame ``frame - 1`` has been read (frame 0: after
+    ``mstrack_enable``, before the video).  Each result interrupt reads every target's word of the frame
+    (``mstrack_read_frame`` in the handler).  Raises :class:`DriverSimError` when the run does not end
+    with every frame's words read (unless ``check`` is false)."""
+    from ..fixed.vhdl_pkg import DEFAULT_LANES
+    cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes or DEFAULT_LANES,
+                       max_frame_w=max_frame_w)
+    g = cfg.generics()
+    exe, build_s = build_driver(cfg, max_targets=max_targets)
+    tmp = tempfile.TemporaryDirectory(prefix="drvsim_") if workdir is None else None
+    wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
+    wd.mkdir(parents=True, exist_ok=True)
+    try:
+        n, w, h = fastsim._write_pixels(frames, wd / "pixels.bin")
+        if w > max_frame_w:
+            raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
+        lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", "multi 1",
+                 f"hblank {hblank}", f"vblank {vblank}", f"io_gap {io_gap}", f"results {n}", f"tail {tail}",
+                 f"watchdog {watchdog}"]
+        if irq_mask is not None:
+            lines.append(f"irq_mask {irq_mask}")
+        labels: set[str] = set()
+        for op in ops:
+            fr, what, label = int(op[0]), op[1], str(op[2])
+            if not label or any(c.isspace() for c in label):
+                raise ValueError(f"op label {label!r}: one word")
+            if what == "add":
+                if label in labels:
+                    raise ValueError(f"label {label!r} added twice")
+                labels.add(label)
+                lines.append(f"op {fr} add {label} " + " ".join(str(int(v)) for v in op[3]))
+            elif what == "remove":
+                lines.append(f"op {fr} remove {label}")
+            else:
+                raise ValueError(f"op {what!r}: add or remove")
+        (wd / "job.txt").write_text("\n".join(lines) + "\n")
+        import subprocess
+        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
+        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
+            raise DriverSimError(f"driver harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+        run = _parse_multi(wd / "out.txt", ops, g)
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+    run.build_seconds = build_s
+    if check and run.status != "done":
+        raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
+                             f"{len(run.frames)} frames of {n})")
+    return run
+
+
+def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
+    """Everything a multi-target driver run must show for *model* (a
+    :class:`mstrack.hw.cosim_multi.CoreModelMulti` fed ``run.commands(max_targets)``: :func:`expected_multi`),
+    one string per difference:
+
+    * ``mstrack_init`` and the enable returned MSTRACK_OK, no bus error;
+    * each add / remove returned what the model's report says (the id of an add; MSTRACK_ERR_FULL for a
+      refused add, MSTRACK_ERR_ARG for a remove of an id not live);
+    * one result interrupt per frame; its target mask is the ids of the model's words without
+      ``no_target``; each target's raw word equals the model's word field by field (target id included),
+      and the driver's fields (read from the RES_* registers) equal the raw word's;
+    * the interrupt bits: result always; lost / reacquired / error exactly when a word of the frame has
+      status lost / reacquired / flag error or rejected (the command bit is not compared: it follows the
+      command reports, which the handler sees whenever they come);
+    * the counters (frames, lost / error / rejected words) and, at the end, the live slots and the
+      rejected boxes the handler saw (a subset of the model's).
+    """
+    from .cosim_multi import CMD_BOX, CMD_OK
+    out = []
+    if run.calls != {"init": 0, "start": 0}:
+        out.append(f"driver calls returned {run.calls} (MSTRACK_OK = 0)")
+    if run.bus_errors:
+        out.append(f"{run.bus_errors} register accesses answered SLVERR")
+    reports = [o for o in model.outcomes if o.code != CMD_BOX]
+    issued = []
+    ids: dict[str, int] = {}
+    for o in run.ops:                         # the commands the core was given (a remove of a failed add was not)
+        if o["op"] == "add":
+            issued.append(o)
+            if o["rc"] == 0:
+                ids[o["label"]] = o["id"]
+        elif o["label"] in ids:
+            issued.append(o)
+    if len(issued) != len(reports):
+        out.append(f"{len(issued)} commands given, the model reports {len(reports)}")
+    for o, rep in zip(issued, reports):
+        want = (0 if rep.code == CMD_OK else -5) if o["op"] == "add" else (0 if rep.code == CMD_OK else -3)
+        if o["rc"] != want or (o["op"] == "add" and rep.code == CMD_OK and o["id"] != rep.target_id):
+            out.append(f"{o['op']} {o['label']}: driver rc={o['rc']} id={o.get('id')}, model code={rep.code} "
+                       f"id={rep.target_id}")
+    irq = irq_bits()
+    if len(run.frames) != len(model.frames):
+        out.append(f"{len(run.frames)} result interrupts, the model has {len(model.frames)} frames")
+    for i, (got, exp) in enumerate(zip(run.frames, model.frames)):
+        live = {w["target_id"]: w for w in exp if not w["flags"] & FLAG["no_target"]}
+        mask = sum(1 << k for k in live)
+        if got["mask"] != mask or set(got["words"]) != set(live):
+            out.append(f"frame {i}: targets {got['mask']:#x} ({sorted(got['words'])}), expected {mask:#x}")
+        for k, w in sorted(got["words"].items()):
+            if k not in live:
+                continue
+            d = diff_fields(w["fields"], live[k], COMPARED_FIELDS_V2)
+            if d:
+                out.append(f"frame {i} target {k}: raw word: " + "; ".join(d))
+            drv = w["driver"]
+            bad = [f"{f}: driver={v} word={w['fields'][f]}" for f, v in drv.items()
+                   if f in w["fields"] and w["fields"][f] != v]
+            if drv.get("valid") != 1 or drv.get("target_id") != k or drv.get("again_frame_count") != drv.get("frame_count"):
+                bad.append(f"valid={drv.get('valid')} target_id={drv.get('target_id')} "
+                           f"frame_count={drv.get('frame_count')} read again={drv.get('again_frame_count')}")
+            if bad:
+                out.append(f"frame {i} target {k}: driver decode: " + "; ".join(bad))
+        want = irq["result"]
+        for w in exp:
+            want |= irq["lost"] if w["status"] == STATUS["lost"] else 0
+            want |= irq["reacquired"] if w["status"] == STATUS["reacquired"] else 0
+            want |= irq["error"] if w["flags"] & (FLAG["error"] | FLAG["rejected"]) else 0
+        if got["irq"] & ~irq["command"] != want:
+            out.append(f"frame {i}: interrupt bits {got['irq']:#x}, expected {want:#x} (command bit not compared)")
+    other = [q for q in run.other_irqs if q[0] & ~irq["command"]]
+    if other:
+        out.append(f"interrupts without a result: {other[:5]}")
+    words = model.results
+    want_c = {"results": len(model.frames), "lost": sum(w["status"] == STATUS["lost"] for w in words),
+              "errors": sum(bool(w["flags"] & FLAG["error"]) for w in words),
+              "rejected": sum(bool(w["flags"] & FLAG["rejected"]) for w in words), "dropped": 0}
+    if run.counters != want_c:
+        out.append(f"counters {run.counters}, expected {want_c}")
+    live_end = sum(1 << k for k in model.live)
+    if run.live != live_end:
+        out.append(f"live slots at the end {run.live:#x}, expected {live_end:#x}")
+    boxed = sum(1 << o.target_id for o in model.outcomes if o.code == CMD_BOX)
+    if run.box_rejected & ~boxed:
+        out.append(f"rejected boxes {run.box_rejected:#x} not in the model's {boxed:#x}")
+    return out
+
+
+__all__ = ["DriverRun", "DriverSimError", "build_driver", "simulate_driver", "check_run", "axi_generics",
+           "DriverMultiRun", "simulate_driver_multi", "check_run_multi"]

@@ -10,6 +10,12 @@
  *   irq2                     the same, then dev.last_v2 (core v2)
  *   init W H                 mstrack_init; prints the return code, result_version, FRAME_SIZE, CTRL, CMD, INT_STATUS
  *   start X Y W H MASK       mstrack_start; prints the return code, INIT_POS, INIT_SIZE, CMD, INT_ENABLE, CTRL
+ *   slots N                  dev.max_targets = N (what mstrack_init reads from MULTI)
+ *   add X Y W H              mstrack_add; prints the return code, the id, INIT_POS, INIT_SIZE, CMD
+ *   remove ID                mstrack_remove; prints the return code, TARGET, CMD
+ *   frame                    mstrack_read_frame; prints the return code, target_mask, RES_SEL, and per id of
+ *                            the mask t<id>=cx and i<id>=target_id
+ *   irqm                     mstrack_irq_handler (multi-target); prints the bits, target_mask, box_rejected
  * Results print as name=value (decimal) in the field order of the structs.
  */
 #include <stdio.h>
@@ -48,6 +54,7 @@ int main(void)
 {
     char line[4096];
     mstrack_dev_t dev;
+    memset(&dev, 0, sizeof dev);
     dev.base = (uintptr_t)mem;
     dev.irq_mask = 0;
     dev.irq_count = 0;
@@ -130,6 +137,41 @@ int main(void)
             printf("rc=%d INIT_POS=%lu INIT_SIZE=%lu CMD=%lu INT_ENABLE=%lu CTRL=%lu\n", rc,
                    (unsigned long)AT(INIT_POS), (unsigned long)AT(INIT_SIZE), (unsigned long)AT(CMD),
                    (unsigned long)AT(INT_ENABLE), (unsigned long)AT(CTRL));
+        } else if (strcmp(tok, "slots") == 0) {
+            char *a = strtok(NULL, " \t\r\n");
+            dev.max_targets = a ? (uint32_t)strtoul(a, NULL, 10) : 0u;
+            printf("ok\n");
+        } else if (strcmp(tok, "add") == 0) {
+            long v[4] = {0, 0, 0, 0};
+            unsigned i;
+            uint32_t id = 99u;
+            int rc;
+            for (i = 0; i < 4u; i++) {
+                char *t = strtok(NULL, " \t\r\n");
+                v[i] = t ? strtol(t, NULL, 10) : 0;
+            }
+            rc = mstrack_add(&dev, (int32_t)v[0], (int32_t)v[1], (uint32_t)v[2], (uint32_t)v[3], &id);
+            printf("rc=%d id=%lu INIT_POS=%lu INIT_SIZE=%lu CMD=%lu\n", rc, (unsigned long)id,
+                   (unsigned long)AT(INIT_POS), (unsigned long)AT(INIT_SIZE), (unsigned long)AT(CMD));
+        } else if (strcmp(tok, "remove") == 0) {
+            char *a = strtok(NULL, " \t\r\n");
+            int rc = mstrack_remove(&dev, a ? (uint32_t)strtoul(a, NULL, 10) : 0u);
+            printf("rc=%d TARGET=%lu CMD=%lu\n", rc, (unsigned long)AT(TARGET), (unsigned long)AT(CMD));
+        } else if (strcmp(tok, "frame") == 0) {
+            unsigned id;
+            int rc = mstrack_read_frame(&dev);
+            printf("rc=%d mask=%lu RES_SEL=%lu", rc, (unsigned long)dev.target_mask, (unsigned long)AT(RES_SEL));
+            for (id = 0; id < MSTRACK_MAX_TARGETS; id++) {
+                if (dev.target_mask & (1u << id)) {
+                    printf(" t%u=%lu i%u=%lu", id, (unsigned long)dev.target[id].cx, id,
+                           (unsigned long)dev.target[id].target_id);
+                }
+            }
+            printf("\n");
+        } else if (strcmp(tok, "irqm") == 0) {
+            uint32_t st = mstrack_irq_handler(&dev, NULL);
+            printf("st=%lu mask=%lu box_rejected=%lu\n", (unsigned long)st, (unsigned long)dev.target_mask,
+                   (unsigned long)dev.box_rejected);
         } else {
             printf("unknown command %s\n", tok);
         }

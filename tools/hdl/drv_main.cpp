@@ -28,6 +28,12 @@
 //   watchdog          stop when a frame's result has not been read this many clocks after its last
 //                     pixel, or a bus transaction has not completed in 10,000 clocks (default 4e6)
 //   tail              clocks to run after the last expected result (default 200)
+//   multi             1: a multi-target core (ms_tracker_axi MAX_TARGETS >= 1): no init box; the
+//                     driver's mstrack_enable, then the op lines; each result interrupt reads every
+//                     target's word of the frame (mstrack_read_frame)
+//   op F add L X Y W H  (multi, several lines) mstrack_add of target label L with box X Y W H, called
+//                     once the result of frame F-1 has been read (F = 0: before the video starts)
+//   op F remove L     (multi) mstrack_remove of the id that label L's add returned
 //
 // out.txt, one record per line:
 //   D <call> <return code>                          mstrack_init / mstrack_start
@@ -35,6 +41,19 @@
 //                                                   one per handler call that saw a result: the
 //                                                   driver's decoded fields (mstrack_result_v2_t
 //                                                   for result word v2, mstrack_result_t for v1)
+//   M <index> <mask> <irq bits> <irq_cycle> <handled_cycle> <frame_count> <box_rejected>
+//                                                   multi: one per result interrupt: the driver's
+//                                                   dev.target_mask, RES_MASK's frame_count, the
+//                                                   driver's dev.box_rejected after the handler
+//   W <index> <id> <raw word, hex> <key=value ...>  multi: each target of that frame: the driver's
+//                                                   dev.target[id] and the raw word (read again
+//                                                   with mstrack_read_target, mstrack_read_raw)
+//   A <label> <rc> <id> <started before> <started after>
+//                                                   multi: mstrack_add's return code and id, and the
+//                                                   frames whose first pixel had been taken before
+//                                                   the call and at its return
+//   X <label> <rc> <started before> <started after> multi: mstrack_remove
+//   J <box_rejected> <live>                         multi, at the end: dev.box_rejected, mstrack_live
 //   Q <irq bits> <cycle>                            a handler call without a result bit
 //   C results lost errors rejected dropped          mstrack_read_counters at the end
 //   B <bus errors>                                  SLVERR answers seen by the driver's accesses
@@ -73,6 +92,7 @@ struct Sim {
     bool video_on = false, frame_loaded = false, holding = false;
     long long f = 0, x = 0, y = 0, blank = 0;
     std::vector<long long> last_pixel;       // cycle of each frame's last pixel
+    long long started = 0;                   // frames whose first pixel has been taken
     bool bad_pixels = false;
     // bus
     long long io_gap = 0, bus_errors = 0;
@@ -120,6 +140,7 @@ struct Sim {
         top->clk = 1;
         top->eval();
         if (s_fire) {
+            if (x == 0 && y == 0) ++started;
             if (x == W - 1) {
                 blank = hblank;
                 x = 0;
@@ -144,6 +165,11 @@ struct Sim {
 };
 
 Sim* sim = nullptr;
+// RES_MASK's address and frame_count field (generated header)
+constexpr uintptr_t MS_RES_MASK_ADDR = offsetof(ms_tracker_regs_t, RES_MASK);
+inline uint32_t FIELD_RES_MASK_FC(uint32_t v) {
+    return (v & MS_TRACKER_REGS__RES_MASK__FRAME_COUNT_bm) >> MS_TRACKER_REGS__RES_MASK__FRAME_COUNT_bp;
+}
 constexpr long long BUS_LIMIT = 10000;
 
 std::string hex_words(const uint32_t w[5]) {
@@ -215,7 +241,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     harness::Job job;
-    if (!harness::read_job(argv[1], job)) return 2;
+    if (!harness::read_job(argv[1], job, {"op"})) return 2;
     auto num = [&](const char* k, long long d) -> long long { return job.num(k, d); };
     Sim s;
     sim = &s;
@@ -260,10 +286,57 @@ int main(int argc, char** argv) {
 
     std::string status = "done", detail;
     const auto t0 = std::chrono::steady_clock::now();
-    mstrack_dev_t dev;
+    const bool multi = num("multi", 0) != 0;
+    struct Op {
+        long long frame;
+        bool add;
+        std::string label;
+        long long x = 0, y = 0, w = 0, h = 0;
+    };
+    std::vector<Op> ops;
+    for (const auto& kv : job.lines) {
+        std::istringstream ls(kv.second);
+        Op op;
+        std::string what;
+        ls >> op.frame >> what >> op.label;
+        op.add = what == "add";
+        if (op.add) ls >> op.x >> op.y >> op.w >> op.h;
+        if (!ls || (!op.add && what != "remove")) {
+            std::fprintf(stderr, "bad op line: %s\n", kv.second.c_str());
+            return 2;
+        }
+        ops.push_back(op);
+    }
+    std::map<std::string, uint32_t> ids;     // label -> the id its add returned
+    std::size_t next_op = 0;
+    static mstrack_dev_t dev;
+    // the ops due before frame `frame` (called in the application's context, not the handler's)
+    auto run_ops = [&](long long frame) {
+        for (; next_op < ops.size() && ops[next_op].frame <= frame; ++next_op) {
+            const Op& op = ops[next_op];
+            const long long before = s.started;
+            if (op.add) {
+                uint32_t id = 0;
+                const int r = mstrack_add(&dev, static_cast<int32_t>(op.x), static_cast<int32_t>(op.y),
+                                          static_cast<uint32_t>(op.w), static_cast<uint32_t>(op.h), &id);
+                if (r == MSTRACK_OK) ids[op.label] = id;
+                std::fprintf(o, "A %s %d %u %lld %lld\n", op.label.c_str(), r, r == MSTRACK_OK ? id : 0u, before,
+                             s.started);
+            } else {
+                const auto it = ids.find(op.label);
+                const int r = mstrack_remove(&dev, it == ids.end() ? 15u : it->second);
+                std::fprintf(o, "X %s %d %lld %lld\n", op.label.c_str(), r, before, s.started);
+            }
+        }
+    };
     int rc = mstrack_init(&dev, 0, static_cast<uint32_t>(s.W), static_cast<uint32_t>(s.H));
     std::fprintf(o, "D init %d\n", rc);
-    if (rc == MSTRACK_OK) {
+    if (rc == MSTRACK_OK && multi) {
+        mstrack_enable(&dev, static_cast<uint32_t>(num("irq_mask", MSTRACK_IRQ_ALL)));
+        std::fprintf(o, "D start %d\n", dev.max_targets > 0 ? MSTRACK_OK : MSTRACK_ERR_SINGLE);
+        if (dev.max_targets == 0) rc = MSTRACK_ERR_SINGLE;
+        run_ops(0);
+    } else if (rc == MSTRACK_OK) {
         rc = mstrack_start(&dev, static_cast<int32_t>(num("init_x", 0)), static_cast<int32_t>(num("init_y", 0)),
                            static_cast<uint32_t>(num("init_w", 0)), static_cast<uint32_t>(num("init_h", 0)),
                            static_cast<uint32_t>(num("irq_mask", MSTRACK_IRQ_ALL)));
@@ -290,7 +363,27 @@ int main(int argc, char** argv) {
             const long long irq_cycle = s.cycle;
             mstrack_result_t r;
             const uint32_t st = mstrack_irq_handler(&dev, &r);
-            if (st & MSTRACK_IRQ_RESULT) {
+            if ((st & MSTRACK_IRQ_RESULT) && multi) {
+                uint32_t fc = FIELD_RES_MASK_FC(mstrack_io_read32(MS_RES_MASK_ADDR));
+                std::fprintf(o, "M %lld %u %u %lld %lld %u %u\n", n_read, dev.target_mask, st, irq_cycle, s.cycle, fc,
+                             dev.box_rejected);
+                for (uint32_t id = 0; id < MSTRACK_MAX_TARGETS; ++id) {
+                    if (!(dev.target_mask & (1u << id))) continue;
+                    mstrack_result_v2_t again;
+                    uint32_t raw[5];
+                    (void)mstrack_read_target(&dev, id, &again);
+                    mstrack_read_raw(&dev, raw);
+                    const mstrack_result_v2_t& v = dev.target[id];
+                    std::fprintf(o, "W %lld %u %s valid=%u cx=%u cy=%u w8=%u h8=%u rho=%u confidence=%u status=%u"
+                                 " iter=%u stop=%u decim_log2=%u searched=%u flags=%u err_code=%u frame_count=%u"
+                                 " target_id=%u again_frame_count=%u\n",
+                                 n_read, id, hex_words(raw).c_str(), v.valid, v.cx, v.cy, v.w8, v.h8, v.rho,
+                                 v.confidence, v.status, v.iter, v.stop, v.decim_log2, v.searched, v.flags, v.err_code,
+                                 v.frame_count, v.target_id, again.frame_count);
+                }
+                ++n_read;
+                run_ops(n_read);
+            } else if (st & MSTRACK_IRQ_RESULT) {
                 uint32_t raw[5];
                 mstrack_read_raw(&dev, raw);
                 std::fprintf(o, "R %lld %s %u %lld %lld", n_read, hex_words(raw).c_str(), st, irq_cycle, s.cycle);
@@ -330,6 +423,7 @@ int main(int argc, char** argv) {
         mstrack_read_counters(&dev, &c);
         mstrack_stop(&dev);
         std::fprintf(o, "C %u %u %u %u %u\n", c.results, c.lost, c.errors, c.rejected, c.dropped);
+        if (multi) std::fprintf(o, "J %u %u\n", dev.box_rejected, mstrack_live(&dev));
         if (s.bus_timeout) {
             status = "bus_timeout";
             detail = "a register access at the end was not answered";

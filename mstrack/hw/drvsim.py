@@ -153,6 +153,14 @@ def _run_harness(exe: Path, frames: Iterable[np.ndarray], max_frame_w: int, job:
             tmp.cleanup()
 
 
+def _finish(run: _HarnessRun, build_s: float, check: bool, progress: str) -> None:
+    """Record the build time; with *check*, raise :class:`DriverSimError` unless the run ended done."""
+    run.build_seconds = build_s
+    if check and run.status != "done":
+        raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
+                             f"{progress})")
+
+
 def _parse(out: Path, g: dict[str, int], v2: bool) -> DriverRun:
     run = DriverRun()
     unpack = unpack_result_v2 if v2 else unpack_result
@@ -197,10 +205,7 @@ def simulate_driver(frames: Iterable[np.ndarray], box: tuple[int, int, int, int]
     res, n = _run_harness(exe, frames, max_frame_w, [f"{k} {v}" for k, v in job.items()], workdir,
                           lambda out: _parse(out, g, v2))
     run = cast(DriverRun, res)
-    run.build_seconds = build_s
-    if check and run.status != "done":
-        raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
-                             f"{len(run.results)} results of {n})")
+    _finish(run, build_s, check, f"{len(run.results)} results of {n}")
     return run
 
 
@@ -362,10 +367,7 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
     exe, build_s = build_driver(cfg, max_targets=max_targets)
     res, n = _run_harness(exe, frames, max_frame_w, lines, workdir, lambda out: _parse_multi(out, ops, g))
     run = cast(DriverMultiRun, res)
-    run.build_seconds = build_s
-    if check and run.status != "done":
-        raise DriverSimError(f"driver harness stopped: {run.status} {run.detail} (after {run.cycles} clocks, "
-                             f"{len(run.frames)} frames of {n})")
+    _finish(run, build_s, check, f"{len(run.frames)} frames of {n}")
     return run
 
 

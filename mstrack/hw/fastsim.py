@@ -79,6 +79,9 @@ def video_mode(name: str, ppc: int = 1) -> dict[str, int | float]:
 #: OPT_FAST = -Os, so it wins, and also reaches the harness, which is otherwise built without -O).
 #: Measured on Crossing (40 frames, default generics): -O3 0.80M clocks per CPU second, -O2 0.67-0.77M.
 CXX_OPT = "-O3"
+#: for short runs, where the build is most of the time: ms_tracker_multi with 3 colour engines builds in
+#: 120 s at -O1 against 355 s at -O3 (2 cores, one of them busy, ccache empty)
+CXX_OPT_SHORT = "-O1"
 
 
 class FastsimError(RuntimeError):
@@ -403,14 +406,16 @@ class MultiRun:
     build_seconds: float = 0.0
 
 
-def build_multi(cfg: CoreConfigV2, max_targets: int, verbose: bool = False) -> tuple[Path, float]:
-    """Build (or find in the cache) the harness of ms_tracker_multi with *max_targets* core v2 engines."""
+def build_multi(cfg: CoreConfigV2, max_targets: int, verbose: bool = False,
+                cxx_opt: str = CXX_OPT) -> tuple[Path, float]:
+    """Build (or find in the cache) the harness of ms_tracker_multi with *max_targets* core v2 engines
+    (*cxx_opt* as in :func:`build`)."""
     g = {"MAX_TARGETS": max_targets, **cfg.generics()}
     t0 = time.monotonic()
     net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}_{MULTI_TOP}"
     with _lock(net_dir.with_suffix(".lock")):
         vfile = hdl.ghdl_to_verilog(MULTI_TOP, g, out_path=net_dir / f"{MULTI_TOP}.v")
-    exe, built = verilate(vfile.read_text(), g, MULTI_TOP, [MULTI_CPP], include_dirs=[hdl.TOOLS_HDL_DIR],
+    exe, built = verilate(vfile.read_text(), g, MULTI_TOP, [MULTI_CPP], cxx_opt, include_dirs=[hdl.TOOLS_HDL_DIR],
                           exe_name="Vmulti", verbose=verbose)
     return exe, (time.monotonic() - t0) if built else 0.0
 
@@ -419,16 +424,17 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
                    fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int = 4, max_frame_w: int = 2048,
                    hblank: int = 0, vblank: int = 0, out_pause_pct: int = 0, seed: int = 1,
                    words: int | None = None, watchdog: int = 4_000_000, workdir: Path | str | None = None,
-                   check: bool = True, faults: dict[int, str] | None = None) -> MultiRun:
+                   check: bool = True, faults: dict[int, str] | None = None, cxx_opt: str = CXX_OPT) -> MultiRun:
     """Stream *frames* through the verilated ms_tracker_multi, with *commands* given before the frames
     they are keyed by: ``{frame: [("add", (x, y, w, h)) | ("remove", id), ...]}`` (a key of len(frames):
     after the last frame).  *words*: result words to wait for (default: one per frame at least).
     *faults*: ``{frame: "short_line" | "cut"}`` stream faults (as :func:`mstrack.hw.cosim_multi.frame_beats`).
-    Raise :class:`FastsimError` when the harness stops early (unless ``check`` is false)."""
+    *cxx_opt*: the build's C++ optimisation (as :func:`build`; ``-O1`` builds in about half the time of -O3 for
+    short runs).  Raise :class:`FastsimError` when the harness stops early (unless ``check`` is false)."""
     from ..fixed.vhdl_pkg import unpack_result_multi
     cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes, max_frame_w=max_frame_w)
     g = cfg.generics()
-    exe, build_s = build_multi(cfg, max_targets)
+    exe, build_s = build_multi(cfg, max_targets, cxx_opt=cxx_opt)
     tmp = tempfile.TemporaryDirectory(prefix="multisim_") if workdir is None else None
     wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
     wd.mkdir(parents=True, exist_ok=True)

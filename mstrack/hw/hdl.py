@@ -320,6 +320,28 @@ def _ghdl_runner(skip_build: bool):
     return _CachedGhdl()
 
 
+def _reuse_ghdl_build(build_dir: Path, digest: str, exe: str | None) -> bool:
+    """Tests name their own build dirs (their results and waves stay apart), and several of them build
+    the same top from the same sources: copy the library (and the LLVM executable *exe*) of another
+    build dir whose stamp is *digest* instead of analysing and elaborating again.  Returns True when
+    *build_dir* is then current (its stamp written last, after the copy)."""
+    for other in sorted((BUILD_DIR / "sim").glob("*/sources.hash")):
+        src = other.parent
+        try:
+            if src == build_dir or other.read_text() != digest or (exe and not (src / exe).is_file()):
+                continue
+            for f in src.iterdir():
+                if f.is_file() and (f.suffix in (".o", ".cf", ".lst") or f.name == exe):
+                    shutil.copy2(f, build_dir / f.name)
+            if other.read_text() != digest:   # rebuilt meanwhile (another pytest process): build here
+                return False
+        except OSError:                       # removed or rebuilt meanwhile: build here
+            return False
+        (build_dir / "sources.hash").write_text(digest)
+        return True
+    return False
+
+
 def run_ghdl(
     toplevel: str,
     test_module: str,
@@ -366,6 +388,8 @@ def run_ghdl(
     stamp = build_dir / "sources.hash"
     fresh = (stamp.is_file() and stamp.read_text() == digest
              and (backend == "mcode" or (build_dir / toplevel.lower()).is_file()))
+    if not fresh:
+        fresh = _reuse_ghdl_build(build_dir, digest, toplevel.lower() if backend != "mcode" else None)
     _prepare_pythonpath(test_module, test_dirs)
     params = {k: _vhdl_generic(v) for k, v in (generics or {}).items()}
     with _environ(GHDL_BACKEND=backend):

@@ -85,3 +85,27 @@ def test_ms_tracker_ecp5_netlist_build():
     assert not bad, ("; ".join(bad) + f"\ncritical path {cp.get('source')} -> {cp.get('sink')}: "
                      f"{cp.get('total_ns')} ns; update the perf-limits table in docs/performance.md "
                      "only for an intended change")
+
+
+@pytest.mark.ghdl
+def test_multi_pins_wrapper_synthesises(tmp_path):
+    """GHDL synthesis of rtl/wrappers/ms_tracker_multi_pins.vhd (what `mstrack synth --config multi4-colour`
+    places) with 2 colour engines: it elaborates, and its Verilog module has exactly the wrapper's pins
+    (the chain, the command handshake and outcome, the video stream, the serial result, live per slot)."""
+    from mstrack.hw import hdl
+    g = {**synth.CONFIGS["multi4-colour"].pins_generics(), "MAX_TARGETS": 2}
+    v = hdl.ghdl_to_verilog(synth.MULTI_PINS_TOP, g, synth.pins_sources(synth.MULTI_PINS_TOP),
+                            out_path=tmp_path / f"{synth.MULTI_PINS_TOP}.v").read_text()
+    head = re.search(rf"module {synth.MULTI_PINS_TOP}\s*\((.*?)\);", v, re.S)
+    assert head, "no wrapper module in GHDL's output"
+    ports = {m.group(3): (m.group(1), int(m.group(2)) + 1 if m.group(2) else 1)
+             for m in re.finditer(r"(input|output)\s+(?:\[(\d+):0\]\s+)?(\w+)", head.group(1))}
+    assert ports == {
+        "clk": ("input", 1), "rst": ("input", 1), "cfg_shift": ("input", 1), "cfg_din": ("input", 1),
+        "cmd_valid": ("input", 1), "cmd_ready": ("output", 1), "cmd_done": ("output", 1),
+        "cmd_code": ("output", 2), "cmd_id": ("output", 4), "s_axis_tdata": ("input", 24),
+        "s_axis_tvalid": ("input", 1), "s_axis_tready": ("output", 1), "s_axis_tlast": ("input", 1),
+        "s_axis_tuser": ("input", 1), "res_valid": ("output", 1), "res_dout": ("output", 1),
+        "res_last": ("output", 1), "live": ("output", 2), "busy": ("output", 1)}, ports
+    assert re.search(r"^\s+ms_tracker_multi_2_\w+ u_core \(", v, re.M), "the core with MAX_TARGETS 2"
+    assert len(re.findall(r"^\s+ms_tracker_v2_\w+ g_eng_n\d+_u_eng \(", v, re.M)) == 2, "one engine per slot"

@@ -189,6 +189,23 @@ def test_v2_config_has_v2_generics_and_wrapper():
     assert set(c.pins_generics()) <= {n for n, _ in core} and set(g) <= engine
 
 
+def test_multi_pins_wrapper_passes_every_generic():
+    """rtl/wrappers/ms_tracker_multi_pins.vhd has exactly ms_tracker_multi's generics (names, types,
+    defaults) and passes each on by name, so the placed core is the one `mstrack synth` counts."""
+    import re
+
+    def generics(path, entity):
+        t = path.read_text()
+        t = t[t.index(f"entity {entity} is"):]
+        t = re.sub(r"--[^\n]*", "", t[t.index("generic ("):t.index("  port (")])
+        return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
+    multi = generics(synth.REPO_ROOT / "rtl" / "ms_tracker_multi.vhd", "ms_tracker_multi")
+    assert len(multi) > 70 and multi[0][0] == "MAX_TARGETS"
+    assert generics(synth.MULTI_PINS_VHD, "ms_tracker_multi_pins") == multi
+    body = synth.MULTI_PINS_VHD.read_text()
+    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n, _ in multi)
+
+
 def test_v2_configs_are_the_v2_trackers():
     """Configuration "v2": ms_tracker_v2 with the generics of tracker v2's default parameters (mstrack-v2:
     ORIENT_T 64, the gated scale test SCALE_TEST_D256 13; the VHDL defaults of ms_tracker_pins, which
@@ -214,8 +231,9 @@ def test_v2_configs_are_the_v2_trackers():
 
 def test_multi4_colour_config_is_four_colour_engines():
     """Configuration "multi4-colour": ms_tracker_multi with MAX_TARGETS 4 and the generics of "v2-colour"
-    (each engine is core v2 of mstrack-v2-colour); it has no pin wrapper, so no nextpnr, and a plain
-    `mstrack synth` leaves it out.  The other configurations synthesise their own core as before."""
+    (each engine is core v2 of mstrack-v2-colour), placed through its own pin wrapper
+    (ms_tracker_multi_pins); a plain `mstrack synth` leaves it out.  The other configurations
+    synthesise their own core as before."""
     import argparse
     import re
 
@@ -223,7 +241,9 @@ def test_multi4_colour_config_is_four_colour_engines():
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import V2_COLOUR, TrackerParams
     m = synth.CONFIGS["multi4-colour"]
-    assert (m.top, m.core, m.max_targets) == ("ms_tracker_multi", "ms_tracker_v2", 4) and m.v2 and not m.placeable
+    assert (m.top, m.core, m.max_targets) == ("ms_tracker_multi", "ms_tracker_v2", 4) and m.v2 and m.placeable
+    assert m.pins_top == "ms_tracker_multi_pins" and m.pins_generics() == m.generics()
+    assert synth.pins_sources(m.pins_top)[-1] == synth.MULTI_PINS_VHD
     g = m.generics()
     colour = CoreConfigV2(TrackerParams(preset="v2", **V2_COLOUR), FixedParams(), lanes=4, max_frame_w=2048).generics()
     assert g == {"MAX_TARGETS": 4, **colour} == {"MAX_TARGETS": 4, **synth.CONFIGS["v2-colour"].generics()}
@@ -238,6 +258,7 @@ def test_multi4_colour_config_is_four_colour_engines():
     for name, c in synth.CONFIGS.items():
         if name != "multi4-colour":
             assert c.top == c.core and c.placeable and "MAX_TARGETS" not in c.generics()
+            assert c.pins_top == "ms_tracker_pins"
     assert synth.DEFAULT_CONFIGS == tuple(n for n in synth.CONFIGS if n != "multi4-colour")
     ap = argparse.ArgumentParser()
     synth.add_arguments(ap)

@@ -22,8 +22,8 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
   :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` with
   PRESET 1 (160-bit result word v2); the cycle table is the paper core's only.
 * the multi-target core (configuration ``multi4-colour``, only when named with ``--config``):
-  ``ms_tracker_multi`` with MAX_TARGETS 4 engines of ``v2-colour``, yosys resources only (no pin
-  wrapper, so no nextpnr).
+  ``ms_tracker_multi`` with MAX_TARGETS 4 engines of ``v2-colour``, placed as
+  ``rtl/wrappers/ms_tracker_multi_pins.vhd`` (ECP5; the Nexus PDC has the single-target wrapper's pins).
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
@@ -57,8 +57,10 @@ PINS_TOP = "ms_tracker_pins"
 PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_pins.vhd"
 #: core v2's engine, synthesised alone for its resources (placed through PINS_TOP with PRESET 1)
 TOP_V2 = "ms_tracker_v2"
-#: the multi-target core: MAX_TARGETS core v2 engines + the merger (resources only, no pin wrapper)
+#: the multi-target core: MAX_TARGETS core v2 engines + the merger, placed through its own pin wrapper
 TOP_MULTI = "ms_tracker_multi"
+MULTI_PINS_TOP = "ms_tracker_multi_pins"
+MULTI_PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_multi_pins.vhd"
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
@@ -95,8 +97,8 @@ class Config:
     rtl/wrappers/ms_tracker_pins.vhd (:meth:`pins_generics`).
 
     ``top``: the entity synthesised, ``core`` unless named (``""``); ``ms_tracker_multi`` takes
-    ``MAX_TARGETS`` (``max_targets``) ahead of the generics of its ``core`` engine (core v2). Such a
-    configuration has no pin wrapper: resources only (no nextpnr)."""
+    ``MAX_TARGETS`` (``max_targets``) ahead of the generics of its ``core`` engine (core v2), and is
+    placed through rtl/wrappers/ms_tracker_multi_pins.vhd."""
 
     name: str
     note: str
@@ -121,13 +123,14 @@ class Config:
 
     @property
     def placeable(self) -> bool:
-        """True when nextpnr can place it (the pin wrapper holds this top)."""
-        return self.top == self.core
+        """True when nextpnr can place it: every top has a pin wrapper."""
+        return self.top in (self.core, TOP_MULTI)
 
     @property
     def pins_top(self) -> str:
-        """The pin wrapper nextpnr places for this core (one for both presets)."""
-        return PINS_TOP
+        """The pin wrapper nextpnr places for this core (one for both presets of ms_tracker, one for
+        ms_tracker_multi)."""
+        return MULTI_PINS_TOP if self.top == TOP_MULTI else PINS_TOP
 
     def params(self) -> tuple[TrackerParams, FixedParams]:
         tp = TrackerParams(preset="v2", **self.tp) if self.v2 else TrackerParams(**self.tp)
@@ -147,7 +150,10 @@ class Config:
         return g
 
     def pins_generics(self) -> dict[str, int]:
-        """The generics of the pin wrapper (those of ms_tracker): :meth:`generics`, with PRESET 1 for core v2."""
+        """The generics of the pin wrapper (those of ms_tracker): :meth:`generics`, with PRESET 1 for core v2
+        (ms_tracker_multi's wrapper: its own generics)."""
+        if self.top == TOP_MULTI:
+            return self.generics()
         return {"PRESET": 1, **self.generics()} if self.v2 else self.generics()
 
 
@@ -166,7 +172,7 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
     Config("v2-colour", "core v2 of tracker mstrack-v2-colour (mstrack.track.params.V2_COLOUR: colour bins alone, "
                         "ORIENT_T -1, no scale test, loss_rho 0.88, loss_contrast 0.19)", core=TOP_V2, tp=dict(V2_COLOUR)),
     Config("multi4-colour", "ms_tracker_multi with MAX_TARGETS 4 and the v2-colour engine's generics: four colour "
-                            "engines + the merger (resources only: no pin wrapper, no nextpnr)",
+                            "engines + the merger (placed through rtl/wrappers/ms_tracker_multi_pins.vhd)",
            core=TOP_V2, top=TOP_MULTI, max_targets=4, tp=dict(V2_COLOUR)),
 )}
 #: the configurations of a plain `mstrack synth` (the multi-target core only when named with --config)
@@ -231,9 +237,9 @@ def sources(top: str, extra: Sequence[Path] = ()) -> list[Path]:
 
 
 def pins_sources(top: str = PINS_TOP) -> list[Path]:
-    """The core (either preset) + its pin wrapper rtl/wrappers/ms_tracker_pins.vhd (the wrapper always
-    from the working tree)."""
-    return sources(top, extra=[PINS_VHD])
+    """The core + its pin wrapper *top*: rtl/wrappers/ms_tracker_pins.vhd (either preset) or
+    ms_tracker_multi_pins.vhd (the wrapper always from the working tree)."""
+    return sources(top, extra=[MULTI_PINS_VHD if top == MULTI_PINS_TOP else PINS_VHD])
 
 
 # ----------------------------------------------------------------------------- nextpnr
@@ -459,7 +465,7 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         secs["nexus_core"] = round(time.monotonic() - t0, 1)
         out["nexus"] = {k: n[k] for k in NEXUS_KEYS}
         log(f"[{cfg.name}] nexus core: {out['nexus']} ({secs['nexus_core']} s)")
-        if pnr and cfg.placeable:
+        if pnr and cfg.placeable and cfg.pins_top == PINS_TOP:   # NEXUS_PDC places this wrapper's pins
             t0 = time.monotonic()
             npins = yosys_cached("nexus", cfg.pins_top, cfg.pins_generics(), pins_sources(cfg.pins_top),
                                  f"nexuspnr_{cfg.name}")

@@ -326,8 +326,9 @@ def write_overlay(path: Path, fps: float, images: Iterator[np.ndarray]) -> Path 
 
 
 def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool = False,
-            command: str = "") -> dict[str, Any]:
-    """Simulate ``job`` and write results.csv, the overlay video and bitexact.json to ``out``.
+            command: str = "", quick_build: bool = False) -> dict[str, Any]:
+    """Simulate ``job`` and write results.csv, the overlay video and bitexact.json to ``out``
+    (*quick_build*: the Verilator model's C++ at ``fastsim.CXX_OPT_SHORT``, as ``--quick-build``).
 
     Returns the report (bitexact.json's content)."""
     from .hw import fastsim
@@ -343,7 +344,8 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
         "run of a generic set builds the Verilator model, 1-2 min)...")
     # ms_tracker, the entity integrators instantiate (v2: generic PRESET 1)
     run = fastsim.simulate(job.frames(), job.box, job.cfg.tp, job.cfg.fp, lanes=job.cfg.lanes,
-                           max_frame_w=job.cfg.max_frame_w, check=False, v2=v2, top=fastsim.TOP)
+                           max_frame_w=job.cfg.max_frame_w, check=False, v2=v2, top=fastsim.TOP,
+                           cxx_opt=fastsim.CXX_OPT_SHORT if quick_build else fastsim.CXX_OPT)
     t_sim = time.monotonic() - t0
     say(f"simulated {run.cycles} clocks in {run.seconds:.1f} s ({run.status}); running the fixed-point model...")
     t1 = time.monotonic()
@@ -397,11 +399,12 @@ SIM_CSV_FIELDS_MULTI = ("frame", "target_id", *[f for f in SIM_CSV_FIELDS_V2 if 
 
 
 def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path, slots: int,
-                  progress: bool = False, command: str = "") -> dict[str, Any]:
+                  progress: bool = False, command: str = "", quick_build: bool = False) -> dict[str, Any]:
     """Several targets: the boxes added before the first frame of the multi-target core
     ``ms_tracker_multi`` (``slots`` core v2 engines, :func:`mstrack.hw.fastsim.simulate_multi`), every
     word compared with :func:`mstrack.hw.cosim_multi.expected_multi`; writes results.csv
-    (:data:`SIM_CSV_FIELDS_MULTI`, one row per word), overlay.mp4 and bitexact.json to ``out``."""
+    (:data:`SIM_CSV_FIELDS_MULTI`, one row per word), overlay.mp4 and bitexact.json to ``out``
+    (*quick_build* as :func:`run_sim`)."""
     from .hw import fastsim
     from .hw.cosim_multi import expected_multi
     from .multicli import draw_multi_overlay
@@ -420,7 +423,8 @@ def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path
         "model, several minutes)...")
     t0 = time.monotonic()
     run = fastsim.simulate_multi(frames, cmds, cfg.tp, cfg.fp, max_targets=slots, lanes=cfg.lanes,
-                                 max_frame_w=cfg.max_frame_w, words=len(m.results), check=False)
+                                 max_frame_w=cfg.max_frame_w, words=len(m.results), check=False,
+                                 cxx_opt=fastsim.CXX_OPT_SHORT if quick_build else fastsim.CXX_OPT)
     t_sim = time.monotonic() - t0
     keys = [*COMPARED_FIELDS_V2, "target_id"]
     frame_of = [job.first + i for i, fr in enumerate(m.frames) for _ in fr]
@@ -507,7 +511,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         print(f"mstrack: warning: {job.source.path}: {job.source.truncated}", file=sys.stderr)
     if multi:
         rep = run_sim_multi(job, [job.box, *more], out, slots, progress=not args.quiet,
-                            command=getattr(args, "command_line", ""))
+                            command=getattr(args, "command_line", ""), quick_build=args.quick_build)
         sim = rep["simulation"]
         print(f"{rep['words']} words for {job.count} frames {job.size[0]}x{job.size[1]}, {len(boxes)} targets in "
               f"{slots} slots, {sim['cycles']} clocks ({sim['status']})")
@@ -518,7 +522,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
             print(f"mstrack sim: error: the harness stopped early: {sim['status']} {sim['detail']}", file=sys.stderr)
             return EXIT_MISMATCH
         return EXIT_OK if rep["bit_exact"] else EXIT_MISMATCH
-    rep = run_sim(job, out, progress=not args.quiet, command=getattr(args, "command_line", ""))
+    rep = run_sim(job, out, progress=not args.quiet, command=getattr(args, "command_line", ""),
+                  quick_build=args.quick_build)
     sim = rep["simulation"]
     print(f"{rep['results']} results for {job.count} frames {job.size[0]}x{job.size[1]}, {sim['cycles']} clocks "
           f"({sim['status']}), latency {sim['latency_min']}..{sim['latency_max']} clocks after the last pixel")
@@ -559,6 +564,9 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
                         "core's engines)")
     p.add_argument("--colour", action="store_true",
                    help="core v2 on colour bins alone (tracker mstrack-v2-colour's generics, ORIENT_T -1)")
+    p.add_argument("--quick-build", action="store_true",
+                   help="compile the Verilator model at -O1 instead of -O3: a build in about a third of the "
+                        "time, a slower simulation (for a short clip; cached apart from the -O3 build)")
     p.add_argument("--out", help="output folder (default out/sim/<VIDEO name>)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=_cmd_sim)

@@ -312,8 +312,8 @@ def test_sim_preset_v2_real(tmp_path, capsys):
 @pytest.mark.long
 @pytest.mark.verilator
 def test_sim_several_boxes(tmp_path, capsys):
-    """`mstrack sim` with three --box on a generated 4-target scene (an image folder) and --slots 3
-    --colour --max-frame-width 1024 (the build of tb/test_ms_tracker_multi.py): the multi-target core
+    """`mstrack sim` with three --box on a generated 4-target scene (an image folder) and --colour
+    --max-frame-width 1024 --quick-build (the -O1 build of tb/test_ms_tracker_multi.py): the multi-target core
     ms_tracker_multi, every word bit-exact with CoreModelMulti, results.csv one row per word with the
     target's slot, the overlay written."""
     from mstrack.io.synthetic import make_multi_scene
@@ -325,7 +325,7 @@ def test_sim_several_boxes(tmp_path, capsys):
     boxes = [",".join(str(int(v)) for v in r[2:6]) for r in rows if r[0] == 0][:3]
     out = tmp_path / "multi"
     argv = ["sim", str(folder), *[f"--box={b}" for b in boxes], "--colour", "--max-frame-width", "1024",
-            "--out", str(out), "--quiet"]
+            "--quick-build", "--out", str(out), "--quiet"]
     rc = cli.main(argv)
     cap = capsys.readouterr()
     assert rc == 0, cap.out + cap.err

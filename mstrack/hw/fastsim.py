@@ -291,7 +291,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
              max_frame_w: int = 2048, lead: int = 0, in_pause_pct: int = 0, out_pause_pct: int = 0,
              seed: int = 1, watchdog: int | None = None, max_cycles: int | None = None, tail: int = 200,
              init: bool = True, workdir: Path | str | None = None, check: bool = True, ppc: int = 1,
-             v2: bool = False, top: str = TOP) -> FastsimRun:
+             v2: bool = False, top: str = TOP, cxx_opt: str = CXX_OPT) -> FastsimRun:
     """Stream *frames* through the verilated core with the init box *box* on the first frame.
 
     Parameters
@@ -346,7 +346,7 @@ def simulate(frames: Iterable[np.ndarray], box: tuple[int, int, int, int], tp: T
         tp = tp or TrackerParams()
         cfg = CoreConfig(tp, fp, lanes=lanes, max_frame_w=max_frame_w, ppc=ppc)
     g = cfg.generics()
-    exe, build_s = build(cfg, top=top)
+    exe, build_s = build(cfg, top=top, cxx_opt=cxx_opt)
     tmp = None
     if workdir is None:
         tmp = tempfile.TemporaryDirectory(prefix="fastsim_")

@@ -174,12 +174,7 @@ def test_v2_config_has_v2_generics_and_wrapper():
     srcs = synth.pins_sources(c.pins_top)
     assert srcs[-1] == synth.PINS_VHD and {"ms_tracker.vhd", "ms_tracker_v2.vhd"} <= {p.name for p in srcs}
 
-    def generics(path, entity):
-        """(name, type and default) of each generic, comments and spacing left out."""
-        t = path.read_text()
-        t = t[t.index(f"entity {entity} is"):]
-        t = re.sub(r"--[^\n]*", "", t[t.index("generic ("):t.index("  port (")])
-        return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
+    generics = _vhdl_generics
     core = generics(synth.REPO_ROOT / "rtl" / "ms_tracker.vhd", "ms_tracker")
     assert len(core) > 70 and core[0][0] == "PRESET"
     assert generics(synth.PINS_VHD, "ms_tracker_pins") == core
@@ -189,16 +184,21 @@ def test_v2_config_has_v2_generics_and_wrapper():
     assert set(c.pins_generics()) <= {n for n, _ in core} and set(g) <= engine
 
 
+def _vhdl_generics(path, entity) -> list[tuple[str, str]]:
+    """(name, type and default) of each generic of *entity* in *path*, comments and spacing left out."""
+    import re
+    t = path.read_text()
+    t = t[t.index(f"entity {entity} is"):]
+    t = re.sub(r"--[^\n]*", "", t[t.index("generic ("):t.index("  port (")])
+    return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
+
+
 def test_multi_pins_wrapper_passes_every_generic():
     """rtl/wrappers/ms_tracker_multi_pins.vhd has exactly ms_tracker_multi's generics (names, types,
     defaults) and passes each on by name, so the placed core is the one `mstrack synth` counts."""
     import re
 
-    def generics(path, entity):
-        t = path.read_text()
-        t = t[t.index(f"entity {entity} is"):]
-        t = re.sub(r"--[^\n]*", "", t[t.index("generic ("):t.index("  port (")])
-        return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
+    generics = _vhdl_generics
     multi = generics(synth.REPO_ROOT / "rtl" / "ms_tracker_multi.vhd", "ms_tracker_multi")
     assert len(multi) > 70 and multi[0][0] == "MAX_TARGETS"
     assert generics(synth.MULTI_PINS_VHD, "ms_tracker_multi_pins") == multi

@@ -88,7 +88,7 @@ test-multi-mot: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider tb/test_mstrack_drv.py -k mot_sequence $(ARGS)
 
 # The constrained-random test of the multi-target core (tb/test_ms_tracker_multi.py::test_multi_fuzz:
-# commands, stream faults, result back-pressure; Verilator; CI runs seeds 1..3); replay a failing seed
+# commands, stream faults, result back-pressure; Verilator; CI runs seeds 1..10); replay a failing seed
 # with `make test-fuzz-multi SEEDS=<seed> N=1`.
 test-fuzz-multi: setup
 	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_REQUIRE_TOOLS=1 \

@@ -174,13 +174,8 @@ def test_v2_config_has_v2_generics_and_wrapper():
     srcs = synth.pins_sources(c.pins_top)
     assert srcs[-1] == synth.PINS_VHD and {"ms_tracker.vhd", "ms_tracker_v2.vhd"} <= {p.name for p in srcs}
 
-    generics = _vhdl_generics
-    core = generics(synth.REPO_ROOT / "rtl" / "ms_tracker.vhd", "ms_tracker")
-    assert len(core) > 70 and core[0][0] == "PRESET"
-    assert generics(synth.PINS_VHD, "ms_tracker_pins") == core
-    body = synth.PINS_VHD.read_text()
-    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n, _ in core)
-    engine = {n for n, _ in generics(synth.REPO_ROOT / "rtl" / "ms_tracker_v2.vhd", "ms_tracker_v2")}
+    core = _wrapper_passes_every_generic("ms_tracker", "PRESET", synth.PINS_VHD, "ms_tracker_pins")
+    engine = {n for n, _ in _vhdl_generics(synth.REPO_ROOT / "rtl" / "ms_tracker_v2.vhd", "ms_tracker_v2")}
     assert set(c.pins_generics()) <= {n for n, _ in core} and set(g) <= engine
 
 
@@ -193,17 +188,22 @@ def _vhdl_generics(path, entity) -> list[tuple[str, str]]:
     return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
 
 
+def _wrapper_passes_every_generic(core: str, first: str, wrapper_vhd, wrapper: str) -> list[tuple[str, str]]:
+    """Assert that pin wrapper *wrapper* has exactly the generics of rtl/<core>.vhd (the first one *first*)
+    and maps each by name; returns the core's generics."""
+    import re
+    gen = _vhdl_generics(synth.REPO_ROOT / "rtl" / f"{core}.vhd", core)
+    assert len(gen) > 70 and gen[0][0] == first
+    assert _vhdl_generics(wrapper_vhd, wrapper) == gen
+    body = wrapper_vhd.read_text()
+    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n, _ in gen)
+    return gen
+
+
 def test_multi_pins_wrapper_passes_every_generic():
     """rtl/wrappers/ms_tracker_multi_pins.vhd has exactly ms_tracker_multi's generics (names, types,
     defaults) and passes each on by name, so the placed core is the one `mstrack synth` counts."""
-    import re
-
-    generics = _vhdl_generics
-    multi = generics(synth.REPO_ROOT / "rtl" / "ms_tracker_multi.vhd", "ms_tracker_multi")
-    assert len(multi) > 70 and multi[0][0] == "MAX_TARGETS"
-    assert generics(synth.MULTI_PINS_VHD, "ms_tracker_multi_pins") == multi
-    body = synth.MULTI_PINS_VHD.read_text()
-    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n, _ in multi)
+    _wrapper_passes_every_generic("ms_tracker_multi", "MAX_TARGETS", synth.MULTI_PINS_VHD, "ms_tracker_multi_pins")
 
 
 def test_v2_configs_are_the_v2_trackers():

@@ -192,6 +192,88 @@ def test_realtime_v2_1080p60(variant):
     assert not any(stalls) and not misses, f"stalls {stalls}; latencies {run.latencies}:\n" + "\n".join(misses)
 
 
+#: the multi-target core at 1080p60: MAX_TARGETS engines of mstrack-v2-colour (MAX_FRAME_W 2048), all
+#: slots live.  Slot 0 tracks the rider of MotorRolling 30-39 x3 (the loss, the wide search and the
+#: re-acquisition of test_realtime_v2_1080p60); the others hold boxes of 300 x 300 on a 4 x 2 grid,
+#: which each engine shrinks to its largest window (MAX_HALF), so every engine works on its largest
+#: window.  MSTRACK_RT_MULTI_N / MSTRACK_RT_MULTI_FRAMES change the engine count and the clip length.
+MULTI_RT_N = int(os.environ.get("MSTRACK_RT_MULTI_N", "8"))
+MULTI_RT_FRAMES = int(os.environ.get("MSTRACK_RT_MULTI_FRAMES", str(V2_RT_FRAMES)))
+
+
+def multi_rt_boxes(rider: tuple[int, int, int, int], n: int) -> list[tuple[int, int, int, int]]:
+    """The rider's box, then n - 1 boxes of 300 x 300 on a 4 x 2 grid of the 1920 x 1080 frame (cycled
+    with an offset past 8)."""
+    out = [rider]
+    for k in range(1, n):
+        col, row, lap = k % 4, (k // 4) % 2, k // 8
+        out.append((90 + 480 * col + 40 * lap, 120 + 540 * row + 40 * lap, 300, 300))
+    return out
+
+
+def multi_frame_times(run: "fastsim.MultiRun", budget: int) -> tuple[list[int], list[str]]:
+    """Per frame, the clocks from its last pixel to its last result word (tlast); and the frames whose
+    last word came at or after the next frame's first pixel (the last frame: more than *budget* clocks
+    after its last pixel), one line each."""
+    ends = [w["cycle"] for w in run.words if w["last"]]
+    lat, misses = [], []
+    for i, (f, end) in enumerate(zip(run.frames, ends)):
+        lat.append(end - f["last_pixel_cycle"])
+        nxt = (run.frames[i + 1]["first_pixel_cycle"] if i + 1 < len(run.frames)
+               else f["last_pixel_cycle"] + budget + 1)
+        if end >= nxt:
+            misses.append(f"frame {i}: last word at clock {end}, next frame starts at {nxt} "
+                          f"(latency {lat[-1]} > {budget})")
+    return lat, misses
+
+
+@pytest.mark.extra
+@pytest.mark.verilator
+def test_realtime_multi_1080p60():
+    """ms_tracker_multi with MULTI_RT_N (8) colour engines at 1080p60 timing on real footage upscaled, every
+    slot live at the largest window: every word bit-exact with CoreModelMulti (every field, the id, tlast),
+    no input stall, and each frame's last word before the next frame's first pixel (real time).  `make
+    test-extra` (an 8-engine build and about 25 M clocks)."""
+    import cv2
+    from mstrack.hw.cosim_multi import expected_multi
+    from mstrack.io.data import load_sequence
+    from mstrack.track.params import V2_COLOUR
+    seq = SEQ_ROOT / "MotorRolling"
+    if not seq.is_dir():
+        pytest.skip(f"{seq} not found: the multi-target real-time check needs ../shared/data/sequences")
+    s = load_sequence(seq)
+    frames = [cv2.resize(cv2.imread(str(f), cv2.IMREAD_COLOR), (HD_W, HD_H), interpolation=cv2.INTER_LINEAR)
+              for f in s.img_files[V2_RT_START:V2_RT_START + MULTI_RT_FRAMES]]
+    rider = tuple(int(round(float(v) * 3)) for v in s.gt[V2_RT_START])
+    boxes = multi_rt_boxes(rider, MULTI_RT_N)  # type: ignore[arg-type]
+    cmds = {0: [("add", b) for b in boxes]}
+    tp, fp = TrackerParams(preset="v2", **V2_COLOUR), FixedParams()
+    m = expected_multi(frames, cmds, tp, fp, MULTI_RT_N, 2048)
+    assert all(len(fr) == MULTI_RT_N for fr in m.frames), "every slot must stay live (model)"
+    run = fastsim.simulate_multi(frames, cmds, tp, fp, max_targets=MULTI_RT_N, lanes=DEFAULT_LANES,
+                                 max_frame_w=2048, hblank=HBLANK, vblank=VBLANK, words=len(m.results))
+    from mstrack.hw.cosim import COMPARED_FIELDS_V2
+    keys = [*COMPARED_FIELDS_V2, "target_id"]
+    mism = [f"word {i}: " + "; ".join(f"{k}: dut={a[k]} model={b[k]}" for k in keys if a[k] != b[k])
+            for i, (a, b) in enumerate(zip(run.words, m.results)) if any(a[k] != b[k] for k in keys)]
+    lat, misses = multi_frame_times(run, BUDGET)
+    stalls = [f["stall_cycles"] for f in run.frames]
+    _report(f"realtime_multi{MULTI_RT_N}_1080p60_lanes{DEFAULT_LANES}", {
+        "source": f"MotorRolling {V2_RT_START}-{V2_RT_START + MULTI_RT_FRAMES - 1} x3", "targets": MULTI_RT_N,
+        "frames": len(frames), "boxes": [list(b) for b in boxes], "lanes": DEFAULT_LANES, "budget_clocks": BUDGET,
+        "latency_clocks": lat, "worst_latency_clocks": max(lat) if lat else None, "stall_cycles": stalls,
+        "searched": [[w["searched"] for w in fr] for fr in m.frames],
+        "iter": [[w["iter"] for w in fr] for fr in m.frames],
+        "cycles": run.cycles, "seconds": round(run.seconds, 2), "cpu_seconds": round(run.cpu_seconds, 2),
+        "build_seconds": round(run.build_seconds, 1), "mismatches": mism[:20], "realtime_misses": misses})
+    assert len(run.words) == len(m.results), (len(run.words), len(m.results))
+    assert not mism, "DUT differs from the model:\n" + "\n".join(mism[:10])
+    lasts = [i == len(fr) - 1 for fr in m.frames for i in range(len(fr))]
+    assert [bool(w["last"]) for w in run.words] == lasts
+    assert len(run.frames) == len(frames)
+    assert not any(stalls) and not misses, f"stalls {stalls}; latencies {lat}:\n" + "\n".join(misses)
+
+
 def _lanes_720p60() -> list:
     lanes = [int(v) for v in os.environ.get("MSTRACK_RT720_LANES", str(DEFAULT_LANES)).split(",")]
     miss = pytest.mark.xfail(

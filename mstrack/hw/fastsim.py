@@ -395,12 +395,16 @@ MULTI_TOP = "ms_tracker_multi"
 class MultiRun:
     """Outcome of one :func:`simulate_multi` run: ``words`` (field dicts of
     :func:`mstrack.fixed.vhdl_pkg.unpack_result_multi` with ``last`` and ``cycle``), ``reports``
-    ((cmd_code, cmd_id) per cmd_done), ``taken`` ((frame, command index, cycle) per command taken)."""
+    ((cmd_code, cmd_id) per cmd_done), ``taken`` ((frame, command index, cycle) per command taken),
+    ``frames`` (per frame streamed: ``first_pixel_cycle``, ``last_pixel_cycle``, ``stall_cycles``, the clocks
+    in which one of its pixels was offered and not taken)."""
     words: list[dict] = field(default_factory=list)
     reports: list[tuple[int, int]] = field(default_factory=list)
     taken: list[tuple[int, int, int]] = field(default_factory=list)
+    frames: list[dict] = field(default_factory=list)
     cycles: int = 0
     seconds: float = 0.0
+    cpu_seconds: float = 0.0
     status: str = "missing"
     detail: str = ""
     build_seconds: float = 0.0
@@ -471,8 +475,12 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
                 run.reports.append((int(p[1]), int(p[2])))
             elif p[0] == "T":
                 run.taken.append((int(p[1]), int(p[2]), int(p[3])))
+            elif p[0] == "F":
+                run.frames.append({"first_pixel_cycle": int(p[2]), "last_pixel_cycle": int(p[3]),
+                                   "stall_cycles": int(p[4])})
             elif p[0] == "E":
-                run.status, run.cycles, run.seconds, run.detail = p[1], int(p[2]), float(p[3]), " ".join(p[4:])
+                run.status, run.cycles, run.seconds, run.cpu_seconds = p[1], int(p[2]), float(p[3]), float(p[4])
+                run.detail = " ".join(p[5:])
     finally:
         if tmp is not None:
             tmp.cleanup()

@@ -28,13 +28,18 @@
 //   W <index> <word, hex, MSB first> <last> <cycle>    a result word taken
 //   K <code> <id> <cycle>                             a cmd_done report
 //   T <frame> <command index> <cycle>                  a command taken
-//   E <status: done | watchdog> <cycles> <seconds> <detail>
+//   F <frame> <first_pixel_cycle> <last_pixel_cycle> <stall_cycles>   per frame streamed, at the end
+//   E <status: done | watchdog> <cycles> <seconds> <cpu_seconds> <detail>
+// stall_cycles counts the clocks in which a pixel of that frame was offered (s_axis_tvalid = 1)
+// and not taken (s_axis_tready = 0): the core back-pressuring the video.  seconds is the
+// wall time of the simulation loop, cpu_seconds its CPU time.
 #include "Vms_tracker_multi.h"
 #include "verilated.h"
 #include "harness_job.h"
 
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -47,6 +52,10 @@ namespace {
 
 struct Cmd {
     long long frame, op, id, x, y, w, h;
+};
+
+struct FrameTimes {
+    long long first = -1, last = -1, stalls = 0;
 };
 
 }  // namespace
@@ -120,7 +129,9 @@ int main(int argc, char** argv) {
     std::size_t next_cmd = 0;
     bool frame_loaded = false;
     std::string status = "done", detail;
+    std::vector<FrameTimes> times(static_cast<std::size_t>(n_frames));
     const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t cpu0 = std::clock();
     long long cycle = 0;
     for (;; ++cycle) {
         // ---- inputs of this clock: a command of the next frame first, then the video
@@ -174,6 +185,12 @@ int main(int argc, char** argv) {
             ++next_cmd;
             last_event = cycle;
         }
+        if (s_valid && f < n_frames) {
+            FrameTimes& ft = times[static_cast<std::size_t>(f)];
+            if (!s_fire) ++ft.stalls;
+            if (s_fire && at_frame_start) ft.first = cycle;
+            if (s_fire) ft.last = cycle;
+        }
         if (s_fire) {
             last_event = cycle;
             ++frame_beats;
@@ -212,7 +229,12 @@ int main(int argc, char** argv) {
         }
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::fprintf(o, "E %s %lld %.6f %s\n", status.c_str(), cycle, secs, detail.c_str());
+    const double cpu_secs = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+        if (times[i].first >= 0)
+            std::fprintf(o, "F %zu %lld %lld %lld\n", i, times[i].first, times[i].last, times[i].stalls);
+    }
+    std::fprintf(o, "E %s %lld %.6f %.6f %s\n", status.c_str(), cycle, secs, cpu_secs, detail.c_str());
     std::fclose(o);
     std::fclose(pix_f);
     top.final();

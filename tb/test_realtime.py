@@ -231,7 +231,8 @@ def multi_frame_times(run: "fastsim.MultiRun", budget: int) -> tuple[list[int], 
 @pytest.mark.verilator
 def test_realtime_multi_1080p60():
     """ms_tracker_multi with MULTI_RT_N (8) colour engines at 1080p60 timing on real footage upscaled, every
-    slot live at the largest window: every word bit-exact with CoreModelMulti (every field, the id, tlast),
+    slot live at the largest window (the adds given in the vertical blanking before the first frame, as a
+    host does): every word bit-exact with CoreModelMulti (every field, the id, tlast),
     no input stall, and each frame's last word before the next frame's first pixel (real time).  `make
     test-extra` (an 8-engine build and about 25 M clocks)."""
     import cv2
@@ -251,7 +252,8 @@ def test_realtime_multi_1080p60():
     m = expected_multi(frames, cmds, tp, fp, MULTI_RT_N, 2048)
     assert all(len(fr) == MULTI_RT_N for fr in m.frames), "every slot must stay live (model)"
     run = fastsim.simulate_multi(frames, cmds, tp, fp, max_targets=MULTI_RT_N, lanes=DEFAULT_LANES,
-                                 max_frame_w=2048, hblank=HBLANK, vblank=VBLANK, words=len(m.results))
+                                 max_frame_w=2048, hblank=HBLANK, vblank=VBLANK, lead=VBLANK,
+                                 words=len(m.results))
     from mstrack.hw.cosim import COMPARED_FIELDS_V2
     keys = [*COMPARED_FIELDS_V2, "target_id"]
     mism = [f"word {i}: " + "; ".join(f"{k}: dut={a[k]} model={b[k]}" for k in keys if a[k] != b[k])

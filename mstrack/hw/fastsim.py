@@ -426,12 +426,13 @@ def build_multi(cfg: CoreConfigV2, max_targets: int, verbose: bool = False,
 
 def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]], tp: TrackerParams | None = None,
                    fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int = 4, max_frame_w: int = 2048,
-                   hblank: int = 0, vblank: int = 0, out_pause_pct: int = 0, seed: int = 1,
+                   hblank: int = 0, vblank: int = 0, lead: int = 0, out_pause_pct: int = 0, seed: int = 1,
                    words: int | None = None, watchdog: int = 4_000_000, workdir: Path | str | None = None,
                    check: bool = True, faults: dict[int, str] | None = None, cxx_opt: str = CXX_OPT) -> MultiRun:
     """Stream *frames* through the verilated ms_tracker_multi, with *commands* given before the frames
     they are keyed by: ``{frame: [("add", (x, y, w, h)) | ("remove", id), ...]}`` (a key of len(frames):
-    after the last frame).  *words*: result words to wait for (default: one per frame at least).
+    after the last frame).  *hblank* / *vblank*: idle clocks after each line / frame; *lead*: idle clocks
+    after frame 0's commands, before its first pixel.  *words*: result words to wait for (default: one per frame at least).
     *faults*: ``{frame: "short_line" | "cut"}`` stream faults (as :func:`mstrack.hw.cosim_multi.frame_beats`).
     *cxx_opt*: the build's C++ optimisation (as :func:`build`; ``-O1`` builds in about half the time of -O3 for
     short runs).  Raise :class:`FastsimError` when the harness stops early (unless ``check`` is false)."""
@@ -446,7 +447,7 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
     try:
         n, w, h = _write_pixels(frames, wd / "pixels.bin")
         lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", f"hblank {hblank}",
-                 f"vblank {vblank}", f"out_pause_pct {out_pause_pct}", f"seed {seed}",
+                 f"vblank {vblank}", f"lead {lead}", f"out_pause_pct {out_pause_pct}", f"seed {seed}",
                  f"words {words if words is not None else n}", f"watchdog {watchdog}"]
         for fr, kind in sorted((faults or {}).items()):
             if kind not in ("short_line", "cut"):

@@ -12,6 +12,8 @@
 // job.txt, one "key value" per line ('#' starts a comment line):
 //   width, height, frames, pixels   as tools/hdl/cosim_main.cpp (frame_width / frame_height ports)
 //   hblank, vblank                  tvalid-low clocks after each line / extra after each frame
+//   lead                            tvalid-low clocks before the first frame, after its commands
+//                                   (the vertical blanking a camera gives before it; default 0)
 //   out_pause_pct, seed             random m_axis_result_tready = 0 (percent), its seed
 //   words                           result words to wait for
 //   watchdog                        stop when no word has come for this many clocks after the last
@@ -119,7 +121,7 @@ int main(int argc, char** argv) {
     }
     top.rst = 0;
 
-    long long f = 0, x = 0, y = 0, blank = 0, n_got = 0, last_event = 0, done_at = -1, frame_beats = 0;
+    long long f = 0, x = 0, y = 0, blank = num("lead", 0), n_got = 0, last_event = 0, done_at = -1, frame_beats = 0;
     auto fault_of = [&](long long fr) -> std::string {
         auto it = faults.find(fr);
         return it == faults.end() ? std::string() : it->second;

@@ -194,20 +194,21 @@ def test_realtime_v2_1080p60(variant):
 
 #: the multi-target core at 1080p60: MAX_TARGETS engines of mstrack-v2-colour (MAX_FRAME_W 2048), all
 #: slots live.  Slot 0 tracks the rider of MotorRolling 30-39 x3 (the loss, the wide search and the
-#: re-acquisition of test_realtime_v2_1080p60); the others hold boxes of 300 x 300 on a 4 x 2 grid,
-#: which each engine shrinks to its largest window (MAX_HALF), so every engine works on its largest
-#: window.  MSTRACK_RT_MULTI_N / MSTRACK_RT_MULTI_FRAMES change the engine count and the clip length.
+#: re-acquisition of test_realtime_v2_1080p60); the others hold boxes of MULTI_RT_SIDE px on a 4 x 2
+#: grid: the largest box whose window (1.25 x 406 / D = 4) is max_window, 127 decimated px, so every
+#: other engine works on its largest window (the colour tracker keeps the box size).  MSTRACK_RT_MULTI_N / MSTRACK_RT_MULTI_FRAMES change the engine count and the clip length.
 MULTI_RT_N = int(os.environ.get("MSTRACK_RT_MULTI_N", "8"))
 MULTI_RT_FRAMES = int(os.environ.get("MSTRACK_RT_MULTI_FRAMES", str(V2_RT_FRAMES)))
+MULTI_RT_SIDE = 406
 
 
 def multi_rt_boxes(rider: tuple[int, int, int, int], n: int) -> list[tuple[int, int, int, int]]:
-    """The rider's box, then n - 1 boxes of 300 x 300 on a 4 x 2 grid of the 1920 x 1080 frame (cycled
-    with an offset past 8)."""
+    """The rider's box, then n - 1 boxes of MULTI_RT_SIDE px on a 4 x 2 grid of the 1920 x 1080 frame
+    (cycled with an offset past 8)."""
     out = [rider]
     for k in range(1, n):
         col, row, lap = k % 4, (k // 4) % 2, k // 8
-        out.append((90 + 480 * col + 40 * lap, 120 + 540 * row + 40 * lap, 300, 300))
+        out.append((37 + 480 * col + 20 * lap, 67 + 540 * row + 20 * lap, MULTI_RT_SIDE, MULTI_RT_SIDE))
     return out
 
 
@@ -249,6 +250,9 @@ def test_realtime_multi_1080p60():
     boxes = multi_rt_boxes(rider, MULTI_RT_N)  # type: ignore[arg-type]
     cmds = {0: [("add", b) for b in boxes]}
     tp, fp = TrackerParams(preset="v2", **V2_COLOUR), FixedParams()
+    from mstrack.fixed.blocks_v2 import ms_decimation, ms_window_size, sixteenths
+    s8, pad16 = MULTI_RT_SIDE << 8, sixteenths(tp.pad, "pad")
+    assert ms_window_size(s8, pad16, ms_decimation(s8, s8, pad16, tp.max_window), tp.max_window) == tp.max_window
     m = expected_multi(frames, cmds, tp, fp, MULTI_RT_N, 2048)
     assert all(len(fr) == MULTI_RT_N for fr in m.frames), "every slot must stay live (model)"
     run = fastsim.simulate_multi(frames, cmds, tp, fp, max_targets=MULTI_RT_N, lanes=DEFAULT_LANES,

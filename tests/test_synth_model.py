@@ -229,10 +229,11 @@ def test_v2_configs_are_the_v2_trackers():
     assert re.search(r"^\s+ORIENT_T\s*: integer range -1 to 2047 := 64", body, re.M)
 
 
-def test_multi4_colour_config_is_four_colour_engines():
-    """Configuration "multi4-colour": ms_tracker_multi with MAX_TARGETS 4 and the generics of "v2-colour"
-    (each engine is core v2 of mstrack-v2-colour), placed through its own pin wrapper
-    (ms_tracker_multi_pins); a plain `mstrack synth` leaves it out.  The other configurations
+@pytest.mark.parametrize("name,n", [("multi4-colour", 4), ("multi3-colour", 3)])
+def test_multi_colour_configs_are_colour_engines(name, n):
+    """Configurations "multi4-colour" / "multi3-colour": ms_tracker_multi with MAX_TARGETS 4 / 3 and the
+    generics of "v2-colour" (each engine is core v2 of mstrack-v2-colour), placed through its own pin
+    wrapper (ms_tracker_multi_pins); a plain `mstrack synth` leaves them out.  The other configurations
     synthesise their own core as before."""
     import argparse
     import re
@@ -240,13 +241,14 @@ def test_multi4_colour_config_is_four_colour_engines():
     from mstrack.fixed import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import V2_COLOUR, TrackerParams
-    m = synth.CONFIGS["multi4-colour"]
-    assert (m.top, m.core, m.max_targets) == ("ms_tracker_multi", "ms_tracker_v2", 4) and m.v2 and m.placeable
+    multi = ("multi4-colour", "multi3-colour")
+    m = synth.CONFIGS[name]
+    assert (m.top, m.core, m.max_targets) == ("ms_tracker_multi", "ms_tracker_v2", n) and m.v2 and m.placeable
     assert m.pins_top == "ms_tracker_multi_pins" and m.pins_generics() == m.generics()
     assert synth.pins_sources(m.pins_top)[-1] == synth.MULTI_PINS_VHD
     g = m.generics()
     colour = CoreConfigV2(TrackerParams(preset="v2", **V2_COLOUR), FixedParams(), lanes=4, max_frame_w=2048).generics()
-    assert g == {"MAX_TARGETS": 4, **colour} == {"MAX_TARGETS": 4, **synth.CONFIGS["v2-colour"].generics()}
+    assert g == {"MAX_TARGETS": n, **colour} == {"MAX_TARGETS": n, **synth.CONFIGS["v2-colour"].generics()}
     assert list(g)[0] == "MAX_TARGETS" and g["ORIENT_T"] == -1 and g["SCALE_TEST_D256"] == 0
     # every generic is one of ms_tracker_multi's (MAX_TARGETS + those of ms_tracker_v2)
     t = (synth.REPO_ROOT / "rtl" / "ms_tracker_multi.vhd").read_text()
@@ -255,18 +257,18 @@ def test_multi4_colour_config_is_four_colour_engines():
     names = set(re.findall(r"^\s+(\w+)\s*:", t, re.M))
     assert "MAX_TARGETS" in names and set(g) <= names
     assert "ms_tracker_multi.vhd" in {p.name for p in synth.sources(m.top)}
-    for name, c in synth.CONFIGS.items():
-        if name != "multi4-colour":
+    for other, c in synth.CONFIGS.items():
+        if other not in multi:
             assert c.top == c.core and c.placeable and "MAX_TARGETS" not in c.generics()
             assert c.pins_top == "ms_tracker_pins"
-    assert synth.DEFAULT_CONFIGS == tuple(n for n in synth.CONFIGS if n != "multi4-colour")
+    assert synth.DEFAULT_CONFIGS == tuple(c for c in synth.CONFIGS if c not in multi)
     ap = argparse.ArgumentParser()
     synth.add_arguments(ap)
     assert ap.parse_args([]).config == list(synth.DEFAULT_CONFIGS)
-    assert ap.parse_args(["--config", "multi4-colour"]).config == ["multi4-colour"]
+    assert ap.parse_args(["--config", name]).config == [name]
     # the Vitis comparison counts its MAX_TARGETS targets (a single-target core: 1, figures as before)
     x = {"LUT": 40000, "FF": 50000, "BRAM36": 92.0, "DSP48E1": 8}
-    rows = synth.vitis_table([{"config": "multi4-colour", "xc7": x, "generics": g},
+    rows = synth.vitis_table([{"config": "multi4-colour", "xc7": x, "generics": synth.CONFIGS["multi4-colour"].generics()},
                               {"config": "v2-colour", "xc7": x, "generics": synth.CONFIGS["v2-colour"].generics()}])
     assert "| mstrack multi4-colour (xc7, yosys) | 4 | 40,000 | 50,000 | 92 | 8 | 10,000 / 12,500 / 23.0 / 2.0 |" in rows
     assert "| mstrack v2-colour (xc7, yosys) | 1 | 40,000 | 50,000 | 92 | 8 | 40,000 / 50,000 / 92 / 8 |" in rows

@@ -149,6 +149,20 @@ def test_realtime_1080p60(lanes):
 V2_RT_START, V2_RT_FRAMES = 30, 10
 
 
+def _motor_rolling_hd(n: int, what: str) -> tuple[list[np.ndarray], tuple[int, ...]]:
+    """MotorRolling frames V2_RT_START .. + n - 1 upscaled x3 to 1920x1080 and the GT box of the first x3;
+    skip (naming *what* needs them) without ../shared."""
+    import cv2
+    from mstrack.io.data import load_sequence
+    seq = SEQ_ROOT / "MotorRolling"
+    if not seq.is_dir():
+        pytest.skip(f"{seq} not found: {what} needs ../shared/data/sequences")
+    s = load_sequence(seq)
+    frames = [cv2.resize(cv2.imread(str(f), cv2.IMREAD_COLOR), (HD_W, HD_H), interpolation=cv2.INTER_LINEAR)
+              for f in s.img_files[V2_RT_START:V2_RT_START + n]]
+    return frames, tuple(int(round(float(v) * 3)) for v in s.gt[V2_RT_START])
+
+
 @pytest.mark.long
 @pytest.mark.verilator
 @pytest.mark.parametrize("variant", ["colour", "joint"])
@@ -159,16 +173,8 @@ def test_realtime_v2_1080p60(variant):
     the v2 cycle budget of docs/fixed_point.md ("Hardware cost of v2").  ``colour``: mstrack-v2-colour
     (V2_COLOUR: ORIENT_T -1, no scale test); ``joint``: the default tracker v2, mstrack-v2 (ORIENT_T 64,
     the gated scale test, its loss thresholds; `make test-extra`, tb/conftest.py CI_EXTRA)."""
-    import cv2
     from mstrack.hw.cosim import COMPARED_FIELDS_V2, expected_results_v2
-    from mstrack.io.data import load_sequence
-    seq = SEQ_ROOT / "MotorRolling"
-    if not seq.is_dir():
-        pytest.skip(f"{seq} not found: the v2 real-time check needs ../shared/data/sequences")
-    s = load_sequence(seq)
-    frames = [cv2.resize(cv2.imread(str(f), cv2.IMREAD_COLOR), (HD_W, HD_H), interpolation=cv2.INTER_LINEAR)
-              for f in s.img_files[V2_RT_START:V2_RT_START + V2_RT_FRAMES]]
-    box = tuple(int(round(float(v) * 3)) for v in s.gt[V2_RT_START])
+    frames, box = _motor_rolling_hd(V2_RT_FRAMES, "the v2 real-time check")
     from mstrack.track.params import V2_COLOUR, V2_JOINT
     tp, fp = TrackerParams(preset="v2", **(V2_JOINT if variant == "joint" else V2_COLOUR)), FixedParams()
     exp = expected_results_v2(frames, box, tp, fp)
@@ -236,17 +242,9 @@ def test_realtime_multi_1080p60():
     host does): every word bit-exact with CoreModelMulti (every field, the id, tlast),
     no input stall, and each frame's last word before the next frame's first pixel (real time).  `make
     test-extra` (an 8-engine build and about 25 M clocks)."""
-    import cv2
     from mstrack.hw.cosim_multi import expected_multi
-    from mstrack.io.data import load_sequence
     from mstrack.track.params import V2_COLOUR
-    seq = SEQ_ROOT / "MotorRolling"
-    if not seq.is_dir():
-        pytest.skip(f"{seq} not found: the multi-target real-time check needs ../shared/data/sequences")
-    s = load_sequence(seq)
-    frames = [cv2.resize(cv2.imread(str(f), cv2.IMREAD_COLOR), (HD_W, HD_H), interpolation=cv2.INTER_LINEAR)
-              for f in s.img_files[V2_RT_START:V2_RT_START + MULTI_RT_FRAMES]]
-    rider = tuple(int(round(float(v) * 3)) for v in s.gt[V2_RT_START])
+    frames, rider = _motor_rolling_hd(MULTI_RT_FRAMES, "the multi-target real-time check")
     boxes = multi_rt_boxes(rider, MULTI_RT_N)  # type: ignore[arg-type]
     cmds = {0: [("add", b) for b in boxes]}
     tp, fp = TrackerParams(preset="v2", **V2_COLOUR), FixedParams()

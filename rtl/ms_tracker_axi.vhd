@@ -45,7 +45,8 @@
 -- show (2 x MAX_TARGETS x 160 flip-flops), with RES_MASK (the ids with a word without flag no_target) and
 -- its frame_count: RES_SEL.id chooses the target whose word RES_HEAD returns and snapshots, so every
 -- target's word of one frame is read without tearing while the next frame's words come.
--- INT_STATUS.result fires once per frame (its last word); lost / error / reacquired on any word of it;
+-- INT_STATUS.result fires once per frame (its last word); lost / error / reacquired are set in the same
+-- clock when any word of that frame has them (one interrupt per frame tells the whole frame);
 -- RESULT_COUNT counts frames, LOST / ERROR / REJECT_COUNT words.
 -- Generics: those of ms_tracker (passed through; the derived widths come from
 -- mstrack.fixed.vhdl_pkg.core_generics, core v2's from mstrack.hw.cosim.CoreConfigV2.tracker_generics)
@@ -265,7 +266,9 @@ architecture rtl of ms_tracker_axi is
   signal live     : std_logic_vector(15 downto 0) := (others => '0');
   signal vis_mask : std_logic_vector(15 downto 0) := (others => '0');
   signal vis_fc   : std_logic_vector(15 downto 0) := (others => '0');
-  signal ev_res, ev_lost, ev_err, ev_rej, ev_reacq : std_logic := '0';
+  signal ev_res, ev_lost, ev_err, ev_rej, ev_reacq : std_logic := '0';    -- per word (ev_res: per frame)
+  signal acc_lost, acc_err, acc_reacq : std_logic := '0';                   -- events of the frame's earlier words
+  signal fr_lost, fr_err, fr_reacq : std_logic := '0';                      -- events of the frame, with ev_res
   signal busy     : std_logic;
   signal fw, fh   : unsigned(COORD_W - 1 downto 0);
 
@@ -342,10 +345,12 @@ begin
   hw_in.STATUS.result_valid.next_q <= lat_ok;
 
   -- interrupts (level inputs of sticky intr fields: a one-clock pulse sets the bit) and counters
+  -- (lost / error / reacquired with the frame's result: the events of all its words, set in the clock
+  -- the result bit is set, so one interrupt tells the whole frame; the counters count words)
   hw_in.INT_STATUS.result.next_q <= ev_res;
-  hw_in.INT_STATUS.lost.next_q   <= ev_lost;
-  hw_in.INT_STATUS.error.next_q  <= ev_err or ev_rej;
-  hw_in.INT_STATUS.reacquired.next_q <= ev_reacq;
+  hw_in.INT_STATUS.lost.next_q   <= ev_res and fr_lost;
+  hw_in.INT_STATUS.error.next_q  <= ev_res and fr_err;
+  hw_in.INT_STATUS.reacquired.next_q <= ev_res and fr_reacq;
   hw_in.INT_STATUS.command.next_q <= ev_cmd;
   irq <= hw_out.INT_STATUS.intr;
   hw_in.RESULT_COUNT.count.incr <= ev_res;
@@ -821,6 +826,14 @@ begin
       ev_err  <= r_take and c_err;
       ev_rej  <= r_take and c_rej;
       ev_reacq <= r_take and c_reacq;
+      fr_lost  <= acc_lost or c_lost;
+      fr_err   <= acc_err or c_err or c_rej;
+      fr_reacq <= acc_reacq or c_reacq;
+      if r_take = '1' then                           -- collect over the frame's words; clear at its last
+        acc_lost  <= (acc_lost or c_lost) and not r_last;
+        acc_err   <= (acc_err or c_err or c_rej) and not r_last;
+        acc_reacq <= (acc_reacq or c_reacq) and not r_last;
+      end if;
       if hw_out.RES_HEAD.frame_count.swacc = '1' then  -- read of RES_HEAD: S <= L, same clock
         snap <= lat;
       end if;
@@ -831,6 +844,9 @@ begin
         ev_err <= '0';
         ev_rej <= '0';
         ev_reacq <= '0';
+        acc_lost <= '0';
+        acc_err <= '0';
+        acc_reacq <= '0';
       end if;
     end if;
   end process;

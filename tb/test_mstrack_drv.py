@@ -57,14 +57,19 @@ def test_driver_against_paper_core():
 @pytest.mark.verilator
 def test_driver_against_multi_target_core():
     """ms_tracker_axi with MAX_TARGETS 2 (two colour core v2 engines, MAX_FRAME_W 1024) on TUD-Stadtmitte
-    (640 x 480), 12 frames, 1080p60 blanking, a CPU 8 idle clocks per access slower than the bus.  The
+    (640 x 480), 12 frames, 1080p60 blanking, a CPU 8 idle clocks per access slower than the bus, and the
+    result stream on too, into a sink that idles 64 clocks after each word (so a frame's two words come
+    65 clocks apart, and an event of the first must wait for the second to interrupt).  The
     driver (mstrack_enable, then mstrack_add / mstrack_remove between frames, as the people appear and
     leave): three people added before frame 0 (the third refused: both slots taken, flag rejected on
-    frame 0's word); before frame 5 the first removed and another person added in its slot; before frame 7
-    the second removed and a box outside the frame added (taken, then rejected by its engine: the command
-    report code 3, the slot free again); before frame 9 a person added in that slot; before frame 10 a
+    frame 0's word); before frame 5 the first removed and another person added in its slot (id 0); before
+    frame 7 that person removed and a box outside the frame added (taken, then rejected by its engine: the
+    command report code 3, the slot free again; its word is id 0's, so the error comes with the frame's
+    first word and must reach the handler in the frame's one interrupt, with the result); before frame 9 a
+    person added in that slot; before frame 10 a
     remove of the refused person (the driver refuses it: no id).  Every target's word of every frame, read
-    by the handler through RES_SEL / RES_HEAD, against CoreModelMulti fed the commands where they landed."""
+    by the handler through RES_SEL / RES_HEAD, and every word of the stream, against CoreModelMulti fed the
+    commands where they landed."""
     from mstrack.fixed import FixedParams
     from mstrack.fixed.blocks import round_box
     from mstrack.hw import drvsim, fastsim
@@ -82,10 +87,10 @@ def test_driver_against_multi_target_core():
         return round_box(*seq.boxes_at(frame)[pid].as_tuple())
     ops = [(0, "add", "p1", box(0, 1)), (0, "add", "p4", box(0, 4)), (0, "add", "p7", box(0, 7)),
            (5, "remove", "p1"), (5, "add", "p8", box(5, 8)),
-           (7, "remove", "p4"), (7, "add", "off", (2000, -500, 10, 10)),
+           (7, "remove", "p8"), (7, "add", "off", (2000, -500, 10, 10)),
            (9, "add", "p7b", box(9, 7)), (10, "remove", "p7")]
     run = drvsim.simulate_driver_multi(frames, ops, tp, FixedParams(), max_targets=2, max_frame_w=1024, io_gap=8,
-                                       **fastsim.HD1080P60)
+                                       result_gap=64, **fastsim.HD1080P60)
     cmds = run.commands(2)                   # where each command landed: the frame planned (the result of
     assert sorted(cmds) == [0, 5, 7, 9]      # the frame before is read well inside the vertical blanking)
     model = expected_multi(frames, cmds, tp, FixedParams(), 2, 1024)
@@ -95,10 +100,13 @@ def test_driver_against_multi_target_core():
     # the rejected box: reported (command interrupt) with the frame whose word shows it; its slot given
     # again before frame 9, which clears the driver's bit
     assert [o.code for o in model.outcomes].count(CMD_BOX) == 1
-    assert [f["box_rejected"] for f in run.frames] == [0] * 7 + [0b10] * 2 + [0] * 3
+    assert [f["box_rejected"] for f in run.frames] == [0] * 7 + [0b01] * 2 + [0] * 3
     assert run.frames[7]["irq"] & drvsim.irq_bits()["command"]
-    assert [f["mask"] for f in run.frames] == [0b11] * 7 + [0b01] * 2 + [0b11] * 3
+    assert run.frames[7]["irq"] & drvsim.irq_bits()["error"]      # id 0's rejected word, in the result's interrupt
+    assert [f["mask"] for f in run.frames] == [0b11] * 7 + [0b10] * 2 + [0b11] * 3
     assert max(run.handler_clocks()) < 2000
+    assert run.stream is not None and len(run.stream) == len(model.results) == 22
+    assert min(b["cycle"] - a["cycle"] for a, b in zip(run.stream, run.stream[1:])) == 65
 
 
 @pytest.mark.extra
@@ -166,7 +174,8 @@ def test_check_run_finds_differences():
 
 def test_check_run_multi_finds_differences():
     """check_run_multi reports a changed field, a wrong target mask, a driver decode that differs from the
-    raw word, an add whose id differs from the model's and wrong counters (a run assembled by hand, no RTL)."""
+    raw word, an add whose id differs from the model's, wrong counters and a result stream beat that differs
+    (a run assembled by hand, no RTL)."""
     from mstrack.fixed.vhdl_pkg import pack_result_v2, unpack_result_v2
     from mstrack.hw import drvsim
     from mstrack.hw.cosim_multi import CMD_OK, Outcome
@@ -204,3 +213,10 @@ def test_check_run_multi_finds_differences():
         assert what in msgs, what
     with pytest.raises(ValueError, match="started during the call"):
         drvsim.DriverMultiRun(ops=[{**good.ops[0], "after": 1}]).commands(2)
+    # the result stream: its beat against the model's word, field by field, tlast on the frame's last
+    beat = {"word": word, "fields": {**unpack_result_v2(word), "target_id": 0}, "last": 1, "cycle": 10}
+    assert drvsim.check_run_multi(drvsim.DriverMultiRun(**{**good.__dict__, "stream": [beat]}), model, 2) == []
+    msgs = "\n".join(drvsim.check_run_multi(drvsim.DriverMultiRun(**{**good.__dict__, "stream": [
+        {**beat, "fields": {**beat["fields"], "target_id": 1}, "last": 0}, beat]}), model, 2))
+    for what in ("2 beats, the model has 1", "target_id: dut=1 model=0", "tlast: dut=0 model=1"):
+        assert what in msgs, what

@@ -28,7 +28,7 @@ import numpy as np
 from . import fastsim, hdl
 from .cosim import COMPARED_FIELDS, COMPARED_FIELDS_V2, CoreConfig, CoreConfigV2, diff_fields
 from ..fixed import FixedParams
-from ..fixed.vhdl_pkg import RESULT_FLAGS, STATUS_V2, unpack_result, unpack_result_v2
+from ..fixed.vhdl_pkg import RESULT_FLAGS, STATUS_V2, unpack_result, unpack_result_multi, unpack_result_v2
 from ..track.params import TrackerParams
 
 DRV_CPP = hdl.TOOLS_HDL_DIR / "drv_main.cpp"
@@ -100,12 +100,13 @@ class DriverRun(_HarnessRun):
         return [r["handled_cycle"] - r["irq_cycle"] for r in self.results]
 
 
-def axi_generics(cfg: CoreConfig | CoreConfigV2, max_targets: int = 0) -> dict[str, int]:
+def axi_generics(cfg: CoreConfig | CoreConfigV2, max_targets: int = 0, result_stream: bool = False) -> dict[str, int]:
     """The generics of ms_tracker_axi for *cfg*: those of ms_tracker, results through the registers
-    only (RESULT_STREAM false, as a CPU-only integration builds it); *max_targets* >= 1: the
-    multi-target core with that many slots (core v2)."""
+    only (RESULT_STREAM false, as a CPU-only integration builds it; *result_stream*: true, the
+    m_axis_result stream as well); *max_targets* >= 1: the multi-target core with that many slots
+    (core v2)."""
     g: dict[str, int] = dict(cfg.tracker_generics() if isinstance(cfg, CoreConfigV2) else cfg.generics())
-    g["RESULT_STREAM"] = 0
+    g["RESULT_STREAM"] = int(result_stream)
     if max_targets:
         if not isinstance(cfg, CoreConfigV2) or not 1 <= max_targets <= 16:
             raise ValueError("a multi-target core is core v2 with 1 .. 16 slots")
@@ -113,11 +114,12 @@ def axi_generics(cfg: CoreConfig | CoreConfigV2, max_targets: int = 0) -> dict[s
     return g
 
 
-def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, max_targets: int = 0) -> tuple[Path, float]:
-    """Build (or find in the cache) the driver harness for *cfg* (*max_targets* as :func:`axi_generics`):
-    (executable, seconds spent building)."""
+def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, max_targets: int = 0,
+                 result_stream: bool = False) -> tuple[Path, float]:
+    """Build (or find in the cache) the driver harness for *cfg* (*max_targets*, *result_stream* as
+    :func:`axi_generics`): (executable, seconds spent building)."""
     import time
-    g = axi_generics(cfg, max_targets)
+    g = axi_generics(cfg, max_targets, result_stream)
     vg = {k: (v != 0) if k == "RESULT_STREAM" else v for k, v in g.items()}
     t0 = time.monotonic()
     net_dir = fastsim.FASTSIM_DIR / f"netlist_{fastsim._generics_hash(g)}_{TOP}"
@@ -275,11 +277,15 @@ class DriverMultiRun(_HarnessRun):
     ``ops``: each ``mstrack_add`` / ``mstrack_remove`` the harness called: ``label``, ``op``, ``rc``, ``id``
     (add), ``before`` / ``after`` (frames whose first pixel had been taken before the call / at its
     return).  ``box_rejected``, ``live``: the driver's ``dev.box_rejected`` and ``mstrack_live`` at the end.
+    ``stream``: with a result stream sink (:func:`simulate_driver_multi` *result_gap*), each beat it
+    took: ``{"word", "fields", "last", "cycle"}`` (``word`` with the target id at its top bits, ``fields``
+    its decode); ``None`` without one.
     """
     frames: list[dict] = field(default_factory=list)
     ops: list[dict] = field(default_factory=list)
     box_rejected: int = 0
     live: int = 0
+    stream: list[dict] | None = None
 
     def handler_clocks(self) -> list[int]:
         """Clocks from irq high to the handler's return (every target's word read), per frame."""
@@ -327,6 +333,12 @@ def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMu
             run.ops.append({"op": "remove", "label": p[1], "rc": int(p[2]), "before": int(p[3]), "after": int(p[4])})
         elif p[0] == "J":
             run.box_rejected, run.live = int(p[1]), int(p[2])
+        elif p[0] == "T":
+            if run.stream is None:
+                run.stream = []
+            word = int(p[2], 16)
+            run.stream.append({"word": word, "fields": unpack_result_multi(word, g), "last": int(p[1]),
+                               "cycle": int(p[3])})
     return run
 
 
@@ -334,14 +346,18 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
                           fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int | None = None,
                           max_frame_w: int = 2048, hblank: int = 0, vblank: int = 0, io_gap: int = 0,
                           irq_mask: int | None = None, watchdog: int = 4_000_000, tail: int = 200,
-                          workdir: Path | str | None = None, check: bool = True) -> DriverMultiRun:
+                          result_gap: int | None = None, workdir: Path | str | None = None,
+                          check: bool = True) -> DriverMultiRun:
     """Run the driver against ms_tracker_axi with ``MAX_TARGETS`` = *max_targets* (core v2 engines, the
     parameters *tp*, default tracker v2) on *frames*.  *ops*: ``(frame, "add", label, (x, y, w, h))`` or
     ``(frame, "remove", label)``, in order: the harness calls ``mstrack_add`` / ``mstrack_remove`` (the id
     its add of *label* returned) once the result of frame ``frame - 1`` has been read (frame 0: after
     ``mstrack_enable``, before the video).  Each result interrupt reads every target's word of the frame
     (``mstrack_read_frame`` in the handler).  Raises :class:`DriverSimError` when the run does not end
-    with every frame's words read (unless ``check`` is false)."""
+    with every frame's words read (unless ``check`` is false).  *result_gap*: None, results through the
+    registers only (``RESULT_STREAM`` false); an int >= 0, the core built with its result stream too and
+    a sink that takes a beat, then holds ``tready`` low *result_gap* clocks (``run.stream``): the words
+    of a frame then come that far apart, as behind a slow DMA."""
     from ..fixed.vhdl_pkg import DEFAULT_LANES
     cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes or DEFAULT_LANES,
                        max_frame_w=max_frame_w)
@@ -350,6 +366,10 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
              f"watchdog {watchdog}"]
     if irq_mask is not None:
         lines.append(f"irq_mask {irq_mask}")
+    if result_gap is not None:
+        if result_gap < 0:
+            raise ValueError(f"result_gap {result_gap}: >= 0 or None")
+        lines.append(f"result_gap {result_gap}")
     labels: set[str] = set()
     for op in ops:
         fr, what, label = int(op[0]), op[1], str(op[2])
@@ -364,7 +384,7 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
             lines.append(f"op {fr} remove {label}")
         else:
             raise ValueError(f"op {what!r}: add or remove")
-    exe, build_s = build_driver(cfg, max_targets=max_targets)
+    exe, build_s = build_driver(cfg, max_targets=max_targets, result_stream=result_gap is not None)
     res, n = _run_harness(exe, frames, max_frame_w, lines, workdir, lambda out: _parse_multi(out, ops, g))
     run = cast(DriverMultiRun, res)
     _finish(run, build_s, check, f"{len(run.frames)} frames of {n}")
@@ -401,7 +421,9 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
       status lost / reacquired / flag error or rejected (the command bit is not compared: it follows the
       command reports, which the handler sees whenever they come);
     * the counters (frames, lost / error / rejected words) and, at the end, the live slots and the
-      rejected boxes the handler saw (a subset of the model's).
+      rejected boxes the handler saw (a subset of the model's);
+    * with a result stream sink (``run.stream``): its beats are the model's words, frame by frame, field
+      by field (target id included), ``tlast`` on each frame's last.
     """
     from .cosim_multi import CMD_BOX, CMD_OK
     out = []
@@ -470,6 +492,23 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
     boxed = sum(1 << o.target_id for o in model.outcomes if o.code == CMD_BOX)
     if run.box_rejected & ~boxed:
         out.append(f"rejected boxes {run.box_rejected:#x} not in the model's {boxed:#x}")
+    if run.stream is not None:
+        out += _check_stream(run.stream, model.frames)
+    return out
+
+
+def _check_stream(stream: list[dict], frames: list[list[dict[str, int]]]) -> list[str]:
+    """The beats of the result stream against the model's words of each frame (:func:`check_run_multi`)."""
+    out = []
+    want = [(w, i, j == len(f) - 1) for i, f in enumerate(frames) for j, w in enumerate(f)]
+    if len(stream) != len(want):
+        out.append(f"result stream: {len(stream)} beats, the model has {len(want)} words")
+    for b, (w, i, last) in zip(stream, want):
+        d = diff_fields(b["fields"], w, (*COMPARED_FIELDS_V2, "target_id"))
+        if b["last"] != last:
+            d.append(f"tlast: dut={b['last']} model={int(last)}")
+        if d:
+            out.append(f"result stream, frame {i} target {w['target_id']}: " + "; ".join(d))
     return out
 
 

@@ -28,6 +28,9 @@
 //   watchdog          stop when a frame's result has not been read this many clocks after its last
 //                     pixel, or a bus transaction has not completed in 10,000 clocks (default 4e6)
 //   tail              clocks to run after the last expected result (default 200)
+//   result_gap        a core built with RESULT_STREAM: a sink on m_axis_result that holds tready low
+//                     for this many clocks after each beat it takes (-1, default: tready always 1, no
+//                     T records); its beats are written as T records
 //   multi             1: a multi-target core (ms_tracker_axi MAX_TARGETS >= 1): no init box; the
 //                     driver's mstrack_enable, then the op lines; each result interrupt reads every
 //                     target's word of the frame (mstrack_read_frame)
@@ -55,6 +58,7 @@
 //   X <label> <rc> <started before> <started after> multi: mstrack_remove
 //   J <box_rejected> <live>                         multi, at the end: dev.box_rejected, mstrack_live
 //   Q <irq bits> <cycle>                            a handler call without a result bit
+//   T <tlast> <tdata, hex, MSB first> <cycle>       result_gap >= 0: each beat the sink took
 //   C results lost errors rejected dropped          mstrack_read_counters at the end
 //   B <bus errors>                                  SLVERR answers seen by the driver's accesses
 //   E <status: done | watchdog_result | bus_timeout | driver_error> <cycles> <seconds> <detail>
@@ -71,6 +75,7 @@ extern "C" {
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -79,6 +84,21 @@ extern "C" {
 #include <vector>
 
 namespace {
+
+// A Verilator port of any width (a scalar or VlWide) as hex, most significant 32-bit word first.
+template <class T>
+std::string hex_wide(const T& v) {
+    const std::size_t n = (sizeof(T) + 3) / 4;
+    uint32_t w[8] = {};
+    std::memcpy(w, &v, sizeof(T) < sizeof w ? sizeof(T) : sizeof w);
+    std::string s;
+    char buf[9];
+    for (std::size_t i = n < 8 ? n : 8; i-- > 0;) {
+        std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(w[i]));
+        s += buf;
+    }
+    return s;
+}
 
 // The simulation: the core, the video source and the clock; one object, used by the driver's
 // register accessors through the pointer `sim`.
@@ -94,6 +114,9 @@ struct Sim {
     std::vector<long long> last_pixel;       // cycle of each frame's last pixel
     long long started = 0;                   // frames whose first pixel has been taken
     bool bad_pixels = false;
+    // result stream sink (result_gap >= 0)
+    long long result_gap = -1, r_hold = 0;
+    std::vector<std::string> beats;          // "T ..." records
     // bus
     long long io_gap = 0, bus_errors = 0;
     bool bus_timeout = false;
@@ -125,8 +148,14 @@ struct Sim {
             }
         }
         top->s_axis_tvalid = s_valid;
+        if (result_gap >= 0) top->m_axis_result_tready = (r_hold == 0);
         top->clk = 0;
         top->eval();
+        const bool r_fire = result_gap >= 0 && top->m_axis_result_tvalid && top->m_axis_result_tready;
+        if (r_fire) {
+            beats.push_back("T " + std::to_string(static_cast<int>(top->m_axis_result_tlast)) + " " +
+                            hex_wide(top->m_axis_result_tdata) + " " + std::to_string(cycle));
+        }
         Edge e;
         e.aw = top->s_axil_awvalid && top->s_axil_awready;
         e.w = top->s_axil_wvalid && top->s_axil_wready;
@@ -139,6 +168,11 @@ struct Sim {
         const bool s_fire = s_valid && top->s_axis_tready;
         top->clk = 1;
         top->eval();
+        if (r_fire) {
+            r_hold = result_gap;
+        } else if (r_hold > 0) {
+            --r_hold;
+        }
         if (s_fire) {
             if (x == 0 && y == 0) ++started;
             if (x == W - 1) {
@@ -255,6 +289,7 @@ int main(int argc, char** argv) {
     s.hblank = num("hblank", 0);
     s.vblank = num("vblank", 0);
     s.io_gap = num("io_gap", 0);
+    s.result_gap = num("result_gap", -1);
     const long long n_results = num("results", s.n_frames);
     const long long watchdog = num("watchdog", 4000000);
     const long long tail = num("tail", 200);
@@ -430,6 +465,7 @@ int main(int argc, char** argv) {
         }
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (const auto& b : s.beats) std::fprintf(o, "%s\n", b.c_str());
     std::fprintf(o, "B %lld\n", s.bus_errors);
     std::fprintf(o, "E %s %lld %.6f %s\n", status.c_str(), s.cycle, secs, detail.c_str());
     std::fclose(o);

@@ -214,9 +214,9 @@ def test_check_run_multi_finds_differences():
     with pytest.raises(ValueError, match="started during the call"):
         drvsim.DriverMultiRun(ops=[{**good.ops[0], "after": 1}]).commands(2)
     # the result stream: its beat against the model's word, field by field, tlast on the frame's last
-    beat = {"word": word, "fields": {**unpack_result_v2(word), "target_id": 0}, "last": 1, "cycle": 10}
+    beat = {**unpack_result_v2(word), "target_id": 0, "word": word, "last": 1, "cycle": 10}
     assert drvsim.check_run_multi(drvsim.DriverMultiRun(**{**good.__dict__, "stream": [beat]}), model, 2) == []
     msgs = "\n".join(drvsim.check_run_multi(drvsim.DriverMultiRun(**{**good.__dict__, "stream": [
-        {**beat, "fields": {**beat["fields"], "target_id": 1}, "last": 0}, beat]}), model, 2))
+        {**beat, "target_id": 1, "last": 0}, beat]}), model, 2))
     for what in ("2 beats, the model has 1", "target_id: dut=1 model=0", "tlast: dut=0 model=1"):
         assert what in msgs, what

@@ -26,8 +26,9 @@ report (``cmd_done``: code, id).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Sequence
 
-from .cosim import CoreModelV2
+from .cosim import COMPARED_FIELDS_V2, CoreModelV2, diff_fields
 from ..fixed import FixedParams
 from ..fixed.vhdl_pkg import RESULT_FLAGS, pack_result_multi
 from ..track.params import TrackerParams
@@ -140,6 +141,22 @@ class CoreModelMulti:
         self.count += 1
 
 
+def diff_words(words: Sequence[dict], frames: Sequence[Sequence[dict[str, int]]]) -> list[str]:
+    """The words a core sent (field dicts of :func:`mstrack.fixed.vhdl_pkg.unpack_result_multi` with
+    ``last``, the stream's tlast) against the model's words of each frame (:attr:`CoreModelMulti.frames`):
+    every compared field, the target id, tlast on each frame's last word; one string per difference,
+    empty when bit-exact."""
+    want = [(w, i, j == len(f) - 1) for i, f in enumerate(frames) for j, w in enumerate(f)]
+    out = [] if len(words) == len(want) else [f"{len(words)} beats, the model has {len(want)} words"]
+    for b, (w, i, last) in zip(words, want):
+        d = diff_fields(b, w, (*COMPARED_FIELDS_V2, "target_id"))
+        if bool(b["last"]) != last:
+            d.append(f"tlast: dut={b['last']} model={int(last)}")
+        if d:
+            out.append(f"frame {i} target {w['target_id']}: " + "; ".join(d))
+    return out
+
+
 def frame_beats(words, fault: str | None = None) -> list[tuple[int, int, int]]:
     """The beats (data, tuser, tlast) of one frame of 24-bit words as the harness streams it: whole, or
     with a fault: ``short_line`` (row 5 three pixels short, tlast on its last), ``cut`` (the first 700
@@ -175,4 +192,4 @@ def expected_multi(frames, commands: dict[int, list[tuple]], tp: TrackerParams |
     return m
 
 
-__all__ = ["CoreModelMulti", "expected_multi", "frame_beats", "Outcome", "CMD_OK", "CMD_REFUSED", "CMD_BOX"]
+__all__ = ["CoreModelMulti", "expected_multi", "diff_words", "frame_beats", "Outcome", "CMD_OK", "CMD_REFUSED", "CMD_BOX"]

@@ -278,8 +278,8 @@ class DriverMultiRun(_HarnessRun):
     (add), ``before`` / ``after`` (frames whose first pixel had been taken before the call / at its
     return).  ``box_rejected``, ``live``: the driver's ``dev.box_rejected`` and ``mstrack_live`` at the end.
     ``stream``: with a result stream sink (:func:`simulate_driver_multi` *result_gap*), each beat it
-    took: ``{"word", "fields", "last", "cycle"}`` (``word`` with the target id at its top bits, ``fields``
-    its decode); ``None`` without one.
+    took: its fields (:func:`mstrack.fixed.vhdl_pkg.unpack_result_multi`) with ``word`` (the raw word, the
+    target id at its top bits), ``last`` and ``cycle``; ``None`` without one.
     """
     frames: list[dict] = field(default_factory=list)
     ops: list[dict] = field(default_factory=list)
@@ -337,8 +337,7 @@ def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMu
             if run.stream is None:
                 run.stream = []
             word = int(p[2], 16)
-            run.stream.append({"word": word, "fields": unpack_result_multi(word, g), "last": int(p[1]),
-                               "cycle": int(p[3])})
+            run.stream.append({**unpack_result_multi(word, g), "word": word, "last": int(p[1]), "cycle": int(p[3])})
     return run
 
 
@@ -425,7 +424,7 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
     * with a result stream sink (``run.stream``): its beats are the model's words, frame by frame, field
       by field (target id included), ``tlast`` on each frame's last.
     """
-    from .cosim_multi import CMD_BOX, CMD_OK
+    from .cosim_multi import CMD_BOX, CMD_OK, diff_words
     out = []
     if run.calls != {"init": 0, "start": 0}:
         out.append(f"driver calls returned {run.calls} (MSTRACK_OK = 0)")
@@ -493,22 +492,7 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
     if run.box_rejected & ~boxed:
         out.append(f"rejected boxes {run.box_rejected:#x} not in the model's {boxed:#x}")
     if run.stream is not None:
-        out += _check_stream(run.stream, model.frames)
-    return out
-
-
-def _check_stream(stream: list[dict], frames: list[list[dict[str, int]]]) -> list[str]:
-    """The beats of the result stream against the model's words of each frame (:func:`check_run_multi`)."""
-    out = []
-    want = [(w, i, j == len(f) - 1) for i, f in enumerate(frames) for j, w in enumerate(f)]
-    if len(stream) != len(want):
-        out.append(f"result stream: {len(stream)} beats, the model has {len(want)} words")
-    for b, (w, i, last) in zip(stream, want):
-        d = diff_fields(b["fields"], w, (*COMPARED_FIELDS_V2, "target_id"))
-        if b["last"] != last:
-            d.append(f"tlast: dut={b['last']} model={int(last)}")
-        if d:
-            out.append(f"result stream, frame {i} target {w['target_id']}: " + "; ".join(d))
+        out += [f"result stream: {d}" for d in diff_words(run.stream, model.frames)]
     return out
 
 

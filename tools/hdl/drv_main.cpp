@@ -75,7 +75,6 @@ extern "C" {
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -84,21 +83,6 @@ extern "C" {
 #include <vector>
 
 namespace {
-
-// A Verilator port of any width (a scalar or VlWide) as hex, most significant 32-bit word first.
-template <class T>
-std::string hex_wide(const T& v) {
-    const std::size_t n = (sizeof(T) + 3) / 4;
-    uint32_t w[8] = {};
-    std::memcpy(w, &v, sizeof(T) < sizeof w ? sizeof(T) : sizeof w);
-    std::string s;
-    char buf[9];
-    for (std::size_t i = n < 8 ? n : 8; i-- > 0;) {
-        std::snprintf(buf, sizeof buf, "%08x", static_cast<unsigned>(w[i]));
-        s += buf;
-    }
-    return s;
-}
 
 // The simulation: the core, the video source and the clock; one object, used by the driver's
 // register accessors through the pointer `sim`.
@@ -154,7 +138,7 @@ struct Sim {
         const bool r_fire = result_gap >= 0 && top->m_axis_result_tvalid && top->m_axis_result_tready;
         if (r_fire) {
             beats.push_back("T " + std::to_string(static_cast<int>(top->m_axis_result_tlast)) + " " +
-                            hex_wide(top->m_axis_result_tdata) + " " + std::to_string(cycle));
+                            harness::hex_of(top->m_axis_result_tdata) + " " + std::to_string(cycle));
         }
         Edge e;
         e.aw = top->s_axil_awvalid && top->s_axil_awready;

@@ -229,7 +229,8 @@ def test_v2_configs_are_the_v2_trackers():
     assert re.search(r"^\s+ORIENT_T\s*: integer range -1 to 2047 := 64", body, re.M)
 
 
-@pytest.mark.parametrize("name,n", [("multi4-colour", 4), ("multi3-colour", 3)])
+@pytest.mark.parametrize("name,n", [("multi4-colour", 4), ("multi3-colour", 3), ("multi1-colour", 1),
+                                    ("multi8-colour", 8), ("multi10-colour", 10), ("multi16-colour", 16)])
 def test_multi_colour_configs_are_colour_engines(name, n):
     """Configurations "multi4-colour" / "multi3-colour": ms_tracker_multi with MAX_TARGETS 4 / 3 and the
     generics of "v2-colour" (each engine is core v2 of mstrack-v2-colour), placed through its own pin
@@ -241,7 +242,7 @@ def test_multi_colour_configs_are_colour_engines(name, n):
     from mstrack.fixed import FixedParams
     from mstrack.hw.cosim import CoreConfigV2
     from mstrack.track.params import V2_COLOUR, TrackerParams
-    multi = ("multi4-colour", "multi3-colour")
+    multi = ("multi4-colour", "multi3-colour", "multi1-colour", "multi8-colour", "multi10-colour", "multi16-colour")
     m = synth.CONFIGS[name]
     assert (m.top, m.core, m.max_targets) == ("ms_tracker_multi", "ms_tracker_v2", n) and m.v2 and m.placeable
     assert m.pins_top == "ms_tracker_multi_pins" and m.pins_generics() == m.generics()

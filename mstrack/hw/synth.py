@@ -21,8 +21,8 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * core v2 (configurations ``v2``, ``v2-colour``): the same flow on ``ms_tracker_v2`` (generics from
   :class:`mstrack.hw.cosim.CoreConfigV2`), placed as ``rtl/wrappers/ms_tracker_pins.vhd`` with
   PRESET 1 (160-bit result word v2); the cycle table is the paper core's only.
-* the multi-target core (configurations ``multi3-colour``, ``multi4-colour``, only when named with
-  ``--config``): ``ms_tracker_multi`` with MAX_TARGETS 3 or 4 engines of ``v2-colour``, placed as
+* the multi-target core (configurations ``multi<N>-colour``, N = 1, 3, 4, 8, 10, 16, only when named
+  with ``--config``): ``ms_tracker_multi`` with MAX_TARGETS N engines of ``v2-colour``, placed as
   ``rtl/wrappers/ms_tracker_multi_pins.vhd`` (ECP5; the Nexus PDC has the single-target wrapper's pins).
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
@@ -178,6 +178,10 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
                             "replicated colour core that nextpnr places on the LFE5U-85F (four engines fill 97 % of "
                             "its TRELLIS_COMB and do not place)",
            core=TOP_V2, top=TOP_MULTI, max_targets=3, tp=dict(V2_COLOUR)),
+    *(Config(f"multi{n}-colour", f"ms_tracker_multi with MAX_TARGETS {n} and the v2-colour engine's generics"
+                                 + (": the merger around one engine, the base of the per-target figures" if n == 1 else
+                                    ": more block RAM than the LFE5U-85F has (xc7: --no-ecp5 --no-pnr)"),
+             core=TOP_V2, top=TOP_MULTI, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 8, 10, 16)),
 )}
 #: the configurations of a plain `mstrack synth` (the multi-target core only when named with --config)
 DEFAULT_CONFIGS = tuple(n for n, c in CONFIGS.items() if c.top != TOP_MULTI)

@@ -273,6 +273,14 @@ def test_multi_colour_configs_are_colour_engines(name, n):
                               {"config": "v2-colour", "xc7": x, "generics": synth.CONFIGS["v2-colour"].generics()}])
     assert "| mstrack multi4-colour (xc7, yosys) | 4 | 40,000 | 50,000 | 92 | 8 | 10,000 / 12,500 / 23.0 / 2.0 |" in rows
     assert "| mstrack v2-colour (xc7, yosys) | 1 | 40,000 | 50,000 | 92 | 8 | 40,000 / 50,000 / 92 / 8 |" in rows
+    assert "per added target" not in rows
+    # beside the one-slot core, the cost of an added target: (core(N) - core(1)) / (N - 1)
+    one = {"LUT": 12000, "FF": 13000, "BRAM36": 23.0, "DSP48E1": 2}
+    eight = {"LUT": 89000, "FF": 97000, "BRAM36": 184.0, "DSP48E1": 16}
+    rows = synth.vitis_table([{"config": c, "xc7": x, "generics": synth.CONFIGS[c].generics()}
+                              for c, x in (("multi1-colour", one), ("multi4-colour", x), ("multi8-colour", eight))])
+    assert ("| mstrack per added target: (multi8-colour - multi1-colour) / 7 | 1 | 11,000 | 12,000 | 23.0 | 2.0 | "
+            "11,000 / 12,000 / 23.0 / 2.0 |") in rows
 
 
 def test_write_section_keeps_rows_of_other_configs(tmp_path):

@@ -281,6 +281,8 @@ def test_multi_colour_configs_are_colour_engines(name, n):
                               for c, x in (("multi1-colour", one), ("multi4-colour", x), ("multi8-colour", eight))])
     assert ("| mstrack per added target: (multi8-colour - multi1-colour) / 7 | 1 | 11,000 | 12,000 | 23.0 | 2.0 | "
             "11,000 / 12,000 / 23.0 / 2.0 |") in rows
+    assert "| mstrack per added target: (multi4-colour - multi1-colour) / 3 | 1 | 9,333 | 12,333 | 23.0 | 2.0 |" in rows
+    assert rows.index("(multi4-colour - multi1-colour)") < rows.index("(multi8-colour - multi1-colour)")
 
 
 def test_write_section_keeps_rows_of_other_configs(tmp_path):

@@ -976,12 +976,13 @@ def vitis_table(rows: Iterable[dict]) -> str:
                f"{x['LUT'] / t:,.0f} / {x['FF'] / t:,.0f} / {x['BRAM36'] / t:.1f} / {x['DSP48E1'] / t:.1f}")
         out.append(f"| mstrack {s['config']} (xc7, yosys) | {t} | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
                    f"{x['DSP48E1']} | {per} |")
-    # the cost of a target added to the multi-target core: (core(N) - core(1)) / (N - 1), for the
-    # largest N synthesised beside the one-slot core (the merger and the AXI-free ports counted once)
+    # the cost of a target added to the multi-target core: (core(N) - core(1)) / (N - 1), for each N
+    # synthesised beside the one-slot core (the merger's fixed part counted once)
     multi = {s.get("generics", {}).get("MAX_TARGETS", 0): s for s in rows}
     multi.pop(0, None)
-    if 1 in multi and max(multi) > 1:
-        n = max(multi)
+    for n in sorted(multi) if 1 in multi else ():
+        if n == 1:
+            continue
         a, b = multi[1]["xc7"], multi[n]["xc7"]
         d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
         out.append(f"| mstrack per added target: ({multi[n]['config']} - {multi[1]['config']}) / {n - 1} | 1 | "

@@ -371,3 +371,16 @@ def test_nexus_pdc_places_every_pin_of_its_wrapper(vhd=synth.PINS_VHD, pdc=(synt
     got = re.findall(r"ldc_set_location -site \{(\w+)\} \[get_ports \{?([\w\[\]]+)\}?\]", text)
     assert {p for _, p in got} == want
     assert len({s for s, _ in got}) == len(got)
+
+
+def test_load_summary_takes_the_ecp5_run_then_one_without_it(tmp_path, monkeypatch):
+    """--from-summaries finds a configuration's summary whether or not its run had ECP5: the full run's
+    first, then an xc7-only or Nexus-only run's (saved beside it, not over it)."""
+    import json
+    monkeypatch.setattr(synth, "SYNTH_DIR", tmp_path)
+    assert synth.load_summary("multi8-colour") is None
+    (tmp_path / "summary_multi8-colour_xc7.json").write_text(json.dumps({"config": "multi8-colour", "run": "xc7"}))
+    assert synth.load_summary("multi8-colour")["run"] == "xc7"
+    (tmp_path / "summary_multi8-colour.json").write_text(json.dumps({"config": "multi8-colour", "run": "all"}))
+    assert synth.load_summary("multi8-colour")["run"] == "all"
+    assert synth.load_summary("multi8-colour", speed=8) is None

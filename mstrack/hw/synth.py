@@ -503,9 +503,9 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
     from ..versions import SYNTH_TOOLS, tool_versions
     out["tools"] = {k: tool_versions()[k] for k in SYNTH_TOOLS + (("nextpnr-nexus",) if nexus else ())}
     SYNTH_DIR.mkdir(parents=True, exist_ok=True)
-    # a Nexus-only run (ecp5=False) keeps its own summary beside the ECP5 one
-    (SYNTH_DIR / f"summary_{cfg.name}{'' if ecp5 else '_nexus'}{_gtag(speed)}{_tag()}.json").write_text(
-        json.dumps(out, indent=1))
+    # a run without ECP5 keeps its own summary beside the ECP5 one, named by the parts it has
+    part = "" if ecp5 else "".join(f"_{k}" for k in ("nexus", "xc7") if k in out)
+    (SYNTH_DIR / f"summary_{cfg.name}{part}{_gtag(speed)}{_tag()}.json").write_text(json.dumps(out, indent=1))
     return out
 
 
@@ -639,8 +639,13 @@ def _gtag(speed: int) -> str:
 
 
 def load_summary(name: str, speed: int = SPEED) -> dict[str, Any] | None:
-    p = SYNTH_DIR / f"summary_{name}{_gtag(speed)}{_tag()}.json"
-    return json.loads(p.read_text()) if p.is_file() else None
+    """The saved summary of configuration *name*: the run with ECP5, else one without it (Nexus and / or
+    xc7 alone), else None."""
+    for part in ("", "_nexus_xc7", "_xc7", "_nexus"):
+        p = SYNTH_DIR / f"summary_{name}{part}{_gtag(speed)}{_tag()}.json"
+        if p.is_file():
+            return json.loads(p.read_text())
+    return None
 
 
 # ----------------------------------------------------------------------------- cycle model

@@ -384,3 +384,19 @@ def test_load_summary_takes_the_ecp5_run_then_one_without_it(tmp_path, monkeypat
     (tmp_path / "summary_multi8-colour.json").write_text(json.dumps({"config": "multi8-colour", "run": "all"}))
     assert synth.load_summary("multi8-colour")["run"] == "all"
     assert synth.load_summary("multi8-colour", speed=8) is None
+
+
+def test_write_section_keeps_notes_of_rows_named_with_parentheses(tmp_path):
+    """Row names such as "mstrack v2 (xc7, yosys)" hold parentheses and commas: a third --write still
+    credits each kept row to the run that made it."""
+    p = tmp_path / "perf.md"
+    t = "| design | n |\n|---|---|\n"
+    synth.write_section("RTL: r1.\n\n" + t + "| mstrack a (xc7, yosys) | 1 |", "v", "cmd a", p, tools="Tools: t1.")
+    synth.write_section("RTL: r2.\n\n" + t + "| mstrack b (xc7, yosys) | 2 |", "v", "cmd b", p, tools="Tools: t2.",
+                        keep_rows=True)
+    synth.write_section("RTL: r3.\n\n" + t + "| mstrack c (xc7, yosys) | 3 |", "v", "cmd c", p, tools="Tools: t3.",
+                        keep_rows=True)
+    text = p.read_text()
+    assert "Rows kept from an earlier run (mstrack a (xc7, yosys)): Command: `cmd a` Tools: t1. RTL: r1." in text
+    assert "Rows kept from an earlier run (mstrack b (xc7, yosys)): Command: `cmd b` Tools: t2. RTL: r2." in text
+    assert "| mstrack a (xc7, yosys) | 1 |\n| mstrack b (xc7, yosys) | 2 |\n| mstrack c (xc7, yosys) | 3 |" in text

@@ -1042,7 +1042,10 @@ def _merge_rows(old_block: str, md: str) -> str:
         if not para or para.startswith("<!--"):
             continue
         if para.startswith("Rows kept from an earlier run ("):      # an older note: keep it while its rows stay
-            names = set(para[len("Rows kept from an earlier run ("):].split(")")[0].split(", "))
+            # its row names (which may hold parentheses and commas themselves) up to the note's "Command:"
+            lst = para[len("Rows kept from an earlier run ("):].split(" Command: ")[0]
+            names = {k for k in map(_row_key, old_rows) if lst.startswith(k + ")") or lst.startswith(k + ", ")
+                     or f", {k})" in lst or f", {k}, " in lst}
             if kept_keys & names:
                 notes.append(para)
                 covered |= names

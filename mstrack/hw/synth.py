@@ -983,14 +983,12 @@ def vitis_table(rows: Iterable[dict]) -> str:
                    f"{x['DSP48E1']} | {per} |")
     # the cost of a target added to the multi-target core: (core(N) - core(1)) / (N - 1), for each N
     # synthesised beside the one-slot core (the merger's fixed part counted once)
-    multi = {s.get("generics", {}).get("MAX_TARGETS", 0): s for s in rows}
-    multi.pop(0, None)
-    for n in sorted(multi) if 1 in multi else ():
-        if n == 1:
-            continue
-        a, b = multi[1]["xc7"], multi[n]["xc7"]
+    multi = {s["generics"]["MAX_TARGETS"]: s for s in rows if "MAX_TARGETS" in s.get("generics", {})}
+    one = multi.pop(1, None)
+    for n in sorted(multi) if one else ():
+        a, b = one["xc7"], multi[n]["xc7"]
         d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
-        out.append(f"| mstrack per added target: ({multi[n]['config']} - {multi[1]['config']}) / {n - 1} | 1 | "
+        out.append(f"| mstrack per added target: ({multi[n]['config']} - {one['config']}) / {n - 1} | 1 | "
                    f"{d['LUT']:,.0f} | {d['FF']:,.0f} | {d['BRAM36']:.1f} | {d['DSP48E1']:.1f} | "
                    f"{d['LUT']:,.0f} / {d['FF']:,.0f} / {d['BRAM36']:.1f} / {d['DSP48E1']:.1f} |")
     return "\n".join(out)
@@ -1043,9 +1041,8 @@ def _merge_rows(old_block: str, md: str) -> str:
             continue
         if para.startswith("Rows kept from an earlier run ("):      # an older note: keep it while its rows stay
             # its row names (which may hold parentheses and commas themselves) up to the note's "Command:"
-            lst = para[len("Rows kept from an earlier run ("):].split(" Command: ")[0]
-            names = {k for k in map(_row_key, old_rows) if lst.startswith(k + ")") or lst.startswith(k + ", ")
-                     or f", {k})" in lst or f", {k}, " in lst}
+            lst = ", " + para[len("Rows kept from an earlier run ("):].split(" Command: ")[0]
+            names = {k for k in map(_row_key, old_rows) if f", {k})" in lst or f", {k}, " in lst}
             if kept_keys & names:
                 notes.append(para)
                 covered |= names

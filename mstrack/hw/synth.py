@@ -985,7 +985,9 @@ def vitis_table(rows: Iterable[dict]) -> str:
     # synthesised beside the one-slot core (the merger's fixed part counted once)
     multi = {s["generics"]["MAX_TARGETS"]: s for s in rows if "MAX_TARGETS" in s.get("generics", {})}
     one = multi.pop(1, None)
-    for n in sorted(multi) if one else ():
+    for n in sorted(multi):
+        if one is None:
+            break
         a, b = one["xc7"], multi[n]["xc7"]
         d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
         out.append(f"| mstrack per added target: ({multi[n]['config']} - {one['config']}) / {n - 1} | 1 | "

@@ -985,14 +985,13 @@ def vitis_table(rows: Iterable[dict]) -> str:
     # synthesised beside the one-slot core (the merger's fixed part counted once)
     multi = {s["generics"]["MAX_TARGETS"]: s for s in rows if "MAX_TARGETS" in s.get("generics", {})}
     one = multi.pop(1, None)
-    for n in sorted(multi):
-        if one is None:
-            break
-        a, b = one["xc7"], multi[n]["xc7"]
-        d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
-        out.append(f"| mstrack per added target: ({multi[n]['config']} - {one['config']}) / {n - 1} | 1 | "
-                   f"{d['LUT']:,.0f} | {d['FF']:,.0f} | {d['BRAM36']:.1f} | {d['DSP48E1']:.1f} | "
-                   f"{d['LUT']:,.0f} / {d['FF']:,.0f} / {d['BRAM36']:.1f} / {d['DSP48E1']:.1f} |")
+    if one is not None:
+        for n in sorted(multi):
+            a, b = one["xc7"], multi[n]["xc7"]
+            d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
+            out.append(f"| mstrack per added target: ({multi[n]['config']} - {one['config']}) / {n - 1} | 1 | "
+                       f"{d['LUT']:,.0f} | {d['FF']:,.0f} | {d['BRAM36']:.1f} | {d['DSP48E1']:.1f} | "
+                       f"{d['LUT']:,.0f} / {d['FF']:,.0f} / {d['BRAM36']:.1f} / {d['DSP48E1']:.1f} |")
     return "\n".join(out)
 
 

@@ -357,18 +357,18 @@ def test_speed_grade_selection(tmp_path, monkeypatch):
         ap.parse_args(["--speed", "5"])
 
 
-def test_nexus_pdc_places_every_pin_of_its_wrapper(vhd=synth.PINS_VHD, pdc=(synth.NEXUS_PDC,)):
-    """nextpnr-nexus refuses an unconstrained I/O: the pins wrapper's PDC gives every port bit a
-    site, and no site twice (the wrapper has the same pins for both presets)."""
+@pytest.mark.parametrize("config", ["default", "v2-colour", "multi1-colour", "multi3-colour", "multi8-colour"])
+def test_nexus_pdc_places_every_pin_of_its_wrapper(config):
+    """nextpnr-nexus refuses an unconstrained I/O: the PDC that synth_config gives a configuration's pin
+    wrapper (ms_tracker_pins for both presets, ms_tracker_multi_pins for N targets) gives every port bit
+    a site, no site twice, and names no port the wrapper does not have."""
     import re
-    text = vhd.read_text()
-    ports = text[text.index("port ("):text.index("end entity")]
-    want = set()
-    for name, hi in re.findall(r"^\s*(\w+)\s*:\s*(?:in|out)\s+std_logic(?:_vector\(([\w *+-]+) downto 0\))?", ports, re.M):
-        top = eval(hi, {"PPC": 1}) if hi else None  # the Nexus runs are PPC 1
-        want |= {f"{name}[{i}]" for i in range(top + 1)} if hi else {name}
-    text = "".join(p.read_text() for p in pdc)   # as run_nextpnr joins them
-    got = re.findall(r"ldc_set_location -site \{(\w+)\} \[get_ports \{?([\w\[\]]+)\}?\]", text)
+    cfg = synth.CONFIGS[config]
+    want = synth.wrapper_ports(synth.MULTI_PINS_VHD if cfg.top == synth.TOP_MULTI else synth.PINS_VHD,
+                               cfg.pins_generics())
+    assert {"clk", "s_axis_tdata[23]", "res_dout"} <= want and "s_axis_tdata[24]" not in want
+    assert ("live[%d]" % (cfg.max_targets - 1) in want) == (cfg.top == synth.TOP_MULTI)
+    got = re.findall(r"ldc_set_location -site \{(\w+)\} \[get_ports \{?([\w\[\]]+)\}?\]", synth.nexus_pdc(cfg))
     assert {p for _, p in got} == want
     assert len({s for s, _ in got}) == len(got)
 

@@ -82,6 +82,8 @@ SEEDS = (1, 2, 3)
 #: 5 LRAM, 56 18x18 multipliers; speed grade 7 = the slowest, like the ECP5 runs' default grade 6)
 NEXUS_DEVICE = "LIFCL-40-7BG400C"
 NEXUS_PDC = REPO_ROOT / "tools" / "hdl" / "ms_tracker_pins_lifcl40.pdc"
+#: the multi-target wrapper's own ports (with :data:`NEXUS_PDC` for the ports both wrappers have)
+NEXUS_MULTI_PDC = REPO_ROOT / "tools" / "hdl" / "ms_tracker_multi_pins_lifcl40.pdc"
 
 #: AMD Vitis Vision xf::cv::MeanShift, 10 targets, 300 MHz, UltraScale+ (figures of the issue)
 VITIS = {"targets": 10, "LUT": 10064, "FF": 13198, "BRAM36": 76, "DSP": 14}
@@ -250,6 +252,35 @@ def pins_sources(top: str = PINS_TOP) -> list[Path]:
     return sources(top, extra=[MULTI_PINS_VHD if top == MULTI_PINS_TOP else PINS_VHD])
 
 
+def wrapper_ports(vhd: Path, generics: dict[str, int]) -> set[str]:
+    """Every port bit of the pin wrapper *vhd* with *generics* (``clk``, ``s_axis_tdata[0]``, ...)."""
+    text = vhd.read_text()
+    ports = text[text.index("port ("):text.index("end entity")]
+    out: set[str] = set()
+    for name, hi in re.findall(r"^\s*(\w+)\s*:\s*(?:in|out)\s+std_logic(?:_vector\(([\w *+-]+) downto 0\))?",
+                               ports, re.M):
+        if hi:
+            top = eval(hi, {"__builtins__": {}}, {**generics, "PPC": 1})  # noqa: S307 (the wrapper's own bounds)
+            out |= {f"{name}[{i}]" for i in range(top + 1)}
+        else:
+            out.add(name)
+    return out
+
+
+def nexus_pdc(cfg: "Config") -> str:
+    """The Nexus pin constraints of *cfg*'s pin wrapper: the lines of :data:`NEXUS_PDC` and (the
+    multi-target wrapper) :data:`NEXUS_MULTI_PDC` that name one of its ports (PPC 1, as the Nexus runs)."""
+    vhd = MULTI_PINS_VHD if cfg.pins_top == MULTI_PINS_TOP else PINS_VHD
+    want = wrapper_ports(vhd, cfg.pins_generics())
+    files = (NEXUS_PDC, NEXUS_MULTI_PDC) if cfg.pins_top == MULTI_PINS_TOP else (NEXUS_PDC,)
+    keep = []
+    for line in "".join(f.read_text() for f in files).splitlines(keepends=True):
+        m = re.search(r"\[get_ports \{?([\w\[\]]+)\}?\]", line)
+        if m is None or m.group(1) in want:
+            keep.append(line)
+    return "".join(keep)
+
+
 # ----------------------------------------------------------------------------- nextpnr
 
 
@@ -328,11 +359,11 @@ def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, 
 
 
 def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5",
-                speed: int = SPEED, pdc: Sequence[Path] = (NEXUS_PDC,)) -> dict[str, Any]:
+                speed: int = SPEED, pdc: str | None = None) -> dict[str, Any]:
     """nextpnr-ecp5 (family "ecp5", LFE5U-85F CABGA381, speed grade *speed*) or nextpnr-nexus (family
     "nexus", :data:`NEXUS_DEVICE`) on ``<synth_dir>/out.json`` (a yosys ``synth_ecp5`` / ``synth_nexus``
-    netlist) with one seed; *pdc*: the Nexus pin constraint files, joined into ``<synth_dir>/pins.pdc``
-    (default :data:`NEXUS_PDC`, the pins of ms_tracker_pins).
+    netlist) with one seed; *pdc*: the Nexus pin constraints (:func:`nexus_pdc`), written to
+    ``<synth_dir>/pins.pdc`` (default: :data:`NEXUS_PDC`, the pins of ms_tracker_pins).
 
     Writes ``nextpnr_s<seed>[_g<speed>].log`` / ``report_s<seed>[_g<speed>].json`` there (``_g<speed>``
     for an ECP5 grade other than 6).  Returns ``{"seed", "speed", "fmax_mhz", "utilization": {bel: (used,
@@ -351,7 +382,7 @@ def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, fa
                + list(NEXTPNR_ECP5_OPTS))
     else:                   # the pins wrapper's I/O sites; the carry-in workaround of hdl.nexus_fix_carry_in
         # router1: router2 (the default) fails on the clock pad -> DCC arc of this design (nextpnr 0.11)
-        (d / "pins.pdc").write_text("".join(Path(p).read_text() for p in pdc))
+        (d / "pins.pdc").write_text(NEXUS_PDC.read_text() if pdc is None else pdc)
         dev = ["--device", NEXUS_DEVICE, "--pdc", "pins.pdc", "--router", "router1"]
         netlist = "out_cin.json"
         if not (d / netlist).is_file() or (d / netlist).stat().st_mtime < (d / "out.json").stat().st_mtime:
@@ -473,14 +504,14 @@ def synth_config(cfg: Config | str, seeds: Sequence[int] = SEEDS, freq_mhz: floa
         secs["nexus_core"] = round(time.monotonic() - t0, 1)
         out["nexus"] = {k: n[k] for k in NEXUS_KEYS}
         log(f"[{cfg.name}] nexus core: {out['nexus']} ({secs['nexus_core']} s)")
-        if pnr and cfg.placeable and cfg.pins_top == PINS_TOP:   # NEXUS_PDC places this wrapper's pins
+        if pnr and cfg.placeable:
             t0 = time.monotonic()
             npins = yosys_cached("nexus", cfg.pins_top, cfg.pins_generics(), pins_sources(cfg.pins_top),
                                  f"nexuspnr_{cfg.name}")
             secs["nexus_pins_yosys"] = round(time.monotonic() - t0, 1)
             nruns = []
             for sd in seeds:
-                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus")
+                pr = run_nextpnr(npins["dir"], sd, freq_mhz, family="nexus", pdc=nexus_pdc(cfg))
                 nruns.append(pr)
                 secs[f"nextpnr_nexus_s{sd}"] = pr["seconds"]
                 cp = pr["critical_path"]

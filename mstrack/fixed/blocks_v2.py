@@ -376,3 +376,22 @@ def ms_chroma_bin(frame: np.ndarray, bits: int, k: int) -> np.ndarray:
     f = frame.astype(np.int64)
     s = f[..., 0] + f[..., 1] + f[..., 2]
     return ((s >> (10 - k)) << (2 * bits)) | (((f[..., 2] << bits) // (s + 1)) << bits) | ((f[..., 1] << bits) // (s + 1))
+
+
+def ms_slot_capture(bins: np.ndarray, d: int, reg_x: int, reg_y: int, reg_w: int, reg_h: int) -> np.ndarray:
+    """One target's slot of the shared-engine multi-target core (rtl/ms_slot_capture.vhd): the
+    pixels of the decimated image ``bins[::d, ::d]`` inside the region (decimated px), (reg_h, reg_w):
+    ``FixedTrackerV2._capture`` of that target's decimation and region.  The RTL writes region pixel
+    (rx, ry) to bank ``rx % LANES``, word ``ry * STRIDE + rx // LANES`` (:func:`slot_words`)."""
+    dec = bins[::d, ::d]
+    if not (0 <= reg_x and 0 <= reg_y and reg_w >= 1 and reg_h >= 1
+            and reg_x + reg_w <= dec.shape[1] and reg_y + reg_h <= dec.shape[0]):
+        raise ValueError(f"region ({reg_x}, {reg_y}, {reg_w}, {reg_h}) is not inside the {dec.shape[1]}x{dec.shape[0]} "
+                         f"decimated image (d = {d})")
+    return dec[reg_y: reg_y + reg_h, reg_x: reg_x + reg_w].copy()
+
+
+def slot_words(region: np.ndarray, lanes: int, stride: int) -> dict[tuple[int, int], int]:
+    """The slot's RAM words of a captured region: ``{(bank, word): value}`` (ms_region_capture's layout)."""
+    h, w = region.shape
+    return {(rx % lanes, ry * stride + rx // lanes): int(region[ry, rx]) for ry in range(h) for rx in range(w)}

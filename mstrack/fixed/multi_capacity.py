@@ -221,6 +221,14 @@ def job_clocks(kind: JobKind, wd: int, hd: int, tp: TrackerParams, costs: PassCo
 
 
 # ----------------------------------------------------------------------------- demands
+def release_line(reg_y: int, reg_h: int, d: int, frame_h: int) -> int:
+    """The frame line after which a region (rows ``reg_y`` .. ``reg_y + reg_h - 1`` of the decimated
+    frame at decimation ``d``) has streamed in: its last full-resolution row, the Sobel's line of delay
+    and the capture, D + 1 lines after its last row (at most the frame's height).  rtl/ms_slot_capture.vhd
+    releases the region no later (tb/test_ms_slot_capture.py)."""
+    return min((reg_y + reg_h) * d + 1, frame_h)
+
+
 def _dims(frame_w: int, frame_h: int, d: int) -> tuple[int, int]:
     """(width, height) of frame[::d, ::d]."""
     return (frame_w - 1) // d + 1, (frame_h - 1) // d + 1
@@ -275,7 +283,7 @@ def demand_from_state(w8: int, h8: int, c8: tuple[int, int], lost: bool, frame_s
     reg = ms_region((c8[0] >> sh, c8[1] >> sh), ex, ey, dw, dh, fp.with_(margin=min(margin, 255)))
     kind: JobKind = "lost" if lost else "track"
     clocks = job_clocks(kind, wd, hd, tp, costs, window_limit=min(tp.max_window, dw - 2, dh - 2))
-    release = min((reg.y + reg.h) * d + 1, fh)
+    release = release_line(reg.y, reg.h, d, fh)
     # the next frame: tracked with the size grown by scale_step, or searched (lost) at twice the base D
     g = ((1 << 16) + q16(tp.scale_step))
     w8g, h8g = min((w8 * g) >> 16, fw << 8), min((h8 * g) >> 16, fh << 8)

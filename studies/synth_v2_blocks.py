@@ -5,7 +5,8 @@
 Generics: the v2 defaults (``TrackerParams(preset="v2")``, ``FixedParams()``), as core v2 will
 map them.  Prints a Markdown table (the docs/blocks/ pages quote it).
 
-Run: ``PYTHONPATH=. .venv/bin/python studies/synth_v2_blocks.py [block ...]``.
+Run: ``PYTHONPATH=. .venv/bin/python studies/synth_v2_blocks.py [--speed=8] [block ...]`` (ECP5 speed grade 6 by
+default).
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
     s8_w = fp.coord_bits + 8                       # w8, h8: Q(COORD_W).8
     pad16 = sixteenths(tp.pad, "pad")
     g = core_generics(tp.with_(kernel="epanechnikov", preset="paper", features="fused"), fp)
+    c = synth.CONFIGS["v2-colour"].generics()
     return {
         "ms_decimation": {"S8_W": s8_w, "PAD16": pad16, "MAX_WINDOW": tp.max_window},
         "ms_window_size": {"S8_W": s8_w, "PAD16": pad16, "N_W": tp.max_window.bit_length()},
@@ -33,25 +35,32 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
                         "EDGE_BINS_LOG2": tp.edge_bins_log2},
         # KA/KB on (v2's d2q needs them with the flat kernel)
         "ms_kernel_tables": {k: g[k] for k in ("HALF_W", "KERNEL_EPAN", "KERNEL_BITS", "KVAL_W", "KD_W")},
+        # one slot of the shared-engine core, at the colour engine's region (configuration v2-colour)
+        "ms_slot_capture": {**{k: c[k] for k in ("LANES", "COORD_W", "REGION_MAX", "STRIDE", "ADDR_W")},
+                            "DATA_W": 3 * c["COLOUR_BITS"], "LOG2_D_MAX": 4},
     }
 
 
-def main(names: list[str]) -> None:
-    rows = ["| block | generics | LUT4 | FF | CCU2C | DP16KD | MULT18X18D | Fmax alone (MHz) | critical path |",
-            "|---|---|---:|---:|---:|---:|---:|---:|---|"]
+def main(names: list[str], speed: int = synth.SPEED) -> None:
+    rows = [f"| block | generics | LUT4 | FF | CCU2C | DP16KD | MULT18X18D | Fmax alone, grade {speed} (MHz) | critical path "
+            "| xc7 LUT | xc7 FF |",
+            "|---|---|---:|---:|---:|---:|---:|---:|---|---:|---:|"]
     for top, gen in v2_block_generics().items():
         if names and top not in names:
             continue
         r = synth.yosys_cached("ecp5", top, gen, None, f"v2blk_{top}")
-        p = synth.run_nextpnr(r["dir"], 1)
+        p = synth.run_nextpnr(r["dir"], 1, speed=speed)
         fmax = p["fmax_mhz"]
+        x = synth.yosys_cached("xc7", top, gen, None, f"v2blk_xc7_{top}")
         gtxt = ", ".join(f"{k} {v}" for k, v in gen.items())
         rows.append(f"| {top} | {gtxt} | {r['LUT4']} | {r['TRELLIS_FF']} | {r['CCU2C']} | {r['DP16KD']} | "
                     f"{r['MULT18X18D']} | {fmax if fmax else 'no reg-to-reg path'} | "
-                    f"{synth.path_summary(p['critical_path']) or '-'} |")
+                    f"{synth.path_summary(p['critical_path']) or '-'} | {x['LUT']} | {x['FF']} |")
         print(rows[-1], file=sys.stderr, flush=True)
     print("\n".join(rows))
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    args = sys.argv[1:]
+    sp = next((int(a.split("=", 1)[1]) for a in args if a.startswith("--speed=")), synth.SPEED)
+    main([a for a in args if not a.startswith("--speed=")], sp)

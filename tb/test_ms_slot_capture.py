@@ -13,10 +13,12 @@ frame it checks, value by value:
   frame's last rows), and so before the stream reaches the capacity rule's ``release_line``;
 * ``late`` pulses for a ``load_now`` after the region's first row, and only then.
 
-Scenarios: loads between frames and during the previous frame (for the next one), ``load_now``
-during the frame before the region (also in the frame_start clock), a late ``load_now``, a frame with
-no load, a second load replacing a pending one, an abandoned frame (frame_error) with its region half
-written, D = 1 .. 16 on regions touching the decimated interior's borders, then random frames.
+Scenarios: loads between frames, in the frame_start clock and during the previous frame after its
+release (for the next one), ``load_now`` during the frame before the region (also in the
+frame_start clock), a late ``load_now``, a frame with no load, a second load replacing a pending one,
+an abandoned frame (frame_error) with its region half written and the same region loaded again, D =
+1 .. 16 on regions touching the decimated interior's borders, then random frames.  The region goes in
+at full resolution (x D, y D, (x + w) D, (y + h) D), as the engine gives it.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_slot_capture.py``.
 """
@@ -88,7 +90,7 @@ class SlotTB:
         self.cycle = 0
         for s in ("rst", "frame_start", "frame_end", "frame_error", "ip_valid", "load", "load_now"):
             getattr(dut, s).value = Immediate(0)
-        for s in ("ip_x", "ip_y", "ip_data", "dec_log2", "reg_x", "reg_y", "reg_w", "reg_h"):
+        for s in ("ip_x", "ip_y", "ip_data", "dec_log2", "fx0", "fy0", "fx1", "fy1"):
             getattr(dut, s).value = Immediate(0)
         cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
         self.writes: list[tuple[int, int, int, int]] = []   # (cycle, bank, word, data)
@@ -119,7 +121,8 @@ class SlotTB:
         if ld is not None:
             d.load_now.value = int(ld.now)
             d.dec_log2.value = ld.d.bit_length() - 1
-            d.reg_x.value, d.reg_y.value, d.reg_w.value, d.reg_h.value = ld.reg
+            x, y, w, h = ld.reg              # the engine gives the region at full resolution
+            d.fx0.value, d.fy0.value, d.fx1.value, d.fy1.value = x * ld.d, y * ld.d, (x + w) * ld.d, (y + h) * ld.d
         else:
             d.load_now.value = 0
 
@@ -226,15 +229,19 @@ def scripted(rng: random.Random, nrng: np.random.Generator, data_w: int, rmax: i
     fr.append(Frame(bins(), [b], expect=b))
     c = Load(2, (2, 4, 6, 3), now=True, at=pixel_index(5, 8))                 # its first row (8) started
     fr.append(Frame(bins(), [c], late=1))
-    e_next = Load(8, random_region(rng, 8, rmax))
-    e = Load(4, (3, 2, 5, 4))
-    e_next.at = pixel_index(1, 5)                                            # for the next frame, in this one
-    fr.append(Frame(bins(), [e, e_next], error_at=pixel_index(4, 11), expect=e))  # abandoned mid-region
-    fr.append(Frame(bins(), [], expect=e_next))
+    e = Load(4, (3, 2, 5, 4))                                                 # full-resolution rows 8 .. 20
+    fr.append(Frame(bins(), [e], error_at=pixel_index(4, 11), expect=e))      # abandoned mid-region
+    fr.append(Frame(bins(), [e], expect=e))                                   # loaded again: captured
+    r = Load(2, (1, 2, 6, 3))                                                 # rows 4 .. 8: released at row 9
+    r_next = Load(8, random_region(rng, 8, rmax), at=pixel_index(1, 20))       # after the release, for the next
+    fr.append(Frame(bins(), [r, r_next], expect=r))
+    fr.append(Frame(bins(), [], expect=r_next))
     f1, f2 = Load(16, (1, 1, 1, 1)), Load(1, (1, 1, min(rmax, W - 2), min(rmax, H - 2)))
     fr.append(Frame(bins(), [f1, f2], expect=f2))                              # the second load replaces
     g = Load(1, (W - 2 - 7, H - 2 - 5, 7, 5), now=True, at=-2)                 # load_now with frame_start
     fr.append(Frame(bins(), [g], expect=g))
+    g2 = Load(2, random_region(rng, 2, rmax), at=-2)                           # a load with frame_start
+    fr.append(Frame(bins(), [g2], expect=g2))
     h = Load(4, (1, 1, 3, 2), now=True, at=0)                                 # first row 4: not late
     fr.append(Frame(bins(), [h], expect=h))
     return fr

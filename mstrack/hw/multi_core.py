@@ -11,9 +11,9 @@ per-object figures.  Built from per-block figures:
 * the region slot and model memories are tiled like yosys maps them (checked against yosys
   ``synth_ecp5`` of ``ms_region_ram`` / ``ms_ram_sdp`` at those sizes: :data:`YOSYS_BLOCKS`,
   :func:`yosys_check`);
-* the per-target logic (state record in LUT RAM, capture descriptor and comparators, scheduler
-  entry) is counted from its registers and comparators (:data:`PER_TARGET`), an estimate until the
-  RTL exists.
+* the per-target logic (:data:`PER_TARGET`): the region capture as synthesised
+  (rtl/ms_slot_capture.vhd, :data:`SLOT_CAPTURE`), the state record in LUT RAM, and an estimate of
+  the write arbiter's share and the scheduler entry until that RTL exists.
 
 Cycles come from :mod:`mstrack.fixed.multi_capacity` (the capacity rule's own job clocks) with
 pass costs from :mod:`mstrack.hw.synth`'s cycle model (:func:`pass_costs`).
@@ -53,15 +53,18 @@ VITIS = synth.VITIS
 #: LFE5U-85F: DP16KD, placed combinational cells (TRELLIS_COMB), flip-flops.
 LFE5U_85F = {"DP16KD": 208, "comb": 83640, "FF": 83640}
 
-#: Per target, besides its memories (estimate from the registers and comparators the RTL needs):
-#: the state record (213 bits: c8, w8, h8, w0_8, rho_ref, share_ref, spread_ref, lost, rho0, rho_s,
-#: contrast_s, loss reported) + its region and job descriptor (D, region origin and size, slot base,
-#: release / next line, clocks, kind, age: 53 bits) in LUT RAM, 16 words deep (one DPR16X4 per 4
-#: bits, for up to 16 targets); the capture descriptor (4 x 12-bit region bounds, row address
-#: accumulator, column counter, decimation phase: ~95 FF; 4 bound comparators, address adder and the
-#: write arbiter's share: ~130 LUT4); the scheduler's release compare (~10 LUT4).
+#: One target's region capture, rtl/ms_slot_capture.vhd alone at the colour engine's sizes (LANES 4,
+#: REGION_MAX 256, DATA_W 9), yosys ``synth_ecp5`` / ``synth_xilinx``: docs/blocks/ms_slot_capture.md
+#: (``studies/synth_v2_blocks.py ms_slot_capture``, 2026-11-29).
+SLOT_CAPTURE = {"LUT4": 212, "FF": 178, "CCU2C": 55, "xc7_LUT": 134, "xc7_FF": 151}
+#: Per target, besides its memories: the state record (213 bits: c8, w8, h8, w0_8, rho_ref, share_ref,
+#: spread_ref, lost, rho0, rho_s, contrast_s, loss reported) + its region and job descriptor (D,
+#: region origin and size, slot base, release / next line, clocks, kind, age: 53 bits) in LUT RAM, 16
+#: words deep (one DPR16X4 per 4 bits, for up to 16 targets); the region capture (measured:
+#: :data:`SLOT_CAPTURE`); the write arbiter's share and the scheduler's release compare (estimate, until
+#: that RTL exists: ~30 LUT4).
 STATE_BITS = 213 + 53
-PER_TARGET = {"LUT4": 140, "FF": 100}
+PER_TARGET = {"LUT4": SLOT_CAPTURE["LUT4"] + 30, "FF": SLOT_CAPTURE["FF"]}
 #: Added once for N > 1: the scheduler (admission adder and compare, the job queue), the result
 #: reorder buffer's control and the 4-bit target id in the result word (estimate).
 MULTI_FIXED = {"LUT4": 400, "FF": 300}

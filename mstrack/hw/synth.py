@@ -253,17 +253,16 @@ def pins_sources(top: str = PINS_TOP) -> list[Path]:
 
 
 def wrapper_ports(vhd: Path, generics: dict[str, int]) -> set[str]:
-    """Every port bit of the pin wrapper *vhd* with *generics* (``clk``, ``s_axis_tdata[0]``, ...)."""
+    """Every port bit of the pin wrapper *vhd* with *generics*, named as nextpnr names them (``clk``,
+    ``s_axis_tdata[0]``, ``live`` for a vector of one bit)."""
     text = vhd.read_text()
     ports = text[text.index("port ("):text.index("end entity")]
     out: set[str] = set()
     for name, hi in re.findall(r"^\s*(\w+)\s*:\s*(?:in|out)\s+std_logic(?:_vector\(([\w *+-]+) downto 0\))?",
                                ports, re.M):
-        if hi:
-            top = eval(hi, {"__builtins__": {}}, {**generics, "PPC": 1})  # noqa: S307 (the wrapper's own bounds)
-            out |= {f"{name}[{i}]" for i in range(top + 1)}
-        else:
-            out.add(name)
+        top = eval(hi, {"__builtins__": {}}, {**generics, "PPC": 1}) if hi else 0  # noqa: S307 (its own bounds)
+        # a one-bit vector is a scalar port in the netlist (yosys / nextpnr name it without an index)
+        out |= {f"{name}[{i}]" for i in range(top + 1)} if top > 0 else {name}
     return out
 
 
@@ -276,8 +275,11 @@ def nexus_pdc(cfg: "Config") -> str:
     keep = []
     for line in "".join(f.read_text() for f in files).splitlines(keepends=True):
         m = re.search(r"\[get_ports \{?([\w\[\]]+)\}?\]", line)
-        if m is None or m.group(1) in want:
-            keep.append(line)
+        if m is not None and m.group(1).endswith("[0]") and m.group(1)[:-3] in want:
+            line = line.replace(m.group(1), m.group(1)[:-3])      # live[0] of MAX_TARGETS 1: the port live
+        elif m is not None and m.group(1) not in want:
+            continue
+        keep.append(line)
     return "".join(keep)
 
 

@@ -43,6 +43,8 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
                          "DATA_W": 3 * c["COLOUR_BITS"], "LOG2_D_MAX": 4, "RD_LAT": 4, "WR_LAT": 1},
         # the capacity rule, once per core (16 targets)
         "ms_admit": {"MAX_TARGETS": 16, "CLK_W": 24, "LINE_W": 12, "LC_W": 13, "SUM_W": 28},
+        # a window's worst-case pixel pass clocks (the job clocks' window term), LANES 4
+        "ms_pass_clocks": {"LANES": c["LANES"], "HALF_W": 6, "PASS_LAT": 10, "KD_W": 29, "OUT_W": 16},
     }
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import sys
 
 from mstrack.hw import synth
+from mstrack.hw.multi_core import job_clocks_generics
 from mstrack.fixed.blocks_v2 import sixteenths
 from mstrack.fixed.formats import FixedParams
 from mstrack.fixed.vhdl_pkg import core_generics
@@ -45,6 +46,8 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "ms_admit": {"MAX_TARGETS": 16, "CLK_W": 24, "LINE_W": 12, "LC_W": 13, "SUM_W": 28},
         # a window's worst-case pixel pass clocks (the job clocks' window term), LANES 4
         "ms_pass_clocks": {"LANES": c["LANES"], "HALF_W": 6, "PASS_LAT": 10, "KD_W": 29, "OUT_W": 16},
+        # a target's worst-case job clocks, the default tracker v2 (the scale test's second pass)
+        "ms_job_clocks": job_clocks_generics(tp),
     }
 
 

@@ -485,3 +485,29 @@ def render_doc(text: str) -> str:
         head, rest = text.split(BEGIN, 1)
         return head + body + rest.split(END, 1)[1]
     return text.rstrip("\n") + "\n\n" + body + "\n"
+
+
+# ----------------------------------------------------------------------------- rtl/ms_job_clocks.vhd
+def job_clocks_generics(tp: TrackerParams, costs: PassCosts = PassCosts(), half_w: int = 6) -> dict[str, int]:
+    """Generics of rtl/ms_job_clocks.vhd for tracker parameters *tp* and the engine's step clocks
+    *costs*: :func:`mstrack.fixed.multi_capacity.job_clocks` written as
+    ``C_kind + M_kind pp(wd, hd) [+ 2 pp(up(wd), up(hd)) + C_SCALE] [+ ring rows x cols]``.
+    tb/test_ms_job_clocks.py checks the block against ``job_clocks`` itself."""
+    c = costs
+    b = c.bin_pass + (c.bank_tree if tp.orient_T > 0 else 0)
+    qload = tp.n_colour_bins + c.qload_extra
+    common = c.front + qload + c.v2_overhead + c.back + c.job_switch
+
+    def engine_const(passes: int) -> int:           # _engine without its passes x pp term
+        n = passes - 1
+        return passes * b + n * c.centre + c.iter_overhead * n + 6
+
+    st = round(1000 * tp.scale_test)
+    return {
+        "LANES": c.lanes, "HALF_W": half_w, "PASS_LAT": c.pass_lat,
+        "M_TRACK": tp.max_iter + 1, "C_TRACK": common + engine_const(tp.max_iter + 1),
+        "M_LOST": 9 * (tp.search_iter + 1), "C_LOST": common + 9 * engine_const(tp.search_iter + 1) + 8 * c.confidence,
+        "C_INIT": common + 3 * tp.n_bins_v2 + c.bg_drain + b,
+        "SCALE_PERMILLE": st if tp.scale_test > 0 else 0,
+        "C_SCALE": 2 * (c.kernel_tables + qload + b + c.scale_window_extra),
+    }

@@ -17,12 +17,13 @@
 -- ms_decimate).
 --
 -- Descriptor (dec_log2, fx0, fy0, fx1, fy1), taken on `load`; one load, one capture:
---   * load_now = '0', or any load between frames: for the next frame (taken at its frame_start; a
---     second load before it replaces the first);
+--   * between frames, or load_now = '0' during a frame: for the next frame (armed at its frame_start;
+--     a second load before it replaces the first);
+--   * in a frame_start clock: for the frame that starts;
 --   * load_now = '1' during a frame: for this frame, from the next pixel on.  If a pixel of the
---     region's first full-resolution row (reg_y * D) or a later row has already arrived (in the load
---     clock included), nothing is captured and `late` pulses: the deadline of the target's job was
---     missed (the capacity rule of mstrack.fixed.multi_capacity makes that impossible).
+--     region's first full-resolution row (fy0) or a later row has already arrived (in the load clock
+--     included), nothing is captured and `late` pulses: the deadline of the target's job was missed
+--     (the capacity rule of mstrack.fixed.multi_capacity makes that impossible).
 --   A frame without a load for it captures nothing.  A load while a capture is armed (not released)
 --   replaces it, which ends that capture without a release (the shared engine loads a slot only
 --   after its release, or between frames).
@@ -34,11 +35,11 @@
 -- `release_line`).  frame_error disarms without a release.
 -- dec_log2 above LOG2_D_MAX gives D = 1 (as ms_decimate).
 -- Latency: ip_valid -> we 3 clocks; the release 3 clocks after its pixel, 4 after frame_end.
--- Cost (docs/blocks/ms_slot_capture.md): the grid mask, six COORD_W-bit comparators, two counters,
--- one descriptor register; no shifter, no multiplier.
+-- Cost (docs/blocks/ms_slot_capture.md): the grid mask, seven COORD_W-bit comparators, two
+-- counters, one descriptor register; no shifter, no multiplier.
 -- Throughput: 1 pixel per clock, no handshake.
 -- Python model: mstrack.fixed.blocks_v2.ms_slot_capture (the slot's words) and
--- mstrack.fixed.multi_capacity.TargetDemand.release_line (the bound on the release).
+-- mstrack.fixed.multi_capacity.release_line (the bound on the release).
 -- Reset: synchronous, active high: nothing armed, nothing pending.
 library ieee;
 use ieee.std_logic_1164.all;

@@ -48,6 +48,8 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "ms_pass_clocks": {"LANES": c["LANES"], "HALF_W": 6, "PASS_LAT": 10, "KD_W": 29, "OUT_W": 16},
         # a target's worst-case job clocks, the default tracker v2 (the scale test's second pass)
         "ms_job_clocks": job_clocks_generics(tp),
+        # the result words of 16 targets in id order
+        "ms_result_order": {"N_SLOTS": 16, "WORD_W": 160},
     }
 
 

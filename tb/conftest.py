@@ -225,6 +225,9 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_pass_clocks.py::test_ms_pass_clocks_verilator":
         "test_ms_pass_clocks[4] / [2] / [8] (the same bench on the RTL under GHDL); this case: the netlist under "
         "Verilator",
+    "tb/test_ms_result_order.py::test_ms_result_order_verilator":
+        "test_ms_result_order[n5] / [n16] / [n1] (the same bench on the RTL under GHDL); this case: the netlist "
+        "under Verilator",
     "tb/test_ms_job_clocks.py::test_ms_job_clocks_verilator":
         "test_ms_job_clocks[v2] / [v2-colour] (the same bench on the RTL under GHDL); this case: the netlist under "
         "Verilator",

@@ -245,11 +245,6 @@ architecture rtl of ms_bg_model is
 
   signal done_r         : std_logic := '0';
 
-  function to_sl(b : boolean) return std_logic is
-  begin
-    if b then return '1'; end if;
-    return '0';
-  end function;
   -- joint address {obin, colour} = obin 2**BIN_W + colour (N_ORIENT = 1: the colour bin)
   function jaddr(ob : unsigned(ORIENT_W - 1 downto 0); c : unsigned(BIN_W - 1 downto 0)) return unsigned is
   begin

@@ -42,7 +42,7 @@ entity ms_pass_clocks is
 end entity;
 
 architecture rtl of ms_pass_clocks is
-  constant LOG2L : natural := clog2(LANES) * boolean'pos(LANES > 1);
+  constant LOG2L : natural := log2_lanes(LANES);
   type acc_arr is array (0 to LANES - 1) of unsigned(OUT_W - 1 downto 0);
   signal acc     : acc_arr;
   signal kt_we   : std_logic;
@@ -57,13 +57,7 @@ architecture rtl of ms_pass_clocks is
   signal best_r  : unsigned(OUT_W - 1 downto 0);
   signal idx     : natural range 0 to LANES := 0;
   signal pick    : std_logic := '0';
-  function bool_sl(b : boolean) return std_logic is
-  begin
-    if b then
-      return '1';
-    end if;
-    return '0';
-  end function;
+
   signal ex_r, ey_r : unsigned(HALF_W - 1 downto 0);
   signal t_start : std_logic;
 begin
@@ -91,8 +85,8 @@ begin
         ey_r <= resize(shift_right(h - 1, 1), HALF_W);
       end if;
       -- stage 1: a table entry (rows dy = +-i, i <= ey; once for i = 0): the group ends per alignment
-      v1   <= run and kt_we and bool_sl(kt_addr <= ey_r);
-      dbl1 <= bool_sl(kt_addr /= 0);
+      v1   <= run and kt_we and to_sl(kt_addr <= ey_r);
+      dbl1 <= to_sl(kt_addr /= 0);
       for a in 0 to LANES - 1 loop
         hi1(a) <= resize(ex_r, HALF_W + 2) + a + kt_xr;
         lo1(a) <= resize(ex_r, HALF_W + 2) + a - kt_xr;

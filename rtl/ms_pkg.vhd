@@ -11,6 +11,10 @@ package ms_pkg is
   function clog2(n : natural) return natural;
   -- bits to hold 0 .. n
   function bits_for(n : natural) return natural;
+  -- log2 of a power of two, 0 for 1 (bank / lane index bits)
+  function log2_lanes(n : natural) return natural;
+  -- '1' for true
+  function to_sl(b : boolean) return std_logic;
   function max(a, b : integer) return integer;
   function min(a, b : integer) return integer;
   -- stop codes of a mean-shift loop (mstrack.fixed.blocks.STOP_CODES)
@@ -44,6 +48,22 @@ package body ms_pkg is
       r := r + 1;
     end loop;
     return r;
+  end function;
+
+  function log2_lanes(n : natural) return natural is
+  begin
+    if n <= 1 then
+      return 0;
+    end if;
+    return clog2(n);
+  end function;
+
+  function to_sl(b : boolean) return std_logic is
+  begin
+    if b then
+      return '1';
+    end if;
+    return '0';
   end function;
 
   function max(a, b : integer) return integer is

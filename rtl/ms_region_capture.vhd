@@ -71,13 +71,6 @@ entity ms_region_capture is
 end entity;
 
 architecture rtl of ms_region_capture is
-  function log2_lanes(n : natural) return natural is
-  begin
-    if n <= 1 then
-      return 0;
-    end if;
-    return clog2(n);
-  end function;
   constant LOG2L  : natural := log2_lanes(LANES);  -- log2(LANES), 0 for 1 lane
   constant BANK_W : natural := clog2(LANES);
 

@@ -89,13 +89,6 @@ entity ms_slot_capture is
 end entity;
 
 architecture rtl of ms_slot_capture is
-  function log2_lanes(n : natural) return natural is
-  begin
-    if n <= 1 then
-      return 0;
-    end if;
-    return clog2(n);
-  end function;
   constant LOG2L  : natural := log2_lanes(LANES);
   constant BANK_W : natural := clog2(LANES);
   constant LW     : natural := LOG2_D_MAX + 1;          -- low bits of the grid test

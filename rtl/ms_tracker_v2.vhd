@@ -6,7 +6,7 @@
 --
 -- Computes, per video frame:
 --   before the frame (input closed): log2 D = ms_decimation(w8, h8) (+ 1 while lost), the decimated
---   frame size, the window diameters (ms_window_size), the search offsets (STEP16) and the region
+--   frame size, the window diameters (ms_window_size), the search offsets (STEP16) and the region (ms_region_v2)
 --   around c8 >> log2 D (margin MARGIN, + the offset while lost, at most MARGIN_MAX); on an init frame
 --   the box (ms_box_size) and the start of ms_bg_model;
 --   during the frame: ms_frontend -> ms_decimate -> ms_region_capture (colour region RAM, + the 4-bit
@@ -23,7 +23,7 @@
 -- as ms_tracker (error result with status 6; state unchanged; a fault on the init frame re-arms
 -- ms_bg_model, and a start of frame that cuts the init frame is held until then).
 --
--- Latency: between frames about 24 clocks (+ ms_bg_model's reset and set-up before an init frame);
+-- Latency: between frames about 25 clocks (+ ms_bg_model's reset and set-up before an init frame);
 -- last pixel -> result: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
 -- (docs/realtime.md), ~60 clocks of statistics and about 230 of confidence, loss flag, scale and
 -- resize; while lost 8 more mean shifts with their confidence; on the init frame ms_bg_model's
@@ -175,7 +175,7 @@ architecture rtl of ms_tracker_v2 is
   constant ST_ERROR  : unsigned(2 downto 0) := "110";
 
   type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BOX1, T_BOX2, T_BG_RST, T_BG_START, T_BG_WAIT,
-                    T_REGION, T_RG0, T_RG1, T_RG2, T_RG3, T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
+                    T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
                     T_CNEXT, T_STATS0, T_STATS, T_CONF,
                     T_DECIDE, T_ST_SIZE, T_ST_WS, T_ST_WS_WAIT, T_ST_FIT, T_ST_RUN, T_ST_RHO, T_ST_NEXT,
                     T_ST_GATE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
@@ -201,7 +201,6 @@ architecture rtl of ms_tracker_v2 is
   signal ex_r, ey_r   : unsigned(HALF_W - 1 downto 0) := to_unsigned(1, HALF_W);
   signal s8x, s8y     : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');      -- start centre (decimated)
   signal k_acc        : unsigned(HIST_W - 1 downto 0) := (others => '0');
-  signal margin_r     : unsigned(COORD_W - 1 downto 0) := to_unsigned(MARGIN, COORD_W);  -- region margin of this frame
   signal ox_r, oy_r   : unsigned(COORD_W - 1 downto 0) := (others => '0');                -- search offsets (decimated px)
   -- start points: 0 the last centre, 1 .. 8 (while lost) the centre +- (ox, oy)
   signal cand         : unsigned(3 downto 0) := (others => '0');
@@ -216,12 +215,13 @@ architecture rtl of ms_tracker_v2 is
   signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal hi_x, hi_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal reg_w_c, reg_h_c : unsigned(COORD_W - 1 downto 0);
-  -- the region (ms_region) over five clocks T_REGION .. T_REGION_WAIT, one carry chain per clock and
-  -- axis; signed, COORD_W + 3 bits (rg_t: x, y axis)
+  -- the region (ms_region_v2, started when the window sizes are known); S - 2 per axis for the init box
   type rg_pair_t is array (0 to 1) of signed(COORD_W + 2 downto 0);
-  signal rg_rc, rg_rce, rg_e2, rg_ep1, rg_s2, rg_s1, rg_na, rg_a0, rg_nn, rg_t, rg_hi : rg_pair_t;
-  signal rg_a0lt1     : std_logic_vector(0 to 1);
-  signal rg_mx        : unsigned(COORD_W - 1 downto 0) := (others => '0');   -- max(ox, oy)
+  signal rg_s2        : rg_pair_t;
+  signal rv_in_valid, rv_out_valid : std_logic := '0';
+  signal rv_cx, rv_cy : unsigned(COORD_W + CF - 1 downto 0);
+  signal rv_reg_x, rv_reg_y : unsigned(COORD_W - 1 downto 0);
+  signal rv_reg_w, rv_reg_h, rv_hi_x, rv_hi_y : unsigned(REGION_W - 1 downto 0);
   -- init box centre (T_BOX .. T_BOX2): round(c), half size, interior limits [hx + 1, S - 2 - hx]
   signal bx_c, by_c, bx_h, by_h, bx_lo, by_lo, bx_hi, by_hi : unsigned(COORD_W - 1 downto 0) := (others => '0');
   -- ms_region per axis: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
@@ -242,19 +242,6 @@ architecture rtl of ms_tracker_v2 is
     else
       if c > hi then return hi; else return c; end if;
     end if;
-  end function;
-  -- clamp(a0, 1, t) = max(min(a0, t), 1), with a0 < 1 known (a0_lt1) from the clock before
-  function rg_clamp(a0, t : signed; a0_lt1 : std_logic) return unsigned is
-    variable a : signed(a0'length - 1 downto 0);
-  begin
-    if a0 > t then
-      a := t;
-      if t < 1 then a := to_signed(1, a'length); end if;
-    else
-      a := a0;
-      if a0_lt1 = '1' then a := to_signed(1, a'length); end if;
-    end if;
-    return unsigned(a(COORD_W - 1 downto 0));
   end function;
   signal lim_w, lim_h : unsigned(COORD_W - 1 downto 0);
   signal lim_wn, lim_hn : unsigned(WIN_W - 1 downto 0);
@@ -684,6 +671,16 @@ begin
     port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => h8, log2_d => l2d, limit => lim_h,
               out_valid => bs_h_valid, n => bs_h);
 
+  rv_cx <= resize(s8x, COORD_W + CF);
+  rv_cy <= resize(s8y, COORD_W + CF);
+  u_region : entity work.ms_region_v2
+    generic map (COORD_W => COORD_W, CF => CF, HALF_W => HALF_W, REGION_W => REGION_W, MARGIN => MARGIN,
+                 MARGIN_MAX => MARGIN_MAX)
+    port map (clk => clk, rst => rst, in_valid => rv_in_valid, cx => rv_cx, cy => rv_cy, ex => ex_r, ey => ey_r,
+              ox => ox_r, oy => oy_r, lost => lost_st, frame_w => dw, frame_h => dh, out_valid => rv_out_valid,
+              reg_x => rv_reg_x, reg_y => rv_reg_y, reg_w => rv_reg_w, reg_h => rv_reg_h, hi_x => rv_hi_x,
+              hi_y => rv_hi_y, region_margin => open);
+
   u_clip : entity work.ms_box_clip
     generic map (COORD_W => COORD_W, HALF_W => BOX_HALF_W, MAX_HALF => 2 ** BOX_HALF_W - 1, CF => CF)
     port map (clk => clk, rst => rst, in_valid => bc_valid, box_x => in_x, box_y => in_y,
@@ -905,7 +902,6 @@ begin
     variable stat  : unsigned(2 downto 0);
     variable lost_now : std_logic;
     variable srch4    : unsigned(3 downto 0);
-    variable rst_v : unsigned(COORD_W - 1 downto 0);
     variable sxo, syo : signed(CENTRE_ABS_W + 1 downto 0);
   begin
     if rising_edge(clk) then
@@ -915,6 +911,7 @@ begin
       fifo_valid <= '0';
       dec_in_valid <= '0';
       ws_in_valid <= '0';
+      rv_in_valid <= '0';
       bg_start <= '0';
       bg_rst_p <= '0';
       fu_start <= '0'; sh_start <= '0'; sp_start <= '0'; rs_start <= '0';
@@ -981,8 +978,6 @@ begin
 
         when T_SIZE =>                         -- lim_* follow dw, dh (registered in T_DEC)
           ws_in_valid <= '1';
-          rg_rc(0) <= rg_round(s8x);           -- region: round(c) (T_DEC's s8x, s8y)
-          rg_rc(1) <= rg_round(s8y);
           bx_c <= resize(shift_right(s8x + 2 ** (CF - 1), CF), COORD_W);   -- init box: round(c)
           by_c <= resize(shift_right(s8y + 2 ** (CF - 1), CF), COORD_W);
           state <= T_SIZE_WAIT;
@@ -999,65 +994,16 @@ begin
             -- max(ox, oy) while lost (at most MARGIN_MAX)
             ox_r <= resize(shift_right(resize(ws_w, COORD_W + 6) * STEP16, 4), COORD_W);
             oy_r <= resize(shift_right(resize(ws_h, COORD_W + 6) * STEP16, 4), COORD_W);
-            state <= T_REGION;
+            rv_in_valid <= '1';                -- ms_region_v2 takes ex_r .. oy_r the next clock
+            rg_s2(0) <= rg_s(dw) - 2;
+            rg_s2(1) <= rg_s(dh) - 2;
+            state <= T_REGION_WAIT;
           end if;
 
-        when T_REGION =>
-          if ox_r >= oy_r then rg_mx <= ox_r; else rg_mx <= oy_r; end if;
-          -- region terms without the margin: 2e + 1, e + 1, round(c) - e, S - 2, S - 1
-          rg_e2(0) <= rg_s(shift_left(resize(ex_r, COORD_W), 1) + 1);
-          rg_e2(1) <= rg_s(shift_left(resize(ey_r, COORD_W), 1) + 1);
-          rg_ep1(0) <= rg_s(resize(ex_r, COORD_W) + 1);
-          rg_ep1(1) <= rg_s(resize(ey_r, COORD_W) + 1);
-          rg_rce(0) <= rg_rc(0) - rg_s(resize(ex_r, COORD_W));
-          rg_rce(1) <= rg_rc(1) - rg_s(resize(ey_r, COORD_W));
-          rg_s2(0) <= rg_s(dw) - 2;
-          rg_s2(1) <= rg_s(dh) - 2;
-          rg_s1(0) <= rg_s(dw) - 1;
-          rg_s1(1) <= rg_s(dh) - 1;
-          state <= T_RG0;
-
-        when T_RG0 =>                          -- region margin: + max(ox, oy) while lost, <= MARGIN_MAX
-          if lost_st = '1' then
-            if rg_mx + MARGIN > MARGIN_MAX then
-              margin_r <= to_unsigned(MARGIN_MAX, COORD_W);
-            else
-              margin_r <= rg_mx + MARGIN;
-            end if;
-          else
-            margin_r <= to_unsigned(MARGIN, COORD_W);
-          end if;
-          state <= T_RG1;
-
-        when T_RG1 =>                          -- region: na = 2e + 2m + 1, a0 = round(c) - e - m
-          for i in 0 to 1 loop
-            rg_na(i) <= rg_e2(i) + shift_left(signed(resize(margin_r, COORD_W + 3)), 1);
-            rg_a0(i) <= rg_rce(i) - signed(resize(margin_r, COORD_W + 3));
-          end loop;
-          state <= T_RG2;
-
-        when T_RG2 =>                          -- n = min(na, S - 2), a0 < 1
-          for i in 0 to 1 loop
-            if rg_na(i) < rg_s2(i) then rg_nn(i) <= rg_na(i); else rg_nn(i) <= rg_s2(i); end if;
-            if rg_a0(i) < 1 then rg_a0lt1(i) <= '1'; else rg_a0lt1(i) <= '0'; end if;
-          end loop;
-          state <= T_RG3;
-
-        when T_RG3 =>                          -- t = S - 1 - n, hi = n - 1 - e
-          for i in 0 to 1 loop
-            rg_t(i) <= rg_s1(i) - rg_nn(i);
-            rg_hi(i) <= rg_nn(i) - rg_ep1(i);
-          end loop;
-          state <= T_REGION_WAIT;
-
-        when T_REGION_WAIT =>                  -- start = clamp(a0, 1, t): mstrack.fixed.blocks.ms_region
-          rst_v := rg_clamp(rg_a0(0), rg_t(0), rg_a0lt1(0));
-          reg_x <= rst_v; reg_w <= resize(unsigned(rg_nn(0)(COORD_W - 1 downto 0)), REGION_W);
-          hi_x <= resize(unsigned(resize(rg_hi(0), COORD_W)), REGION_W);
-          rst_v := rg_clamp(rg_a0(1), rg_t(1), rg_a0lt1(1));
-          reg_y <= rst_v; reg_h <= resize(unsigned(rg_nn(1)(COORD_W - 1 downto 0)), REGION_W);
-          hi_y <= resize(unsigned(resize(rg_hi(1), COORD_W)), REGION_W);
-          if true then
+        when T_REGION_WAIT =>                  -- the region of this frame (ms_region_v2)
+          if rv_out_valid = '1' then
+            reg_x <= rv_reg_x; reg_w <= rv_reg_w; hi_x <= rv_hi_x;
+            reg_y <= rv_reg_y; reg_h <= rv_reg_h; hi_y <= rv_hi_y;
             if init_pending = '1' then
               state <= T_BOX;
             else

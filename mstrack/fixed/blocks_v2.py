@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..track.params import TrackerParams
-from .blocks import ms_kernel
+from .blocks import Region, ms_kernel, ms_region
+from .formats import FixedParams
 from .primitives import ms_divider, ms_isqrt
 
 ONE = 1 << 16          # Q.16 one
@@ -22,6 +23,7 @@ BG_FRAC = 8            # CBWH factors v_u are Q.8 (2**8 = 1)
 QN_BITS = 16           # the normalised model Qn sums to about 2**16
 PAD_FRAC = 4           # pad, bg_ring, search_step are multiples of 1/16
 MAX_DECIMATION = 8
+MARGIN_MAX = 255       # largest region margin (MARGIN + the search offset while lost)
 
 
 def q16(x: float) -> int:
@@ -188,6 +190,16 @@ def ms_ring_share(st: TargetStats, K: int) -> int:
     """
     den = K - st.n_in
     return int(ms_divider((st.nt - st.nt_in) << 16, den, 17)) if den > 0 else 0
+
+
+def ms_region_v2(c8d: tuple[int, int], ex: int, ey: int, ox: int, oy: int, lost: bool, frame_w: int,
+                 frame_h: int, fp: FixedParams, margin_max: int = MARGIN_MAX) -> tuple[Region, int]:
+    """Tracker v2's search region and its margin: :func:`ms_region` around the decimated centre
+    ``c8d`` (Q.CF) for the window half extents ``ex``, ``ey`` on the decimated ``frame_w`` x
+    ``frame_h`` frame, with the margin MARGIN, + max(ox, oy) (the search offsets) while lost, at most
+    ``margin_max`` (MARGIN_MAX).  Returns (region, margin)."""
+    margin = min(fp.margin + (max(ox, oy) if lost else 0), margin_max)
+    return ms_region(c8d, ex, ey, frame_w, frame_h, fp.with_(margin=margin)), margin
 
 
 def ms_lost_decimation(d0: int, lost_n: int, widen: int) -> int:

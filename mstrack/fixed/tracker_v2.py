@@ -29,7 +29,7 @@ from ..track.types import Box, Status, TrackResult
 from .blocks import (STOP_CODES, Region, clamp_centre, ms_bin_pass, ms_box_clip, ms_colour_bin, ms_grey, ms_histogram,
                      ms_kernel, ms_meanshift, ms_region, ms_rho_out, ms_round_centre, round_box)
 from .blocks_v2 import (ONE, SIZE_FRAC, ModelV2, ms_bg_model, ms_confidence, ms_decimation, ms_loss_filter,
-                        ms_loss_flag, ms_loss_jump, ms_loss_latch, ms_lost_decimation, ms_model_scale, ms_ref_update, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
+                        ms_loss_flag, ms_loss_jump, ms_loss_latch, ms_lost_decimation, ms_model_scale, ms_ref_update, ms_region_v2, ms_resize, ms_ring_share, ms_scale, ms_share, ms_spread,
                         ms_target_stats,
                         ms_window_size, ms_box_size, q16, rate_shift, sixteenths, ms_joint_bin, ms_orient_bin,
                         ORIENT_FLAT,
@@ -314,8 +314,7 @@ class FixedTrackerV2:
         start8 = (self.c8[0] >> sh, self.c8[1] >> sh)
         # one region per frame: the window box + MARGIN, + the search offsets while lost
         ox, oy = ((self.step16 * wd) >> 4) * reach, ((self.step16 * hd) >> 4) * reach
-        margin = fx.margin + (max(ox, oy) if self.lost else 0)
-        reg = ms_region(start8, ker.ex, ker.ey, img.shape[1], img.shape[0], fx.with_(margin=min(margin, 255)))
+        reg, _ = ms_region_v2(start8, ker.ex, ker.ey, ox, oy, self.lost, img.shape[1], img.shape[0], fx)
         sub = self._capture(img, reg, frame, d)
         c8d, S, it, stop, st = self._run(img, Qw, ker, start8, reg, p.search_iter if self.lost else p.max_iter, sub)
         rho = ms_rho_out(S, ker.K, fx)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import sys
 
 from mstrack.hw import synth
-from mstrack.hw.multi_core import job_clocks_generics
+from mstrack.hw.multi_core import job_clocks_generics, job_demand_generics
 from mstrack.fixed.blocks_v2 import sixteenths
 from mstrack.fixed.formats import FixedParams
 from mstrack.fixed.vhdl_pkg import core_generics
@@ -48,6 +48,11 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "ms_pass_clocks": {"LANES": c["LANES"], "HALF_W": 6, "PASS_LAT": 10, "KD_W": 29, "OUT_W": 16},
         # a target's worst-case job clocks, the default tracker v2 (the scale test's second pass)
         "ms_job_clocks": job_clocks_generics(tp),
+        # tracker v2's region before a frame (core v2, and ms_job_demand's)
+        "ms_region_v2": {k: v for k, v in job_demand_generics(tp, fp).items()
+                         if k in ("COORD_W", "CF", "HALF_W", "REGION_W", "MARGIN", "MARGIN_MAX")},
+        # a live target's next job from its state (one per core)
+        "ms_job_demand": job_demand_generics(tp, fp),
         # the result words of 16 targets in id order
         "ms_result_order": {"N_SLOTS": 16, "WORD_W": 160},
     }

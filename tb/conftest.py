@@ -231,6 +231,12 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_job_clocks.py::test_ms_job_clocks_verilator":
         "test_ms_job_clocks[v2] / [v2-colour] (the same bench on the RTL under GHDL); this case: the netlist under "
         "Verilator",
+    "tb/test_ms_region_v2.py::test_ms_region_v2_verilator":
+        "test_ms_region_v2 / test_ms_region_v2_small (the same bench on the RTL under GHDL) and core v2's netlist "
+        "runs (test_tracker_v2_fastsim_long), which contain it; this case: the block's netlist under Verilator",
+    "tb/test_ms_job_demand.py::test_ms_job_demand_verilator":
+        "test_ms_job_demand_real / test_ms_job_demand_colour (the same bench on the RTL under GHDL); this case: the "
+        "netlist under Verilator",
     "tb/test_ms_init_merge.py::test_ms_init_merge_real":
         "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
         "frames (marker long)",

@@ -42,7 +42,7 @@ import numpy as np
 from ..track.params import TrackerParams
 from ..track.types import Box, Status, TrackResult
 from .blocks import Region, ms_box_clip, ms_kernel, ms_region, ms_round_centre, round_box
-from .blocks_v2 import (MAX_DECIMATION, ms_box_size, ms_decimation, ms_window_size, q16, sixteenths)
+from .blocks_v2 import ms_box_size, ms_decimation, ms_region_v2, ms_window_size, q16, sixteenths
 from .formats import FixedParams
 from .tracker_v2 import STATUS_CODES_V2, FixedTrackerV2
 
@@ -238,15 +238,31 @@ def _window(s8: int, pad16: int, d: int, size: int, tp: TrackerParams) -> int:
     return ms_window_size(s8, pad16, d, min(tp.max_window, size - 2))
 
 
-def _half_span_lines(h8: int, w8: int, d: int, lost: bool, frame_w: int, frame_h: int, tp: TrackerParams,
-                     fp: FixedParams) -> int:
-    """Full-resolution lines from a window centre to the top of its region (ms_region's
-    e + margin, + the search offset while lost), rounded up to whole decimation steps."""
+@dataclass(frozen=True)
+class _Geometry:
+    """A frame's geometry from a target's state: decimation, decimated frame size, window, region."""
+
+    d: int
+    dw: int
+    dh: int
+    wd: int
+    hd: int
+    region: Region
+    margin: int
+
+
+def _geometry(w8: int, h8: int, c8: tuple[int, int], lost: bool, frame_w: int, frame_h: int, tp: TrackerParams,
+              fp: FixedParams) -> _Geometry:
+    """What ``FixedTrackerV2.update`` computes before a frame from the state (size w8, h8, centre c8,
+    lost; search_widen 0): D (x 2 while lost), the window and the region with its margin."""
     pad16, step16 = sixteenths(tp.pad, "pad"), sixteenths(tp.search_step, "search_step")
+    d = ms_decimation(w8, h8, pad16, tp.max_window) * (2 if lost else 1)
     dw, dh = _dims(frame_w, frame_h, d)
     wd, hd = _window(w8, pad16, d, dw, tp), _window(h8, pad16, d, dh, tp)
-    m = min(fp.margin + (max((step16 * wd) >> 4, (step16 * hd) >> 4) if lost else 0), 255)
-    return ((hd - 1) // 2 + m + 1) * d
+    sh = d.bit_length() - 1
+    reg, margin = ms_region_v2((c8[0] >> sh, c8[1] >> sh), (wd - 1) // 2, (hd - 1) // 2, (step16 * wd) >> 4,
+                               (step16 * hd) >> 4, lost, dw, dh, fp)
+    return _Geometry(d, dw, dh, wd, hd, reg, margin)
 
 
 def target_demand(trk: FixedTrackerV2, target_id: int, tp: TrackerParams | None = None,
@@ -261,37 +277,32 @@ def target_demand(trk: FixedTrackerV2, target_id: int, tp: TrackerParams | None 
     fp = fp or trk.fixed
     if trk._shape is None:
         raise ValueError("target_demand needs an initialised tracker (init() first)")
-    return demand_from_state(trk.w8, trk.h8, trk.c8, trk.lost, trk._shape, target_id, tp, fp, costs)
+    return ms_job_demand(trk.w8, trk.h8, trk.c8, trk.lost, trk._shape, target_id, tp, fp, costs)
 
 
-def demand_from_state(w8: int, h8: int, c8: tuple[int, int], lost: bool, frame_shape: tuple[int, int],
-                      target_id: int, tp: TrackerParams | None = None, fp: FixedParams | None = None,
-                      costs: PassCosts = PassCosts()) -> TargetDemand:
+def ms_job_demand(w8: int, h8: int, c8: tuple[int, int], lost: bool, frame_shape: tuple[int, int],
+                  target_id: int, tp: TrackerParams | None = None, fp: FixedParams | None = None,
+                  costs: PassCosts = PassCosts()) -> TargetDemand:
     """:func:`target_demand` from the state fields it reads: size w8, h8 (Q.8 px), centre c8 (Q.CF
-    px), the search state ``lost`` and the frame shape (height, width)."""
+    px), the search state ``lost`` and the frame shape (height, width).  rtl/ms_job_demand.vhd
+    computes the same in three geometry passes (this frame's, the next frame's tracked with the size
+    grown by scale_step, and searched at twice the base D)."""
     tp = tp or TrackerParams(preset="v2")
     fp = fp or FixedParams()
     fh, fw = frame_shape
-    pad16, step16 = sixteenths(tp.pad, "pad"), sixteenths(tp.search_step, "search_step")
-    base = ms_decimation(w8, h8, pad16, tp.max_window)
-    d = base * (2 if lost else 1)
-    dw, dh = _dims(fw, fh, d)
-    wd, hd = _window(w8, pad16, d, dw, tp), _window(h8, pad16, d, dh, tp)
-    ex, ey = (wd - 1) // 2, (hd - 1) // 2
-    sh = d.bit_length() - 1
-    margin = fp.margin + (max((step16 * wd) >> 4, (step16 * hd) >> 4) if lost else 0)
-    reg = ms_region((c8[0] >> sh, c8[1] >> sh), ex, ey, dw, dh, fp.with_(margin=min(margin, 255)))
+    g = _geometry(w8, h8, c8, lost, fw, fh, tp, fp)
+    reg, d = g.region, g.d
     kind: JobKind = "lost" if lost else "track"
-    clocks = job_clocks(kind, wd, hd, tp, costs, window_limit=min(tp.max_window, dw - 2, dh - 2))
+    clocks = job_clocks(kind, g.wd, g.hd, tp, costs, window_limit=min(tp.max_window, g.dw - 2, g.dh - 2))
     release = release_line(reg.y, reg.h, d, fh)
-    # the next frame: tracked with the size grown by scale_step, or searched (lost) at twice the base D
-    g = ((1 << 16) + q16(tp.scale_step))
-    w8g, h8g = min((w8 * g) >> 16, fw << 8), min((h8 * g) >> 16, fh << 8)
-    dg = ms_decimation(w8g, h8g, pad16, tp.max_window)
-    half = max(_half_span_lines(h8g, w8g, dg, False, fw, fh, tp, fp),
-               _half_span_lines(h8, w8, min(2 * base, 2 * MAX_DECIMATION), True, fw, fh, tp, fp))
+    # the next frame: tracked with the size grown by scale_step, or searched (lost) at twice the base D:
+    # from a window centre to the top of its region, e + margin + 1 decimated lines
+    gr = (1 << 16) + q16(tp.scale_step)
+    w8g, h8g = min((w8 * gr) >> 16, fw << 8), min((h8 * gr) >> 16, fh << 8)
+    half = max(((n.hd - 1) // 2 + n.margin + 1) * n.d
+               for n in (_geometry(w8g, h8g, c8, False, fw, fh, tp, fp), _geometry(w8, h8, c8, True, fw, fh, tp, fp)))
     next_line = max(0, reg.lo[1] * d - half)
-    return TargetDemand(target_id, kind, d, wd, hd, reg.h, reg.w, reg.y * d, clocks, release, next_line)
+    return TargetDemand(target_id, kind, d, g.wd, g.hd, reg.h, reg.w, reg.y * d, clocks, release, next_line)
 
 
 def init_demand(box: Box | tuple[float, float, float, float], frame_w: int, frame_h: int, target_id: int,

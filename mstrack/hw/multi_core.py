@@ -25,9 +25,9 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
-from ..fixed.blocks_v2 import MAX_DECIMATION, sixteenths
+from ..fixed.blocks_v2 import MARGIN_MAX, MAX_DECIMATION, q16, sixteenths
 from ..fixed.formats import FixedParams
-from ..fixed.multi_capacity import (MultiCoreConfig, PassCosts, TargetDemand, VideoTiming, demand_from_state,
+from ..fixed.multi_capacity import (MultiCoreConfig, PassCosts, TargetDemand, VideoTiming, ms_job_demand,
                                     init_demand, job_clocks, plan_frame)
 from ..track.params import V2_COLOUR, TrackerParams
 from . import synth
@@ -422,7 +422,7 @@ def _grid(n: int, w: int, h: int, frame: tuple[int, int] = (1920, 1080), cols: i
 def _tracking(boxes: Sequence[tuple[int, int, int, int]], lost: bool = False, frame: tuple[int, int] = (1920, 1080),
               tp: TrackerParams | None = None) -> list[TargetDemand]:
     cf = FixedParams().centre_frac
-    return [demand_from_state(w << 8, h << 8, ((2 * x + w - 1) << (cf - 1), (2 * y + h - 1) << (cf - 1)), lost,
+    return [ms_job_demand(w << 8, h << 8, ((2 * x + w - 1) << (cf - 1), (2 * y + h - 1) << (cf - 1)), lost,
                               (frame[1], frame[0]), i, tp) for i, (x, y, w, h) in enumerate(boxes)]
 
 
@@ -511,3 +511,18 @@ def job_clocks_generics(tp: TrackerParams, costs: PassCosts = PassCosts(), half_
         "SCALE_PERMILLE": st if tp.scale_test > 0 else 0,
         "C_SCALE": 2 * (c.kernel_tables + qload + b + c.scale_window_extra),
     }
+
+
+# ----------------------------------------------------------------------------- rtl/ms_job_demand.vhd
+def job_demand_generics(tp: TrackerParams, fp: FixedParams | None = None, costs: PassCosts = PassCosts(),
+                        half_w: int = 6) -> dict[str, int]:
+    """Generics of rtl/ms_job_demand.vhd (and its ms_region_v2 and ms_job_clocks) for tracker
+    parameters *tp*: :func:`mstrack.fixed.multi_capacity.ms_job_demand` in RTL.  REGION_W holds the
+    widest region a lost target's margin gives (2 e + 2 MARGIN_MAX + 1).  tb/test_ms_job_demand.py
+    checks the block against ``ms_job_demand`` itself."""
+    fp = fp or FixedParams()
+    return {"COORD_W": fp.coord_bits, "CF": fp.centre_frac, "PAD16": sixteenths(tp.pad, "pad"),
+            "MAX_WINDOW": tp.max_window, "HALF_W": half_w,
+            "REGION_W": (2 * ((1 << half_w) - 1) + 2 * MARGIN_MAX + 1).bit_length(),
+            "MARGIN": fp.margin, "MARGIN_MAX": MARGIN_MAX, "STEP16": sixteenths(tp.search_step, "search_step"),
+            "GROW_Q16": q16(tp.scale_step), **job_clocks_generics(tp, costs, half_w)}

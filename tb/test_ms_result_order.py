@@ -7,8 +7,10 @@ written while the previous frame's leave; the sink takes words with random back-
 checks every word, value by value: the ids of each frame in ascending order
 (``mstrack.hw.cosim_multi.CoreModelMulti``'s order), each with the last word written for it in that
 frame, ``m_last`` on the frame's last word only; ``missing`` pulses exactly for a mask id that had no
-word; a close waits (``close_ready``) while a frame's words are still in the bank (a slow sink for six
-frames makes it wait).
+word; a close waits (``close_ready``) while a frame's words are still to be read from their bank (a
+slow sink for six frames makes it wait).  A last frame of all ids (id 0's word in the close clock),
+closed when everything has left, into a sink that is always ready: its first word is on ``m_data``
+FIRST_LAT clocks after the close edge, the others follow one per clock.
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_result_order.py``.
 """
@@ -27,6 +29,9 @@ from mstrack.fixed.vhdl_pkg import TARGET_ID_W
 from mstrack.hw.hdl import dut_generics
 
 DEFAULTS = {"N_SLOTS": 5, "WORD_W": 160}
+#: edges after the close edge until the first word is on m_data (rtl/ms_result_order.vhd, Latency:
+#: RD_LAT + 3 with the store's RD_LAT 2)
+FIRST_LAT = 5
 
 
 @cocotb.test()
@@ -49,16 +54,21 @@ async def run_test(dut):
     p_ready = [0.7]                                            # the sink's readiness
     waits = 0                                                  # clocks a close waited for close_ready
 
+    fe = [0]                                                   # falling edges so far
+    got_at: list[int] = []                                     # the falling edge of each word taken
+
     async def sink():
         # decide m_ready mid-cycle; a word moves at the next rising edge when m_valid and m_ready
         while not stop[0]:
             await FallingEdge(dut.clk)
+            fe[0] += 1
             dut.m_ready.value = int(rng.random() < p_ready[0])
             await ReadOnly()
             if int(dut.m_valid.value) and int(dut.m_ready.value):
                 bits = str(dut.m_data.value)          # a missing id's entry may never have been written
                 word = int(bits[4:], 2) if set(bits[4:]) <= {"0", "1"} else None
                 got.append((int(bits[:4], 2), word, int(dut.m_last.value)))
+                got_at.append(fe[0])
             missing[0] += int(dut.missing.value)
 
     cocotb.start_soon(sink())
@@ -83,13 +93,15 @@ async def run_test(dut):
             dut.s_valid.value = 0
             for _ in range(rng.randint(0, 2)):
                 await RisingEdge(dut.clk)
-        while True:                                              # close when the bank is free
+        for _ in range(2000):                                    # close when the bank is free
             await ReadOnly()
             ready = int(dut.close_ready.value)
             await RisingEdge(dut.clk)
             if ready:
                 break
             waits += 1
+        else:
+            raise AssertionError(f"frame {f}: close_ready stayed low for 2000 clocks")
         dut.close.value, dut.close_mask.value = 1, sum(1 << i for i in mask)
         await RisingEdge(dut.clk)
         dut.close.value = 0
@@ -99,6 +111,26 @@ async def run_test(dut):
         await RisingEdge(dut.clk)
         if len(got) >= len(want):
             break
+    # latency and throughput: every id, closed when all has left, into a sink that is always ready
+    p_ready[0] = 1.0
+    words = {i: rng.getrandbits(ww) for i in range(n)}
+    for i in reversed(range(1, n)):
+        dut.s_valid.value, dut.s_id.value, dut.s_word.value = 1, i, words[i]
+        await RisingEdge(dut.clk)
+    dut.s_valid.value = 0
+    await ReadOnly()
+    assert int(dut.close_ready.value) and not int(dut.m_valid.value)
+    await RisingEdge(dut.clk)
+    # id 0's word in the close clock: it belongs to the closed frame
+    dut.s_valid.value, dut.s_id.value, dut.s_word.value = 1, 0, words[0]
+    dut.close.value, dut.close_mask.value = 1, (1 << n) - 1
+    await RisingEdge(dut.clk)                                    # the close edge
+    close_fe = fe[0]                                             # its cycle's falling edge comes next
+    dut.close.value = dut.s_valid.value = 0
+    first = len(got)
+    want += [(i, words[i], int(i == n - 1)) for i in range(n)]
+    for _ in range(FIRST_LAT + n + 4):
+        await RisingEdge(dut.clk)
     await ClockCycles(dut.clk, 4)
     stop[0] = True
     assert len(got) == len(want), f"{len(got)} words sent, {len(want)} expected"
@@ -106,8 +138,11 @@ async def run_test(dut):
         assert (gi, gl) == (wi, wl), f"word {k}: id {gi} last {gl}, expected id {wi} last {wl}"
         assert ww_ is None or gw == ww_, f"word {k} (id {gi}): data differs"
     assert missing[0] == want_missing, f"missing pulsed {missing[0]} times, expected {want_missing}"
+    assert got_at[first:] == [close_fe + FIRST_LAT + 1 + j for j in range(n)], \
+        f"words of the last frame on the falling edges {[f - close_fe for f in got_at[first:]]} after the close " \
+        f"edge, expected {FIRST_LAT + 1} .. {FIRST_LAT + n} (one per clock)"
     assert waits > 0, "no close had to wait"
-    dut._log.info("%d words in order, %d missing flagged", len(got), missing[0])
+    dut._log.info("%d words in order, %d missing flagged, closes waited %d clocks", len(got), missing[0], waits)
 
 
 from mstrack.hw import hdl  # noqa: E402
@@ -125,5 +160,5 @@ def test_ms_result_order(generics, hdl_waves):
 
 @pytest.mark.verilator
 def test_ms_result_order_verilator(hdl_waves):
-    """The netlist under Verilator (the word store in LUT RAM, the lowest-id encoder)."""
+    """The netlist under Verilator (the word store as ms_ram_sdp, the read pipeline and ring, the lowest-id finder)."""
     hdl.run_verilator(TOP, MODULE, DEFAULTS, hdl.rtl_sources(TOP), waves=hdl_waves)

@@ -53,6 +53,8 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
                          if k in ("COORD_W", "CF", "HALF_W", "REGION_W", "MARGIN", "MARGIN_MAX")},
         # a live target's next job from its state (one per core)
         "ms_job_demand": job_demand_generics(tp, fp),
+        # a frame's plan: ms_job_demand and ms_admit (one per core, 16 targets)
+        "ms_frame_plan": {"MAX_TARGETS": 16, **job_demand_generics(tp, fp), "LC_W": 13, "SUM_W": 28},
         # the result words of 16 targets in id order
         "ms_result_order": {"N_SLOTS": 16, "WORD_W": 160},
     }

@@ -12,7 +12,7 @@
 -- start, each add's init job (a_offer: its clocks, release and next line, and a_full when MAX_TARGETS
 -- targets are live) gets its code on a_done (0 ok, 1 full, 2 cycles), checked against the jobs taken
 -- and the adds taken before it (check_add).
--- Latency: per live target the state read, ms_job_demand (at most 484 clocks for tracker v2) and
+-- Latency: per live target the state read, ms_job_demand (at most 485 clocks for tracker v2) and
 -- ms_admit (LC_W + 3); 16 targets take under 8,500 clocks.  An add: LC_W + 4 clocks.
 -- Throughput: one plan at a time (`busy`); adds one at a time (`a_ready`).
 -- Handshake: start when busy = '0' (sampled with n_live, frame_w, frame_h); st_req pulses, st_valid

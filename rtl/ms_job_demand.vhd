@@ -18,7 +18,7 @@
 --   region can start on.
 -- The products w8 G are shift-and-add, one bit of G per clock (no multiplier block); at most one carry
 -- chain after a barrel shift per clock.
--- Latency: about 3 x 16 clocks of geometry + 2 x 18 of the grown sizes, beside ms_job_clocks (at most
+-- Latency: about 3 x 18 clocks of geometry + 18 of the grown sizes, beside ms_job_clocks (at most
 -- 453 clocks at LANES 4 with the scale test): `done` when both are in.
 -- Throughput: one job per run; `start` is taken when busy = '0'.
 -- Handshake: start with the inputs (sampled on that clock), busy while running, done pulses one
@@ -83,7 +83,8 @@ architecture rtl of ms_job_demand is
   constant G     : natural := 2 ** 16 + GROW_Q16;
   constant G_W   : natural := bits_for(G);
   constant LW    : natural := COORD_W + 6;                   -- lines x D, spans x D
-  type state_t is (S_IDLE, S_GROW, S_DEC, S_DEC_WAIT, S_DIM, S_WS, S_WS_WAIT, S_RG, S_RG_WAIT, S_SPAN, S_NEXT,
+  type state_t is (S_IDLE, S_GROW, S_DEC, S_DEC_WAIT, S_DIM, S_DIM2, S_WS, S_WS_WAIT, S_RG, S_RG_WAIT, S_SPAN,
+                   S_SPAN2, S_NEXT,
                    S_CLK_WAIT, S_DONE);
   signal state : state_t := S_IDLE;
   signal pass  : natural range 0 to 2 := 0;                  -- A, B, C
@@ -92,6 +93,7 @@ architecture rtl of ms_job_demand is
   signal cx_r, cy_r : unsigned(COORD_W + CF - 1 downto 0);
   signal lost_r     : std_logic;
   signal fw_r, fh_r : unsigned(COORD_W - 1 downto 0);
+  signal fw_m1, fh_m1 : unsigned(COORD_W - 1 downto 0);      -- frame size - 1
   -- the grown sizes, shift-and-add over the bits of G
   signal gb         : natural range 0 to G_W := 0;
   signal g_sh       : unsigned(G_W - 1 downto 0);            -- G, shifted right one bit per clock
@@ -103,6 +105,7 @@ architecture rtl of ms_job_demand is
   signal s8w, s8h   : unsigned(S8_W - 1 downto 0);
   signal l2d        : unsigned(2 downto 0);
   signal dw, dh     : unsigned(COORD_W - 1 downto 0);
+  signal dw2, dh2   : unsigned(COORD_W - 1 downto 0);        -- dw - 2, dh - 2
   signal lim_w, lim_h : unsigned(WIN_W - 1 downto 0);
   signal ws_in, ws_w_valid, ws_h_valid : std_logic := '0';
   signal ws_w, ws_h : unsigned(WIN_W - 1 downto 0);
@@ -117,6 +120,7 @@ architecture rtl of ms_job_demand is
   -- pass A's results and the spans
   signal lo_line    : unsigned(LW - 1 downto 0);
   signal sum_a, sum_lo, sum_sp : unsigned(LW - 1 downto 0);  -- reg_y + reg_h, reg_y + e_y, e_y + margin + 1
+  signal lines_r, span_r : unsigned(LW - 1 downto 0);          -- sum_a D, sum_sp D
   signal half_max   : unsigned(LW - 1 downto 0);
   -- ms_job_clocks
   signal jc_start, jc_busy, jc_done : std_logic := '0';
@@ -160,9 +164,6 @@ begin
               done => jc_done, clocks => jc_clocks);
 
   p_main : process (clk)
-    variable lines : unsigned(LW - 1 downto 0);
-    variable span  : unsigned(LW - 1 downto 0);
-    variable dw_v, dh_v : unsigned(COORD_W - 1 downto 0);
   begin
     if rising_edge(clk) then
       done     <= '0';
@@ -178,6 +179,7 @@ begin
         when S_IDLE =>
           if start = '1' then
             w8_r <= w8; h8_r <= h8; cx_r <= c8x; cy_r <= c8y; lost_r <= lost; fw_r <= frame_w; fh_r <= frame_h;
+            fw_m1 <= frame_w - 1; fh_m1 <= frame_h - 1;
             acc_w <= (others => '0'); acc_h <= (others => '0'); gb <= 0;
             mc_w <= resize(w8, S8_W + G_W); mc_h <= resize(h8, S8_W + G_W);
             g_sh <= to_unsigned(G, G_W);
@@ -219,18 +221,21 @@ begin
             state <= S_DIM;
           end if;
 
-        when S_DIM =>                          -- the decimated frame, the centre, the window limits
-          dw_v := shift_right(fw_r - 1, to_integer(l2d)) + 1;
-          dh_v := shift_right(fh_r - 1, to_integer(l2d)) + 1;
-          dw <= dw_v;
-          dh <= dh_v;
+        when S_DIM =>                          -- the decimated frame, the centre
+          dw <= shift_right(fw_m1, to_integer(l2d)) + 1;
+          dh <= shift_right(fh_m1, to_integer(l2d)) + 1;
           cxd <= shift_right(cx_r, to_integer(l2d));
           cyd <= shift_right(cy_r, to_integer(l2d));
+          state <= S_DIM2;
+
+        when S_DIM2 =>
+          dw2 <= dw - 2;
+          dh2 <= dh - 2;
           state <= S_WS;
 
-        when S_WS =>
-          lim_w <= resize(umin(dw - 2, to_unsigned(MAX_WINDOW, COORD_W)), WIN_W);
-          lim_h <= resize(umin(dh - 2, to_unsigned(MAX_WINDOW, COORD_W)), WIN_W);
+        when S_WS =>                           -- the window limits min(MAX_WINDOW, S_d - 2)
+          lim_w <= resize(umin(dw2, to_unsigned(MAX_WINDOW, COORD_W)), WIN_W);
+          lim_h <= resize(umin(dh2, to_unsigned(MAX_WINDOW, COORD_W)), WIN_W);
           ws_in <= '1';                        -- ms_window_size takes the limits the next clock
           state <= S_WS_WAIT;
 
@@ -268,20 +273,23 @@ begin
             state <= S_SPAN;
           end if;
 
-        when S_SPAN =>                         -- A: release, lo; B, C: the span (e_y + margin + 1) D
+        when S_SPAN =>                         -- x D
+          lines_r <= shift_left(sum_a, to_integer(l2d));
+          span_r  <= shift_left(sum_sp, to_integer(l2d));
           if pass = 0 then
-            lines := shift_left(sum_a, to_integer(l2d));      -- release = min(lines + 1, frame_h)
-            if lines >= resize(fh_r, LW) then
+            lo_line <= shift_left(sum_lo, to_integer(l2d));
+          end if;
+          state <= S_SPAN2;
+
+        when S_SPAN2 =>                        -- A: the release line; B, C: the span (e_y + margin + 1) D
+          if pass = 0 then
+            if lines_r >= resize(fh_r, LW) then  -- release = min(lines + 1, frame_h)
               release_line <= fh_r;
             else
-              release_line <= resize(lines + 1, COORD_W);
+              release_line <= resize(lines_r + 1, COORD_W);
             end if;
-            lo_line <= shift_left(sum_lo, to_integer(l2d));
-          else
-            span := shift_left(sum_sp, to_integer(l2d));
-            if span > half_max then
-              half_max <= span;
-            end if;
+          elsif span_r > half_max then
+            half_max <= span_r;
           end if;
           if pass = 2 then
             state <= S_NEXT;

@@ -55,6 +55,8 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "ms_job_demand": job_demand_generics(tp, fp),
         # a frame's plan: ms_job_demand and ms_admit (one per core, 16 targets)
         "ms_frame_plan": {"MAX_TARGETS": 16, **job_demand_generics(tp, fp), "LC_W": 13, "SUM_W": 28},
+        # 16 targets' state records (213 b) with the stream-fault rule
+        "ms_state_store": {"N_SLOTS": 16, "DATA_W": 213},
         # the result words of 16 targets in id order
         "ms_result_order": {"N_SLOTS": 16, "WORD_W": 160},
     }

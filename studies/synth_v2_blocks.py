@@ -57,6 +57,8 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "ms_frame_plan": {"MAX_TARGETS": 16, **job_demand_generics(tp, fp), "LC_W": 13, "SUM_W": 28},
         # 16 targets' state records (213 b) with the stream-fault rule
         "ms_state_store": {"N_SLOTS": 16, "DATA_W": 213},
+        # the released jobs of 16 slots
+        "ms_job_queue": {"N_SLOTS": 16},
         # the result words of 16 targets in id order
         "ms_result_order": {"N_SLOTS": 16, "WORD_W": 160},
     }

@@ -243,6 +243,9 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_state_store.py::test_ms_state_store_verilator":
         "test_ms_state_store[16] / [5] / [1] (the same bench on the RTL under GHDL); this case: the netlist under "
         "Verilator",
+    "tb/test_ms_job_queue.py::test_ms_job_queue_verilator":
+        "test_ms_job_queue[16] / [5] / [1] (the same bench on the RTL under GHDL); this case: the netlist under "
+        "Verilator",
     "tb/test_ms_init_merge.py::test_ms_init_merge_real":
         "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
         "frames (marker long)",

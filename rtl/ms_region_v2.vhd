@@ -17,8 +17,10 @@
 --   4 n = min(2e + 2m + 1, S - 2), round(c) - e - m < 1
 --   5 S - 1 - n, hi = n - (e + 1)
 --   6 start = clamp, the outputs
--- Latency: 6 clocks from in_valid to out_valid.  Throughput: 1 per clock.
--- Handshake: valid only (no back-pressure); the outputs hold until the next out_valid.
+-- Latency: 6 clocks from in_valid to out_valid.  Throughput: one input per 6 clocks (in_valid again
+-- at the earliest in out_valid's clock): stage 1 holds its values, the later stages read them.
+-- Handshake: valid only (no back-pressure); the inputs are sampled with in_valid; the outputs hold
+-- until the next out_valid.
 -- Reset: synchronous, active high; valid flags only.
 library ieee;
 use ieee.std_logic_1164.all;
@@ -59,11 +61,11 @@ architecture rtl of ms_region_v2 is
   subtype s_t is signed(SW - 1 downto 0);
   type pair_t is array (0 to 1) of s_t;
   signal v : std_logic_vector(1 to 6) := (others => '0');
-  -- each value is registered once per stage it passes, so a new input can come every clock
-  signal rc, ee, e2, ep1, s2, s1, rce, e2_2, ep1_2, s2_2, s1_2, na, a0, ep1_3, s1_3, s2_3, a0_4, nn, ep1_4, s1_4,
-         a0_5, nn_5, t, hi : pair_t;
-  signal a0lt1, a0lt1_5 : std_logic_vector(0 to 1);
-  signal mx, m, m3, m4, m5 : unsigned(COORD_W - 1 downto 0);
+  -- stage 1 holds its values until the next input; the later stages compute from them and from each
+  -- other (one register per value, as the FSM states they replace in core v2 had)
+  signal rc, ee, e2, ep1, s2, s1, rce, na, a0, nn, t, hi : pair_t;
+  signal a0lt1 : std_logic_vector(0 to 1);
+  signal mx, m : unsigned(COORD_W - 1 downto 0);
   signal lost1 : std_logic;
 
   function to_s(u : unsigned) return s_t is
@@ -100,20 +102,21 @@ begin
       c(0) := round_c(cx);  c(1) := round_c(cy);
       e(0) := to_s(ex);     e(1) := to_s(ey);
       s(0) := to_s(frame_w); s(1) := to_s(frame_h);
-      for i in 0 to 1 loop
-        rc(i)  <= c(i);
-        ee(i)  <= e(i);
-        e2(i)  <= shift_left(e(i), 1) + 1;
-        ep1(i) <= e(i) + 1;
-        s2(i)  <= s(i) - 2;
-        s1(i)  <= s(i) - 1;
-      end loop;
-      if ox >= oy then mx <= ox; else mx <= oy; end if;
-      lost1 <= lost;
+      if in_valid = '1' then                  -- held until the next input: stages 2 .. 6 read them
+        for i in 0 to 1 loop
+          rc(i)  <= c(i);
+          ee(i)  <= e(i);
+          e2(i)  <= shift_left(e(i), 1) + 1;
+          ep1(i) <= e(i) + 1;
+          s2(i)  <= s(i) - 2;
+          s1(i)  <= s(i) - 1;
+        end loop;
+        if ox >= oy then mx <= ox; else mx <= oy; end if;
+        lost1 <= lost;
+      end if;
       -- 2: round(c) - e, the margin
       for i in 0 to 1 loop
         rce(i) <= rc(i) - ee(i);
-        e2_2(i) <= e2(i); ep1_2(i) <= ep1(i); s2_2(i) <= s2(i); s1_2(i) <= s1(i);
       end loop;
       if lost1 = '1' then
         if resize(mx, COORD_W + 1) + MARGIN > MARGIN_MAX then
@@ -126,35 +129,28 @@ begin
       end if;
       -- 3: 2e + 2m + 1, round(c) - e - m
       for i in 0 to 1 loop
-        na(i) <= e2_2(i) + shift_left(to_s(m), 1);
+        na(i) <= e2(i) + shift_left(to_s(m), 1);
         a0(i) <= rce(i) - to_s(m);
-        ep1_3(i) <= ep1_2(i); s1_3(i) <= s1_2(i); s2_3(i) <= s2_2(i);
       end loop;
-      m3 <= m;
       -- 4: n = min(2e + 2m + 1, S - 2), a0 < 1
       for i in 0 to 1 loop
-        if na(i) < s2_3(i) then nn(i) <= na(i); else nn(i) <= s2_3(i); end if;
+        if na(i) < s2(i) then nn(i) <= na(i); else nn(i) <= s2(i); end if;
         if a0(i) < 1 then a0lt1(i) <= '1'; else a0lt1(i) <= '0'; end if;
-        a0_4(i) <= a0(i); ep1_4(i) <= ep1_3(i); s1_4(i) <= s1_3(i);
       end loop;
-      m4 <= m3;
       -- 5: S - 1 - n, hi = n - (e + 1)
       for i in 0 to 1 loop
-        t(i)  <= s1_4(i) - nn(i);
-        hi(i) <= nn(i) - ep1_4(i);
-        a0_5(i) <= a0_4(i); nn_5(i) <= nn(i);
+        t(i)  <= s1(i) - nn(i);
+        hi(i) <= nn(i) - ep1(i);
       end loop;
-      a0lt1_5 <= a0lt1;
-      m5 <= m4;
       -- 6: start = clamp(a0, 1, S - 1 - n), registered outputs
       if v(5) = '1' then
-        reg_x  <= clamp(a0_5(0), t(0), a0lt1_5(0));
-        reg_y  <= clamp(a0_5(1), t(1), a0lt1_5(1));
-        reg_w  <= resize(unsigned(nn_5(0)(COORD_W - 1 downto 0)), REGION_W);
-        reg_h  <= resize(unsigned(nn_5(1)(COORD_W - 1 downto 0)), REGION_W);
+        reg_x  <= clamp(a0(0), t(0), a0lt1(0));
+        reg_y  <= clamp(a0(1), t(1), a0lt1(1));
+        reg_w  <= resize(unsigned(nn(0)(COORD_W - 1 downto 0)), REGION_W);
+        reg_h  <= resize(unsigned(nn(1)(COORD_W - 1 downto 0)), REGION_W);
         hi_x   <= resize(unsigned(hi(0)(COORD_W - 1 downto 0)), REGION_W);
         hi_y   <= resize(unsigned(hi(1)(COORD_W - 1 downto 0)), REGION_W);
-        region_margin <= m5;
+        region_margin <= m;
       end if;
       if rst = '1' then
         v <= (others => '0');

@@ -45,10 +45,12 @@ async def start(dut) -> None:
 
 
 async def stream(dut, vectors: Sequence[dict[str, int]], outputs: Sequence[str], latency: int,
-                 expected: Callable[[dict[str, int]], tuple[int, ...]], gap: float, seed: int) -> int:
-    """Drive ``vectors`` (port -> value) with in_valid, one per clock or with random gaps
-    (garbage on the inputs while in_valid = 0); check every result (``outputs`` when out_valid)
-    against ``expected(vector)`` and its latency.  Returns the number of vectors checked."""
+                 expected: Callable[[dict[str, int]], tuple[int, ...]], gap: float, seed: int,
+                 spacing: int = 1) -> int:
+    """Drive ``vectors`` (port -> value) with in_valid, one per clock (at most one per ``spacing``
+    clocks) or with random gaps (garbage on the inputs while in_valid = 0); check every result
+    (``outputs`` when out_valid) against ``expected(vector)`` and its latency.  Returns the number
+    of vectors checked."""
     rng = random.Random(seed)
     got: list[tuple[int, tuple[int, ...]]] = []
     widths = {p: len(getattr(dut, p)) for p in vectors[0]}
@@ -73,6 +75,11 @@ async def stream(dut, vectors: Sequence[dict[str, int]], outputs: Sequence[str],
         dut.in_valid.value = 1
         issued.append(cycle())
         await RisingEdge(dut.clk)
+        for _ in range(spacing - 1):                   # the block is busy: garbage on the inputs
+            dut.in_valid.value = 0
+            for p, w in widths.items():
+                getattr(dut, p).value = rng.getrandbits(w)
+            await RisingEdge(dut.clk)
     dut.in_valid.value = 0
     await ClockCycles(dut.clk, latency + 3)
     mon.cancel()

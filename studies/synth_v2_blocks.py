@@ -53,10 +53,9 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
                          if k in ("COORD_W", "CF", "HALF_W", "REGION_W", "MARGIN", "MARGIN_MAX")},
         # a live target's next job from its state (one per core)
         "ms_job_demand": job_demand_generics(tp, fp),
-        # a frame's plan: ms_job_demand and ms_admit (one per core, 16 targets)
-        "ms_frame_plan": {"MAX_TARGETS": 16, **job_demand_generics(tp, fp), "LC_W": 13, "SUM_W": 28},
-        # 16 targets' state records (213 b) with the stream-fault rule
-        "ms_state_store": {"N_SLOTS": 16, "DATA_W": 213},
+        # 16 targets' state records with the stream-fault rule, 100-bit records (213 bits in and out would
+        # need more pins than the package has; the records' LUT RAM and registers scale with DATA_W)
+        "ms_state_store": {"N_SLOTS": 16, "DATA_W": 100},
         # the released jobs of 16 slots
         "ms_job_queue": {"N_SLOTS": 16},
         # the result words of 16 targets in id order

@@ -15,7 +15,8 @@
 -- records and cur, then the read register); rd_slot -> rd_data 1 clock.
 -- Throughput: one write, one verdict and one read per clock.
 -- Handshake: valid only (wr_en, fr_start, fr_done, drop pulses).
--- Memory: 2 x N_SLOTS records of DATA_W bits (LUT RAM: one write, one read port).
+-- Memory: 2 x N_SLOTS records of DATA_W bits: record 0 and record 1 of the slots in two LUT RAMs
+-- (one write, one read port each).
 -- Rule of use: a slot's next write comes after the verdict of its pending one (one job per slot
 -- and frame, released after the previous frame has ended).
 -- Reset: synchronous, active high: every cur and pending bit 0, both tags unknown (the records
@@ -49,21 +50,26 @@ entity ms_state_store is
 end entity;
 
 architecture rtl of ms_state_store is
-  type mem_t is array (0 to 2 * N_SLOTS - 1) of std_logic_vector(DATA_W - 1 downto 0);
-  signal mem    : mem_t;
+  -- record r of every slot in its own LUT RAM, so that a read looks up cur(rd_slot) beside the two
+  -- RAM reads instead of before one
+  type mem_t is array (0 to N_SLOTS - 1) of std_logic_vector(DATA_W - 1 downto 0);
+  signal mem0, mem1 : mem_t;
   signal cur    : std_logic_vector(N_SLOTS - 1 downto 0) := (others => '0');
   signal pend   : std_logic_vector(N_SLOTS - 1 downto 0) := (others => '0');
   signal ptag   : std_logic_vector(N_SLOTS - 1 downto 0) := (others => '0');
   signal known  : std_logic_vector(0 to 1) := "00";          -- per tag: verdict given
   signal good   : std_logic_vector(0 to 1) := "00";          -- per tag: the verdict
-  signal rd_idx : natural range 0 to 2 * N_SLOTS - 1;
 begin
-  -- the records: slot s, record r at word 2 s + r
+  -- the records: a write goes to the record that is not committed
   p_mem : process (clk)
   begin
     if rising_edge(clk) then
       if wr_en = '1' and to_integer(wr_slot) < N_SLOTS then
-        mem(2 * to_integer(wr_slot) + to_integer(unsigned'("" & not cur(to_integer(wr_slot))))) <= wr_data;
+        if cur(to_integer(wr_slot)) = '1' then
+          mem0(to_integer(wr_slot)) <= wr_data;
+        else
+          mem1(to_integer(wr_slot)) <= wr_data;
+        end if;
       end if;
     end if;
   end process;
@@ -122,7 +128,11 @@ begin
       pend <= pend_v;
       -- the committed record of rd_slot, registered
       if to_integer(rd_slot) < N_SLOTS then
-        rd_data <= mem(2 * to_integer(rd_slot) + to_integer(unsigned'("" & cur(to_integer(rd_slot)))));
+        if cur(to_integer(rd_slot)) = '1' then
+          rd_data <= mem1(to_integer(rd_slot));
+        else
+          rd_data <= mem0(to_integer(rd_slot));
+        end if;
       end if;
       if rst = '1' then
         cur   <= (others => '0');

@@ -374,13 +374,19 @@ def test_region_max_v2_bounds_the_fixed_model_regions(scene, monkeypatch):
     g = CoreConfigV2(V2, FixedParams()).generics()
     assert g["REGION_MAX"] == 256 and region_max_v2(V2, FixedParams(), 4095) == 255
     sizes = []
-    real = tv2.ms_region
+    real, real_v2 = tv2.ms_region, tv2.ms_region_v2
 
-    def spy(*a, **k):
+    def spy(*a, **k):                       # the init frame's region
         reg = real(*a, **k)
         sizes.append((reg.w, reg.h))
         return reg
+
+    def spy_v2(*a, **k):                    # every update's region (tracking and lost)
+        reg, m = real_v2(*a, **k)
+        sizes.append((reg.w, reg.h))
+        return reg, m
     monkeypatch.setattr(tv2, "ms_region", spy)
+    monkeypatch.setattr(tv2, "ms_region_v2", spy_v2)
     rng = np.random.default_rng(7)
     shape, box = {"lost_at_d4": ((1400, 1400), (500, 500, 203, 203)),    # D 2, lost D 4: window 63
                   "lost_at_d16": ((1300, 2048), (100, 100, 1800, 1100)),  # D 8, lost D 16: frame-bound

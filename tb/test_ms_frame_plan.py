@@ -36,7 +36,7 @@ from mstrack.hw import hdl
 from mstrack.hw.multi_core import job_demand_generics
 from mstrack.track.params import TrackerParams
 
-from v2_common import SEQ_ROOT
+from v2_common import SEQ_ROOT, tracker_states
 
 TP = TrackerParams(preset="v2")
 SUM_W = 28
@@ -58,21 +58,6 @@ def random_state(rng: random.Random, fw: int, fh: int) -> dict[str, int]:
     else:
         w, h = rng.uniform(8, 120), rng.uniform(16, 240)
     return state(w, h, rng.uniform(0, fw - 1), rng.uniform(0, fh - 1), rng.random() < 0.3)
-
-
-def real_states(frames: int = 40) -> list[dict[str, int]]:
-    from mstrack.fixed.tracker_v2 import FixedTrackerV2
-    from mstrack.io.data import load_sequence
-
-    out = []
-    for name in ("Deer", "Football1", "MotorRolling"):
-        seq = load_sequence(SEQ_ROOT / name)
-        t = FixedTrackerV2(TP)
-        t.init(seq.frame(0), seq.init_box())
-        for i in range(1, min(frames, len(seq))):
-            out.append({"w8": t.w8, "h8": t.h8, "c8x": t.c8[0], "c8y": t.c8[1], "lost": int(t.lost)})
-            t.update(seq.frame(i))
-    return out
 
 
 def demand(s: dict[str, int], slot: int, fw: int, fh: int):
@@ -219,7 +204,8 @@ async def run_test(dut):
                            [(rng.uniform(0, fw - 60), rng.uniform(0, fh - 60), rng.uniform(8, 400), rng.uniform(8, 400))
                             for _ in range(rng.randint(0, 3))]))
         if real and name == "1080p60":
-            rs = real_states()
+            rs = [{k: v for k, v in st.items() if not k.startswith("frame")}
+                  for st in tracker_states(("Deer", "Football1", "MotorRolling"), 40, TP)]
             for i in range(0, len(rs), mt):
                 frames.append((rs[i:i + mt], []))
         for targets, adds in frames:

@@ -31,7 +31,7 @@ from mstrack.hw import hdl
 from mstrack.hw.multi_core import job_demand_generics
 from mstrack.track.params import V2_COLOUR, TrackerParams
 
-from v2_common import SEQ_ROOT
+from v2_common import SEQ_ROOT, tracker_states
 
 TRACKERS = {"v2": TrackerParams(preset="v2"), "v2-colour": TrackerParams(preset="v2", **V2_COLOUR)}
 OUTPUTS = ("log2_d", "wd", "hd", "reg_x", "reg_y", "reg_w", "reg_h", "clocks", "first_line", "release_line",
@@ -49,24 +49,6 @@ def model(s: dict[str, int], tp: TrackerParams) -> tuple[int, ...]:
     assert (g.d, g.region.h, g.region.w) == (dm.d, dm.rows, dm.cols)
     return (g.d.bit_length() - 1, dm.wd, dm.hd, g.region.x, g.region.y, dm.cols, dm.rows, dm.clocks,
             dm.first_line, dm.release_line, dm.next_line)
-
-
-def real_states(tp: TrackerParams, frames: int = 80) -> list[dict[str, int]]:
-    """The state FixedTrackerV2 holds before each frame of REAL_SEQS (after init)."""
-    from mstrack.fixed.tracker_v2 import FixedTrackerV2
-    from mstrack.io.data import load_sequence
-
-    out = []
-    for name in REAL_SEQS:
-        seq = load_sequence(SEQ_ROOT / name)
-        t = FixedTrackerV2(tp)
-        f0 = seq.frame(0)
-        t.init(f0, seq.init_box())
-        for i in range(1, min(frames, len(seq))):
-            out.append({"w8": t.w8, "h8": t.h8, "c8x": t.c8[0], "c8y": t.c8[1], "lost": int(t.lost),
-                        "frame_w": f0.shape[1], "frame_h": f0.shape[0]})
-            t.update(seq.frame(i))
-    return out
 
 
 def synthetic_states(rng: random.Random, n: int) -> list[dict[str, int]]:
@@ -104,7 +86,7 @@ async def job_demand(dut):
     rng = random.Random(7)
     states = synthetic_states(rng, int(cfg["random"]))
     if cfg.get("real"):
-        states += real_states(tp)
+        states += tracker_states(REAL_SEQS, 80, tp)
     bad, worst = [], 0
     for s in states:
         for k, v in s.items():

@@ -28,7 +28,7 @@ from mstrack.hw import hdl
 from mstrack.hw.hdl import dut_generics
 
 from test_ms_window_size import start, stream
-from v2_common import SEQ_ROOT
+from v2_common import SEQ_ROOT, record_v2_calls
 
 #: in_valid -> out_valid (rtl/ms_region_v2.vhd header)
 LATENCY = 6
@@ -47,28 +47,8 @@ def model(v: dict[str, int], g: dict) -> tuple[int, ...]:
 
 def real_vectors(frames: int = 60) -> list[dict[str, int]]:
     """The arguments of every ms_region_v2 call of FixedTrackerV2 on REAL_SEQS."""
-    import mstrack.fixed.tracker_v2 as tv2
-    from mstrack.io.data import load_sequence
-
-    out: list[dict[str, int]] = []
-    orig = tv2.ms_region_v2
-
-    def rec(c8d, ex, ey, ox, oy, lost, fw, fh, fp):
-        out.append({"cx": c8d[0], "cy": c8d[1], "ex": ex, "ey": ey, "ox": ox, "oy": oy, "lost": int(lost),
-                    "frame_w": fw, "frame_h": fh})
-        return orig(c8d, ex, ey, ox, oy, lost, fw, fh, fp)
-
-    tv2.ms_region_v2 = rec
-    try:
-        for name in REAL_SEQS:
-            seq = load_sequence(SEQ_ROOT / name)
-            t = tv2.FixedTrackerV2()
-            t.init(seq.frame(0), seq.init_box())
-            for i in range(1, min(frames, len(seq))):
-                t.update(seq.frame(i))
-    finally:
-        tv2.ms_region_v2 = orig
-    return out
+    keys = ("cx", "cy", "ex", "ey", "ox", "oy", "lost", "frame_w", "frame_h")
+    return [dict(zip(keys, a)) for a in record_v2_calls(REAL_SEQS, frames)["ms_region_v2"]]
 
 
 def edge_vectors(g: dict, rng: random.Random) -> list[dict[str, int]]:

@@ -33,7 +33,8 @@ def record_v2_calls(names: Sequence[str] = REAL_SEQS, frames: int = 40) -> dict[
     ms_share (nt_in, n_in), ms_spread (st2, nt), ms_scale (spread, spread_ref, w8, w0_8),
     ms_resize (s8, s, frame_size), ms_ring_share (nt, nt_in, n_in, K), ms_loss_filter (s, x, k),
     ms_loss_flag (rho_s, rho0, con_s, share, loss_rho, loss_contrast),
-    ms_confidence (rho, share, rho_ref, share_ref), ms_ref_update (ref, x, k)."""
+    ms_confidence (rho, share, rho_ref, share_ref), ms_ref_update (ref, x, k),
+    ms_region_v2 (cx, cy, ex, ey, ox, oy, lost, frame_w, frame_h: the decimated centre and frame)."""
     import mstrack.fixed.tracker_v2 as tv2
     from mstrack.io.data import load_sequence
 
@@ -47,6 +48,7 @@ def record_v2_calls(names: Sequence[str] = REAL_SEQS, frames: int = 40) -> dict[
         "ms_loss_flag": lambda *a: tuple(a),
         "ms_confidence": lambda *a: tuple(a),
         "ms_ref_update": lambda r, x, k: (r, x, k),
+        "ms_region_v2": lambda c8d, ex, ey, ox, oy, lost, fw, fh, fp: (*c8d, ex, ey, ox, oy, int(lost), fw, fh),
     }
     out: dict[str, list[tuple]] = {k: [] for k in args_of}
     orig = {k: getattr(tv2, k) for k in out}
@@ -69,6 +71,25 @@ def record_v2_calls(names: Sequence[str] = REAL_SEQS, frames: int = 40) -> dict[
     finally:
         for k, f in orig.items():
             setattr(tv2, k, f)
+    return out
+
+
+def tracker_states(names: Sequence[str], frames: int, tp=None) -> list[dict[str, int]]:
+    """The state FixedTrackerV2 (parameters ``tp``, default v2) holds before each of the first ``frames``
+    frames of each sequence, after init: w8, h8, c8x, c8y, lost and the frame size."""
+    from mstrack.fixed.tracker_v2 import FixedTrackerV2
+    from mstrack.io.data import load_sequence
+
+    out = []
+    for name in names:
+        seq = load_sequence(SEQ_ROOT / name)
+        t = FixedTrackerV2(tp)
+        f0 = seq.frame(0)
+        t.init(f0, seq.init_box())
+        for i in range(1, min(frames, len(seq))):
+            out.append({"w8": t.w8, "h8": t.h8, "c8x": t.c8[0], "c8y": t.c8[1], "lost": int(t.lost),
+                        "frame_w": f0.shape[1], "frame_h": f0.shape[0]})
+            t.update(seq.frame(i))
     return out
 
 

@@ -35,7 +35,8 @@
 -- exactly).
 --
 -- Memories: count RAM N_ORIENT N_BINS x (1 + Q_W + O_W) (ms_ram_sdp, RD_LAT 3), model RAM N_ORIENT
--- banks of N_BINS x 18 {T | Qn}, XR table and Q delay memory (LUT RAM); the ECP5 mapping, cost and
+-- banks of MODELS N_BINS x 18 {T | Qn} (MODELS > 1: one model per target, learnt into model m_wr_sel
+-- (taken with start), read from model m_rd_sel; the others keep theirs; m_wr_sel, m_rd_sel < MODELS), XR table and Q delay memory (LUT RAM); the ECP5 mapping, cost and
 -- Fmax: docs/blocks/ms_bg_model.md.
 --
 -- Latency (tb/test_ms_bg_model.py measures both):
@@ -79,7 +80,8 @@ entity ms_bg_model is
     KD_W    : natural := 29;  -- kernel-table width (ms_kernel_tables: holds w^2 h^2)
     N_ORIENT : natural range 1 to 16 := 1;  -- orientation banks: the joint bin (px_bin, px_obin) has
                               -- N_ORIENT 2**BIN_W values (RAM depths, clocks per pass); 1 = colour only
-    ORIENT_W : natural := 4   -- width of px_obin, m_rd_obin (2**ORIENT_W >= N_ORIENT)
+    ORIENT_W : natural := 4;  -- width of px_obin, m_rd_obin (2**ORIENT_W >= N_ORIENT)
+    MODELS   : positive := 1  -- models held (one per target): model RAM depth MODELS N_BINS per bank
   );
   port (
     clk       : in  std_logic;                             -- clock
@@ -91,6 +93,8 @@ entity ms_bg_model is
     wb        : in  unsigned(HALF_W downto 0);             -- box diameter x (3 ..)
     hb        : in  unsigned(HALF_W downto 0);             -- box diameter y (3 ..)
     ring16    : in  unsigned(RING_W - 1 downto 0);         -- ring width per side, 1/16 of the box size
+    m_wr_sel  : in  unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');
+                                                           -- the model this start learns (MODELS > 1)
     busy      : out std_logic;                             -- from start (or reset) until done
     counting  : out std_logic;                             -- pixels are counted
     done      : out std_logic;                             -- pulse: model written
@@ -110,6 +114,8 @@ entity ms_bg_model is
     -- model read port
     m_rd_addr : in  unsigned(BIN_W - 1 downto 0);          -- bin (colour bin when N_ORIENT > 1)
     m_rd_obin : in  unsigned(ORIENT_W - 1 downto 0) := (others => '0');  -- orientation bank (N_ORIENT > 1)
+    m_rd_sel  : in  unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');
+                                                           -- the model read (MODELS > 1)
     m_qn      : out unsigned(16 downto 0);                 -- Qn[bin] (Q0.16, <= 2**16), 1 clock later
     m_t       : out std_logic;                             -- T[bin], 1 clock later
     m_qn_all  : out std_logic_vector(N_ORIENT * 17 - 1 downto 0);  -- Qn of bank o at o*17, 1 clock later
@@ -233,8 +239,19 @@ architecture rtl of ms_bg_model is
   signal mv_tag_in, mv_tag : std_logic_vector(MVT_W - 1 downto 0);
   signal mv_p           : std_logic_vector(QV_W - 1 downto 0);
 
-  -- model RAM: N_ORIENT banks of N_BINS words (bank = the address's obin)
-  type m_ram_t is array (0 to N_BINS - 1) of std_logic_vector(MW - 1 downto 0);
+  -- model RAM: N_ORIENT banks of MODELS N_BINS words (bank = the address's obin; model m at words
+  -- m N_BINS ..: the address {model, colour bin})
+  constant SEL_W  : natural := clog2(MODELS);              -- m_wr_sel / m_rd_sel width (model bits of an
+                                                            -- address when MODELS > 1)
+  type m_ram_t is array (0 to MODELS * N_BINS - 1) of std_logic_vector(MW - 1 downto 0);
+  signal m_sel_r        : unsigned(SEL_W - 1 downto 0) := (others => '0');   -- m_wr_sel taken with start
+  function m_index(sel : unsigned; bin : unsigned) return natural is
+  begin
+    if MODELS = 1 then
+      return to_integer(bin);
+    end if;
+    return to_integer(sel & bin);
+  end function;
   type m_rd_arr_t is array (0 to N_ORIENT - 1) of std_logic_vector(MW - 1 downto 0);
   signal m_rd_all       : m_rd_arr_t := (others => (others => '0'));
   signal m_obin_r       : unsigned(ORIENT_W - 1 downto 0) := (others => '0');
@@ -291,6 +308,7 @@ begin
           end if;
         when S_IDLE =>
           if start = '1' then
+            m_sel_r <= m_wr_sel;
             cx_r <= cx;
             cy_r <= cy;
             wb_r <= wb;
@@ -705,9 +723,9 @@ begin
     begin
       if rising_edge(clk) then
         if m_we = '1' and shift_right(m_wa, BIN_W) = o then
-          mram(to_integer(m_wa(BIN_W - 1 downto 0))) <= m_wd;
+          mram(m_index(m_sel_r, m_wa(BIN_W - 1 downto 0))) <= m_wd;
         end if;
-        m_rd_all(o) <= mram(to_integer(m_rd_addr));
+        m_rd_all(o) <= mram(m_index(m_rd_sel, m_rd_addr));
       end if;
     end process;
     m_qn_all((o + 1) * QN_W - 1 downto o * QN_W) <= m_rd_all(o)(QN_W - 1 downto 0);

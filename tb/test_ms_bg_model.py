@@ -12,6 +12,9 @@ geometry of FixedTrackerV2.init (checked against the tracker's own model).  Full
 random input gaps, with a `start` pulse while busy (ignored); an init frame abandoned half way
 by a reset, then a model from scratch.  The clocks from the last pixel to `done` must equal LAT_DONE of the header
 (3 N_BINS + 65 at the default widths), models follow each other without reset (pass 3 clears the counts).
+With MODELS > 1 (one model per target): models learnt into models chosen by m_wr_sel in a mixed order,
+each read back through m_rd_sel, then every model read again after the others were learnt and after a
+reset (the model RAM keeps them).
 
 Run: ``.venv/bin/python -m pytest tb/test_ms_bg_model.py``.
 """
@@ -135,6 +138,8 @@ class BgTB:
         d.px_x.value = 0
         d.px_y.value = 0
         d.m_rd_addr.value = 0
+        d.m_wr_sel.value = 0
+        d.m_rd_sel.value = 0
         for k in ("cx", "cy", "wb", "hb", "ring16"):
             getattr(d, k).value = 0
         await ClockCycles(d.clk, 3)
@@ -149,16 +154,20 @@ class BgTB:
         await Timer(1, "ns")
 
     async def run(self, bins: np.ndarray, cx: int, cy: int, wb: int, hb: int, ring16: int, gap: float,
-                  rng: random.Random, order: str = "raster", name: str = "") -> None:
+                  rng: random.Random, order: str = "raster", name: str = "", sel: int = 0) -> dict:
+        """Learn a model of *bins* into model *sel* (m_wr_sel) and check it (read through m_rd_sel), its
+        sums and both latencies; returns the expected model."""
         d, g = self.dut, self.g
         exp = expected(bins, cx, cy, wb, hb, ring16, self.n_bins, int(g["O_W"]))
         await self.wait_idle()
         for k, v in (("cx", cx), ("cy", cy), ("wb", wb), ("hb", hb), ("ring16", ring16)):
             getattr(d, k).value = v
+        d.m_wr_sel.value = sel
         d.start.value = 1
         await RisingEdge(d.clk)
         t_start = self.cyc
         d.start.value = 0
+        d.m_wr_sel.value = (sel + 1) % int(g.get("MODELS", 1))   # taken with start: changes after it are ignored
         while True:                                  # set-up (kernel tables of the box)
             await RisingEdge(d.clk)
             await ReadOnly()
@@ -210,6 +219,29 @@ class BgTB:
         got = {"nq": d.n_box.value.to_unsigned(), "no": d.n_ring.value.to_unsigned(),
                "omin": d.o_min.value.to_unsigned(), "tot": d.qv_sum.value.to_unsigned()}
         await Timer(1, "ns")
+        qn, t, qn_all, t_all = await self.read_model(sel)
+        msg = f"{name}: cx={cx} cy={cy} wb={wb} hb={hb} ring16={ring16} image {w}x{h} gap={gap} model {sel}"
+        for k in ("nq", "no", "omin", "tot"):
+            assert got[k] == exp[k], f"{msg}: {k} = {got[k]}, model {exp[k]}"
+        self.compare_model(exp, qn, t, qn_all, t_all, msg)
+        assert lat == lat_done(g), f"{msg}: px_last -> done {lat} clocks, header says {lat_done(g)}"
+        d._log.info("%s: ok (nq %d, no %d, o* %d, tot %d, %d bins with T; set-up %d, last -> done %d clocks)",
+                    msg, exp["nq"], exp["no"], exp["omin"], exp["tot"], int(exp["T"].sum()), setup, lat)
+        return exp
+
+    @staticmethod
+    def compare_model(exp: dict, qn, t, qn_all, t_all, msg: str) -> None:
+        bad = np.nonzero((qn != exp["Qn"]) | (t != exp["T"]))[0]
+        assert bad.size == 0, (f"{msg}: {bad.size} bins differ, first {bad[:5].tolist()}: "
+                               f"Qn {qn[bad[:5]].tolist()} model {exp['Qn'][bad[:5]].tolist()}, "
+                               f"T {t[bad[:5]].tolist()} model {exp['T'][bad[:5]].tolist()}")
+        bad = np.nonzero((qn_all != exp["Qn"]) | (t_all != exp["T"]))[0]
+        assert bad.size == 0, f"{msg}: m_qn_all / m_t_all: {bad.size} joint bins differ, first {bad[:5].tolist()}"
+
+    async def read_model(self, sel: int) -> tuple:
+        """Every joint bin of model *sel* through m_qn / m_t and m_qn_all / m_t_all."""
+        d = self.dut
+        d.m_rd_sel.value = sel
         qn = np.zeros(self.n_bins, np.int64)
         t = np.zeros(self.n_bins, np.int64)
         qn_all = np.zeros(self.n_bins, np.int64)     # from m_qn_all / m_t_all (all banks of a colour)
@@ -230,18 +262,7 @@ class BgTB:
                     qn_all[u + o] = (qa >> (17 * o)) & 0x1FFFF
                     t_all[u + o] = (ta >> o) & 1
             await Timer(1, "ns")
-        msg = f"{name}: cx={cx} cy={cy} wb={wb} hb={hb} ring16={ring16} image {w}x{h} gap={gap}"
-        for k in ("nq", "no", "omin", "tot"):
-            assert got[k] == exp[k], f"{msg}: {k} = {got[k]}, model {exp[k]}"
-        bad = np.nonzero((qn != exp["Qn"]) | (t != exp["T"]))[0]
-        assert bad.size == 0, (f"{msg}: {bad.size} bins differ, first {bad[:5].tolist()}: "
-                               f"Qn {qn[bad[:5]].tolist()} model {exp['Qn'][bad[:5]].tolist()}, "
-                               f"T {t[bad[:5]].tolist()} model {exp['T'][bad[:5]].tolist()}")
-        bad = np.nonzero((qn_all != exp["Qn"]) | (t_all != exp["T"]))[0]
-        assert bad.size == 0, f"{msg}: m_qn_all / m_t_all: {bad.size} joint bins differ, first {bad[:5].tolist()}"
-        assert lat == lat_done(g), f"{msg}: px_last -> done {lat} clocks, header says {lat_done(g)}"
-        d._log.info("%s: ok (nq %d, no %d, o* %d, tot %d, %d bins with T; set-up %d, last -> done %d clocks)",
-                    msg, exp["nq"], exp["no"], exp["omin"], exp["tot"], int(exp["T"].sum()), setup, lat)
+        return qn, t, qn_all, t_all
 
 
 def synthetic_cases(g: dict, rng: random.Random) -> list[dict]:
@@ -329,6 +350,33 @@ async def bg_model_synthetic(dut, gap):
     for c in synthetic_cases(tb.g, rng):
         await tb.run(c["bins"], c["cx"], c["cy"], c["wb"], c["hb"], c["ring16"], gap, rng,
                      order=c["order"], name=c["name"])
+
+
+@cocotb.test()
+async def bg_model_models(dut):
+    """MODELS > 1: one model per target.  Learn a different case into each model in a mixed order (the
+    last model learnt twice), then read every model again after the others and after a reset."""
+    tb = BgTB(dut)
+    await tb.reset()
+    n_models = int(tb.g.get("MODELS", 1))
+    rng = random.Random(1400)
+    cases = synthetic_cases(tb.g, rng)
+    order = list(range(n_models))[::-1] + [n_models - 1]     # n - 1 .. 0, then n - 1 again
+    held: dict[int, dict] = {}
+    for i, sel in enumerate(order):
+        c = cases[(1 + 2 * i) % len(cases)]
+        held[sel] = await tb.run(c["bins"], c["cx"], c["cy"], c["wb"], c["hb"], c["ring16"], 0.2, rng,
+                                 order=c["order"], name=c["name"], sel=sel)
+    for when in ("after all were learnt", "after a reset"):
+        if when == "after a reset":
+            tb.dut.rst.value = 1
+            await ClockCycles(tb.dut.clk, 2)
+            tb.dut.rst.value = 0
+            await tb.wait_idle()
+        for sel in rng.sample(range(n_models), n_models):
+            got = await tb.read_model(sel)
+            tb.compare_model(held[sel], *got, msg=f"model {sel} {when}")
+    dut._log.info("%d models kept apart, %d learnt", n_models, len(order))
 
 
 @cocotb.test()
@@ -484,6 +532,22 @@ PARAMS = [
 def test_ms_bg_model_ghdl(generics, hdl_waves):
     hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves,
                  test_filter="bg_model_synthetic|bg_model_abandoned")
+
+
+@pytest.mark.ghdl
+def test_ms_bg_model_models_ghdl(hdl_waves):
+    """MODELS 3 (one model per target) on the small joint bins (4 x 8): each model its own."""
+    generics = {**PARAMS[4].values[0], "MODELS": 3}
+    hdl.run_ghdl(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves, test_filter="bg_model_models",
+                 build_name=f"ghdl_{TOP}_models3")
+
+
+@pytest.mark.verilator
+def test_ms_bg_model_models_verilator(hdl_waves):
+    """The netlist of MODELS 3 (one model per target) on the small joint bins."""
+    generics = {**PARAMS[4].values[0], "MODELS": 3}
+    hdl.run_verilator(TOP, MODULE, generics, hdl.rtl_sources(TOP), waves=hdl_waves, test_filter="bg_model_models",
+                      build_name=f"verilator_{TOP}_models3")
 
 
 @pytest.mark.ghdl

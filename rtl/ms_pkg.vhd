@@ -17,6 +17,8 @@ package ms_pkg is
   function to_sl(b : boolean) return std_logic;
   function max(a, b : integer) return integer;
   function min(a, b : integer) return integer;
+  -- bits of core v2's target state record (ms_tracker_v2 tgt_state: mstrack.fixed.vhdl_pkg.target_state_layout_v2)
+  function v2_state_w(centre_abs_w, size_w, coord_w, share_w, con_w, spread_w : natural) return natural;
   -- stop codes of a mean-shift loop (mstrack.fixed.blocks.STOP_CODES)
   constant STOP_SHIFT    : std_logic_vector(1 downto 0) := "00";
   constant STOP_RHO      : std_logic_vector(1 downto 0) := "01";
@@ -25,6 +27,11 @@ package ms_pkg is
 end package;
 
 package body ms_pkg is
+  function v2_state_w(centre_abs_w, size_w, coord_w, share_w, con_w, spread_w : natural) return natural is
+  begin
+    return 3 + 2 * centre_abs_w + 3 * size_w + 2 * coord_w + 3 * share_w + 2 * con_w + spread_w;
+  end function;
+
   function clog2(n : natural) return natural is
     variable r : natural := 0;
     variable v : natural := 1;

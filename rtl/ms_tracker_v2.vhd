@@ -124,7 +124,9 @@ entity ms_tracker_v2 is
     -- default tracker v2's 64): -1 = off (colour bins alone: mstrack-v2-colour, bit for bit);
     -- >= 0: a pixel's bin is 9 colour + ms_orient_bin(grey, ORIENT_T) (4,608 bins: N_ORIENT 9 banks of
     -- the histogram, the bin pass, the model and T; a 4-bit orientation region RAM beside the colour one)
-    ORIENT_T        : integer range -1 to 2047 := 64
+    ORIENT_T        : integer range -1 to 2047 := 64;
+    -- target models held (one per target when one engine serves several: the tgt_* ports); 1 = core v2
+    MODELS          : positive := 1
   );
   port (
     clk                  : in  std_logic;
@@ -146,7 +148,18 @@ entity ms_tracker_v2 is
     m_axis_result_tvalid : out std_logic;
     m_axis_result_tready : in  std_logic;
     m_axis_result_tlast  : out std_logic;
-    busy                 : out std_logic
+    busy                 : out std_logic;
+    -- the target this engine works for (several targets on one engine; docs/blocks/ms_tracker_v2.md,
+    -- "Target state"): its state record (mstrack.fixed.vhdl_pkg.target_state_layout_v2), valid
+    -- while tgt_load_ready = 1; a load, taken between frames like s_init, replaces the record and
+    -- selects the target's model in ms_bg_model (an init learns into it, a frame reads it)
+    tgt_state            : out std_logic_vector(v2_state_w(CENTRE_ABS_W, SIZE_W, COORD_W, SHARE_W, CON_W,
+                                                           SPREAD_W) - 1 downto 0);
+    tgt_load_valid       : in  std_logic := '0';
+    tgt_load_ready       : out std_logic;
+    tgt_load_state       : in  std_logic_vector(v2_state_w(CENTRE_ABS_W, SIZE_W, COORD_W, SHARE_W, CON_W,
+                                                           SPREAD_W) - 1 downto 0) := (others => '0');
+    tgt_load_model       : in  unsigned(clog2(MODELS) - 1 downto 0) := (others => '0')
   );
 end entity;
 
@@ -190,6 +203,23 @@ architecture rtl of ms_tracker_v2 is
   signal spread_ref   : unsigned(SPREAD_W - 1 downto 0) := (others => '0');
   signal lost_st, reported_lost : std_logic := '0';
   signal lost_st_frame : std_logic := '0';             -- lost_st of the frame being finished
+  -- the target state record (tgt_state): field offsets from bit 0 (target_state_layout_v2)
+  constant TS_W      : natural := v2_state_w(CENTRE_ABS_W, SIZE_W, COORD_W, SHARE_W, CON_W, SPREAD_W);
+  constant TS_C8X    : natural := 3;
+  constant TS_C8Y    : natural := TS_C8X + CENTRE_ABS_W;
+  constant TS_W8     : natural := TS_C8Y + CENTRE_ABS_W;
+  constant TS_H8     : natural := TS_W8 + SIZE_W;
+  constant TS_W0     : natural := TS_H8 + SIZE_W;
+  constant TS_FW     : natural := TS_W0 + SIZE_W;
+  constant TS_FH     : natural := TS_FW + COORD_W;
+  constant TS_RREF   : natural := TS_FH + COORD_W;
+  constant TS_SREF   : natural := TS_RREF + SHARE_W;
+  constant TS_RHO0   : natural := TS_SREF + SHARE_W;
+  constant TS_RHOS   : natural := TS_RHO0 + SHARE_W;
+  constant TS_CONS   : natural := TS_RHOS + CON_W;
+  constant TS_SPREF  : natural := TS_CONS + CON_W;
+  signal m_sel       : unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');   -- the target's model
+  signal tgt_ready_i, tgt_take : std_logic;
   signal tgt_w, tgt_h : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
   signal in_fw, in_fh : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
 
@@ -484,7 +514,7 @@ begin
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
   bg_rearm <= s_axis_tuser and init_pending and not bg_clean;
   accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
-                     and fe_err_now = '0' and init_take = '0' and bg_rearm = '0' else '0';
+                     and fe_err_now = '0' and init_take = '0' and tgt_take = '0' and bg_rearm = '0' else '0';
   s_axis_tready <= accept;
   beat <= s_axis_tvalid and accept;
 
@@ -636,8 +666,9 @@ begin
 
   u_bg : entity work.ms_bg_model
     generic map (BIN_W => BIN_C_W, HALF_W => HALF_W, COORD_W => COORD_W, RING_W => 5, Q_W => BG_Q_W,
-                 O_W => BG_O_W, KD_W => KD_W, N_ORIENT => N_OR)
-    port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy,
+                 O_W => BG_O_W, KD_W => KD_W, N_ORIENT => N_OR, MODELS => MODELS)
+    port map (clk => clk, rst => bg_rst, start => bg_start, cx => bg_cx, cy => bg_cy, m_wr_sel => m_sel,
+              m_rd_sel => m_sel,
               wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1), ring16 => to_unsigned(RING16, 5),
               busy => bg_busy, counting => bg_counting, done => bg_done,
               px_valid => bg_px_valid, px_bin => unsigned(bg_px_bin), px_obin => bg_px_obin,
@@ -1094,6 +1125,25 @@ begin
             in_fw <= frame_width; in_fh <= frame_height;
             bc_valid <= '1';
             state <= T_CLIP;
+          elsif tgt_take = '1' then            -- another target: its state, its model
+            target_valid  <= tgt_load_state(0);
+            lost_st       <= tgt_load_state(1);
+            reported_lost <= tgt_load_state(2);
+            c8x        <= unsigned(tgt_load_state(TS_C8Y - 1 downto TS_C8X));
+            c8y        <= unsigned(tgt_load_state(TS_W8 - 1 downto TS_C8Y));
+            w8         <= unsigned(tgt_load_state(TS_H8 - 1 downto TS_W8));
+            h8         <= unsigned(tgt_load_state(TS_W0 - 1 downto TS_H8));
+            w0_8       <= unsigned(tgt_load_state(TS_FW - 1 downto TS_W0));
+            tgt_w      <= unsigned(tgt_load_state(TS_FH - 1 downto TS_FW));
+            tgt_h      <= unsigned(tgt_load_state(TS_RREF - 1 downto TS_FH));
+            rho_ref    <= unsigned(tgt_load_state(TS_SREF - 1 downto TS_RREF));
+            share_ref  <= unsigned(tgt_load_state(TS_RHO0 - 1 downto TS_SREF));
+            rho0       <= unsigned(tgt_load_state(TS_RHOS - 1 downto TS_RHO0));
+            rho_s      <= signed(tgt_load_state(TS_CONS - 1 downto TS_RHOS));
+            con_s      <= signed(tgt_load_state(TS_SPREF - 1 downto TS_CONS));
+            spread_ref <= unsigned(tgt_load_state(TS_W - 1 downto TS_SPREF));
+            m_sel <= tgt_load_model;
+            state <= T_PREP;                   -- its region for the next frame
           elsif s_axis_tvalid = '1' and bg_rearm = '1' and gate_closed = '0' and err_hold = '0'
                 and fe_err_now = '0' then
             state <= T_PREP;                   -- re-arm ms_bg_model before this start of frame
@@ -1489,6 +1539,7 @@ begin
         c8y <= (others => '0');
         lost_st <= '0';
         reported_lost <= '0';
+        m_sel <= (others => '0');
         ql_issue <= '0';
         bg_clean <= '0';
         st_sel <= '0';
@@ -1500,6 +1551,15 @@ begin
                          and gate_closed = '0' and err_hold = '0' and fe_err_now = '0' else '0';
   init_take <= s_init_tvalid and init_ready;
   s_init_tready <= init_ready;
+  -- a target load: between frames like an init (which goes first), not while an init frame is pending
+  tgt_ready_i <= init_ready and not init_pending and not s_init_tvalid;
+  tgt_take <= tgt_load_valid and tgt_ready_i;
+  tgt_load_ready <= tgt_ready_i;
+  tgt_state <= std_logic_vector(spread_ref) & std_logic_vector(con_s) & std_logic_vector(rho_s)
+               & std_logic_vector(rho0) & std_logic_vector(share_ref) & std_logic_vector(rho_ref)
+               & std_logic_vector(tgt_h) & std_logic_vector(tgt_w) & std_logic_vector(w0_8)
+               & std_logic_vector(h8) & std_logic_vector(w8) & std_logic_vector(c8y) & std_logic_vector(c8x)
+               & reported_lost & lost_st & target_valid;
 
   -- T table of ms_target_stats: written with the Qw load (T of the bin read the clock before)
   t_we   <= ql_v1;

@@ -109,3 +109,38 @@ def test_real_sequence_results_fit_and_decode(name):
     seq = load_sequence(SEQ_ROOT / name)
     res = _track(seq.frames(), seq.init_box(), n=120)
     _check_frames(res)
+
+
+def test_target_state_record_holds_every_state_of_a_run():
+    """Core v2's target state record (target_state_layout_v2, the RTL's tgt_state): contiguous, 239 bits at
+    the default widths (ms_pkg.v2_state_w), and every state FixedTrackerV2 reaches on a generated scene
+    with a loss fits its fields and reads back the same (rho_s, con_s signed)."""
+    from mstrack.fixed.tracker_v2 import FixedTrackerV2
+    from mstrack.fixed.vhdl_pkg import (TARGET_STATE_SIGNED, target_state_layout_v2, target_state_v2,
+                                        unpack_target_state_v2)
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.fixed import FixedParams
+    from mstrack.track.params import TrackerParams
+    g = CoreConfigV2(TrackerParams(preset="v2"), FixedParams()).generics()
+    lay = target_state_layout_v2(g)
+    off = 0
+    for name, o, w in lay:
+        assert o == off and w > 0, name
+        off += w
+    assert off == 3 + 2 * g["CENTRE_ABS_W"] + 3 * g["SIZE_W"] + 2 * g["COORD_W"] + 3 * g["SHARE_W"] \
+        + 2 * g["CON_W"] + g["SPREAD_W"] == 239
+    trk = FixedTrackerV2()
+    assert set(target_state_v2(trk, g).values()) == {0}              # no target: the empty record
+    frames, boxes = make_scene(20, 96, 72, seed=4)
+    trk.init(frames[0], tuple(int(v) for v in boxes[0]))
+    for f in [*frames[1:], *[np.zeros_like(frames[0])] * 3]:           # three blank frames: lost
+        trk.update(f)
+        st = target_state_v2(trk, g)
+        word = 0
+        for name, o, w in lay:
+            v = st[name]
+            lo, hi = (-(1 << (w - 1)), 1 << (w - 1)) if name in TARGET_STATE_SIGNED else (0, 1 << w)
+            assert lo <= v < hi, f"{name} = {v} does not fit {w} bits"
+            word |= (v & ((1 << w) - 1)) << o
+        assert unpack_target_state_v2(word, g) == st
+    assert trk.lost

@@ -348,5 +348,52 @@ def unpack_result_multi(word: int, g: dict[str, int] | None = None) -> dict[str,
     return {**unpack_result_v2(word & ((1 << w) - 1), g), "target_id": (word >> w) & ((1 << TARGET_ID_W) - 1)}
 
 
+
+# ---------------------------------------------------------------------------- core v2's target state
+#: the fields of core v2's target state record that hold signed values (two's complement)
+TARGET_STATE_SIGNED = ("rho_s", "con_s")
+
+
+def target_state_layout_v2(g: dict[str, int]) -> list[tuple[str, int, int]]:
+    """Fields of core v2's target state record (ms_tracker_v2 ``tgt_state`` / ``tgt_load_state``), LSB
+    first: (name, offset, width).  The state :class:`mstrack.fixed.tracker_v2.FixedTrackerV2` carries
+    from one frame to the next (:func:`target_state_v2`); ``g``: the core's generics."""
+    fields_ = [("target_valid", 1), ("lost", 1), ("reported_lost", 1),
+               ("c8x", g["CENTRE_ABS_W"]), ("c8y", g["CENTRE_ABS_W"]),
+               ("w8", g["SIZE_W"]), ("h8", g["SIZE_W"]), ("w0_8", g["SIZE_W"]),
+               ("frame_w", g["COORD_W"]), ("frame_h", g["COORD_W"]),
+               ("rho_ref", g["SHARE_W"]), ("share_ref", g["SHARE_W"]), ("rho0", g["SHARE_W"]),
+               ("rho_s", g["CON_W"]), ("con_s", g["CON_W"]), ("spread_ref", g["SPREAD_W"])]
+    out, off = [], 0
+    for name, w in fields_:
+        out.append((name, off, w))
+        off += w
+    return out
+
+
+def unpack_target_state_v2(word: int, g: dict[str, int]) -> dict[str, int]:
+    """Split a target state record into its fields (``rho_s``, ``con_s`` signed)."""
+    out = {}
+    for name, off, w in target_state_layout_v2(g):
+        v = (word >> off) & ((1 << w) - 1)
+        if name in TARGET_STATE_SIGNED and v >> (w - 1):
+            v -= 1 << w
+        out[name] = v
+    return out
+
+
+def target_state_v2(trk, g: dict[str, int]) -> dict[str, int]:
+    """The target state record's fields of a FixedTrackerV2 (``trk``) after its last frame; a tracker
+    never initialised gives the empty record (all 0).  Only the fields the core keeps: the tracker's
+    options that keep more state (model update, loss latch) are off in core v2."""
+    if getattr(trk, "_shape", None) is None:
+        return {name: 0 for name, _, _ in target_state_layout_v2(g)}
+    fh, fw = trk._shape
+    return {"target_valid": 1, "lost": int(trk.lost), "reported_lost": int(trk.reported_lost),
+            "c8x": trk.c8[0], "c8y": trk.c8[1], "w8": trk.w8, "h8": trk.h8, "w0_8": trk.w0_8,
+            "frame_w": fw, "frame_h": fh, "rho_ref": trk.rho_ref, "share_ref": trk.share_ref,
+            "rho0": trk.rho0, "rho_s": trk.rho_s, "con_s": trk.con_s, "spread_ref": trk.spread_ref}
+
+
 if __name__ == "__main__":
     print(write_formats_pkg(Path(sys.argv[1]) if len(sys.argv) > 1 else PKG_PATH))

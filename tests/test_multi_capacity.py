@@ -182,17 +182,21 @@ def test_demand_follows_the_tracker_through_a_loss():
 
 @pytest.mark.parametrize("box", [(30, 20, 24, 30), (2, 3, 40, 28), (100, 70, 60, 45)])
 def test_init_demand_is_the_init_frames_geometry(box):
-    """The init job's rectangle is ms_bg_model's: its area is the ring count plus the box rectangle
-    (box at the frame border included); D is the init frame's."""
+    """The init capture's ring is ms_bg_model's: its area is the ring count plus the box rectangle
+    (box at the frame border included); D is the init frame's; the job counts the whole captured
+    rectangle (the ring and the init region)."""
     from mstrack.fixed.blocks import ms_kernel
+    from mstrack.fixed.multi_capacity import init_capture
     from mstrack.io.synthetic import make_scene
     frames, _ = make_scene(1, 160, 120, seed=5)
     trk = FixedTrackerV2()
     r = trk.init(frames[0], box)
     dm = init_demand(box, 160, 120, 0)
-    assert dm.d == r.extra["decimation"]
+    ic = init_capture(box, 160, 120)
+    assert dm.d == ic.d == r.extra["decimation"]
     ker = ms_kernel(*_box_diameters(dm, box), "flat", 8)
-    assert dm.rows * dm.cols == int(trk.model.O.sum()) + (2 * ker.ex + 1) * (2 * ker.ey + 1)
+    assert ic.ring[2] * ic.ring[3] == int(trk.model.O.sum()) + (2 * ker.ex + 1) * (2 * ker.ey + 1)
+    assert dm.rows * dm.cols == ic.rect[2] * ic.rect[3] >= ic.ring[2] * ic.ring[3]
 
 
 def _box_diameters(dm, box):

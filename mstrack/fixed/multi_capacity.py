@@ -195,7 +195,8 @@ def job_clocks(kind: JobKind, wd: int, hd: int, tp: TrackerParams, costs: PassCo
     track: Qw load, ``max_iter`` iterations, the v2 per-frame work, the gated scale test's two
     windows (the larger at +scale_test, up to ``window_limit``); lost: the centre and 8 more start
     points of ``search_iter`` iterations each, 8 more confidences; init: the background model
-    counted from the captured box + ring rectangle ``ring`` (rows, cols) at one pixel per clock,
+    counted from the captured rectangle ``ring`` (rows, cols: :func:`init_capture`'s ``rect``, the box,
+    its ring and the init region) at one pixel per clock,
     its 3 passes over the bins, the Qw load and one pass at the init centre.  Every job adds
     ``job_switch`` (the target's state record in and out)."""
     c = costs
@@ -305,12 +306,38 @@ def ms_job_demand(w8: int, h8: int, c8: tuple[int, int], lost: bool, frame_shape
     return TargetDemand(target_id, kind, d, g.wd, g.hd, reg.h, reg.w, reg.y * d, clocks, release, next_line)
 
 
-def init_demand(box: Box | tuple[float, float, float, float], frame_w: int, frame_h: int, target_id: int,
-                tp: TrackerParams | None = None, fp: FixedParams | None = None,
-                costs: PassCosts = PassCosts()) -> TargetDemand:
-    """The job of a target added with ``box`` on a ``frame_w`` x ``frame_h`` frame (the geometry of
-    ``FixedTrackerV2.init``): the box and its background ring are captured into the target's slot
-    and counted after they have streamed in.  Raises ValueError for a box ``init`` refuses."""
+@dataclass(frozen=True)
+class InitCapture:
+    """What the shared-engine core captures of a target on the frame it is added (:func:`init_capture`).
+
+    ``d``: decimation; ``cd``: the box centre (decimated px) kept inside the decimated interior, and
+    ``wb``, ``hb`` the box diameters, as ``FixedTrackerV2.init`` gives them to ``ms_bg_model``; ``ring``:
+    the box and its background ring, clipped to the decimated frame (the pixels ``ms_bg_model``
+    counts); ``region``: the init region (``ms_region`` around the centre: the pass that gives the
+    references); ``rect`` (x, y, w, h): the rectangle the capture writes into the slot, the smallest that holds
+    both, border pixels included.  ``wd``, ``hd``: the window."""
+
+    d: int
+    cd: tuple[int, int]
+    wb: int
+    hb: int
+    wd: int
+    hd: int
+    ring: tuple[int, int, int, int]
+    region: Region
+    rect: tuple[int, int, int, int]
+
+
+def init_capture(box: Box | tuple[float, float, float, float], frame_w: int, frame_h: int,
+                 tp: TrackerParams | None = None, fp: FixedParams | None = None) -> InitCapture:
+    """The init job's capture of a target added with ``box`` on a ``frame_w`` x ``frame_h`` frame,
+    with the geometry of ``FixedTrackerV2.init`` (docs/multi_target_core.md, "The init job").
+
+    The init job counts ``ms_bg_model`` from the slot: every pixel of ``rect`` with its coordinates
+    relative to ``rect`` and the centre ``cd - rect`` origin gives the model ``init`` learns from the
+    whole frame (the ring is inside ``rect``; pixels outside the ring are not counted), then the
+    reference pass reads the window from the same slot with the clamp of ``region``.  Raises
+    ValueError for a box ``init`` refuses."""
     tp = tp or TrackerParams(preset="v2")
     fp = fp or FixedParams()
     b = Box.of(box)
@@ -334,14 +361,29 @@ def init_demand(box: Box | tuple[float, float, float, float], frame_w: int, fram
     gx, gy = (ring16 * wb) >> 4, (ring16 * hb) >> 4
     y0, y1 = max(0, cy - (hb - 1) // 2 - gy), min(dh - 1, cy + (hb - 1) // 2 + gy)
     x0, x1 = max(0, cx - (wb - 1) // 2 - gx), min(dw - 1, cx + (wb - 1) // 2 + gx)
-    ring = (y1 - y0 + 1, x1 - x0 + 1)
+    ring = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
     wd, hd = _window(w8, pad16, d, dw, tp), _window(h8, pad16, d, dh, tp)
     reg: Region = ms_region((c8[0] >> sh, c8[1] >> sh), (wd - 1) // 2, (hd - 1) // 2, dw, dh, fp)
-    clocks = job_clocks("init", wd, hd, tp, costs, ring=ring)
-    release = min((max(y1, reg.y + reg.h - 1) + 1) * d + 1, frame_h)
+    rx0, ry0 = min(x0, reg.x), min(y0, reg.y)
+    rx1, ry1 = max(x1, reg.x + reg.w - 1), max(y1, reg.y + reg.h - 1)
+    rect = (rx0, ry0, rx1 - rx0 + 1, ry1 - ry0 + 1)
+    return InitCapture(d, (cx, cy), wb, hb, wd, hd, ring, reg, rect)
+
+
+def init_demand(box: Box | tuple[float, float, float, float], frame_w: int, frame_h: int, target_id: int,
+                tp: TrackerParams | None = None, fp: FixedParams | None = None,
+                costs: PassCosts = PassCosts()) -> TargetDemand:
+    """The job of a target added with ``box`` on a ``frame_w`` x ``frame_h`` frame (the geometry of
+    ``FixedTrackerV2.init``): :func:`init_capture`'s rectangle (the box, its background ring and the
+    init region) is captured into the target's slot and counted after it has streamed in.  Raises
+    ValueError for a box ``init`` refuses."""
+    tp = tp or TrackerParams(preset="v2")
+    ic = init_capture(box, frame_w, frame_h, tp, fp)
+    d, (_, ry, rw, rh), reg = ic.d, ic.rect, ic.region
+    clocks = job_clocks("init", ic.wd, ic.hd, tp, costs, ring=(rh, rw))
+    release = min((ry + rh) * d + 1, frame_h)
     # the first tracking frame's region is this one (the init frame does not move the centre)
-    return TargetDemand(target_id, "init", d, wd, hd, ring[0], ring[1], min(y0, reg.y) * d, clocks, release,
-                        reg.y * d)
+    return TargetDemand(target_id, "init", d, ic.wd, ic.hd, rh, rw, ry * d, clocks, release, reg.y * d)
 
 
 # ----------------------------------------------------------------------------- the rule

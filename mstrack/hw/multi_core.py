@@ -57,13 +57,13 @@ LFE5U_85F = {"DP16KD": 208, "comb": 83640, "FF": 83640}
 #: REGION_MAX 256, DATA_W 9), yosys ``synth_ecp5`` / ``synth_xilinx``: docs/blocks/ms_slot_capture.md
 #: (``studies/synth_v2_blocks.py ms_slot_capture``, 2026-11-29).
 SLOT_CAPTURE = {"LUT4": 212, "FF": 178, "CCU2C": 55, "xc7_LUT": 134, "xc7_FF": 151}
-#: Per target, besides its memories: the state record (213 bits: c8, w8, h8, w0_8, rho_ref, share_ref,
-#: spread_ref, lost, rho0, rho_s, contrast_s, loss reported) + its region and job descriptor (D,
+#: Per target, besides its memories: the state record (core v2's ``tgt_state``, 239 bits at the default
+#: widths: :func:`mstrack.fixed.vhdl_pkg.target_state_layout_v2`) + its region and job descriptor (D,
 #: region origin and size, slot base, release / next line, clocks, kind, age: 53 bits) in LUT RAM, 16
 #: words deep (one DPR16X4 per 4 bits, for up to 16 targets); the region capture (measured:
 #: :data:`SLOT_CAPTURE`); the write arbiter's share and the scheduler's release compare (estimate, until
 #: that RTL exists: ~30 LUT4).
-STATE_BITS = 213 + 53
+STATE_BITS = 239 + 53
 PER_TARGET = {"LUT4": SLOT_CAPTURE["LUT4"] + 30, "FF": SLOT_CAPTURE["FF"]}
 #: Added once for N > 1: the scheduler (admission adder and compare, the job queue), the result
 #: reorder buffer's control and the 4-bit target id in the result word (estimate).

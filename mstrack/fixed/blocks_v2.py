@@ -403,6 +403,14 @@ def ms_slot_capture(bins: np.ndarray, d: int, reg_x: int, reg_y: int, reg_w: int
     return dec[reg_y: reg_y + reg_h, reg_x: reg_x + reg_w].copy()
 
 
+def ms_slot_scan(region: np.ndarray) -> list[tuple[int, int, int]]:
+    """The init job's pixel stream (rtl/ms_slot_scan.vhd): every pixel of a rectangle captured in a slot,
+    ``(rx, ry, value)`` in raster order with coordinates relative to the rectangle; ``ms_bg_model``
+    counts them (``mstrack.fixed.multi_capacity.init_capture``)."""
+    h, w = region.shape
+    return [(rx, ry, int(region[ry, rx])) for ry in range(h) for rx in range(w)]
+
+
 def slot_words(region: np.ndarray, lanes: int, stride: int) -> dict[tuple[int, int], int]:
     """The slot's RAM words of a captured region: ``{(bank, word): value}`` (ms_region_capture's layout)."""
     h, w = region.shape

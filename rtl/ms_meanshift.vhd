@@ -17,6 +17,8 @@
 -- Cycles per iteration: the pixel pass (sum over the window rows of the LANES
 -- groups of each row's ellipse extent, + 6) + the bin pass (N_BINS + ~35) + ms_centre
 -- (SHIFT_Q_W + 6) + 6 of control; docs/realtime.md, docs/performance.md.
+-- Clamp: the window centre stays in [lo, hi] per axis, region-relative: hi = hi_x / hi_y; lo = ex / ey,
+-- or lo_x_in / lo_y_in with LO_IN (the region a pass may use starts after the RAM's origin).
 -- Handshake: `start` pulse while `busy` = 0; `done` pulse with the results (held).
 -- N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o, u the
 -- colour bin on ram_data, o the orientation bin on ram_obin from an orientation region RAM read at
@@ -65,8 +67,10 @@ entity ms_meanshift is
     EPS2         : natural := 65536;  -- shift stop threshold, Q.2CF px^2
     RAM_LAT      : positive := 1;     -- region RAM read latency (ms_pixel_pass, 1 .. 4; cycles do not change)
     ITER_BINS    : natural := 0;      -- ms_bin_pass ITERATIVE: 1 = iterative arithmetic (few bins; slower pass)
-    N_ORIENT     : natural range 1 to 16 := 1  -- orientation banks (joint bins N_ORIENT u + o, ITER_BINS = 0 only);
+    N_ORIENT     : natural range 1 to 16 := 1;  -- orientation banks (joint bins N_ORIENT u + o, ITER_BINS = 0 only);
                                       -- 1 = colour bins only (ram_obin, q_ext_bank ignored)
+    LO_IN        : boolean := false   -- true: the lowest window centre is lo_x / lo_y (an init job's reference
+                                      -- pass, whose slot rectangle starts before its region); false: ex / ey
   );
   port (
     clk       : in  std_logic;                                    -- clock
@@ -87,6 +91,8 @@ entity ms_meanshift is
     reg_y     : in  unsigned(COORD_W - 1 downto 0);               -- region origin y
     hi_x      : in  unsigned(REGION_W - 1 downto 0);              -- largest window centre x (rel.)
     hi_y      : in  unsigned(REGION_W - 1 downto 0);              -- largest window centre y (rel.)
+    lo_x_in   : in  unsigned(REGION_W - 1 downto 0) := (others => '0');  -- LO_IN: lowest window centre x (rel.)
+    lo_y_in   : in  unsigned(REGION_W - 1 downto 0) := (others => '0');  -- LO_IN: lowest window centre y (rel.)
     -- control
     start     : in  std_logic;                                    -- pulse: run (while busy = 0)
     learn     : in  std_logic;                                    -- with start: learn Q
@@ -188,8 +194,8 @@ architecture rtl of ms_meanshift is
     return resize(shift_right(resize(c, CENTRE_W + 1) + 2 ** (CF - 1), CF), REGION_W);
   end function;
 begin
-  lo_x <= resize(ex, REGION_W);
-  lo_y <= resize(ey, REGION_W);
+  lo_x <= lo_x_in when LO_IN else resize(ex, REGION_W);
+  lo_y <= lo_y_in when LO_IN else resize(ey, REGION_W);
 
   u_pass : entity work.ms_pixel_pass
     generic map (LANES => LANES, BIN_W => BIN_W, HALF_W => HALF_W, REGION_W => REGION_W,

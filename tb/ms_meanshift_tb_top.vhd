@@ -15,7 +15,8 @@ entity ms_meanshift_tb_top is
     RHO_SUM_W : natural := 15; RATIO_Q_W : natural := 16; WEIGHT_W : natural := 8; WF : natural := 4;
     RF : natural := 6; SW_W : natural := 16; SWX_W : natural := 19; SHIFT_Q_W : natural := 11;
     CF : natural := 8; CENTRE_W : natural := 13; CENTRE_ABS_W : natural := 20; MAX_ITER : natural := 20;
-    ITER_W : natural := 5; EPS2 : natural := 65536; N_ORIENT : natural := 1
+    ITER_W : natural := 5; EPS2 : natural := 65536; N_ORIENT : natural := 1;
+    LO_IN : natural := 0                     -- 1: ms_meanshift's LO_IN (the clamp's lower bound from lo_x_in / lo_y_in)
   );
   port (
     clk : in std_logic; rst : in std_logic;
@@ -29,6 +30,8 @@ entity ms_meanshift_tb_top is
     ex : in unsigned(HALF_W - 1 downto 0); ey : in unsigned(HALF_W - 1 downto 0);
     reg_x : in unsigned(COORD_W - 1 downto 0); reg_y : in unsigned(COORD_W - 1 downto 0);
     hi_x : in unsigned(REGION_W - 1 downto 0); hi_y : in unsigned(REGION_W - 1 downto 0);
+    lo_x_in : in unsigned(REGION_W - 1 downto 0) := (others => '0');
+    lo_y_in : in unsigned(REGION_W - 1 downto 0) := (others => '0');
     start : in std_logic; learn : in std_logic;
     start_cx : in unsigned(CENTRE_ABS_W - 1 downto 0); start_cy : in unsigned(CENTRE_ABS_W - 1 downto 0);
     busy : out std_logic; done : out std_logic;
@@ -65,11 +68,11 @@ begin
                  SQRT_IN_W => SQRT_IN_W, RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W,
                  WF => WF, RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
                  CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER, ITER_W => ITER_W,
-                 EPS2 => EPS2, N_ORIENT => N_ORIENT)
+                 EPS2 => EPS2, N_ORIENT => N_ORIENT, LO_IN => LO_IN = 1)
     port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta, kt_tb => kt_tb,
               kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d, ex => ex, ey => ey,
               reg_x => reg_x, reg_y => reg_y,
-              hi_x => hi_x, hi_y => hi_y, start => start, learn => learn, start_cx => start_cx,
+              hi_x => hi_x, hi_y => hi_y, lo_x_in => lo_x_in, lo_y_in => lo_y_in, start => start, learn => learn, start_cx => start_cx,
               start_cy => start_cy, busy => busy, done => done, res_cx => res_cx, res_cy => res_cy,
               res_s => res_s, res_iter => res_iter, res_stop => res_stop, res_k => res_k,
               ram_addr => raddr, ram_data => rdata, ram_obin => odata, max_it => max_it,

@@ -104,7 +104,7 @@ async def load_q(dut, q: np.ndarray, g: dict, parallel: bool) -> None:
 def idle_inputs(dut) -> None:
     """Every input at rest (the Verilator netlist has no port defaults)."""
     for s in ("we", "kt_we", "start", "learn", "wodata", "q_ext_we", "q_ext_addr", "q_ext_data", "q_ext_bank",
-              "q_ext_all_we", "q_ext_all_data"):
+              "q_ext_all_we", "q_ext_all_data", "lo_x_in", "lo_y_in"):
         if hasattr(dut, s):
             getattr(dut, s).value = 0
 
@@ -177,6 +177,14 @@ async def engine_vs_model(dut):
         org = (int(rng.integers(1, 300)), int(rng.integers(1, 200)))
         reg = Region(org[0], org[1], rw, rh, lo=(org[0] + ker.ex, org[1] + ker.ey),
                      hi=(org[0] + rw - 1 - ker.ex, org[1] + rh - 1 - ker.ey))
+        if g.get("LO_IN") and case % 2 == 1:
+            # LO_IN: the clamp's lower bound above ex / ey (an init job's region inside its slot rectangle)
+            up = (int(rng.integers(1, 6)), int(rng.integers(1, 6)))
+            reg = Region(reg.x, reg.y, rw, rh, lo=(min(reg.lo[0] + up[0], reg.hi[0]), min(reg.lo[1] + up[1], reg.hi[1])),
+                         hi=reg.hi)
+        if g.get("LO_IN"):
+            dut.lo_x_in.value = reg.lo[0] - reg.x
+            dut.lo_y_in.value = reg.lo[1] - reg.y
         kind = "noise" if case % 3 == 2 else "blob"
         learn_bins = make_region(rng, rh, rw, nb, kind)
         if no > 1:
@@ -278,6 +286,24 @@ CONFIGS = {
                        "colour"),
     "colour_default": (TrackerParams(), FixedParams(), 2, "colour"),
 }
+
+
+@pytest.mark.ghdl
+def test_ms_meanshift_lo_in():
+    """LO_IN: the clamp's lower bound from lo_x_in / lo_y_in (the init job's reference pass); in every second
+    case it is 1 to 5 px above ex / ey, and the model's Region carries the same bound."""
+    from mstrack.hw.hdl import TB_DIR, rtl_sources, run_ghdl
+    tp, fp, lanes, _ = CONFIGS["colour_l2"]
+    g = core_generics(tp, fp, lanes)
+    g["BIN_W"] = 3 * tp.colour_bits
+    g["LO_IN"] = 1
+    gen = {k: g[k] for k in ENGINE_GENERICS + ("BIN_W", "LO_IN")}
+    job = {"tp": {"colour_bits": tp.colour_bits, "kernel": tp.kernel}, "fp": {"max_half": fp.max_half,
+           "margin": fp.margin}, "seed": 9, "cases": 6}
+    run_ghdl("ms_meanshift_tb_top", "test_ms_meanshift", generics=gen,
+             sources=rtl_sources("ms_meanshift_tb_top", extra=[TB_DIR / "ms_meanshift_tb_top.vhd"]),
+             build_name="ms_meanshift_lo_in", testcase="engine_vs_model",
+             extra_env={"MSTRACK_GENERICS": json.dumps(g), "MSTRACK_JOB": json.dumps(job)})
 
 
 @pytest.mark.parametrize("name", list(CONFIGS))

@@ -1,7 +1,8 @@
 """mstrack.hw.cosim_multi.CoreModelMulti, the stream-level model of the multi-target core ms_tracker_multi
 (docs/multi_target_core.md, "Ports and result stream"), against what it is built from: core v2's
 model for one target, single fixed-point trackers for several, and the multi-target result word's
-layout; refusals, faults and frames without a live target."""
+layout; refusals, faults and frames without a live target; with the capacity rule of the shared-engine
+core, against mstrack.MultiTracker(model="fixed") under the same rule."""
 from __future__ import annotations
 
 import numpy as np
@@ -12,7 +13,7 @@ from mstrack.fixed.blocks import round_box
 from mstrack.fixed.vhdl_pkg import (RESULT_FLAGS, STATUS_V2, pack_result_multi, result_fields_v2,
                                     result_layout_multi, result_width_multi, unpack_result_multi)
 from mstrack.hw.cosim import COMPARED_FIELDS_V2, ERR_SHORT_LINE, CoreModelV2, frame_words
-from mstrack.hw.cosim_multi import CMD_BOX, CMD_OK, CMD_REFUSED, CoreModelMulti, Outcome
+from mstrack.hw.cosim_multi import CMD_BOX, CMD_CYCLES, CMD_OK, CMD_REFUSED, CoreModelMulti, Outcome
 from mstrack.io.synthetic import make_multi_scene, make_scene
 from mstrack.track.params import TrackerParams
 from mstrack.track.tracker import Tracker
@@ -174,3 +175,105 @@ def test_no_live_target_gives_one_no_target_word() -> None:
     assert [len(fr) for fr in m.frames] == [1, 1, 1] and m.results[1]["status"] == STATUS_V2.index("init")
     for fr in (m.frames[0], m.frames[2]):
         assert fr[0]["flags"] == FLAG["no_target"] and fr[0]["target_id"] == 0
+
+
+# ----------------------------------------------------------------------------- the capacity rule
+def _capacity_run(cap, frames, cmds, n_slots: int = 3):
+    """The model with the capacity rule and mstrack.MultiTracker(model="fixed") with the same rule on the same
+    frames and adds ({frame: [box, ...]}, taken before the frame; MultiTracker: update(frame) then add(frame, box)).
+    Returns the model and, per frame, MultiTracker's results by the model's slot of each target."""
+    from mstrack.track.multi import CapacityError, MultiTracker
+    m = CoreModelMulti(TP, FP, 128, max_targets=n_slots, capacity=cap)
+    mt = MultiTracker(model="fixed", params=TP, capacity=cap)
+    slot_of: dict[int, int] = {}                    # MultiTracker id -> the model's slot
+    api: list[dict[int, dict]] = []
+    api_codes: list[int] = []
+    for i, fr in enumerate(frames):
+        words = frame_words(fr)
+        taken = []
+        for box in cmds.get(i, []):
+            taken.append(m.add(box, 96, 80))
+        _feed(m, words)
+        res = {r.target_id: r for r in mt.update(fr)} if mt.targets else {}
+        for box, slot in zip(cmds.get(i, []), taken):
+            try:
+                tid = mt.add(fr, box)
+                res[tid] = mt.last[tid]
+                slot_of[tid] = slot
+                api_codes.append(CMD_OK)
+            except CapacityError as e:
+                api_codes.append(e.add_code)
+        api.append({slot_of[t]: result_fields_v2(r.extra) for t, r in res.items()})
+    return m, api, api_codes
+
+
+def _same_words(m, api) -> int:
+    """Every frame: the model's words are MultiTracker's results, field by field (the flag rejected and the
+    frame count are the core's own); returns the number of held words."""
+    held = 0
+    for i, (fr, want) in enumerate(zip(m.frames, api)):
+        assert [w["target_id"] for w in fr] == sorted(want), f"frame {i}: slots {[w['target_id'] for w in fr]}"
+        for w in fr:
+            e = want[w["target_id"]]
+            got = {k: w[k] for k in COMPARED_FIELDS_V2 if k != "frame_count"}
+            got["flags"] &= ~FLAG["rejected"]
+            assert got == {k: e[k] for k in got}, f"frame {i} slot {w['target_id']}"
+            held += w["err_code"] == 6
+    return held
+
+
+def test_capacity_rule_is_multitrackers() -> None:
+    """A budget (line_clocks 100, 450 blank lines: 45,000 clocks) that holds two of these targets' jobs: of
+    three adds before frame 0 the third is refused (CMD_CYCLES, its slot free again, `rejected` on frame 0's
+    first word); blank frames 4-6 lose both targets, whose wide searches do not fit together, so one is held
+    (status error, err_code 6, its state kept); the third target added again before frame 7.  Every word equals
+    MultiTracker(model="fixed")'s result with the same rule."""
+    from mstrack.fixed.multi_capacity import ADD_CYCLES, MultiCoreConfig, VideoTiming
+    words, frames, boxes = _multi(10)
+    frames = [f if i not in (4, 5, 6) else np.zeros_like(f) for i, f in enumerate(frames)]
+    cap = MultiCoreConfig(3, VideoTiming(80, 530, 100))
+    cmds = {0: [boxes[(0, 1)], boxes[(0, 2)], boxes[(0, 3)]], 7: [boxes[(7, 3)]]}
+    m, api, codes = _capacity_run(cap, frames, cmds)
+    held = _same_words(m, api)
+    assert held >= 1, "no target was held: the case does not test the rule's hold"
+    cycles = [o for o in m.outcomes if o.code == CMD_CYCLES]
+    assert codes.count(ADD_CYCLES) == len(cycles) >= 1 and m.outcomes[:3] == [
+        Outcome(CMD_OK, 0), Outcome(CMD_OK, 1), Outcome(CMD_OK, 2)] and m.outcomes[3] == Outcome(CMD_CYCLES, 2)
+    assert m.frames[0][0]["flags"] & FLAG["rejected"] and [w["target_id"] for w in m.frames[0]] == [0, 1]
+    assert any(p.held for p in m.plans)
+
+
+def test_capacity_rule_with_room_is_ms_tracker_multi() -> None:
+    """With 1080p60's budget nothing is held or refused: the words and reports are those without the rule
+    (targets added and removed as in test_targets_added_and_removed_match_single_trackers)."""
+    from mstrack.fixed.multi_capacity import MultiCoreConfig
+    words, frames, boxes = _multi()
+    cmds = {0: [("add", 1), ("add", 2)], 3: [("add", 3)], 5: [("remove", 0)], 7: [("add", 1)]}
+    models = [CoreModelMulti(TP, FP, 128, max_targets=3), CoreModelMulti(TP, FP, 128, 3, MultiCoreConfig(3))]
+    for m in models:
+        for i, f in enumerate(words):
+            for op, arg in cmds.get(i, []):
+                m.add(boxes[(i, arg)], 96, 80) if op == "add" else m.remove(arg)
+            _feed(m, f)
+    assert models[0].frames == models[1].frames and models[0].outcomes == models[1].outcomes
+    assert not any(p.held for p in models[1].plans)
+
+
+def test_capacity_rule_init_after_a_fault_keeps_its_verdict() -> None:
+    """An accepted add whose init frame has a stream fault: one error word per live target on the faulty
+    frame and none for the add; its init runs on the next good frame, before a later add that then does not
+    fit (CMD_CYCLES); the flag rejected only on that frame."""
+    from mstrack.fixed.multi_capacity import MultiCoreConfig, VideoTiming
+    words, frames, boxes = _multi(6)
+    m = CoreModelMulti(TP, FP, 128, max_targets=3, capacity=MultiCoreConfig(3, VideoTiming(80, 530, 100)))
+    m.add(boxes[(0, 1)], 96, 80)
+    _feed(m, words[0])
+    m.add(boxes[(1, 2)], 96, 80)
+    _feed(m, words[1], "short_line")               # the add's init frame is faulty
+    assert [(w["target_id"], w["err_code"]) for w in m.frames[1]] == [(0, ERR_SHORT_LINE)]
+    m.add(boxes[(2, 3)], 96, 80)                   # with the pending init there is no room for this one
+    for i in range(2, 6):
+        _feed(m, words[i])
+    assert [w["target_id"] for w in m.frames[2]] == [0, 1] and m.frames[2][1]["status"] == STATUS_V2.index("init")
+    assert m.outcomes == [Outcome(CMD_OK, 0), Outcome(CMD_OK, 1), Outcome(CMD_OK, 2), Outcome(CMD_CYCLES, 2)]
+    assert [i for i, fr in enumerate(m.frames) if fr[0]["flags"] & FLAG["rejected"]] == [2]

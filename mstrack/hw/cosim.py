@@ -450,6 +450,9 @@ class CoreModelV2(CoreModel):
         super()._reset_state()
         self.box_wh = (0, 0)                      # w8, h8 of the state
         self.v2: FixedTrackerV2 | None = None     # the target (CoreModel.trk stays None)
+        #: the multi-target core's capacity rule for the next frame (CoreModelMulti with a capacity): the
+        #: target's TargetDemand when it is held on that frame, else None
+        self.hold = None
 
     def has_target(self) -> bool:
         return self.v2 is not None
@@ -490,8 +493,15 @@ class CoreModelV2(CoreModel):
         from ..fixed.tracker_v2 import FixedTrackerV2
         from ..fixed.vhdl_pkg import result_fields_v2
         h, w = words.shape
+        hold, self.hold = self.hold, None
         if (self.pending or self.v2) and (w, h) != self.tgt:
             self._error(ERR_SIZE_CHANGED)
+            return
+        if hold is not None and self.v2 and not self.pending:   # held by the capacity rule: the state stays
+            from ..fixed.multi_capacity import held_result
+            f = result_fields_v2(held_result(self.v2, hold).extra, self.count)
+            del f["frame_count"]
+            self._push("held", **f)
             return
         if self.pending:
             box, _ = self.pending

@@ -18,6 +18,20 @@ behaviour) fed the same beats, plus:
   gives slot 0's word alone (``no_target``, as core v2).  ``rejected`` of any engine's word of the frame
   (or of a refused add) is set on the frame's first word.
 
+**The capacity rule** (``capacity``: a :class:`mstrack.fixed.multi_capacity.MultiCoreConfig`; the shared-engine
+core, docs/multi_target_core.md "Capacity rule"; None: ``ms_tracker_multi``, every engine its own budget).
+At each frame's start the frame is planned: the live targets, oldest first, by
+:func:`~mstrack.fixed.multi_capacity.plan_frame` on their states (:func:`~mstrack.fixed.multi_capacity.target_demand`);
+a held target's word is :func:`~mstrack.fixed.multi_capacity.held_result`'s (status error, ``err_code`` 6) and its
+state stays.  Then the adds taken since the last frame, in the order taken: an init job that fits
+(:func:`~mstrack.fixed.multi_capacity.check_add` with the frame's admitted jobs and the adds taken before it) is
+initialised on this frame; one that does not is refused: report ``CMD_CYCLES`` with its slot, which is free again,
+and the flag ``rejected`` on the frame's first word.  The add itself was reported ``CMD_OK`` with its slot when it
+was taken, as without the rule (a box the engine rejects is reported later, ``CMD_BOX``, in the same way).  An
+accepted add whose init frame has a stream fault keeps its verdict and is initialised on the next good frame (a
+fault changes no state, so it still fits; it counts before that frame's adds).  On a frame with a stream fault
+every live target's word is the error word, held or not.
+
 Feed it, in stream order, ``beat(data, tuser, tlast, fw, fh)`` for every accepted beat, ``add`` /
 ``remove`` where the core took a command, and ``reset()``.  ``frames`` holds, per frame, the list of
 predicted words (field dicts with ``target_id``); ``outcomes`` each command's and each rejected box's
@@ -30,13 +44,15 @@ from typing import Sequence
 
 from .cosim import COMPARED_FIELDS_V2, CoreModelV2, diff_fields
 from ..fixed import FixedParams
+from ..fixed.multi_capacity import MultiCoreConfig
 from ..fixed.vhdl_pkg import RESULT_FLAGS, pack_result_multi
 from ..track.params import TrackerParams
 
 #: cmd_code: an add taken by a slot or a remove done (ok); an add with every slot taken or a remove of
-#: an id that is not live (refused); an add whose box the engine rejected (box, reported when the
+#: an id that is not live (refused); with the capacity rule, an add whose init job does not fit its frame
+#: (cycles, reported at that frame's start); an add whose box the engine rejected (box, reported when the
 #: engine's word shows it)
-CMD_OK, CMD_REFUSED, CMD_BOX = 0, 1, 3
+CMD_OK, CMD_REFUSED, CMD_CYCLES, CMD_BOX = 0, 1, 2, 3
 _REJ = 1 << RESULT_FLAGS.index("rejected")
 _NOT = 1 << RESULT_FLAGS.index("no_target")
 
@@ -53,9 +69,12 @@ class CoreModelMulti:
     (module docstring)."""
 
     def __init__(self, tp: TrackerParams | None = None, fp: FixedParams | None = None, max_frame_w: int = 2048,
-                 max_targets: int = 2) -> None:
+                 max_targets: int = 2, capacity: MultiCoreConfig | None = None) -> None:
         if not 1 <= max_targets <= 16:
             raise ValueError(f"max_targets must be 1 .. 16, got {max_targets}")
+        if capacity is not None and capacity.max_targets != max_targets:
+            raise ValueError(f"capacity.max_targets ({capacity.max_targets}) must be max_targets ({max_targets})")
+        self.capacity = capacity
         self.tp, self.fp, self.max_frame_w, self.n = tp or TrackerParams(preset="v2"), fp or FixedParams(), \
             max_frame_w, max_targets
         self.frames: list[list[dict[str, int]]] = []
@@ -70,6 +89,10 @@ class CoreModelMulti:
         self.rej_flag = False
         self.merged = 0                       # engine results merged (the same index in every engine)
         self.count = 0
+        self.order: list[int] = []            # capacity rule: slots in the order their adds were taken
+        self.waiting: dict[int, tuple] = {}   # capacity rule: adds taken since the last frame start
+        #: capacity rule: each frame's plan (:class:`mstrack.fixed.multi_capacity.FramePlan`), in order
+        self.plans: list = []
 
     @property
     def results(self) -> list[dict[str, int]]:
@@ -92,7 +115,11 @@ class CoreModelMulti:
         k = free[0]
         self.alloc[k] = self.pend[k] = True
         x, y, w, h = (int(v) for v in box)
-        self.engines[k].init((x, y, w, h), fw, fh)
+        if self.capacity is not None:         # initialised at the next frame's start if it fits
+            self.waiting[k] = ((x, y, w, h), fw, fh)
+            self.order.append(k)
+        else:
+            self.engines[k].init((x, y, w, h), fw, fh)
         self.outcomes.append(Outcome(CMD_OK, k))
         return k
 
@@ -101,6 +128,9 @@ class CoreModelMulti:
         if 0 <= target_id < self.n and self.alloc[target_id]:
             self.engines[target_id].reset()
             self.alloc[target_id] = self.pend[target_id] = False
+            self.waiting.pop(target_id, None)
+            if target_id in self.order:
+                self.order.remove(target_id)
             self.outcomes.append(Outcome(CMD_OK, target_id))
             return True
         self.outcomes.append(Outcome(CMD_REFUSED, target_id & 0xF))
@@ -109,6 +139,8 @@ class CoreModelMulti:
     # -- the stream ----------------------------------------------------------------------------------
     def beat(self, data: int, tuser: int, tlast: int, fw: int, fh: int) -> None:
         """One beat taken by every engine."""
+        if tuser and self.capacity is not None:
+            self._plan()
         for e in self.engines:
             e.beat(data, tuser, tlast, fw, fh)
         n = len(self.engines[0].results)
@@ -117,6 +149,44 @@ class CoreModelMulti:
         while self.merged < n:
             self._merge([e.results[self.merged] for e in self.engines])
             self.merged += 1
+
+    def _plan(self) -> None:
+        """The capacity rule at a frame's start (module docstring)."""
+        from ..fixed.multi_capacity import ADD_OK, check_add, init_demand, plan_frame, target_demand
+        cap = self.capacity
+        live = [k for k in self.order if self.engines[k].v2 is not None and not self.engines[k].pending]
+        demands = {k: target_demand(self.engines[k].v2, k, costs=cap.costs) for k in live}
+        plan = plan_frame([demands[k] for k in live], cap)
+        self.plans.append(plan)
+        admitted = list(plan.jobs)
+        n_live = len(self.order) - len(self.waiting)
+        for k in live:
+            self.engines[k].hold = demands[k] if k in plan.held else None
+        # accepted adds whose init frame had a fault keep their verdict: a fault changes no state, so the
+        # live targets' jobs are those the add was checked against, and it is checked before this frame's adds
+        for k in [k for k in self.order if self.engines[k].pending]:
+            (box, _), (fw, fh) = self.engines[k].pending, self.engines[k].tgt
+            new = self._init_job(init_demand, box, fw, fh, k)
+            admitted += [new] if new is not None else []
+        for k, (box, fw, fh) in list(self.waiting.items()):
+            del self.waiting[k]
+            new = self._init_job(init_demand, box, fw, fh, k)
+            if new is not None and check_add(admitted, n_live, new, cap) != ADD_OK:
+                self.alloc[k] = self.pend[k] = False
+                self.order.remove(k)
+                self.rej_flag = True
+                self.outcomes.append(Outcome(CMD_CYCLES, k))
+                continue
+            self.engines[k].init(box, fw, fh)
+            n_live += 1
+            admitted += [new] if new is not None else []
+
+    def _init_job(self, init_demand, box, fw: int, fh: int, k: int):
+        """The add's init job, or None for a box its engine rejects (reported CMD_BOX by the engine's word)."""
+        try:
+            return init_demand(box, fw, fh, k, self.tp, self.fp, self.capacity.costs)
+        except ValueError:
+            return None
 
     def _merge(self, words: list[dict[str, int]]) -> None:
         rej = self.rej_flag
@@ -171,13 +241,13 @@ def frame_beats(words, fault: str | None = None) -> list[tuple[int, int, int]]:
 
 def expected_multi(frames, commands: dict[int, list[tuple]], tp: TrackerParams | None = None,
                    fp: FixedParams | None = None, max_targets: int = 2, max_frame_w: int = 2048,
-                   faults: dict[int, str] | None = None) -> CoreModelMulti:
+                   faults: dict[int, str] | None = None, capacity: MultiCoreConfig | None = None) -> CoreModelMulti:
     """The model fed as :func:`mstrack.hw.fastsim.simulate_multi` feeds the core: *commands* (``{frame:
     [("add", (x, y, w, h)) | ("remove", id), ...]}``) before the frames they are keyed by, every frame
     (BGR arrays) as :func:`frame_beats` streams it with its fault in *faults*.  Returns the model
     (``frames``, ``results``, ``outcomes``)."""
     from .cosim import frame_words
-    m = CoreModelMulti(tp, fp, max_frame_w, max_targets)
+    m = CoreModelMulti(tp, fp, max_frame_w, max_targets, capacity)
     n = 0
     for i, fr in enumerate(frames):
         words = frame_words(fr)
@@ -192,4 +262,5 @@ def expected_multi(frames, commands: dict[int, list[tuple]], tp: TrackerParams |
     return m
 
 
-__all__ = ["CoreModelMulti", "expected_multi", "diff_words", "frame_beats", "Outcome", "CMD_OK", "CMD_REFUSED", "CMD_BOX"]
+__all__ = ["CoreModelMulti", "expected_multi", "diff_words", "frame_beats", "Outcome", "CMD_OK", "CMD_REFUSED",
+           "CMD_CYCLES", "CMD_BOX"]

@@ -246,6 +246,9 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_job_queue.py::test_ms_job_queue_verilator":
         "test_ms_job_queue[16] / [5] / [1] (the same bench on the RTL under GHDL); this case: the netlist under "
         "Verilator",
+    "tb/test_ms_init_job.py::test_ms_init_job_joint_verilator":
+        "test_ms_init_job (the same bench on the RTL under GHDL, colour bins) and ms_bg_model's joint-bin tests "
+        "(test_ms_bg_model_verilator[orient9]); this case: the joint bins' netlist",
     "tb/test_ms_slot_scan.py::test_ms_slot_scan_verilator":
         "test_ms_slot_scan (the same bench on the RTL under GHDL); this case: the netlist under Verilator",
     "tb/test_ms_bg_model.py::test_ms_bg_model_models_verilator":

@@ -45,7 +45,7 @@ entity ms_frame_plan is
     C_TRACK        : natural := 13254;
     M_LOST         : natural := 54;
     C_LOST         : natural := 32591;
-    C_INIT         : natural := 15597;
+    C_INIT         : natural := 15826;
     SCALE_PERMILLE : natural := 50;
     C_SCALE        : natural := 2870;
     -- ms_admit

@@ -32,7 +32,7 @@ entity ms_job_clocks is
     C_TRACK        : natural := 13254;
     M_LOST         : natural := 54;      -- passes of a lost job (9 start points x (search_iter + 1))
     C_LOST         : natural := 32591;
-    C_INIT         : natural := 15597;
+    C_INIT         : natural := 15826;
     SCALE_PERMILLE : natural := 50;      -- round(1000 scale_test); 0: no scale test
     C_SCALE        : natural := 2870
   );

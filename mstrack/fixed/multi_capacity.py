@@ -104,6 +104,8 @@ class PassCosts:
     qload_extra: int = 6        # Qw load = colour addresses + 6
     scale_window_extra: int = 77  # per scale-test window: size / window / fit 8 + bin pass tail 35 + rho 34
     bg_drain: int = 65          # ms_bg_model: 3 passes over the bins + 65
+    init_start: int = 229       # init job (rtl/ms_init_job.vhd): ms_bg_model's set-up of the largest box, 217
+                                # at HALF_W 6, + the slot scan's start: its read latency 5 + 7 registers
     job_switch: int = 64        # multi-target core: state record in / out, region set-up per job
 
     def __post_init__(self) -> None:
@@ -194,7 +196,8 @@ def job_clocks(kind: JobKind, wd: int, hd: int, tp: TrackerParams, costs: PassCo
 
     track: Qw load, ``max_iter`` iterations, the v2 per-frame work, the gated scale test's two
     windows (the larger at +scale_test, up to ``window_limit``); lost: the centre and 8 more start
-    points of ``search_iter`` iterations each, 8 more confidences; init: the background model
+    points of ``search_iter`` iterations each, 8 more confidences; init: ms_init_job (``init_start``: the
+    background model's set-up and the scan's start), the background model
     counted from the captured rectangle ``ring`` (rows, cols: :func:`init_capture`'s ``rect``, the box,
     its ring and the init region) at one pixel per clock,
     its 3 passes over the bins, the Qw load and one pass at the init centre.  Every job adds
@@ -215,7 +218,7 @@ def job_clocks(kind: JobKind, wd: int, hd: int, tp: TrackerParams, costs: PassCo
     elif kind == "lost":
         work = qload + 9 * _engine(tp.search_iter + 1, pp, b, c) + 8 * c.confidence + scale
     elif kind == "init":
-        work = ring[0] * ring[1] + 3 * tp.n_bins_v2 + c.bg_drain + qload + pp + b
+        work = c.init_start + ring[0] * ring[1] + 3 * tp.n_bins_v2 + c.bg_drain + qload + pp + b
     else:
         raise ValueError(f"job kind must be init, track or lost, got {kind!r}")
     return c.front + work + c.v2_overhead + c.back + c.job_switch

@@ -507,7 +507,7 @@ def job_clocks_generics(tp: TrackerParams, costs: PassCosts = PassCosts(), half_
         "LANES": c.lanes, "HALF_W": half_w, "PASS_LAT": c.pass_lat,
         "M_TRACK": tp.max_iter + 1, "C_TRACK": common + engine_const(tp.max_iter + 1),
         "M_LOST": 9 * (tp.search_iter + 1), "C_LOST": common + 9 * engine_const(tp.search_iter + 1) + 8 * c.confidence,
-        "C_INIT": common + 3 * tp.n_bins_v2 + c.bg_drain + b,
+        "C_INIT": common + c.init_start + 3 * tp.n_bins_v2 + c.bg_drain + b,
         "SCALE_PERMILLE": st if tp.scale_test > 0 else 0,
         "C_SCALE": 2 * (c.kernel_tables + qload + b + c.scale_window_extra),
     }

@@ -64,6 +64,9 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         # RD_LAT 4 in the slot RAM + its multiplexer)
         "ms_slot_scan": {"LANES": c["LANES"], "STRIDE": 64, "ADDR_W": 14, "DATA_W": 13, "REGION_W": 9,
                          "RD_LAT": 5},
+        # the init job of the joint core: ms_slot_scan into ms_bg_model (4,608 joint bins), two models
+        "ms_init_job": {"LANES": c["LANES"], "STRIDE": 64, "ADDR_W": 14, "REGION_W": 9, "RD_LAT": 5, "BIN_W": 9,
+                        "N_ORIENT": 9, "HALF_W": 6, "RING_W": 5, "Q_W": 14, "O_W": 17, "KD_W": 29, "MODELS": 2},
     }
 
 

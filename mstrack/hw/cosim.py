@@ -6,7 +6,7 @@ field by field, frame by frame, with :func:`expected_results`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Iterable, Sequence
 
 import numpy as np
 
@@ -452,7 +452,7 @@ class CoreModelV2(CoreModel):
         self.v2: FixedTrackerV2 | None = None     # the target (CoreModel.trk stays None)
         #: the multi-target core's capacity rule for the next frame (CoreModelMulti with a capacity): the
         #: target's TargetDemand when it is held on that frame, else None
-        self.hold = None
+        self.hold: Any = None
 
     def has_target(self) -> bool:
         return self.v2 is not None

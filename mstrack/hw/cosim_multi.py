@@ -152,25 +152,29 @@ class CoreModelMulti:
 
     def _plan(self) -> None:
         """The capacity rule at a frame's start (module docstring)."""
-        from ..fixed.multi_capacity import ADD_OK, check_add, init_demand, plan_frame, target_demand
+        from ..fixed.multi_capacity import ADD_OK, TargetDemand, check_add, plan_frame, target_demand
         cap = self.capacity
-        live = [k for k in self.order if self.engines[k].v2 is not None and not self.engines[k].pending]
-        demands = {k: target_demand(self.engines[k].v2, k, costs=cap.costs) for k in live}
+        assert cap is not None
+        trackers = {k: e.v2 for k, e in enumerate(self.engines) if e.v2 is not None and not e.pending}
+        live = [k for k in self.order if k in trackers]
+        demands = {k: target_demand(trackers[k], k, costs=cap.costs) for k in live}
         plan = plan_frame([demands[k] for k in live], cap)
         self.plans.append(plan)
-        admitted = list(plan.jobs)
+        admitted: list[TargetDemand] = list(plan.jobs)
         n_live = len(self.order) - len(self.waiting)
         for k in live:
             self.engines[k].hold = demands[k] if k in plan.held else None
         # accepted adds whose init frame had a fault keep their verdict: a fault changes no state, so the
         # live targets' jobs are those the add was checked against, and it is checked before this frame's adds
-        for k in [k for k in self.order if self.engines[k].pending]:
-            (box, _), (fw, fh) = self.engines[k].pending, self.engines[k].tgt
-            new = self._init_job(init_demand, box, fw, fh, k)
-            admitted += [new] if new is not None else []
+        for k in self.order:
+            pending = self.engines[k].pending
+            if pending is not None:
+                (fw, fh) = self.engines[k].tgt
+                new = self._init_job(pending[0], fw, fh, k)
+                admitted += [new] if new is not None else []
         for k, (box, fw, fh) in list(self.waiting.items()):
             del self.waiting[k]
-            new = self._init_job(init_demand, box, fw, fh, k)
+            new = self._init_job(box, fw, fh, k)
             if new is not None and check_add(admitted, n_live, new, cap) != ADD_OK:
                 self.alloc[k] = self.pend[k] = False
                 self.order.remove(k)
@@ -181,8 +185,10 @@ class CoreModelMulti:
             n_live += 1
             admitted += [new] if new is not None else []
 
-    def _init_job(self, init_demand, box, fw: int, fh: int, k: int):
+    def _init_job(self, box: tuple, fw: int, fh: int, k: int):
         """The add's init job, or None for a box its engine rejects (reported CMD_BOX by the engine's word)."""
+        from ..fixed.multi_capacity import init_demand
+        assert self.capacity is not None
         try:
             return init_demand(box, fw, fh, k, self.tp, self.fp, self.capacity.costs)
         except ValueError:

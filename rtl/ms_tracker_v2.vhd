@@ -32,7 +32,8 @@
 -- Throughput: 1 pixel per clock while a frame streams; the input is closed from a frame's last pixel
 -- until its result is in the FIFO (as ms_tracker).
 -- Handshake: AXI4-Stream in (s_axis) and out (m_axis_result, one word per frame, tlast = 1), s_init
--- valid / ready (taken between frames), busy = the engine is running.
+-- valid / ready (taken between frames), busy = the engine is running; tgt_load valid / ready (another
+-- target's state record and model, taken between frames after any s_init; MODELS > 1).
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;

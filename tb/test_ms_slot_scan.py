@@ -10,15 +10,12 @@ a scan, and checks the stream:
 * a `start` while busy is ignored.
 
 Cases: random rectangles from 1 x 1 to the slot's full width (LANES x STRIDE), widths that are not a
-multiple of LANES, scans back to back.  With ../shared: the init capture of a real frame
-(:func:`mstrack.fixed.multi_capacity.init_capture` on Girl's first frame, joint bins).  The stream the
-RTL gives goes into the model's ms_bg_model, which must give FixedTrackerV2.init's model.
+multiple of LANES, scans back to back.  The scan of a real init rectangle into ms_bg_model is
+tb/test_ms_init_job.py's.
 Run: ``.venv/bin/python -m pytest tb/test_ms_slot_scan.py``.
 """
 from __future__ import annotations
 
-import json
-import os
 import random
 from pathlib import Path
 
@@ -36,9 +33,7 @@ from mstrack.hw.hdl import dut_generics
 TOP = "ms_slot_scan_tb_top"
 MODULE = "test_ms_slot_scan"
 TB_DIR = Path(__file__).resolve().parent
-SEQ_ROOT = TB_DIR.parents[1] / "shared" / "data" / "sequences"
 SMALL = {"LANES": 4, "STRIDE": 8, "ADDR_W": 8, "DATA_W": 13, "REGION_W": 6, "DEPTH": 256, "RD_LAT": 4}
-WIDE = {"LANES": 4, "STRIDE": 64, "ADDR_W": 14, "DATA_W": 13, "REGION_W": 9, "DEPTH": 16384, "RD_LAT": 4}
 
 
 class ScanTB:
@@ -160,37 +155,6 @@ async def slot_scan_cases(dut):
     await tb.scan(region, "back_to_back_b", poke_start=False)
 
 
-@cocotb.test()
-async def slot_scan_init(dut):
-    """The init capture of a real frame: the RTL's stream through the model's ms_bg_model is init's model."""
-    from mstrack.fixed.blocks_v2 import ms_bg_model
-    from mstrack.fixed.multi_capacity import init_capture
-    from mstrack.fixed.tracker_v2 import FixedTrackerV2
-    from mstrack.io.data import load_sequence
-    job = json.loads(os.environ["MSTRACK_JOB"])
-    seq = load_sequence(SEQ_ROOT / job["seq"])
-    frame, box = seq.frame(0), seq.init_box()
-    trk = FixedTrackerV2()
-    trk.init(frame, box)
-    fh, fw = frame.shape[:2]
-    ic = init_capture(box, fw, fh)
-    x, y, w, h = ic.rect
-    region = trk._bins(frame, ic.d)[y: y + h, x: x + w]
-    tb = ScanTB(dut)
-    await tb.reset()
-    await tb.fill(region)
-    got = await tb.scan(region, f"{job['seq']} init rectangle", poke_start=True)
-    bins = np.zeros((h, w), np.int64)
-    for rx, ry, v in got:
-        bins[ry, rx] = v
-    m = ms_bg_model(bins, ic.cd[0] - x, ic.cd[1] - y, ic.wb, ic.hb, trk.ring16, trk.params.n_bins_v2,
-                    trk.fixed.bg_frac)
-    for k in ("Qn", "T", "Q", "O"):
-        assert np.array_equal(np.asarray(getattr(m, k)), np.asarray(getattr(trk.model, k))), \
-            f"{job['seq']}: {k} of the model learnt from the scanned slot differs from init's"
-    dut._log.info("%s: rectangle %d x %d at (%d, %d), D = %d: init's model from the slot", job["seq"], w, h, x, y, ic.d)
-
-
 # ----------------------------------------------------------------------------- pytest side
 def _sources() -> list:
     return hdl.rtl_sources(TOP, extra=[TB_DIR / "ms_slot_scan_tb_top.vhd"])
@@ -200,15 +164,6 @@ def _sources() -> list:
 def test_ms_slot_scan(hdl_waves):
     hdl.run_ghdl(TOP, MODULE, SMALL, _sources(), waves=hdl_waves, test_filter="slot_scan_cases",
                  build_name="ghdl_ms_slot_scan_small")
-
-
-@pytest.mark.ghdl
-def test_ms_slot_scan_init(hdl_waves):
-    """Girl's init rectangle (joint bins) in a slot of the default size (STRIDE 64, 16,384 words per bank)."""
-    if not (SEQ_ROOT / "Girl").is_dir():
-        pytest.skip(f"{SEQ_ROOT / 'Girl'} not found: the real init frame needs ../shared/data/sequences")
-    hdl.run_ghdl(TOP, MODULE, WIDE, _sources(), waves=hdl_waves, test_filter="slot_scan_init",
-                 build_name="ghdl_ms_slot_scan_wide", extra_env={"MSTRACK_JOB": json.dumps({"seq": "Girl"})})
 
 
 @pytest.mark.verilator

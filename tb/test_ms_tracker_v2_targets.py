@@ -103,9 +103,8 @@ async def run_targets(dut):
         for k in sorted(trackers):
             trk = trackers[k]
             await load_target(dut, records[k], k)
-            new = any(k == a for a, _ in adds.get(t, []))
-            if new:
-                box = dict(adds[t])[k]
+            box = dict(adds.get(t, [])).get(k)          # its box on the frame it is added
+            if box is not None:
                 await tb.init(box)
                 r = trk.init(frame, box)
             else:

@@ -19,6 +19,14 @@ package ms_pkg is
   function min(a, b : integer) return integer;
   -- bits of core v2's target state record (ms_tracker_v2 tgt_state: mstrack.fixed.vhdl_pkg.target_state_layout_v2)
   function v2_state_w(centre_abs_w, size_w, coord_w, share_w, con_w, spread_w : natural) return natural;
+  -- result word v2 (mstrack.fixed.vhdl_pkg.result_layout_v2), from bit 0: cx, cy (centre_abs_w each),
+  -- w8, h8 (size_w each), rho (rho_w), confidence 17, status 3, iter (iter_w), stop 2, decim_log2 3,
+  -- searched 4, flags 8, err_code 3, frame_count 16; result_w bits (the rest 0)
+  function v2_word(result_w, centre_abs_w, size_w, rho_w, iter_w : natural;
+                   cx, cy, bw, bh, rh, cn, st, it : unsigned; sp : std_logic_vector; dl, srch : unsigned;
+                   flags, err : std_logic_vector; fc : unsigned) return std_logic_vector;
+  -- result word v2's flags: 0 init, 1 clipped, 2 lost, 3 error, 4 rejected, 5 no_target, 6 overflow
+  function v2_flags(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector;
   -- stop codes of a mean-shift loop (mstrack.fixed.blocks.STOP_CODES)
   constant STOP_SHIFT    : std_logic_vector(1 downto 0) := "00";
   constant STOP_RHO      : std_logic_vector(1 downto 0) := "01";
@@ -27,6 +35,34 @@ package ms_pkg is
 end package;
 
 package body ms_pkg is
+  function v2_word(result_w, centre_abs_w, size_w, rho_w, iter_w : natural;
+                   cx, cy, bw, bh, rh, cn, st, it : unsigned; sp : std_logic_vector; dl, srch : unsigned;
+                   flags, err : std_logic_vector; fc : unsigned) return std_logic_vector is
+    variable v : std_logic_vector(result_w - 1 downto 0) := (others => '0');
+    variable o : natural := 0;
+  begin
+    v(o + centre_abs_w - 1 downto o) := std_logic_vector(resize(cx, centre_abs_w)); o := o + centre_abs_w;
+    v(o + centre_abs_w - 1 downto o) := std_logic_vector(resize(cy, centre_abs_w)); o := o + centre_abs_w;
+    v(o + size_w - 1 downto o) := std_logic_vector(resize(bw, size_w)); o := o + size_w;
+    v(o + size_w - 1 downto o) := std_logic_vector(resize(bh, size_w)); o := o + size_w;
+    v(o + rho_w - 1 downto o) := std_logic_vector(resize(rh, rho_w)); o := o + rho_w;
+    v(o + 16 downto o) := std_logic_vector(resize(cn, 17)); o := o + 17;
+    v(o + 2 downto o) := std_logic_vector(resize(st, 3)); o := o + 3;
+    v(o + iter_w - 1 downto o) := std_logic_vector(resize(it, iter_w)); o := o + iter_w;
+    v(o + 1 downto o) := sp; o := o + 2;
+    v(o + 2 downto o) := std_logic_vector(resize(dl, 3)); o := o + 3;
+    v(o + 3 downto o) := std_logic_vector(resize(srch, 4)); o := o + 4;
+    v(o + 7 downto o) := flags; o := o + 8;
+    v(o + 2 downto o) := err; o := o + 3;
+    v(o + 15 downto o) := std_logic_vector(resize(fc, 16));
+    return v;
+  end function;
+
+  function v2_flags(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector is
+  begin
+    return '0' & ovf & notgt & rej & err & lost & clipped & init;
+  end function;
+
   function v2_state_w(centre_abs_w, size_w, coord_w, share_w, con_w, spread_w : natural) return natural is
   begin
     return 3 + 2 * centre_abs_w + 3 * size_w + 2 * coord_w + 3 * share_w + 2 * con_w + spread_w;

@@ -1,17 +1,23 @@
--- ms_tracker_v2: the sequencer of core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2) bit for
--- bit, on the ports and stream behaviour of ms_tracker, with result word v2.  Integrators instantiate
--- ms_tracker with PRESET 1, which passes every port and generic here.  The block page,
--- docs/blocks/ms_tracker_v2.md, gives each step, the joint bins, the gated scale test, the stream
--- faults, the measured latencies and the tests.
+-- ms_tracker_v2: core v2: tracker v2 (mstrack.fixed.tracker_v2.FixedTrackerV2) bit for bit, on the ports
+-- and stream behaviour of ms_tracker, with result word v2.  Integrators instantiate ms_tracker with
+-- PRESET 1, which passes every port and generic here.  The block page, docs/blocks/ms_tracker_v2.md,
+-- gives each step, the joint bins, the gated scale test, the stream faults, the measured latencies and
+-- the tests.
 --
+-- Structure: the stream side (this entity) around ms_engine, the sequencer of one target's job
+-- (docs/blocks/ms_engine.md).  The stream side holds the stream check and gate, the front end,
+-- ms_decimate, the region capture and RAM, ms_bg_model (counted on the init frame's stream), the
+-- stream faults and the result FIFO; the engine the target's record, the geometry and the work after
+-- the frame.
 -- Computes, per video frame:
---   before the frame (input closed): log2 D = ms_decimation(w8, h8) (+ 1 while lost), the decimated
---   frame size, the window diameters (ms_window_size), the search offsets (STEP16) and the region (ms_region_v2)
---   around c8 >> log2 D (margin MARGIN, + the offset while lost, at most MARGIN_MAX); on an init frame
---   the box (ms_box_size) and the start of ms_bg_model;
+--   before the frame (input closed): the engine's geometry: log2 D = ms_decimation(w8, h8) (+ 1 while
+--   lost), the decimated frame size, the window diameters (ms_window_size), the search offsets (STEP16)
+--   and the region (ms_region_v2) around c8 >> log2 D (margin MARGIN, + the offset while lost, at most
+--   MARGIN_MAX); on an init frame the box (ms_box_size), then ms_bg_model reset and started here;
 --   during the frame: ms_frontend -> ms_decimate -> ms_region_capture (colour region RAM, + the 4-bit
 --   orientation RAM with ORIENT_T >= 0); on the init frame ms_bg_model counts the decimated frame;
---   after the frame: ms_kernel_tables + K, the Qw load (ms_model_scale into the engine's Q RAM, T into
+--   after the frame (the engine's job, started once the region is in and on an init frame the model
+--   learnt): ms_kernel_tables + K, the Qw load (ms_model_scale into the engine's Q RAM, T into
 --   ms_target_stats), ms_meanshift from c8 >> log2 D (init frame: one pass, `single`), ms_target_stats,
 --   rho (ms_fusion), ms_share, ms_confidence; while lost 8 more start points x SEARCH_ITER iterations,
 --   the best confidence wins; for the winner ms_spread, ms_ring_share, ms_loss_filter x 2,
@@ -168,114 +174,35 @@ architecture rtl of ms_tracker_v2 is
   constant BIN_C_W   : natural := 3 * COLOUR_BITS;
   constant OR_ON     : boolean := ORIENT_T >= 0;
   constant N_OR      : natural := 9 * boolean'pos(OR_ON) + boolean'pos(not OR_ON);   -- orientation banks
-  constant N_BINS    : natural := 2 ** BIN_C_W;
   constant DEPTH     : natural := REGION_MAX * STRIDE;
   constant REGION_RD_LAT : positive := 4;  -- ms_ram_sdp ecp5: 25 rows per bank, the row multiplexer in two registered levels
   constant REGION_WR_LAT : natural := 1;
   constant DRAIN     : natural := 63;
-  constant FLAGS_W   : natural := 8;
-  constant ERR_W     : natural := 3;
   constant FCOUNT_W  : natural := 16;
-  constant ONE16     : natural := 65536;
-  constant BOX_HALF_W : natural := COORD_W - 1;     -- ms_box_clip without shrink: MAX_HALF 2**(COORD_W-1) - 1
-  constant MS_LAT    : natural := 4;                -- ms_model_scale latency (HIST_W = 14)
-  -- status codes (mstrack.fixed.vhdl_pkg.STATUS_V2)
+  constant TS_W      : natural := v2_state_w(CENTRE_ABS_W, SIZE_W, COORD_W, SHARE_W, CON_W, SPREAD_W);
   constant ST_OK     : unsigned(2 downto 0) := "000";
-  constant ST_UNC    : unsigned(2 downto 0) := "001";
-  constant ST_LOST   : unsigned(2 downto 0) := "010";
-  constant ST_REACQ  : unsigned(2 downto 0) := "011";
-  constant ST_INIT   : unsigned(2 downto 0) := "100";
-  constant ST_CLIP   : unsigned(2 downto 0) := "101";
   constant ST_ERROR  : unsigned(2 downto 0) := "110";
 
-  type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BOX1, T_BOX2, T_BG_RST, T_BG_START, T_BG_WAIT,
-                    T_REGION_WAIT, T_IDLE, T_CLIP, T_BGDONE, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
-                    T_CNEXT, T_STATS0, T_STATS, T_CONF,
-                    T_DECIDE, T_ST_SIZE, T_ST_WS, T_ST_WS_WAIT, T_ST_FIT, T_ST_RUN, T_ST_RHO, T_ST_NEXT,
-                    T_ST_GATE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
-  signal state : tstate_t := T_PREP;
-
-  -- target state (one record per target)
-  signal target_valid, init_pending, init_clipped, rejected_pending : std_logic := '0';
-  signal c8x, c8y     : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
-  signal w8, h8, w0_8 : unsigned(SIZE_W - 1 downto 0) := (others => '0');
-  signal rho_ref, share_ref, rho0 : unsigned(SHARE_W - 1 downto 0) := (others => '0');
-  signal rho_s, con_s : signed(CON_W - 1 downto 0) := (others => '0');
-  signal spread_ref   : unsigned(SPREAD_W - 1 downto 0) := (others => '0');
-  signal lost_st, reported_lost : std_logic := '0';
-  signal lost_st_frame : std_logic := '0';             -- lost_st of the frame being finished
-  -- the target state record (tgt_state): field offsets from bit 0 (target_state_layout_v2)
-  constant TS_W      : natural := v2_state_w(CENTRE_ABS_W, SIZE_W, COORD_W, SHARE_W, CON_W, SPREAD_W);
-  constant TS_C8X    : natural := 3;
-  constant TS_C8Y    : natural := TS_C8X + CENTRE_ABS_W;
-  constant TS_W8     : natural := TS_C8Y + CENTRE_ABS_W;
-  constant TS_H8     : natural := TS_W8 + SIZE_W;
-  constant TS_W0     : natural := TS_H8 + SIZE_W;
-  constant TS_FW     : natural := TS_W0 + SIZE_W;
-  constant TS_FH     : natural := TS_FW + COORD_W;
-  constant TS_RREF   : natural := TS_FH + COORD_W;
-  constant TS_SREF   : natural := TS_RREF + SHARE_W;
-  constant TS_RHO0   : natural := TS_SREF + SHARE_W;
-  constant TS_RHOS   : natural := TS_RHO0 + SHARE_W;
-  constant TS_CONS   : natural := TS_RHOS + CON_W;
-  constant TS_SPREF  : natural := TS_CONS + CON_W;
-  signal m_sel       : unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');   -- the target's model
+  -- the stream side's steps around the engine: S_IDLE (the engine idle too: a frame streams, a command
+  -- is taken), S_ARM1..3 (ms_bg_model reset and armed for an init frame), S_BG (the init frame's model
+  -- is being learnt), S_RUN (the engine's job, until its word is in the FIFO), S_PUSH (a word of the
+  -- stream side: a stream fault's, a changed frame size's, no target's)
+  type sstate_t is (S_IDLE, S_ARM1, S_ARM2, S_ARM3, S_BG, S_RUN, S_PUSH);
+  signal tstate : sstate_t := S_IDLE;
+  signal ctl_idle, err_push : std_logic;
+  signal rejected_pending : std_logic := '0';
   signal tgt_ready_i, tgt_take : std_logic;
-  signal tgt_w, tgt_h : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
-  signal in_fw, in_fh : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
 
-  -- per-frame geometry
-  signal l2d          : unsigned(2 downto 0) := (others => '0');
-  signal dw, dh       : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);   -- decimated frame size
-  signal wd, hd       : unsigned(WIN_W - 1 downto 0) := to_unsigned(3, WIN_W);
-  signal wb, hb       : unsigned(COORD_W - 1 downto 0) := to_unsigned(3, COORD_W);
-  signal ex_r, ey_r   : unsigned(HALF_W - 1 downto 0) := to_unsigned(1, HALF_W);
-  signal s8x, s8y     : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');      -- start centre (decimated)
-  signal k_acc        : unsigned(HIST_W - 1 downto 0) := (others => '0');
-  signal ox_r, oy_r   : unsigned(COORD_W - 1 downto 0) := (others => '0');                -- search offsets (decimated px)
-  -- start points: 0 the last centre, 1 .. 8 (while lost) the centre +- (ox, oy)
-  signal cand         : unsigned(3 downto 0) := (others => '0');
-  signal eng_cx, eng_cy : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
-  signal eng_max_it   : unsigned(ITER_W - 1 downto 0) := to_unsigned(MAX_ITER, ITER_W);
-  signal best_cx, best_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
-  signal best_s       : unsigned(RHO_SUM_W - 1 downto 0);
-  signal best_conf    : unsigned(16 downto 0);
-  signal best_take    : std_logic := '0';            -- T_C2 found a better start point (copy next clock)
-  signal region_ok    : std_logic := '0';
-  signal reg_x, reg_y : unsigned(COORD_W - 1 downto 0) := (others => '0');
-  signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
-  signal hi_x, hi_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
-  signal reg_w_c, reg_h_c : unsigned(COORD_W - 1 downto 0);
-  -- the region (ms_region_v2, started when the window sizes are known); S - 2 per axis for the init box
-  type rg_pair_t is array (0 to 1) of signed(COORD_W + 2 downto 0);
-  signal rg_s2        : rg_pair_t;
-  signal rv_in_valid, rv_out_valid : std_logic := '0';
-  signal rv_cx, rv_cy : unsigned(COORD_W + CF - 1 downto 0);
-  signal rv_reg_x, rv_reg_y : unsigned(COORD_W - 1 downto 0);
-  signal rv_reg_w, rv_reg_h, rv_hi_x, rv_hi_y : unsigned(REGION_W - 1 downto 0);
-  -- init box centre (T_BOX .. T_BOX2): round(c), half size, interior limits [hx + 1, S - 2 - hx]
-  signal bx_c, by_c, bx_h, by_h, bx_lo, by_lo, bx_hi, by_hi : unsigned(COORD_W - 1 downto 0) := (others => '0');
-  -- ms_region per axis: n = min(2e + 2m + 1, S - 2), start = clamp(round(c) - e - m, 1, S - 1 - n),
-  -- hi (region-relative) = n - 1 - e
-  function rg_s(u : unsigned) return signed is
-  begin
-    return signed(resize(u, COORD_W + 3));
-  end function;
-  function rg_round(c : unsigned) return signed is
-  begin
-    return signed(resize(shift_right(c + to_unsigned(2 ** (CF - 1), c'length), CF), COORD_W + 3));
-  end function;
-  -- init box: c := lo if c < lo; then c := hi if c > hi (unsigned), written with the compares side by side
-  function box_clamp(c, lo, hi : unsigned) return unsigned is
-  begin
-    if c < lo then
-      if lo > hi then return hi; else return lo; end if;
-    else
-      if c > hi then return hi; else return c; end if;
-    end if;
-  end function;
-  signal lim_w, lim_h : unsigned(COORD_W - 1 downto 0);
-  signal lim_wn, lim_hn : unsigned(WIN_W - 1 downto 0);
+  -- the engine
+  signal e_idle, e_geo_done, e_go, e_rearm, e_init_rej, e_res_valid, e_busy : std_logic;
+  signal e_valid, e_init : std_logic;
+  signal e_res_data   : std_logic_vector(RESULT_W - 1 downto 0);
+  signal e_c8x, e_c8y : unsigned(CENTRE_ABS_W - 1 downto 0);
+  signal e_w8, e_h8   : unsigned(SIZE_W - 1 downto 0);
+  signal e_fw, e_fh   : unsigned(COORD_W - 1 downto 0);
+  signal l2d          : unsigned(2 downto 0);
+  signal reg_x, reg_y, reg_w_c, reg_h_c, wb, hb : unsigned(COORD_W - 1 downto 0);
+  signal m_sel        : unsigned(clog2(MODELS) - 1 downto 0);
 
   -- stream gate (as ms_tracker)
   signal accept, beat : std_logic;
@@ -311,25 +238,10 @@ architecture rtl of ms_tracker_v2 is
   signal cap_e        : std_logic_vector(EDGE_BINS_LOG2 - 1 downto 0);
   signal ram_obin     : std_logic_vector(LANES * 4 - 1 downto 0) := (others => '0');   -- orientation RAM data
 
-  -- geometry blocks
-  signal dec_in_valid, dec_out_valid : std_logic := '0';
-  signal dec_l2       : unsigned(1 downto 0);
-  signal ws_in_valid, ws_w_valid, ws_h_valid : std_logic := '0';
-  signal ws_w, ws_h   : unsigned(WIN_W - 1 downto 0);
-  signal bs_w_valid, bs_h_valid : std_logic;
-  signal bs_w, bs_h   : unsigned(COORD_W - 1 downto 0);
-
-  -- init path
-  signal bc_valid, bc_out_valid, bc_rejected, bc_clipped : std_logic := '0';
-  signal bc_x, bc_y, bc_w, bc_h : unsigned(COORD_W - 1 downto 0);
-  signal bc_cx, bc_cy : unsigned(CENTRE_ABS_W - 1 downto 0);
-  signal in_x, in_y   : signed(COORD_W + 1 downto 0);
-  signal in_w, in_h   : unsigned(COORD_W downto 0);
-
   -- background model
   signal bg_rst, bg_rst_p, bg_start, bg_busy, bg_counting, bg_done : std_logic := '0';
   signal bg_got       : std_logic := '0';
-  signal bg_cx, bg_cy : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal bg_cx, bg_cy : unsigned(COORD_W - 1 downto 0);
   signal bg_px_valid, bg_px_last : std_logic := '0';
   signal bg_px_bin    : std_logic_vector(BIN_C_W - 1 downto 0);
   signal bg_px_obin   : unsigned(3 downto 0) := (others => '0');
@@ -339,182 +251,41 @@ architecture rtl of ms_tracker_v2 is
   signal av_x, av_y   : unsigned(COORD_W - 1 downto 0);
   signal av_cbin      : std_logic_vector(BIN_C_W - 1 downto 0);
   signal bg_px_x, bg_px_y : unsigned(COORD_W - 1 downto 0);
-  signal m_rd_addr    : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
+  signal m_rd_addr    : unsigned(BIN_C_W - 1 downto 0);
   signal m_qn         : unsigned(16 downto 0);
   signal m_t          : std_logic;
   signal m_qn_all     : std_logic_vector(N_OR * 17 - 1 downto 0);   -- ORIENT_T >= 0: the 9 banks of m_rd_addr
   signal m_t_all      : std_logic_vector(N_OR - 1 downto 0);
-  signal q_we_one, q_we_all : std_logic;
-  signal ms_out_qw_all : std_logic_vector(N_OR * HIST_W - 1 downto 0) := (others => '0');  -- Qw of the 9 banks
-
-  -- kernel tables
-  signal kt_start, kt_done, kt_we : std_logic := '0';
-  signal kt_addr, kt_xr, kt_ex, kt_ey : unsigned(HALF_W - 1 downto 0);
-  signal kt_ta, kt_tb, kd_d : unsigned(KD_W - 1 downto 0);
-  signal kt_ka, kt_kb : unsigned(KT_W - 1 downto 0);
-
-  -- Qw load
-  signal ql_cnt       : unsigned(BIN_C_W downto 0) := (others => '0');
-  signal ql_issue, ql_v1 : std_logic := '0';
-  signal ql_bin1      : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
-  -- Qn registered once more before ms_model_scale (timing: model RAM read -> the multiplier's 3 Qn chain)
-  signal ql_v2        : std_logic := '0';
-  signal ql_bin2      : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
-  signal m_qn_r       : unsigned(16 downto 0) := (others => '0');
-  signal ms_out_valid : std_logic;
-  signal ms_out_qw    : unsigned(HIST_W - 1 downto 0);
-  signal ms_out_tag   : std_logic_vector(BIN_C_W - 1 downto 0);
-  signal ms_in_tag    : std_logic_vector(BIN_C_W - 1 downto 0);
-  signal ql_seen      : unsigned(BIN_C_W downto 0) := (others => '0');
-
-  -- engine
-  signal eng_start, eng_single : std_logic := '0';
-  signal c_busy, c_done : std_logic;
-  signal c_cx, c_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
-  signal c_s          : unsigned(RHO_SUM_W - 1 downto 0);
-  signal c_iter       : unsigned(ITER_W - 1 downto 0);
-  signal c_stop       : std_logic_vector(1 downto 0);
-  signal c_k          : unsigned(HIST_W - 1 downto 0);
-  signal px_valid, px_last : std_logic;
-  signal px_mask      : std_logic_vector(LANES - 1 downto 0);
-  signal px_dx, px_dy : signed(REGION_W downto 0);
-  type tap_t is record
-    v, l : std_logic;
-    m    : std_logic_vector(LANES - 1 downto 0);
-    dx, dy : signed(REGION_W downto 0);
-  end record;
-  type tap_arr_t is array (1 to REGION_RD_LAT - 1) of tap_t;
-  signal tap          : tap_arr_t;
-  signal t_we         : std_logic := '0';
-  signal t_addr       : unsigned(BIN_C_W - 1 downto 0) := (others => '0');
-  signal t_data       : std_logic := '0';
-
-  -- statistics of the last two passes
-  signal st_done      : std_logic;
-  signal st_nt, st_n_in, st_nt_in : unsigned(COUNT_W - 1 downto 0);
-  signal st_st2       : unsigned(ST2_W - 1 downto 0);
-  type stats_t is record
-    nt, n_in, nt_in : unsigned(COUNT_W - 1 downto 0);
-    st2 : unsigned(ST2_W - 1 downto 0);
-  end record;
-  signal st_cur, st_prev, st_fin, best_st : stats_t;
-
-  -- per-frame results
-  signal r_cx, r_cy   : unsigned(CENTRE_ABS_W - 1 downto 0);
-  signal r_iter       : unsigned(ITER_W - 1 downto 0);
-  signal r_stop       : std_logic_vector(1 downto 0);
-  signal r_s          : unsigned(RHO_SUM_W - 1 downto 0);
-  signal rho, share, ring : unsigned(SHARE_W - 1 downto 0) := (others => '0');
-  signal spread       : unsigned(SPREAD_W - 1 downto 0) := (others => '0');
-  signal conf         : unsigned(16 downto 0) := (others => '0');
-  signal lflag        : std_logic := '0';
-  signal rho_s_n, con_s_n : signed(CON_W - 1 downto 0);
-  signal scale_s      : unsigned(SCALE_W - 1 downto 0);
-  signal w8_n, h8_n   : unsigned(SIZE_W - 1 downto 0);
-  signal rr_rho, rr_share : unsigned(SHARE_W - 1 downto 0);
-  signal status_r     : unsigned(2 downto 0) := (others => '0');
-  signal got          : std_logic_vector(3 downto 0) := (others => '0');
-
-  -- block handshakes
-  signal fu_start, fu_done, sh_start, sh_done, sp_start, sp_done, rs_start, rs_done : std_logic := '0';
-  signal cf_start, cf_done, lf_start, lf_done, fl_start, fl_done : std_logic := '0';
-  signal ru_d         : std_logic := '0';
-  signal ru_start, sc_start, sc_done, rz_start, rzw_done, rzh_done : std_logic := '0';
-  signal fu_rho       : unsigned(RHO_OUT_W - 1 downto 0);
-  signal sh_share, rs_ring : unsigned(SHARE_W - 1 downto 0);
-  signal sp_spread    : unsigned(SPREAD_W - 1 downto 0);
-  signal con_x        : signed(CON_W - 1 downto 0);
-
-  -- the gated scale test (SCALE_TEST_D256 > 0; T_ST_SIZE .. T_ST_GATE): the windows x(1 - d), x(1 + d)
-  -- at the final centre, one after the other through the frame's own blocks (window size, kernel
-  -- tables + K, Qw load, one pass of the engine without moving, ms_fusion's rho)
-  constant ST_ON      : boolean := SCALE_TEST_D256 > 0;
-  signal st_sel       : std_logic := '0';             -- the window-size inputs are the test sizes
-  signal st_up        : std_logic := '0';             -- 0: x(1 - d), 1: x(1 + d)
-  signal st_w8, st_h8 : unsigned(SIZE_W - 1 downto 0) := (others => '0');   -- ms_scale_test_size
-  signal st_rx, st_ry : signed(COORD_W + 2 downto 0) := (others => '0');    -- round(final centre) - region origin
-  signal st_best      : unsigned(SHARE_W - 1 downto 0) := (others => '0');  -- largest rho so far
-  signal st_v         : signed(1 downto 0) := (others => '0');              -- verdict -1 / 0 / +1
-  signal sp_gate      : unsigned(SPREAD_W - 1 downto 0) := (others => '0'); -- ms_scale_gate
-  signal ws_s8w, ws_s8h : unsigned(SIZE_W - 1 downto 0);
-  signal sc_spread    : unsigned(SPREAD_W - 1 downto 0);                    -- ms_scale's spread
-  -- ms_scale_test_size(s8, d256, up) = (s8 (256 -+ d256) + 128) >> 8, saturated to SIZE_W bits (exact:
-  -- a size of 2**SIZE_W - 1 already gives a window above MAX_WINDOW at D <= 16, asserted below)
-  -- in two registered steps (p_st_size): the product s8 f, f = 256 -+ d256, then the rounding and
-  -- saturation (st_round), so no multiplier output reaches a register through an adder in one clock
-  signal st_pw_lo, st_pw_hi, st_ph_lo, st_ph_hi : unsigned(SIZE_W + 9 downto 0) := (others => '0');
-  signal st_w8_lo, st_w8_hi, st_h8_lo, st_h8_hi : unsigned(SIZE_W - 1 downto 0) := (others => '0');
-  constant ST_F_LO : natural := 256 - SCALE_TEST_D256;
-  constant ST_F_HI : natural := 256 + SCALE_TEST_D256;
-  function st_round(prod : unsigned) return unsigned is
-    variable p : unsigned(SIZE_W + 9 downto 0);
-  begin
-    p := prod + 128;
-    p := shift_right(p, 8);
-    if p(SIZE_W + 9 downto SIZE_W) /= 0 then
-      return to_unsigned(2 ** SIZE_W - 1, SIZE_W);
-    end if;
-    return p(SIZE_W - 1 downto 0);
-  end function;
 
   -- results
-  signal res_word     : std_logic_vector(RESULT_W - 1 downto 0);
+  signal top_word, fifo_data : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
   signal fifo_valid, fifo_ready : std_logic;
   signal frame_count  : unsigned(FCOUNT_W - 1 downto 0) := (others => '0');
   signal err_pending, overflow : std_logic := '0';
   signal err_code_r   : std_logic_vector(ERR_CODE_W - 1 downto 0);
 
-  function pack(cx, cy, bw, bh : unsigned; rh, cn : unsigned; st : unsigned; it : unsigned;
-                sp : std_logic_vector; dl : unsigned; srch : unsigned; flags : std_logic_vector;
-                err : std_logic_vector; fc : unsigned) return std_logic_vector is
-    variable v : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
-    variable o : natural := 0;
+  -- a word of the stream side: the target's centre and size, no statistics
+  function side_word(cx, cy, bw, bh : unsigned; st : unsigned; flags, err : std_logic_vector;
+                     fc : unsigned) return std_logic_vector is
   begin
-    v(o + CENTRE_ABS_W - 1 downto o) := std_logic_vector(resize(cx, CENTRE_ABS_W)); o := o + CENTRE_ABS_W;
-    v(o + CENTRE_ABS_W - 1 downto o) := std_logic_vector(resize(cy, CENTRE_ABS_W)); o := o + CENTRE_ABS_W;
-    v(o + SIZE_W - 1 downto o) := std_logic_vector(resize(bw, SIZE_W)); o := o + SIZE_W;
-    v(o + SIZE_W - 1 downto o) := std_logic_vector(resize(bh, SIZE_W)); o := o + SIZE_W;
-    v(o + RHO_OUT_W - 1 downto o) := std_logic_vector(resize(rh, RHO_OUT_W)); o := o + RHO_OUT_W;
-    v(o + 16 downto o) := std_logic_vector(resize(cn, 17)); o := o + 17;
-    v(o + 2 downto o) := std_logic_vector(st); o := o + 3;
-    v(o + ITER_W - 1 downto o) := std_logic_vector(resize(it, ITER_W)); o := o + ITER_W;
-    v(o + 1 downto o) := sp; o := o + 2;
-    v(o + 2 downto o) := std_logic_vector(dl); o := o + 3;
-    v(o + 3 downto o) := std_logic_vector(resize(srch, 4)); o := o + 4;
-    v(o + FLAGS_W - 1 downto o) := flags; o := o + FLAGS_W;
-    v(o + ERR_W - 1 downto o) := err; o := o + ERR_W;
-    v(o + FCOUNT_W - 1 downto o) := std_logic_vector(fc);
-    return v;
-  end function;
-
-  -- flags: 0 init, 1 clipped, 2 lost, 3 error, 4 rejected, 5 no_target, 6 overflow
-  function flags_of(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector is
-  begin
-    return '0' & ovf & notgt & rej & err & lost & clipped & init;
-  end function;
-
-  function umin(a, b : unsigned) return unsigned is
-  begin
-    if a < b then return a; else return b; end if;
+    return v2_word(RESULT_W, CENTRE_ABS_W, SIZE_W, RHO_OUT_W, ITER_W, cx, cy, bw, bh, to_unsigned(0, 17),
+                   to_unsigned(0, 17), st, to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
+                   flags, err, fc);
   end function;
 begin
   assert FEATURES = 1 and KERNEL_EPAN = 0
     report "ms_tracker_v2: tracker v2 is colour only with the flat kernel (FEATURES 1, KERNEL_EPAN 0)"
     severity failure;
-  assert RESULT_W = 160 report "ms_tracker_v2: RESULT_W must be 160 (result word v2)" severity failure;
   -- the tracking region must fit the region RAM (the lost-state bound, 255 at the defaults, is
   -- mstrack.hw.cosim.region_max_v2: it follows from the decimation rule, not from the generics alone)
   assert (REGION_MAX >= MAX_WINDOW + 2 * MARGIN or REGION_MAX >= MAX_FRAME_W - 2) and MARGIN_MAX >= MARGIN
     report "ms_tracker_v2: REGION_MAX must be >= min(MAX_WINDOW + 2 MARGIN, MAX_FRAME_W - 2), MARGIN_MAX >= MARGIN"
     severity failure;
-  -- the scale test's size saturates at 2**SIZE_W - 1: exact while that size's window at D = 16 is >= MAX_WINDOW
-  assert SCALE_TEST_D256 = 0 or (16 + PAD16) * (2 ** (SIZE_W - 16)) >= MAX_WINDOW
-    report "ms_tracker_v2: SIZE_W too small for the scale test's saturated size" severity failure;
 
   ---------------------------------------------------------------------------- video input gate
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
-  bg_rearm <= s_axis_tuser and init_pending and not bg_clean;
-  accept <= '1' when state = T_IDLE and region_ok = '1' and gate_closed = '0' and err_hold = '0'
+  bg_rearm <= s_axis_tuser and e_init and not bg_clean;
+  accept <= '1' when ctl_idle = '1' and gate_closed = '0' and err_hold = '0'
                      and fe_err_now = '0' and init_take = '0' and tgt_take = '0' and bg_rearm = '0' else '0';
   s_axis_tready <= accept;
   beat <= s_axis_tvalid and accept;
@@ -536,7 +307,7 @@ begin
           in_frame <= '0';
         end if;
       end if;
-      if gate_closed = '1' and state = T_IDLE then
+      if gate_closed = '1' and ctl_idle = '1' then
         if drain_cnt = DRAIN then
           gate_closed <= '0';
           drain_cnt <= 0;
@@ -546,7 +317,7 @@ begin
       else
         drain_cnt <= 0;
       end if;
-      if state = T_PUSH and fifo_ready = '1' then
+      if fifo_ready = '1' and (tstate = S_PUSH or (tstate = S_RUN and e_res_valid = '1')) then
         gate_closed <= '0';
       end if;
       if rst = '1' then
@@ -584,9 +355,6 @@ begin
               ip_ebin => ip_ebin, dp_start => dp_start, dp_end => dp_end, dp_error => dp_error,
               dp_valid => dp_valid, dp_x => dp_x, dp_y => dp_y, dp_cbin => dp_cbin, dp_ebin => dp_ebin,
               dec_q => dec_q);
-
-  reg_w_c <= resize(reg_w, COORD_W);
-  reg_h_c <= resize(reg_h, COORD_W);
 
   u_cap : entity work.ms_region_capture
     generic map (LANES => LANES, COORD_W => COORD_W, REGION_MAX => REGION_MAX, STRIDE => STRIDE,
@@ -677,285 +445,70 @@ begin
               px_last => bg_px_last, n_box => open, n_ring => open, o_min => open, qv_sum => open,
               m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all, m_t_all => m_t_all);
 
-  ---------------------------------------------------------------------------- geometry
-  u_decim : entity work.ms_decimation
-    generic map (S8_W => SIZE_W, PAD16 => PAD16, MAX_WINDOW => MAX_WINDOW)
-    port map (clk => clk, rst => rst, in_valid => dec_in_valid, w8 => w8, h8 => h8,
-              out_valid => dec_out_valid, log2_d => dec_l2);
-
-  -- the window-size inputs: the target size, or during the scale test the test window's size
-  ws_s8w <= st_w8 when ST_ON and st_sel = '1' else w8;
-  ws_s8h <= st_h8 when ST_ON and st_sel = '1' else h8;
-  u_wsw : entity work.ms_window_size
-    generic map (S8_W => SIZE_W, PAD16 => PAD16, N_W => WIN_W)
-    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => ws_s8w, log2_d => l2d, limit => lim_wn,
-              out_valid => ws_w_valid, n => ws_w);
-  u_wsh : entity work.ms_window_size
-    generic map (S8_W => SIZE_W, PAD16 => PAD16, N_W => WIN_W)
-    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => ws_s8h, log2_d => l2d, limit => lim_hn,
-              out_valid => ws_h_valid, n => ws_h);
-  u_bsw : entity work.ms_box_size
-    generic map (S8_W => SIZE_W, N_W => COORD_W)
-    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => w8, log2_d => l2d, limit => lim_w,
-              out_valid => bs_w_valid, n => bs_w);
-  u_bsh : entity work.ms_box_size
-    generic map (S8_W => SIZE_W, N_W => COORD_W)
-    port map (clk => clk, rst => rst, in_valid => ws_in_valid, s8 => h8, log2_d => l2d, limit => lim_h,
-              out_valid => bs_h_valid, n => bs_h);
-
-  rv_cx <= resize(s8x, COORD_W + CF);
-  rv_cy <= resize(s8y, COORD_W + CF);
-  u_region : entity work.ms_region_v2
-    generic map (COORD_W => COORD_W, CF => CF, HALF_W => HALF_W, REGION_W => REGION_W, MARGIN => MARGIN,
-                 MARGIN_MAX => MARGIN_MAX)
-    port map (clk => clk, rst => rst, in_valid => rv_in_valid, cx => rv_cx, cy => rv_cy, ex => ex_r, ey => ey_r,
-              ox => ox_r, oy => oy_r, lost => lost_st, frame_w => dw, frame_h => dh, out_valid => rv_out_valid,
-              reg_x => rv_reg_x, reg_y => rv_reg_y, reg_w => rv_reg_w, reg_h => rv_reg_h, hi_x => rv_hi_x,
-              hi_y => rv_hi_y, region_margin => open);
-
-  u_clip : entity work.ms_box_clip
-    generic map (COORD_W => COORD_W, HALF_W => BOX_HALF_W, MAX_HALF => 2 ** BOX_HALF_W - 1, CF => CF)
-    port map (clk => clk, rst => rst, in_valid => bc_valid, box_x => in_x, box_y => in_y,
-              box_w => in_w, box_h => in_h, frame_w => in_fw, frame_h => in_fh,
-              out_valid => bc_out_valid, rejected => bc_rejected, clipped => bc_clipped,
-              clip_x => bc_x, clip_y => bc_y, clip_w => bc_w, clip_h => bc_h, ex => open,
-              ey => open, cx => bc_cx, cy => bc_cy);
-
-  u_tables : entity work.ms_kernel_tables
-    generic map (HALF_W => HALF_W, KERNEL_EPAN => 1, KERNEL_BITS => KERNEL_BITS, KVAL_W => KT_W, KD_W => KD_W)
-    port map (clk => clk, rst => rst, start => kt_start, w => resize(wd, HALF_W + 1),
-              h => resize(hd, HALF_W + 1), busy => open, done => kt_done,
-              ex => kt_ex, ey => kt_ey, kd_d => kd_d, kt_we => kt_we, kt_addr => kt_addr,
-              kt_ta => kt_ta, kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr);
-
-  ---------------------------------------------------------------------------- Qw = ms_model_scale(Qn, K)
-  -- one register stage between the model RAM's read data and the multiplier: T_QLOAD counts the
-  -- results (ql_seen = N_BINS), so it takes one clock more per frame, nothing else changes
-  -- ms_scale_test_size of both test sizes, computed in every clock from w8, h8: the product registered,
-  -- then rounded and saturated (2 clocks).  w8, h8 change only between frames (init) and in T_RESIZE,
-  -- after the test, so at T_ST_SIZE these registers hold the sizes of this frame's w8, h8.
-  g_st_size : if ST_ON generate
-    p_st_size : process (clk)
-    begin
-      if rising_edge(clk) then
-        st_pw_lo <= resize(w8 * to_unsigned(ST_F_LO, 10), SIZE_W + 10);
-        st_pw_hi <= resize(w8 * to_unsigned(ST_F_HI, 10), SIZE_W + 10);
-        st_ph_lo <= resize(h8 * to_unsigned(ST_F_LO, 10), SIZE_W + 10);
-        st_ph_hi <= resize(h8 * to_unsigned(ST_F_HI, 10), SIZE_W + 10);
-        st_w8_lo <= st_round(st_pw_lo);
-        st_w8_hi <= st_round(st_pw_hi);
-        st_h8_lo <= st_round(st_ph_lo);
-        st_h8_hi <= st_round(st_ph_hi);
-      end if;
-    end process;
-  end generate;
-
-  p_qn_r : process (clk)
-  begin
-    if rising_edge(clk) then
-      m_qn_r <= m_qn;
-      ql_bin2 <= ql_bin1;
-      ql_v2 <= ql_v1 and not rst;
-    end if;
-  end process;
-  ms_in_tag <= std_logic_vector(ql_bin2);
-  u_mscale : entity work.ms_model_scale
-    generic map (HIST_W => HIST_W, QN_FRAC => 16, TAG_W => BIN_C_W)
-    port map (clk => clk, rst => rst, in_valid => ql_v2, in_qn => m_qn_r, in_k => k_acc, in_tag => ms_in_tag,
-              out_valid => ms_out_valid, out_qw => ms_out_qw, out_tag => ms_out_tag);
-
-  -- ORIENT_T >= 0: the 9 banks of one colour address per clock (ms_bg_model's m_qn_all), 8 more
-  -- ms_model_scale in lockstep with u_mscale (bank 0 is u_mscale's, m_qn = bank m_rd_obin = 0),
-  -- into the engine's parallel Q load; the walk stays N_BINS colour addresses
-  g_mscale : if OR_ON generate
-    ms_out_qw_all(HIST_W - 1 downto 0) <= std_logic_vector(ms_out_qw);
-    g_bank : for o in 1 to N_OR - 1 generate
-      signal qn_r : unsigned(16 downto 0);
-      signal qw   : unsigned(HIST_W - 1 downto 0);
-    begin
-      p_r : process (clk)
-      begin
-        if rising_edge(clk) then
-          qn_r <= unsigned(m_qn_all(o * 17 + 16 downto o * 17));
-        end if;
-      end process;
-      u_ms : entity work.ms_model_scale
-        generic map (HIST_W => HIST_W, QN_FRAC => 16, TAG_W => 1)
-        port map (clk => clk, rst => rst, in_valid => ql_v2, in_qn => qn_r, in_k => k_acc, in_tag => "0",
-                  out_valid => open, out_qw => qw, out_tag => open);
-      ms_out_qw_all((o + 1) * HIST_W - 1 downto o * HIST_W) <= std_logic_vector(qw);
-    end generate;
-  end generate;
-
-  ---------------------------------------------------------------------------- engine + statistics
-  -- the Qw load: one bin per clock (colour bins), or every bank of a colour address (ORIENT_T >= 0)
-  q_we_one <= ms_out_valid when not OR_ON else '0';
-  q_we_all <= ms_out_valid when OR_ON else '0';
-  u_colour : entity work.ms_meanshift
-    generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
-                 STRIDE => STRIDE, ADDR_W => ADDR_W, COORD_W => COORD_W, KERNEL_EPAN => 0,
-                 KERNEL_BITS => KERNEL_BITS, KVAL_W => KVAL_W, KD_W => KD_W, HIST_W => HIST_W,
-                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, SQRT_IN_W => SQRT_IN_W,
-                 RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, WF => WF,
-                 RF => RF, SW_W => SW_W, SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CF => CF,
-                 CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W, MAX_ITER => MAX_ITER,
-                 ITER_W => ITER_W, EPS2 => EPS2, RAM_LAT => REGION_RD_LAT, N_ORIENT => N_OR)
-    port map (clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
-              kt_tb => kt_tb, kt_ka => kt_ka(KVAL_W - 1 downto 0), kt_kb => kt_kb(KVAL_W - 1 downto 0),
-              kt_xr => kt_xr, kd_d => kd_d, ex => ex_r, ey => ey_r,
-              reg_x => reg_x, reg_y => reg_y, hi_x => hi_x, hi_y => hi_y, start => eng_start,
-              learn => '0', start_cx => eng_cx, start_cy => eng_cy, busy => c_busy, done => c_done,
-              res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
-              res_k => c_k, ram_addr => ram_addr, ram_data => ram_data, ram_obin => ram_obin,
-              single => eng_single, max_it => eng_max_it,
-              q_ext_we => q_we_one, q_ext_addr => unsigned(ms_out_tag), q_ext_data => ms_out_qw,
-              q_ext_all_we => q_we_all, q_ext_all_data => ms_out_qw_all,
-              px_valid => px_valid, px_mask => px_mask, px_dx => px_dx, px_dy => px_dy, px_last => px_last);
-
-  -- the tap is aligned with ram_addr; ms_target_stats wants the bins one clock after it
-  p_tap : process(clk)
-  begin
-    if rising_edge(clk) then
-      tap(1) <= (v => px_valid, l => px_last, m => px_mask, dx => px_dx, dy => px_dy);
-      for i in 2 to REGION_RD_LAT - 1 loop
-        tap(i) <= tap(i - 1);
-      end loop;
-      if rst = '1' then
-        for i in 1 to REGION_RD_LAT - 1 loop
-          tap(i).v <= '0';
-          tap(i).l <= '0';
-        end loop;
-      end if;
-    end if;
-  end process;
-
-  u_stats : entity work.ms_target_stats
-    generic map (LANES => LANES, BIN_W => BIN_C_W, HALF_W => HALF_W, REGION_W => REGION_W,
-                 KERNEL_BITS => KERNEL_BITS, KT_W => KT_W, PAD16 => PAD16, COUNT_W => COUNT_W, ST2_W => ST2_W,
-                 N_ORIENT => N_OR)
-    port map (clk => clk, rst => rst, t_we => t_we, t_addr => t_addr, t_data => t_data, t_data_all => m_t_all,
-              kt_we => kt_we, kt_addr => kt_addr, kt_ka => kt_ka, kt_kb => kt_kb,
-              px_valid => tap(REGION_RD_LAT - 1).v, px_mask => tap(REGION_RD_LAT - 1).m,
-              px_dx => tap(REGION_RD_LAT - 1).dx, px_dy => tap(REGION_RD_LAT - 1).dy,
-              px_last => tap(REGION_RD_LAT - 1).l,
-              ram_data => ram_data, ram_obin => ram_obin, done => st_done, nt => st_nt, st2 => st_st2, n_in => st_n_in,
-              nt_in => st_nt_in);
-
-  busy <= c_busy;
-
-  ---------------------------------------------------------------------------- per-frame arithmetic
-  u_rho : entity work.ms_fusion
-    generic map (FEATURES => 1, RHO_SUM_W => RHO_SUM_W, HIST_W => HIST_W,
-                 CENTRE_ABS_W => CENTRE_ABS_W, AF => AF, ALPHA_W => ALPHA_W, RF => RF,
-                 RHO_OUT_FRAC => RHO_OUT_FRAC, RHO_OUT_W => RHO_OUT_W)
-    port map (clk => clk, rst => rst, start => fu_start, s_c => r_s, s_e => (others => '0'), c_cx => r_cx,
-              c_cy => r_cy, e_cx => r_cx, e_cy => r_cy, k_sum => k_acc, done => fu_done, cx => open,
-              cy => open, alpha_c => open, rho_c => fu_rho, rho_e => open);
-
-  u_share : entity work.ms_share
-    generic map (COUNT_W => COUNT_W, SHARE_W => SHARE_W)
-    port map (clk => clk, rst => rst, start => sh_start, nt_in => st_fin.nt_in, n_in => st_fin.n_in,
-              busy => open, done => sh_done, share => sh_share);
-
-  u_spread : entity work.ms_spread
-    generic map (COUNT_W => COUNT_W, ST2_W => ST2_W, SPREAD_W => SPREAD_W)
-    port map (clk => clk, rst => rst, start => sp_start, st2 => st_fin.st2, nt => st_fin.nt,
-              busy => open, done => sp_done, spread => sp_spread);
-
-  u_ring : entity work.ms_ring_share
-    generic map (COUNT_W => COUNT_W, SHARE_W => SHARE_W)
-    port map (clk => clk, rst => rst, start => rs_start, nt => st_fin.nt, nt_in => st_fin.nt_in,
-              n_in => st_fin.n_in, k => resize(k_acc, COUNT_W), busy => open, done => rs_done,
-              ring_share => rs_ring);
-
-  u_conf : entity work.ms_confidence
-    generic map (W => SHARE_W)
-    port map (clk => clk, rst => rst, start => cf_start, rho => rho, share => share, rho_ref => rho_ref,
-              share_ref => share_ref, busy => open, done => cf_done, conf => conf);
-
-  con_x <= signed(resize(share, CON_W)) - signed(resize(ring, CON_W));
-  u_lf_rho : entity work.ms_loss_filter
-    generic map (W => CON_W, K_SHIFT => LOSS_K)
-    port map (clk => clk, rst => rst, start => lf_start, s => rho_s, x => signed(resize(rho, CON_W)),
-              busy => open, done => lf_done, s_next => rho_s_n);
-  u_lf_con : entity work.ms_loss_filter
-    generic map (W => CON_W, K_SHIFT => LOSS_K)
-    port map (clk => clk, rst => rst, start => lf_start, s => con_s, x => con_x,
-              busy => open, done => open, s_next => con_s_n);
-
-  u_flag : entity work.ms_loss_flag
-    generic map (RHO_W => SHARE_W, CON_W => CON_W, LOSS_RHO => LOSS_RHO, LOSS_CONTRAST => LOSS_CONTRAST)
-    port map (clk => clk, rst => rst, start => fl_start, rho_s => unsigned(rho_s(SHARE_W - 1 downto 0)),
-              rho0 => rho0, con_s => con_s, share => share, busy => open, done => fl_done, lost => lflag);
-
-  u_ref_rho : entity work.ms_ref_update
-    generic map (W => SHARE_W, K_SHIFT => REF_K)
-    port map (clk => clk, rst => rst, start => ru_start, ref_in => rho_ref, x => rho, busy => open,
-              done => open, ref_next => rr_rho);
-  u_ref_share : entity work.ms_ref_update
-    generic map (W => SHARE_W, K_SHIFT => REF_K)
-    port map (clk => clk, rst => rst, start => ru_start, ref_in => share_ref, x => share, busy => open,
-              done => open, ref_next => rr_share);
-
-  sc_spread <= sp_gate when ST_ON else spread;        -- the gated spread (ms_scale_gate) with the scale test
-  u_scale : entity work.ms_scale
-    generic map (SPREAD_W => SPREAD_W, SIZE_W => SIZE_W, SCALE_W => SCALE_W, SCALE_GAIN => SCALE_GAIN,
-                 SCALE_REG => SCALE_REG, SCALE_STEP => SCALE_STEP, RATIO_Q_W => SCALE_RATIO_Q_W,
-                 WR_Q_W => WR_Q_W)
-    port map (clk => clk, rst => rst, start => sc_start, spread => sc_spread, spread_ref => spread_ref,
-              w8 => w8, w0_8 => w0_8, busy => open, done => sc_done, s => scale_s);
-
-  u_rz_w : entity work.ms_resize
-    generic map (SIZE_W => SIZE_W, SCALE_W => SCALE_W, COORD_W => COORD_W)
-    port map (clk => clk, rst => rst, start => rz_start, s8 => w8, s => scale_s, frame_size => tgt_w,
-              busy => open, done => rzw_done, s8_out => w8_n);
-  u_rz_h : entity work.ms_resize
-    generic map (SIZE_W => SIZE_W, SCALE_W => SCALE_W, COORD_W => COORD_W)
-    port map (clk => clk, rst => rst, start => rz_start, s8 => h8, s => scale_s, frame_size => tgt_h,
-              busy => open, done => rzh_done, s8_out => h8_n);
+  ---------------------------------------------------------------------------- the engine
+  u_eng : entity work.ms_engine
+    generic map (MAX_FRAME_W => MAX_FRAME_W, LANES => LANES, COLOUR_BITS => COLOUR_BITS, KERNEL_BITS => KERNEL_BITS,
+                 MAX_HALF => MAX_HALF, MARGIN => MARGIN, COORD_W => COORD_W, CF => CF, WI => WI, WF => WF, RF => RF,
+                 AF => AF, RHO_OUT_FRAC => RHO_OUT_FRAC, MAX_ITER => MAX_ITER, EPS2 => EPS2, HALF_W => HALF_W,
+                 REGION_W => REGION_W, STRIDE => STRIDE, ADDR_W => ADDR_W, KVAL_W => KVAL_W, HIST_W => HIST_W,
+                 COUNT_W => COUNT_W, POSSUM_W => POSSUM_W, KD_W => KD_W, SQRT_IN_W => SQRT_IN_W,
+                 RHO_SUM_W => RHO_SUM_W, RATIO_Q_W => RATIO_Q_W, WEIGHT_W => WEIGHT_W, SW_W => SW_W,
+                 SWX_W => SWX_W, SHIFT_Q_W => SHIFT_Q_W, CENTRE_W => CENTRE_W, CENTRE_ABS_W => CENTRE_ABS_W,
+                 ITER_W => ITER_W, RHO_OUT_W => RHO_OUT_W, ALPHA_W => ALPHA_W, WIN_W => WIN_W,
+                 RESULT_W => RESULT_W, PAD16 => PAD16, RING16 => RING16, MAX_WINDOW => MAX_WINDOW, KT_W => KT_W,
+                 ST2_W => ST2_W, SHARE_W => SHARE_W, SPREAD_W => SPREAD_W, SIZE_W => SIZE_W, SCALE_W => SCALE_W,
+                 SCALE_GAIN => SCALE_GAIN, SCALE_REG => SCALE_REG, SCALE_STEP => SCALE_STEP,
+                 SCALE_RATIO_Q_W => SCALE_RATIO_Q_W, WR_Q_W => WR_Q_W, CON_W => CON_W, LOSS_K => LOSS_K,
+                 REF_K => REF_K, LOSS_RHO => LOSS_RHO, LOSS_CONTRAST => LOSS_CONTRAST, CONF_LOST => CONF_LOST,
+                 CONF_UNCERTAIN => CONF_UNCERTAIN, CONF_REACQUIRE => CONF_REACQUIRE,
+                 SPREAD_DEFAULT => SPREAD_DEFAULT, BG_Q_W => BG_Q_W, BG_O_W => BG_O_W, SEARCH_ITER => SEARCH_ITER,
+                 STEP16 => STEP16, MARGIN_MAX => MARGIN_MAX, SCALE_TEST_D256 => SCALE_TEST_D256,
+                 ORIENT_T => ORIENT_T, MODELS => MODELS, RAM_LAT => REGION_RD_LAT)
+    port map (clk => clk, rst => rst, idle => e_idle, geo_done => e_geo_done, go => e_go, rearm => e_rearm,
+              init_take => init_take, init_x => s_init_x, init_y => s_init_y, init_w => s_init_w,
+              init_h => s_init_h, init_fw => frame_width, init_fh => frame_height, init_rejected => e_init_rej,
+              load_take => tgt_take, load_state => tgt_load_state, load_model => tgt_load_model,
+              rec => tgt_state, rec_valid => e_valid, rec_init => e_init, rec_c8x => e_c8x, rec_c8y => e_c8y,
+              rec_w8 => e_w8, rec_h8 => e_h8, rec_fw => e_fw, rec_fh => e_fh,
+              geo_l2d => l2d, geo_reg_x => reg_x, geo_reg_y => reg_y, geo_reg_w => reg_w_c, geo_reg_h => reg_h_c,
+              geo_wb => wb, geo_hb => hb, geo_bg_cx => bg_cx, geo_bg_cy => bg_cy,
+              m_sel => m_sel, m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all,
+              m_t_all => m_t_all, ram_addr => ram_addr, ram_data => ram_data, ram_obin => ram_obin,
+              res_valid => e_res_valid, res_ready => fifo_ready, res_data => e_res_data,
+              word_fcount => frame_count, word_rejected => rejected_pending, word_overflow => overflow,
+              busy => e_busy);
+  busy <= e_busy;
 
   ---------------------------------------------------------------------------- results
   u_fifo : entity work.ms_fifo
     generic map (WIDTH => RESULT_W, DEPTH => 4)
-    port map (clk => clk, rst => rst, s_valid => fifo_valid, s_ready => fifo_ready, s_data => res_word,
+    port map (clk => clk, rst => rst, s_valid => fifo_valid, s_ready => fifo_ready, s_data => fifo_data,
               m_valid => m_axis_result_tvalid, m_ready => m_axis_result_tready, m_data => m_axis_result_tdata);
   m_axis_result_tlast <= '1';
 
-  -- window-size limits: min(MAX_WINDOW, decimated size - 2)
-  lim_w  <= umin(dw - 2, to_unsigned(MAX_WINDOW, COORD_W));
-  lim_h  <= umin(dh - 2, to_unsigned(MAX_WINDOW, COORD_W));
-  lim_wn <= resize(lim_w, WIN_W);
-  lim_hn <= resize(lim_h, WIN_W);
-
   ---------------------------------------------------------------------------- control
+  -- the stream side takes a frame or a command while it and the engine are idle, and not on the
+  -- clock an init's geometry arrives (ms_bg_model is armed first)
+  ctl_idle <= '1' when tstate = S_IDLE and e_idle = '1' and not (e_geo_done = '1' and e_init = '1') else '0';
+  err_push <= ctl_idle and not cap_done and err_pending and fifo_ready;
+  -- the engine's commands: a job once the region is in (an init's once its model is learnt); the
+  -- geometry again after a word of the stream side, after a fault on an init frame (not a cut), and
+  -- before a start of frame that would reach an ms_bg_model no longer clean
+  e_go <= '1' when (ctl_idle = '1' and cap_done = '1' and e_init = '0' and e_valid = '1'
+                    and fr_w = e_fw and fr_h = e_fh)
+                   or (tstate = S_BG and bg_got = '1') else '0';
+  e_rearm <= '1' when (err_push = '1' and fe_error = '0' and e_init = '1' and err_code_r /= ERR_CUT)
+                      or (ctl_idle = '1' and cap_done = '0' and not (err_pending = '1' and fifo_ready = '1')
+                          and init_take = '0' and tgt_take = '0' and s_axis_tvalid = '1' and bg_rearm = '1'
+                          and gate_closed = '0' and err_hold = '0' and fe_err_now = '0')
+                      or (tstate = S_PUSH and fifo_ready = '1') else '0';
+
   p_ctrl : process(clk)
-    variable k_add : unsigned(HIST_W - 1 downto 0);
-    variable srch  : unsigned(2 downto 0);
-    variable stat  : unsigned(2 downto 0);
-    variable lost_now : std_logic;
-    variable srch4    : unsigned(3 downto 0);
-    variable sxo, syo : signed(CENTRE_ABS_W + 1 downto 0);
   begin
     if rising_edge(clk) then
-      bc_valid <= '0';
-      kt_start <= '0';
-      eng_start <= '0';
       fifo_valid <= '0';
-      dec_in_valid <= '0';
-      ws_in_valid <= '0';
-      rv_in_valid <= '0';
       bg_start <= '0';
       bg_rst_p <= '0';
-      fu_start <= '0'; sh_start <= '0'; sp_start <= '0'; rs_start <= '0';
-      cf_start <= '0'; lf_start <= '0'; fl_start <= '0'; ru_start <= '0';
-      sc_start <= '0'; rz_start <= '0';
-      ql_v1 <= '0';
-      -- the best start point so far (wide search): taken the clock after T_C2 decided it
-      best_take <= '0';
-      if best_take = '1' then
-        best_cx <= r_cx; best_cy <= r_cy; best_s <= r_s; best_st <= st_fin; best_conf <= conf;
-      end if;
-
       if fe_err_now = '1' then
         err_hold <= '1';
       end if;
@@ -972,140 +525,35 @@ begin
       if beat = '1' then
         bg_clean <= '0';
       end if;
-      -- statistics of the last two passes
-      if st_done = '1' then
-        st_prev <= st_cur;
-        st_cur <= (nt => st_nt, n_in => st_n_in, nt_in => st_nt_in, st2 => st_st2);
+      if e_init_rej = '1' then
+        rejected_pending <= '1';
       end if;
 
-      case state is
-        ------------------------------------------------------------ before a frame: geometry
-        when T_PREP =>
-          region_ok <= '0';
-          if init_pending = '1' or target_valid = '1' then
-            dec_in_valid <= '1';
-            state <= T_DEC_WAIT;
-          else
-            l2d <= (others => '0');
-            state <= T_IDLE;
-            region_ok <= '1';
-          end if;
-
-        when T_DEC_WAIT =>
-          if dec_out_valid = '1' then
-            if lost_st = '1' then                -- while lost: D x 2
-              l2d <= resize(dec_l2, 3) + 1;
+      case tstate is
+        when S_IDLE =>
+          if e_geo_done = '1' and e_init = '1' then      -- an init's region: arm ms_bg_model first
+            bg_rst_p <= '1';
+            tstate <= S_ARM1;
+          elsif ctl_idle = '1' and cap_done = '1' then
+            if (e_init = '1' or e_valid = '1') and (fr_w /= e_fw or fr_h /= e_fh) then
+              top_word <= side_word(e_c8x, e_c8y, e_w8, e_h8, ST_ERROR,
+                                    v2_flags('0', '0', '0', '1', rejected_pending, not e_valid, overflow),
+                                    ERR_SIZE_CHANGED, frame_count);
+              tstate <= S_PUSH;
+            elsif e_init = '1' then
+              tstate <= S_BG;
+            elsif e_valid = '1' then
+              tstate <= S_RUN;                           -- e_go
             else
-              l2d <= resize(dec_l2, 3);
+              top_word <= side_word(e_c8x, e_c8y, e_w8, e_h8, ST_OK,
+                                    v2_flags('0', '0', '0', '0', rejected_pending, '1', overflow),
+                                    "000", frame_count);
+              tstate <= S_PUSH;
             end if;
-            state <= T_DEC;
-          end if;
-
-        when T_DEC =>
-          dw <= shift_right(tgt_w - 1, to_integer(l2d)) + 1;
-          dh <= shift_right(tgt_h - 1, to_integer(l2d)) + 1;
-          s8x <= shift_right(c8x, to_integer(l2d));
-          s8y <= shift_right(c8y, to_integer(l2d));
-          state <= T_SIZE;
-
-        when T_SIZE =>                         -- lim_* follow dw, dh (registered in T_DEC)
-          ws_in_valid <= '1';
-          bx_c <= resize(shift_right(s8x + 2 ** (CF - 1), CF), COORD_W);   -- init box: round(c)
-          by_c <= resize(shift_right(s8y + 2 ** (CF - 1), CF), COORD_W);
-          state <= T_SIZE_WAIT;
-
-        when T_SIZE_WAIT =>
-          if ws_w_valid = '1' then
-            wd <= ws_w;
-            hd <= ws_h;
-            ex_r <= resize(shift_right(ws_w - 1, 1), HALF_W);
-            ey_r <= resize(shift_right(ws_h - 1, 1), HALF_W);
-            wb <= bs_w;
-            hb <= bs_h;
-            -- search offsets ox, oy = (step16 wd) >> 4, (step16 hd) >> 4; the region margin grows by
-            -- max(ox, oy) while lost (at most MARGIN_MAX)
-            ox_r <= resize(shift_right(resize(ws_w, COORD_W + 6) * STEP16, 4), COORD_W);
-            oy_r <= resize(shift_right(resize(ws_h, COORD_W + 6) * STEP16, 4), COORD_W);
-            rv_in_valid <= '1';                -- ms_region_v2 takes ex_r .. oy_r the next clock
-            rg_s2(0) <= rg_s(dw) - 2;
-            rg_s2(1) <= rg_s(dh) - 2;
-            state <= T_REGION_WAIT;
-          end if;
-
-        when T_REGION_WAIT =>                  -- the region of this frame (ms_region_v2)
-          if rv_out_valid = '1' then
-            reg_x <= rv_reg_x; reg_w <= rv_reg_w; hi_x <= rv_hi_x;
-            reg_y <= rv_reg_y; reg_h <= rv_reg_h; hi_y <= rv_hi_y;
-            if init_pending = '1' then
-              state <= T_BOX;
-            else
-              region_ok <= '1';
-              state <= T_IDLE;
-            end if;
-          end if;
-
-        when T_BOX =>                          -- init box centre in the decimated interior: half sizes
-          bx_h <= shift_right(resize(wb, COORD_W) - 1, 1);
-          by_h <= shift_right(resize(hb, COORD_W) - 1, 1);
-          state <= T_BOX1;
-
-        when T_BOX1 =>                         -- limits hx + 1, S - 2 - hx (S - 2 from the region)
-          bx_lo <= bx_h + 1;
-          by_lo <= by_h + 1;
-          bx_hi <= unsigned(rg_s2(0)(COORD_W - 1 downto 0)) - bx_h;
-          by_hi <= unsigned(rg_s2(1)(COORD_W - 1 downto 0)) - by_h;
-          state <= T_BOX2;
-
-        when T_BOX2 =>                         -- c := max(c, lo); c := min(c, hi) (compares side by side)
-          bg_cx <= box_clamp(bx_c, bx_lo, bx_hi);
-          bg_cy <= box_clamp(by_c, by_lo, by_hi);
-          bg_rst_p <= '1';
-          state <= T_BG_RST;
-
-        when T_BG_RST =>                       -- (bg_rst_p high this clock)
-          state <= T_BG_START;
-
-        when T_BG_START =>
-          if bg_busy = '0' then
-            bg_start <= '1';
-            state <= T_BG_WAIT;
-          end if;
-
-        when T_BG_WAIT =>
-          if bg_counting = '1' then
-            bg_got <= '0';
-            bg_clean <= '1';
-            region_ok <= '1';
-            state <= T_IDLE;
-          end if;
-
-        ------------------------------------------------------------ waiting for a frame / init
-        when T_IDLE =>
-          if cap_done = '1' then
-            if (init_pending = '1' or target_valid = '1') and (fr_w /= tgt_w or fr_h /= tgt_h) then
-              res_word <= pack(c8x, c8y, w8, h8, to_unsigned(0, 17), to_unsigned(0, 17), ST_ERROR,
-                               to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
-                               flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
-                               ERR_SIZE_CHANGED, frame_count);
-              state <= T_PUSH;
-            elsif init_pending = '1' then
-              state <= T_BGDONE;
-            elsif target_valid = '1' then
-              kt_start <= '1';
-              k_acc <= (others => '0');
-              state <= T_TABLES;
-            else
-              res_word <= pack(c8x, c8y, w8, h8, to_unsigned(0, 17), to_unsigned(0, 17), ST_OK,
-                               to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
-                               flags_of('0', '0', '0', '0', rejected_pending, '1', overflow),
-                               "000", frame_count);
-              state <= T_PUSH;
-            end if;
-          elsif err_pending = '1' and fifo_ready = '1' then
-            res_word <= pack(c8x, c8y, w8, h8, to_unsigned(0, 17), to_unsigned(0, 17), ST_ERROR,
-                             to_unsigned(0, ITER_W), "00", to_unsigned(0, 3), to_unsigned(0, 4),
-                             flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow),
-                             err_code_r, frame_count);
+          elsif err_push = '1' then
+            fifo_data <= side_word(e_c8x, e_c8y, e_w8, e_h8, ST_ERROR,
+                                   v2_flags('0', '0', '0', '1', rejected_pending, not e_valid, overflow),
+                                   err_code_r, frame_count);
             fifo_valid <= '1';
             frame_count <= frame_count + 1;
             overflow <= '0';
@@ -1115,455 +563,69 @@ begin
               if fe_err_now = '0' then
                 err_hold <= '0';
               end if;
-              -- the init frame broke: learn again on the next one (re-arm ms_bg_model); after a cut
-              -- the frame that cut it started on a re-armed ms_bg_model (bg_rearm) and is the next one
-              if init_pending = '1' and err_code_r /= ERR_CUT then
-                state <= T_PREP;
-              end if;
-            end if;
-          elsif init_take = '1' then
-            in_x <= s_init_x; in_y <= s_init_y; in_w <= s_init_w; in_h <= s_init_h;
-            in_fw <= frame_width; in_fh <= frame_height;
-            bc_valid <= '1';
-            state <= T_CLIP;
-          elsif tgt_take = '1' then            -- another target: its state, its model
-            target_valid  <= tgt_load_state(0);
-            lost_st       <= tgt_load_state(1);
-            reported_lost <= tgt_load_state(2);
-            c8x        <= unsigned(tgt_load_state(TS_C8Y - 1 downto TS_C8X));
-            c8y        <= unsigned(tgt_load_state(TS_W8 - 1 downto TS_C8Y));
-            w8         <= unsigned(tgt_load_state(TS_H8 - 1 downto TS_W8));
-            h8         <= unsigned(tgt_load_state(TS_W0 - 1 downto TS_H8));
-            w0_8       <= unsigned(tgt_load_state(TS_FW - 1 downto TS_W0));
-            tgt_w      <= unsigned(tgt_load_state(TS_FH - 1 downto TS_FW));
-            tgt_h      <= unsigned(tgt_load_state(TS_RREF - 1 downto TS_FH));
-            rho_ref    <= unsigned(tgt_load_state(TS_SREF - 1 downto TS_RREF));
-            share_ref  <= unsigned(tgt_load_state(TS_RHO0 - 1 downto TS_SREF));
-            rho0       <= unsigned(tgt_load_state(TS_RHOS - 1 downto TS_RHO0));
-            rho_s      <= signed(tgt_load_state(TS_CONS - 1 downto TS_RHOS));
-            con_s      <= signed(tgt_load_state(TS_SPREF - 1 downto TS_CONS));
-            spread_ref <= unsigned(tgt_load_state(TS_W - 1 downto TS_SPREF));
-            m_sel <= tgt_load_model;
-            state <= T_PREP;                   -- its region for the next frame
-          elsif s_axis_tvalid = '1' and bg_rearm = '1' and gate_closed = '0' and err_hold = '0'
-                and fe_err_now = '0' then
-            state <= T_PREP;                   -- re-arm ms_bg_model before this start of frame
-          end if;
-
-        when T_CLIP =>
-          if bc_out_valid = '1' then
-            if bc_rejected = '1' or in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W then
-              rejected_pending <= '1';
-              state <= T_IDLE;
-            else
-              c8x <= bc_cx;
-              c8y <= bc_cy;
-              w8 <= shift_left(resize(bc_w, SIZE_W), 8);
-              h8 <= shift_left(resize(bc_h, SIZE_W), 8);
-              w0_8 <= shift_left(resize(bc_w, SIZE_W), 8);
-              tgt_w <= in_fw;
-              tgt_h <= in_fh;
-              init_pending <= '1';
-              init_clipped <= bc_clipped;
-              target_valid <= '0';
-              lost_st <= '0';
-              reported_lost <= '0';
-              state <= T_PREP;
             end if;
           end if;
 
-        ------------------------------------------------------------ after a frame
-        when T_BGDONE =>
+        when S_ARM1 =>                                   -- (bg_rst_p high this clock)
+          tstate <= S_ARM2;
+
+        when S_ARM2 =>
+          if bg_busy = '0' then
+            bg_start <= '1';
+            tstate <= S_ARM3;
+          end if;
+
+        when S_ARM3 =>
+          if bg_counting = '1' then
+            bg_got <= '0';
+            bg_clean <= '1';
+            tstate <= S_IDLE;
+          end if;
+
+        when S_BG =>                                     -- e_go once the model is learnt
           if bg_got = '1' then
-            kt_start <= '1';
-            k_acc <= (others => '0');
-            state <= T_TABLES;
+            tstate <= S_RUN;
           end if;
 
-        when T_TABLES =>                       -- K = sum over rows |dy| <= ey of (2 XR + 1)
-          if kt_we = '1' and kt_addr <= ey_r then
-            k_add := resize(shift_left(resize(kt_xr, HIST_W), 1) + 1, HIST_W);
-            if kt_addr = 0 then
-              k_acc <= k_acc + k_add;
-            else
-              k_acc <= k_acc + shift_left(k_add, 1);
-            end if;
-          end if;
-          if kt_done = '1' then
-            ql_cnt <= (others => '0');
-            ql_seen <= (others => '0');
-            state <= T_QLOAD;
-          end if;
-
-        when T_QLOAD =>                        -- Qn, T read -> ms_model_scale -> Q RAM; T -> stats
-          if ql_cnt(BIN_C_W) = '0' then
-            m_rd_addr <= ql_cnt(BIN_C_W - 1 downto 0);
-            ql_cnt <= ql_cnt + 1;
-            ql_issue <= '1';
-          else
-            ql_issue <= '0';
-          end if;
-          ql_v1 <= ql_issue;                   -- m_qn / m_t of m_rd_addr (1 clock)
-          ql_bin1 <= m_rd_addr;
-          if ms_out_valid = '1' then
-            ql_seen <= ql_seen + 1;
-          end if;
-          if ql_seen = N_BINS and ST_ON and st_sel = '1' then
-            -- scale test: one pass without moving at the final centre (clamped: the window fits,
-            -- so round(clamp(c)) = round(c))
-            eng_single <= '1';
-            eng_cx <= r_cx;
-            eng_cy <= r_cy;
-            eng_start <= '1';
-            state <= T_ST_RUN;
-          elsif ql_seen = N_BINS then
-            eng_single <= init_pending;
-            eng_cx <= s8x;
-            eng_cy <= s8y;
-            if lost_st = '1' then
-              eng_max_it <= to_unsigned(SEARCH_ITER, ITER_W);
-            else
-              eng_max_it <= to_unsigned(MAX_ITER, ITER_W);
-            end if;
-            cand <= (others => '0');
-            eng_start <= '1';
-            state <= T_RUN;
-          end if;
-
-        when T_RUN =>
-          if c_done = '1' then
-            r_cx <= c_cx; r_cy <= c_cy; r_s <= c_s;
-            if cand = 0 then                     -- iterations and stop of the centre's run
-              r_iter <= c_iter; r_stop <= c_stop;
-            end if;
-            if c_stop = STOP_RHO then
-              st_fin <= st_prev;
-            else
-              st_fin <= st_cur;
-            end if;
-            state <= T_C0;
-          end if;
-
-        -- confidence of this start point's result; the best (the centre, then strictly better) wins
-        when T_C0 =>
-          got <= (others => '0');
-          fu_start <= '1'; sh_start <= '1';
-          state <= T_C1;
-
-        when T_C1 =>
-          if fu_done = '1' then got(0) <= '1'; rho <= fu_rho; end if;
-          if sh_done = '1' then got(1) <= '1'; share <= sh_share; end if;
-          if got(1 downto 0) = "11" then
-            cf_start <= '1';
-            state <= T_C2;
-          end if;
-
-        when T_C2 =>
-          if cf_done = '1' then
-            -- the decision only is registered here; the copy into best_* follows a clock later
-            -- (in T_CNEXT, from r_*, st_fin and conf, which hold there), so the 17-bit compare
-            -- drives one flip-flop and not the enables of the whole best_* record
-            if cand = 0 or conf > best_conf then
-              best_take <= '1';
-            end if;
-            state <= T_CNEXT;
-          end if;
-
-        when T_CNEXT =>
-          if lost_st = '1' and init_pending = '0' and cand /= 8 then
-            -- next start point (sx, sy) in (-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)
-            sxo := signed(resize(s8x, CENTRE_ABS_W + 2));
-            syo := signed(resize(s8y, CENTRE_ABS_W + 2));
-            case to_integer(cand) is
-              when 0 | 3 | 5 => sxo := sxo - signed(resize(shift_left(resize(ox_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
-              when 2 | 4 | 7 => sxo := sxo + signed(resize(shift_left(resize(ox_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
-              when others => null;
-            end case;
-            case to_integer(cand) is
-              when 0 | 1 | 2 => syo := syo - signed(resize(shift_left(resize(oy_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
-              when 5 | 6 | 7 => syo := syo + signed(resize(shift_left(resize(oy_r, CENTRE_ABS_W), CF), CENTRE_ABS_W + 2));
-              when others => null;
-            end case;
-            if sxo < 0 then sxo := (others => '0'); end if;
-            if syo < 0 then syo := (others => '0'); end if;
-            eng_cx <= unsigned(sxo(CENTRE_ABS_W - 1 downto 0));
-            eng_cy <= unsigned(syo(CENTRE_ABS_W - 1 downto 0));
-            cand <= cand + 1;
-            eng_start <= '1';
-            state <= T_RUN;
-          else
-            if best_take = '0' then            -- else this start point is the best: r_*, st_fin hold it
-              r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s; st_fin <= best_st;
-            end if;
-            state <= T_STATS0;
-          end if;
-
-        when T_STATS0 =>                       -- rho, share, spread, ring share side by side
-          got <= (others => '0');
-          fu_start <= '1'; sh_start <= '1'; sp_start <= '1'; rs_start <= '1';
-          state <= T_STATS;
-
-        when T_STATS =>
-          if fu_done = '1' then got(0) <= '1'; rho <= fu_rho; end if;
-          if sh_done = '1' then got(1) <= '1'; share <= sh_share; end if;
-          if sp_done = '1' then got(2) <= '1'; spread <= sp_spread; end if;
-          if rs_done = '1' then got(3) <= '1'; ring <= rs_ring; end if;
-          if got = "1111" then
-            if init_pending = '1' then
-              state <= T_RESULT;
-            else
-              cf_start <= '1';
-              lf_start <= '1';
-              got <= (others => '0');
-              state <= T_CONF;
-            end if;
-          end if;
-
-        when T_CONF =>
-          if lf_done = '1' then
-            rho_s <= rho_s_n;
-            con_s <= con_s_n;
-            got(1) <= '1';
-          end if;
-          if cf_done = '1' then
-            got(0) <= '1';
-          end if;
-          if got(1) = '1' and got(2) = '0' then
-            fl_start <= '1';
-            got(2) <= '1';
-          end if;
-          if fl_done = '1' then
-            got(3) <= '1';
-          end if;
-          if got(0) = '1' and got(3) = '1' then
-            state <= T_DECIDE;
-          end if;
-
-        when T_DECIDE =>
-          -- search state from the confidence
-          if (lost_st = '1' and conf < CONF_REACQUIRE) or (lost_st = '0' and conf < CONF_LOST) then
-            lost_now := '1';
-            srch := ST_LOST;
-          elsif lost_st = '1' then
-            lost_now := '0';
-            srch := ST_REACQ;
-          elsif conf < CONF_UNCERTAIN then
-            lost_now := '0';
-            srch := ST_UNC;
-          else
-            lost_now := '0';
-            srch := ST_OK;
-          end if;
-          -- reported status from the loss flag
-          if lflag = '1' then
-            if lost_now = '1' then stat := ST_LOST; else stat := ST_UNC; end if;
-          else
-            if reported_lost = '1' then stat := ST_REACQ; else stat := ST_OK; end if;
-          end if;
-          status_r <= stat;
-          lost_st_frame <= lost_st;
-          lost_st <= lost_now;
-          if stat = ST_LOST or (stat = ST_UNC and reported_lost = '1') then
-            reported_lost <= '1';
-          else
-            reported_lost <= '0';
-          end if;
-          c8x <= shift_left(r_cx, to_integer(l2d));
-          c8y <= shift_left(r_cy, to_integer(l2d));
-          if srch = ST_OK then
-            ru_start <= '1';
-          end if;
-          if SCALE_GAIN > 0 and st_fin.nt /= 0 and ST_ON then
-            -- the scale test (mstrack.fixed.tracker_v2 _scale_verdict): rho of the main run is the
-            -- first candidate; the main run's tables, K and Q RAM are no longer needed this frame
-            -- (rho, share, spread, ring share, confidence and loss flag are registered)
-            st_sel <= '1';
-            st_up <= '0';
-            st_best <= rho;
-            st_v <= "00";
-            state <= T_ST_SIZE;
-          elsif SCALE_GAIN > 0 and st_fin.nt /= 0 then
-            sc_start <= '1';
-            state <= T_SCALE;
-          else
-            state <= T_RESULT;
-          end if;
-
-        ------------------------------------------------------------ the gated scale test (ST_ON)
-        when T_ST_SIZE =>                      -- ms_scale_test_size x 2; the final centre's window, region-relative
-          if ST_ON then                        -- (no multiplier in the netlist without the test)
-            if st_up = '1' then
-              st_w8 <= st_w8_hi;
-              st_h8 <= st_h8_hi;
-            else
-              st_w8 <= st_w8_lo;
-              st_h8 <= st_h8_lo;
-            end if;
-            st_rx <= rg_round(r_cx) - rg_s(reg_x);
-            st_ry <= rg_round(r_cy) - rg_s(reg_y);
-          end if;
-          state <= T_ST_WS;
-
-        when T_ST_WS =>                        -- ms_window_size of the test sizes (ws_s8w, ws_s8h)
-          ws_in_valid <= '1';
-          state <= T_ST_WS_WAIT;
-
-        when T_ST_WS_WAIT =>
-          if ws_w_valid = '1' then
-            wd <= ws_w;
-            hd <= ws_h;
-            ex_r <= resize(shift_right(ws_w - 1, 1), HALF_W);
-            ey_r <= resize(shift_right(ws_h - 1, 1), HALF_W);
-            state <= T_ST_FIT;
-          end if;
-
-        when T_ST_FIT =>                       -- a window that leaves the captured region does not count
-          if st_rx >= rg_s(resize(ex_r, COORD_W)) and st_ry >= rg_s(resize(ey_r, COORD_W))
-             and st_rx + rg_s(resize(ex_r, COORD_W)) < rg_s(reg_w_c)
-             and st_ry + rg_s(resize(ey_r, COORD_W)) < rg_s(reg_h_c) then
-            hi_x <= reg_w - 1 - resize(ex_r, REGION_W);
-            hi_y <= reg_h - 1 - resize(ey_r, REGION_W);
-            kt_start <= '1';
-            k_acc <= (others => '0');
-            state <= T_TABLES;                 -- -> T_QLOAD -> T_ST_RUN
-          else
-            state <= T_ST_NEXT;
-          end if;
-
-        when T_ST_RUN =>
-          if c_done = '1' then
-            r_s <= c_s;                        -- (the main run's S is no longer needed: rho is registered)
-            fu_start <= '1';
-            state <= T_ST_RHO;
-          end if;
-
-        when T_ST_RHO =>                       -- ms_scale_test: the largest rho, ties to the earlier window
-          if fu_done = '1' then
-            if fu_rho > st_best then
-              st_best <= fu_rho;
-              if st_up = '1' then st_v <= "01"; else st_v <= "11"; end if;
-            end if;
-            state <= T_ST_NEXT;
-          end if;
-
-        when T_ST_NEXT =>
-          if st_up = '0' then
-            st_up <= '1';
-            state <= T_ST_SIZE;
-          else
-            state <= T_ST_GATE;
-          end if;
-
-        when T_ST_GATE =>                      -- ms_scale_gate: spread if the rho test moves the same way
-          if (spread > spread_ref and st_v = "01") or (spread < spread_ref and st_v = "11") then
-            sp_gate <= spread;
-          else
-            sp_gate <= spread_ref;
-          end if;
-          st_sel <= '0';
-          sc_start <= '1';
-          state <= T_SCALE;
-
-        when T_SCALE =>
-          if sc_done = '1' then
-            rz_start <= '1';
-            state <= T_RESIZE;
-          end if;
-
-        when T_RESIZE =>
-          if rzw_done = '1' then
-            w8 <= w8_n;
-            h8 <= h8_n;
-            state <= T_RESULT;
-          end if;
-
-        when T_RESULT =>
-          if init_pending = '1' then
-            rho_ref <= rho;
-            share_ref <= share;
-            rho0 <= rho;
-            rho_s <= signed(resize(rho, CON_W));
-            con_s <= con_x;
-            if spread /= 0 then
-              spread_ref <= spread;
-            else
-              spread_ref <= to_unsigned(SPREAD_DEFAULT, SPREAD_W);
-            end if;
-            target_valid <= '1';
-            init_pending <= '0';
-            if init_clipped = '1' then stat := ST_CLIP; else stat := ST_INIT; end if;
-            res_word <= pack(c8x, c8y, w8, h8, rho, to_unsigned(ONE16, 17), stat, to_unsigned(0, ITER_W),
-                             "00", l2d, to_unsigned(0, 4),
-                             flags_of(not init_clipped, init_clipped, '0', '0', rejected_pending, '0', overflow),
-                             "000", frame_count);
-          else
-            if status_r = ST_LOST then lost_now := '1'; else lost_now := '0'; end if;
-            if lost_st_frame = '1' then srch := "000"; srch4 := to_unsigned(8, 4); else srch4 := to_unsigned(0, 4); end if;
-            res_word <= pack(c8x, c8y, w8, h8, rho, conf, status_r, r_iter, r_stop, l2d, srch4,
-                             flags_of('0', '0', lost_now, '0', rejected_pending, '0', overflow),
-                             "000", frame_count);
-          end if;
-          state <= T_PUSH;
-
-        when T_PUSH =>
-          if fifo_ready = '1' then
+        when S_RUN =>
+          if e_res_valid = '1' and fifo_ready = '1' then
+            fifo_data <= e_res_data;
             fifo_valid <= '1';
             frame_count <= frame_count + 1;
             overflow <= '0';
             rejected_pending <= '0';
-            state <= T_PREP;
+            tstate <= S_IDLE;
+          end if;
+
+        when S_PUSH =>                                   -- e_rearm with the push
+          if fifo_ready = '1' then
+            fifo_data <= top_word;
+            fifo_valid <= '1';
+            frame_count <= frame_count + 1;
+            overflow <= '0';
+            rejected_pending <= '0';
+            tstate <= S_IDLE;
           end if;
       end case;
 
-      -- the references follow OK frames (ms_ref_update: one clock after ru_start)
-      ru_d <= ru_start;
-      if ru_d = '1' then
-        rho_ref <= rr_rho;
-        share_ref <= rr_share;
-      end if;
-
       if rst = '1' then
-        state <= T_PREP;
-        region_ok <= '0';
-        target_valid <= '0';
-        init_pending <= '0';
+        tstate <= S_IDLE;
         rejected_pending <= '0';
         err_pending <= '0';
         err_hold <= '0';
         overflow <= '0';
         frame_count <= (others => '0');
-        w8 <= (others => '0');
-        h8 <= (others => '0');
-        tgt_w <= to_unsigned(3, COORD_W);
-        tgt_h <= to_unsigned(3, COORD_W);
-        c8x <= (others => '0');
-        c8y <= (others => '0');
-        lost_st <= '0';
-        reported_lost <= '0';
-        m_sel <= (others => '0');
-        ql_issue <= '0';
         bg_clean <= '0';
-        st_sel <= '0';
       end if;
     end if;
   end process;
 
-  init_ready <= '1' when state = T_IDLE and cap_done = '0' and err_pending = '0' and in_frame = '0'
+  init_ready <= '1' when ctl_idle = '1' and cap_done = '0' and err_pending = '0' and in_frame = '0'
                          and gate_closed = '0' and err_hold = '0' and fe_err_now = '0' else '0';
   init_take <= s_init_tvalid and init_ready;
   s_init_tready <= init_ready;
   -- a target load: between frames like an init (which goes first), not while an init frame is pending
-  tgt_ready_i <= init_ready and not init_pending and not s_init_tvalid;
+  tgt_ready_i <= init_ready and not e_init and not s_init_tvalid;
   tgt_take <= tgt_load_valid and tgt_ready_i;
   tgt_load_ready <= tgt_ready_i;
-  tgt_state <= std_logic_vector(spread_ref) & std_logic_vector(con_s) & std_logic_vector(rho_s)
-               & std_logic_vector(rho0) & std_logic_vector(share_ref) & std_logic_vector(rho_ref)
-               & std_logic_vector(tgt_h) & std_logic_vector(tgt_w) & std_logic_vector(w0_8)
-               & std_logic_vector(h8) & std_logic_vector(w8) & std_logic_vector(c8y) & std_logic_vector(c8x)
-               & reported_lost & lost_st & target_valid;
-
-  -- T table of ms_target_stats: written with the Qw load (T of the bin read the clock before)
-  t_we   <= ql_v1;
-  t_addr <= ql_bin1;
-  t_data <= m_t;
 end architecture;

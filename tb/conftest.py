@@ -257,6 +257,10 @@ CI_EXTRA: dict[str, str] = {
         "test_tracker_v2_targets_colour (the same bench and scene on the RTL under GHDL, colour bins) and core "
         "v2's joint netlist runs with one model (test_tracker_v2_fastsim_long); this case: the joint bins' "
         "netlist with 4 models",
+    "tb/test_ms_engine.py::test_ms_engine_joint_verilator":
+        "test_ms_engine (the same bench and jobs on the RTL under GHDL, colour bins, marker long) and core v2's "
+        "joint netlist runs, whose sequencer is ms_engine (test_tracker_v2_fastsim_long); this case: the joint "
+        "bins' netlist with the init job from the slot",
     "tb/test_ms_init_merge.py::test_ms_init_merge_real":
         "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
         "frames (marker long)",

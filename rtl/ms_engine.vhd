@@ -170,6 +170,10 @@ entity ms_engine is
     geo_rect_y     : out unsigned(COORD_W - 1 downto 0);
     geo_rect_w     : out unsigned(COORD_W - 1 downto 0);
     geo_rect_h     : out unsigned(COORD_W - 1 downto 0);
+    -- the frame's last column / row in decimated px when it is a border pixel at full resolution
+    -- ((W - 1) mod D = 0), else all ones (ms_init_job counts border pixels with orientation 8)
+    geo_last_x     : out unsigned(COORD_W - 1 downto 0);
+    geo_last_y     : out unsigned(COORD_W - 1 downto 0);
     -- the target's model (ms_bg_model): m_sel selects it, m_rd_addr -> m_qn, m_t one clock later
     m_sel          : out unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');
     m_rd_addr      : out unsigned(3 * COLOUR_BITS - 1 downto 0) := (others => '0');
@@ -301,6 +305,7 @@ architecture rtl of ms_engine is
   signal rc_x0, rc_y0, rc_x1, rc_y1 : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal rect_x, rect_y, rect_w, rect_h : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal po_x, po_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
+  signal last_x, last_y : unsigned(COORD_W - 1 downto 0) := (others => '1');
   signal ms_reg_x, ms_reg_y : unsigned(COORD_W - 1 downto 0);
   signal ms_hi_x, ms_hi_y, ms_lo_x, ms_lo_y : unsigned(REGION_W - 1 downto 0);
   signal lim_wn, lim_hn : unsigned(WIN_W - 1 downto 0);
@@ -799,6 +804,14 @@ begin
           fsm <= T_SIZE;
 
         when T_SIZE =>                         -- lim_* follow dw, dh (registered in T_DEC)
+          last_x <= (others => '1');
+          last_y <= (others => '1');
+          if ((tgt_w - 1) and (shift_left(to_unsigned(1, COORD_W), to_integer(l2d)) - 1)) = 0 then
+            last_x <= dw - 1;
+          end if;
+          if ((tgt_h - 1) and (shift_left(to_unsigned(1, COORD_W), to_integer(l2d)) - 1)) = 0 then
+            last_y <= dh - 1;
+          end if;
           ws_in_valid <= '1';
           bx_c <= resize(shift_right(s8x + 2 ** (CF - 1), CF), COORD_W);   -- init box: round(c)
           by_c <= resize(shift_right(s8y + 2 ** (CF - 1), CF), COORD_W);
@@ -1338,6 +1351,8 @@ begin
   geo_rect_y <= rect_y;
   geo_rect_w <= rect_w;
   geo_rect_h <= rect_h;
+  geo_last_x <= last_x;
+  geo_last_y <= last_y;
 
   -- T table of ms_target_stats: written with the Qw load (T of the bin read the clock before)
   t_we   <= ql_v1;

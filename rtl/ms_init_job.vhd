@@ -7,6 +7,11 @@
 -- relative to it), which is the model FixedTrackerV2.init learns from the whole decimated frame when
 -- the rectangle is mstrack.fixed.multi_capacity.init_capture's and (cx, cy) its centre cd moved by the
 -- rectangle's origin.  A slot pixel is {orientation bin (4 bits, N_ORIENT > 1), colour bin (BIN_W)}.
+-- A pixel on the frame's border (decimated x = 0, y = 0, or the last column / row when it is a
+-- border pixel at full resolution: last_x, last_y) is counted with orientation 8 whatever the slot
+-- holds there: the slot's orientation comes from the Sobel's interior stream, which has no border
+-- pixels (docs/multi_target_core.md, "The init job").  org_x, org_y: the rectangle's origin in the
+-- decimated frame; last_x, last_y all ones: no such column / row (the defaults: no substitution).
 -- Steps: ms_bg_model's start (the kernel-table set-up of the box), then ms_slot_scan streams the
 -- rectangle into its count port, one pixel per clock, then its three passes write the model.
 -- Latency: `done` comes SETUP + RD_LAT + rect_w rect_h + LAT_DONE + 7 clocks after the edge that takes
@@ -30,6 +35,7 @@ entity ms_init_job is
     STRIDE   : natural := 64;       -- words per slot row per bank
     ADDR_W   : natural := 14;       -- slot word address width
     REGION_W : natural := 9;        -- rectangle sizes and coordinates
+    COORD_W  : natural := 12;       -- decimated frame coordinates (org_*, last_*)
     RD_LAT   : positive := 5;       -- the slot read port's latency
     BIN_W    : natural := 9;        -- colour bin bits
     N_ORIENT : natural range 1 to 16 := 9;   -- orientation banks (1: colour bins only)
@@ -53,6 +59,10 @@ entity ms_init_job is
     hb        : in  unsigned(HALF_W downto 0);
     ring16    : in  unsigned(RING_W - 1 downto 0);
     model     : in  unsigned(clog2(MODELS) - 1 downto 0);       -- the target's model
+    org_x     : in  unsigned(COORD_W - 1 downto 0) := (others => '1');   -- the rectangle's origin
+    org_y     : in  unsigned(COORD_W - 1 downto 0) := (others => '1');
+    last_x    : in  unsigned(COORD_W - 1 downto 0) := (others => '1');   -- the frame's last border column
+    last_y    : in  unsigned(COORD_W - 1 downto 0) := (others => '1');   -- and row (all ones: none)
     busy      : out std_logic;
     done      : out std_logic;                                  -- pulse: the model is written
     -- the slot's read port
@@ -85,6 +95,9 @@ architecture rtl of ms_init_job is
   signal ring_r   : unsigned(RING_W - 1 downto 0) := (others => '0');
   signal model_r  : unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');
   signal done_r   : std_logic := '0';
+  -- the frame's border inside the rectangle (rectangle-relative), taken with start
+  signal bl_x, bl_y, br_x, br_y : std_logic := '0';          -- left / top border, right / bottom border in it
+  signal rel_x, rel_y : unsigned(REGION_W - 1 downto 0) := (others => '0');
 begin
   u_scan : entity work.ms_slot_scan
     generic map (LANES => LANES, STRIDE => STRIDE, ADDR_W => ADDR_W, DATA_W => DATA_W, REGION_W => REGION_W,
@@ -93,7 +106,10 @@ begin
               raddr => raddr, rdata => rdata, px_valid => px_valid, px_x => px_x, px_y => px_y,
               px_data => px_data, px_last => px_last);
 
-  px_obin <= unsigned(px_data(DATA_W - 1 downto BIN_W)) when OR_ON else (others => '0');
+  px_obin <= (others => '0') when not OR_ON else
+             to_unsigned(8, 4) when (bl_x = '1' and px_x = 0) or (bl_y = '1' and px_y = 0)
+                                    or (br_x = '1' and px_x = rel_x) or (br_y = '1' and px_y = rel_y) else
+             unsigned(px_data(DATA_W - 1 downto BIN_W));
 
   u_bg : entity work.ms_bg_model
     generic map (BIN_W => BIN_W, HALF_W => HALF_W, COORD_W => REGION_W, RING_W => RING_W, Q_W => Q_W, O_W => O_W,
@@ -116,6 +132,12 @@ begin
           if start = '1' and bg_busy = '0' then
             w_r <= rect_w; h_r <= rect_h; cx_r <= cx; cy_r <= cy;
             wb_r <= wb; hb_r <= hb; ring_r <= ring16; model_r <= model;
+            bl_x <= to_sl(org_x = 0);
+            bl_y <= to_sl(org_y = 0);
+            br_x <= to_sl(last_x /= 2 ** COORD_W - 1 and last_x >= org_x and last_x - org_x < rect_w);
+            br_y <= to_sl(last_y /= 2 ** COORD_W - 1 and last_y >= org_y and last_y - org_y < rect_h);
+            rel_x <= resize(last_x - org_x, REGION_W);
+            rel_y <= resize(last_y - org_y, REGION_W);
             state <= S_BG_START;
           end if;
         when S_BG_START =>                     -- ms_bg_model takes the box (its inputs registered above)

@@ -261,6 +261,9 @@ CI_EXTRA: dict[str, str] = {
         "test_ms_engine (the same bench and jobs on the RTL under GHDL, colour bins, marker long) and core v2's "
         "joint netlist runs, whose sequencer is ms_engine (test_tracker_v2_fastsim_long); this case: the joint "
         "bins' netlist with the init job from the slot",
+    "tb/test_ms_engine.py::test_ms_engine_real_verilator":
+        "test_ms_engine (the same bench on the generated scene under GHDL) and core v2's real-frame netlist runs "
+        "at D = 2 (test_tracker_v2_fastsim_long); this case: the init job from a slot at D = 2",
     "tb/test_ms_init_merge.py::test_ms_init_merge_real":
         "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
         "frames (marker long)",

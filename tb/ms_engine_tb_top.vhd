@@ -2,7 +2,8 @@
 -- ms_init_job, as the multi-target core joins them: the bench fills the slot through its write port
 -- (a pixel is {orientation bin, colour bin} with the joint bins), starts the init job with the engine's
 -- init geometry, and gives the engine its commands.  The slot's read port is the init job's while it is
--- busy, the engine's otherwise.
+-- busy, the engine's otherwise.  The slot's orientation bins on the frame's border are the bench's
+-- (the core's slot takes them from the Sobel's interior stream): ms_init_job counts them as 8.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -157,7 +158,7 @@ architecture rtl of ms_engine_tb_top is
   signal m_t      : std_logic;
   signal m_qn_all : std_logic_vector(N_OR * 17 - 1 downto 0);
   signal m_t_all  : std_logic_vector(N_OR - 1 downto 0);
-  signal wb, hb, bg_cx, bg_cy, rect_x, rect_y, rect_w, rect_h : unsigned(COORD_W - 1 downto 0);
+  signal wb, hb, bg_cx, bg_cy, rect_x, rect_y, rect_w, rect_h, last_x, last_y : unsigned(COORD_W - 1 downto 0);
 begin
   u_ram : entity work.ms_region_ram
     generic map (LANES => LANES, DEPTH => DEPTH, DATA_W => DATA_W, ADDR_W => ADDR_W, RD_LAT => RAM_LAT,
@@ -173,13 +174,15 @@ begin
   end generate;
 
   u_job : entity work.ms_init_job
-    generic map (LANES => LANES, STRIDE => STRIDE, ADDR_W => ADDR_W, REGION_W => REGION_W, RD_LAT => RAM_LAT,
+    generic map (LANES => LANES, STRIDE => STRIDE, ADDR_W => ADDR_W, REGION_W => REGION_W, COORD_W => COORD_W,
+                 RD_LAT => RAM_LAT,
                  BIN_W => BIN_W, N_ORIENT => N_OR, HALF_W => HALF_W, RING_W => 5, Q_W => BG_Q_W,
                  O_W => BG_O_W, KD_W => KD_W, MODELS => MODELS)
     port map (clk => clk, rst => rst, start => ij_start, rect_w => resize(rect_w, REGION_W),
               rect_h => resize(rect_h, REGION_W), cx => resize(bg_cx - rect_x, REGION_W),
               cy => resize(bg_cy - rect_y, REGION_W), wb => resize(wb, HALF_W + 1), hb => resize(hb, HALF_W + 1),
-              ring16 => to_unsigned(RING16, 5), model => m_sel, busy => j_busy, done => ij_done,
+              ring16 => to_unsigned(RING16, 5), model => m_sel, org_x => rect_x, org_y => rect_y,
+              last_x => last_x, last_y => last_y, busy => j_busy, done => ij_done,
               raddr => j_raddr, rdata => rdata, m_rd_addr => m_rd_addr, m_rd_obin => (others => '0'),
               m_rd_sel => m_sel, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all, m_t_all => m_t_all);
   ij_busy <= j_busy;
@@ -215,6 +218,7 @@ begin
               geo_l2d => geo_l2d, geo_reg_x => geo_reg_x, geo_reg_y => geo_reg_y, geo_reg_w => geo_reg_w,
               geo_reg_h => geo_reg_h, geo_wb => wb, geo_hb => hb, geo_bg_cx => bg_cx, geo_bg_cy => bg_cy,
               geo_rect_x => rect_x, geo_rect_y => rect_y, geo_rect_w => rect_w, geo_rect_h => rect_h,
+              geo_last_x => last_x, geo_last_y => last_y,
               m_sel => m_sel, m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all,
               m_t_all => m_t_all, ram_addr => e_raddr, ram_data => e_cbin, ram_obin => e_obin,
               res_valid => res_valid, res_ready => res_ready, res_data => res_data,

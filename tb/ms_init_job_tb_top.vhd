@@ -38,6 +38,10 @@ entity ms_init_job_tb_top is
     hb        : in  unsigned(HALF_W downto 0);
     ring16    : in  unsigned(RING_W - 1 downto 0);
     model     : in  unsigned(clog2(MODELS) - 1 downto 0);
+    org_x     : in  unsigned(11 downto 0);                      -- the rectangle's origin, the frame's last
+    org_y     : in  unsigned(11 downto 0);                      -- border column / row (ms_init_job)
+    last_x    : in  unsigned(11 downto 0);
+    last_y    : in  unsigned(11 downto 0);
     busy      : out std_logic;
     done      : out std_logic;
     m_rd_addr : in  unsigned(BIN_W - 1 downto 0);
@@ -63,7 +67,8 @@ begin
                  BIN_W => BIN_W, N_ORIENT => N_ORIENT, HALF_W => HALF_W, RING_W => RING_W, Q_W => Q_W,
                  O_W => O_W, KD_W => KD_W, MODELS => MODELS)
     port map (clk => clk, rst => rst, start => start, rect_w => rect_w, rect_h => rect_h, cx => cx, cy => cy,
-              wb => wb, hb => hb, ring16 => ring16, model => model, busy => busy, done => done,
+              wb => wb, hb => hb, ring16 => ring16, model => model, org_x => org_x, org_y => org_y,
+              last_x => last_x, last_y => last_y, busy => busy, done => done,
               raddr => raddr, rdata => rdata, m_rd_addr => m_rd_addr, m_rd_obin => m_rd_obin,
               m_rd_sel => m_rd_sel, m_qn => m_qn, m_t => m_t, m_qn_all => open, m_t_all => open);
 end architecture;

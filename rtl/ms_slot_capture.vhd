@@ -9,7 +9,11 @@
 -- ry = ip_y / D - reg_y,
 --   wbank = rx mod LANES, waddr = ry * STRIDE + rx / LANES, wdata = ip_data.
 -- So the slot holds FixedTrackerV2._capture(frame[::D, ::D], region)
--- (mstrack.fixed.blocks_v2.ms_slot_capture).
+-- (mstrack.fixed.blocks_v2.ms_slot_capture).  A region that reaches the frame's border (an init
+-- rectangle, docs/multi_target_core.md "Border pixels") gets the pixels the stream brings: with
+-- INTERIOR_ONLY (the Sobel's stream) none on the border, and rows start at region column 1 when the
+-- region starts at the frame's column 0 (the top row needs nothing: a row is counted when it arrives);
+-- without it (the all-pixel stream av_*) every pixel.
 -- The region comes at full resolution (fx0 = reg_x D, fy0 = reg_y D, fx1 = (reg_x + reg_w) D,
 -- fy1 = (reg_y + reg_h) D: one shifter in the engine serves every slot), so a slot needs no
 -- shifter: the inside test compares ip_x, ip_y with the bounds, and rx, ry are counters (every
@@ -54,7 +58,11 @@ entity ms_slot_capture is
     STRIDE     : natural := 64;                -- words per region row per bank (>= REGION_MAX / LANES)
     ADDR_W     : natural := 14;                -- slot address width
     DATA_W     : natural := 9;                 -- bits per pixel (colour bin 9; joint: + orientation 4)
-    LOG2_D_MAX : natural range 0 to 7 := 4     -- largest log2 D
+    LOG2_D_MAX : natural range 0 to 7 := 4;    -- largest log2 D
+    -- true: the pixel stream is the Sobel's interior stream, which has no pixel in the frame's column 0,
+    -- so a region that starts there (an init rectangle's orientation) writes each row from region column
+    -- 1 on; false: a stream with every pixel (the front end's av_*, an init rectangle's colour)
+    INTERIOR_ONLY : boolean := true
   );
   port (
     clk         : in  std_logic;                                -- clock
@@ -109,6 +117,7 @@ architecture rtl of ms_slot_capture is
   -- stage 2: region row base and column
   signal row_base   : unsigned(ADDR_W - 1 downto 0);
   signal col_next   : unsigned(CNT_W - 1 downto 0);
+  signal col0       : unsigned(CNT_W - 1 downto 0) := (others => '0');   -- a row's first column written
   signal v2, rel2   : std_logic := '0';
   signal base2      : unsigned(ADDR_W - 1 downto 0);
   signal col2       : unsigned(CNT_W - 1 downto 0);
@@ -148,7 +157,7 @@ begin
       col := col_next;
       if v1 = '1' and nr1 = '1' then
         base := row_base + STRIDE;
-        col := (others => '0');
+        col := col0;
       end if;
       if v1 = '1' then
         row_base <= base;
@@ -202,6 +211,10 @@ begin
           end if;
         end loop;
         mask <= m;
+        col0 <= (others => '0');
+        if INTERIOR_ONLY and fx0 = 0 then         -- column 0 never arrives: rows start at region column 1
+          col0 <= to_unsigned(1, CNT_W);
+        end if;
         x0   <= fx0;
         y0   <= fy0;
         x1   <= fx1;
@@ -222,7 +235,14 @@ begin
       if arm_now or (frame_start = '1' and wait_start = '1' and load = '0') then
         row_y    <= fy0 when arm_now else y0;
         row_base <= (others => '0');
-        col_next <= (others => '0');
+        if arm_now then
+          col_next <= (others => '0');
+          if INTERIOR_ONLY and fx0 = 0 then
+            col_next <= to_unsigned(1, CNT_W);
+          end if;
+        else
+          col_next <= col0;
+        end if;
       end if;
       if arm_now then
         v1   <= '0';                              -- pixels in flight belong to the old descriptor (the

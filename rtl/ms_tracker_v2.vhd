@@ -190,6 +190,16 @@ architecture rtl of ms_tracker_v2 is
   type sstate_t is (S_IDLE, S_ARM1, S_ARM2, S_ARM3, S_BG, S_RUN, S_PUSH);
   signal tstate : sstate_t := S_IDLE;
   signal ctl_idle, err_push : std_logic;
+  -- the engine's commands, registered (with the init box and the record they carry): the engine takes
+  -- them one clock after the stream side decides, which keeps the stream side's conditions off the
+  -- engine's paths; the stream side waits that clock (cmd_pending)
+  signal c_go, c_rearm, c_init, c_load, cmd_pending : std_logic := '0';
+  signal c_init_x, c_init_y : signed(COORD_W + 1 downto 0) := (others => '0');
+  signal c_init_w, c_init_h : unsigned(COORD_W downto 0) := (others => '0');
+  signal c_init_fw, c_init_fh : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal c_load_state : std_logic_vector(v2_state_w(CENTRE_ABS_W, SIZE_W, COORD_W, SHARE_W, CON_W, SPREAD_W) - 1
+                                         downto 0) := (others => '0');
+  signal c_load_model : unsigned(clog2(MODELS) - 1 downto 0) := (others => '0');
   signal rejected_pending : std_logic := '0';
   signal tgt_ready_i, tgt_take : std_logic;
 
@@ -464,10 +474,10 @@ begin
                  SPREAD_DEFAULT => SPREAD_DEFAULT, BG_Q_W => BG_Q_W, BG_O_W => BG_O_W, SEARCH_ITER => SEARCH_ITER,
                  STEP16 => STEP16, MARGIN_MAX => MARGIN_MAX, SCALE_TEST_D256 => SCALE_TEST_D256,
                  ORIENT_T => ORIENT_T, MODELS => MODELS, RAM_LAT => REGION_RD_LAT)
-    port map (clk => clk, rst => rst, idle => e_idle, geo_done => e_geo_done, go => e_go, rearm => e_rearm,
-              init_take => init_take, init_x => s_init_x, init_y => s_init_y, init_w => s_init_w,
-              init_h => s_init_h, init_fw => frame_width, init_fh => frame_height, init_rejected => e_init_rej,
-              load_take => tgt_take, load_state => tgt_load_state, load_model => tgt_load_model,
+    port map (clk => clk, rst => rst, idle => e_idle, geo_done => e_geo_done, go => c_go, rearm => c_rearm,
+              init_take => c_init, init_x => c_init_x, init_y => c_init_y, init_w => c_init_w,
+              init_h => c_init_h, init_fw => c_init_fw, init_fh => c_init_fh, init_rejected => e_init_rej,
+              load_take => c_load, load_state => c_load_state, load_model => c_load_model,
               rec => tgt_state, rec_valid => e_valid, rec_init => e_init, rec_c8x => e_c8x, rec_c8y => e_c8y,
               rec_w8 => e_w8, rec_h8 => e_h8, rec_fw => e_fw, rec_fh => e_fh,
               geo_l2d => l2d, geo_reg_x => reg_x, geo_reg_y => reg_y, geo_reg_w => reg_w_c, geo_reg_h => reg_h_c,
@@ -489,7 +499,9 @@ begin
   ---------------------------------------------------------------------------- control
   -- the stream side takes a frame or a command while it and the engine are idle, and not on the
   -- clock an init's geometry arrives (ms_bg_model is armed first)
-  ctl_idle <= '1' when tstate = S_IDLE and e_idle = '1' and not (e_geo_done = '1' and e_init = '1') else '0';
+  ctl_idle <= '1' when tstate = S_IDLE and e_idle = '1' and cmd_pending = '0'
+                      and not (e_geo_done = '1' and e_init = '1') else '0';
+  cmd_pending <= c_go or c_rearm or c_init or c_load;
   err_push <= ctl_idle and not cap_done and err_pending and fifo_ready;
   -- the engine's commands: a job once the region is in (an init's once its model is learnt); the
   -- geometry again after a word of the stream side, after a fault on an init frame (not a cut), and
@@ -502,6 +514,30 @@ begin
                           and init_take = '0' and tgt_take = '0' and s_axis_tvalid = '1' and bg_rearm = '1'
                           and gate_closed = '0' and err_hold = '0' and fe_err_now = '0')
                       or (tstate = S_PUSH and fifo_ready = '1') else '0';
+
+  p_cmd : process(clk)
+  begin
+    if rising_edge(clk) then
+      c_go <= e_go;
+      c_rearm <= e_rearm;
+      c_init <= init_take;
+      c_load <= tgt_take;
+      if init_take = '1' then
+        c_init_x <= s_init_x; c_init_y <= s_init_y; c_init_w <= s_init_w; c_init_h <= s_init_h;
+        c_init_fw <= frame_width; c_init_fh <= frame_height;
+      end if;
+      if tgt_take = '1' then
+        c_load_state <= tgt_load_state;
+        c_load_model <= tgt_load_model;
+      end if;
+      if rst = '1' then
+        c_go <= '0';
+        c_rearm <= '0';
+        c_init <= '0';
+        c_load <= '0';
+      end if;
+    end if;
+  end process;
 
   p_ctrl : process(clk)
   begin

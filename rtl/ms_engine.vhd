@@ -20,8 +20,8 @@
 -- Commands, taken while idle = 1, at most one per clock: go (run the job), init_take (an init box:
 --   ms_box_clip; a box it rejects gives init_rejected, otherwise the record becomes an init pending),
 --   load_take (another target's record and model), rearm (compute the geometry again).
--- Latency: geometry about 25 clocks (+ 3 with an init pending); go -> res_valid: the kernel tables
---   (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
+-- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT); go -> res_valid:
+--   the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 --   statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean shifts
 --   with their confidence; the gated scale test adds about 2 x (tables + Qw load + one pass) on a
 --   frame that scales.  Measured per sequence: docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).
@@ -875,7 +875,8 @@ begin
           ring_gy <= resize(shift_right(resize(hb, COORD_W + 5) * to_unsigned(RING16, 5), 4), COORD_W);
           fsm <= T_RECT1;
 
-        when T_RECT1 =>                        -- the ring clipped to the frame: [max(0, c - h - g), min(S - 1, c + h + g)]
+        when T_RECT1 =>                        -- the ring clipped to the frame:
+                                               -- [max(0, c - h - g), min(S - 1, c + h + g)]
           if resize(bx_h, COORD_W + 1) + ring_gx > bg_cx then
             rc_x0 <= (others => '0');
           else

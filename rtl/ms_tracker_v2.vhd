@@ -30,7 +30,7 @@
 -- ms_bg_model, and a start of frame that cuts the init frame is held until then).
 --
 -- Latency: between frames about 25 clocks (+ ms_bg_model's reset and set-up before an init frame);
--- last pixel -> result: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
+-- last pixel -> result: 1 clock (the registered go), the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
 -- (docs/realtime.md), ~60 clocks of statistics and about 230 of confidence, loss flag, scale and
 -- resize; while lost 8 more mean shifts with their confidence; on the init frame ms_bg_model's
 -- 3 N_BINS + 65 clocks first; the gated scale test adds about 2 x (tables + Qw load + one pass) on a

@@ -203,7 +203,6 @@ architecture rtl of ms_engine is
   constant N_BINS    : natural := 2 ** BIN_C_W;
   constant ONE16     : natural := 65536;
   constant BOX_HALF_W : natural := COORD_W - 1;     -- ms_box_clip without shrink: MAX_HALF 2**(COORD_W-1) - 1
-  constant MS_LAT    : natural := 4;                -- ms_model_scale latency (HIST_W = 14)
   -- status codes (mstrack.fixed.vhdl_pkg.STATUS_V2)
   constant ST_OK     : unsigned(2 downto 0) := "000";
   constant ST_UNC    : unsigned(2 downto 0) := "001";
@@ -211,7 +210,6 @@ architecture rtl of ms_engine is
   constant ST_REACQ  : unsigned(2 downto 0) := "011";
   constant ST_INIT   : unsigned(2 downto 0) := "100";
   constant ST_CLIP   : unsigned(2 downto 0) := "101";
-  constant ST_ERROR  : unsigned(2 downto 0) := "110";
 
   type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BOX1, T_BOX2, T_RECT0, T_RECT1,
                     T_RECT2, T_RECT3,

@@ -313,11 +313,8 @@ architecture rtl of ms_tracker is
     return v;
   end function;
 
-  -- flags: 0 init, 1 clipped, 2 lost, 3 error, 4 rejected, 5 no_target, 6 overflow
-  function flags_of(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector is
-  begin
-    return '0' & ovf & notgt & rej & err & lost & clipped & init;
-  end function;
+  -- flags (ms_pkg.v2_flags, the same byte in both result words): 0 init, 1 clipped, 2 lost, 3 error,
+  -- 4 rejected, 5 no_target, 6 overflow
 
   ------------------------------------------------------------------------------ generic checks
   -- The derived widths are generics (computed by mstrack.fixed.vhdl_pkg.core_generics; `mstrack hdl
@@ -767,7 +764,7 @@ begin
             if (init_pending = '1' or target_valid = '1') and size_mis = '1' then
               -- not the size the target was initialised for: not tracked, state unchanged
               res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '0';
-              res_flags <= flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow);
+              res_flags <= v2_flags('0', '0', '0', '1', rejected_pending, not target_valid, overflow);
               res_err <= ERR_SIZE_CHANGED;
               state <= T_PUSH;
             elsif init_pending = '1' or target_valid = '1' then
@@ -778,14 +775,14 @@ begin
               state <= T_RUN;
             else
               res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '0';
-              res_flags <= flags_of('0', '0', '0', '0', rejected_pending, '1', overflow);
+              res_flags <= v2_flags('0', '0', '0', '0', rejected_pending, '1', overflow);
               res_err <= "000";
               state <= T_PUSH;
             end if;
           elsif err_pending = '1' and fifo_ready = '1' and err_push = '0' and fifo_valid = '0' then
             -- (no write on its way: fifo_ready counts every word already written)
             res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '0';
-            res_flags <= flags_of('0', '0', '0', '1', rejected_pending, not target_valid, overflow);
+            res_flags <= v2_flags('0', '0', '0', '1', rejected_pending, not target_valid, overflow);
             res_err <= err_code_r;
             err_push <= '1';
             overflow <= '0';
@@ -844,7 +841,7 @@ begin
               target_valid <= '1';
               init_pending <= '0';
               res_ld <= '1'; rs_learn <= '1'; rs_fuse <= '0';
-              res_flags <= flags_of('1', init_clipped, '0', '0', rejected_pending, '0', overflow);
+              res_flags <= v2_flags('1', init_clipped, '0', '0', rejected_pending, '0', overflow);
               res_err <= "000";
               state <= T_PUSH;
             else
@@ -867,7 +864,7 @@ begin
             -- the word a clock later (above); an unused feature reports 0 iterations and stop
             -- code 0 (as the model)
             res_ld <= '1'; rs_learn <= '0'; rs_fuse <= '1';
-            res_flags <= flags_of('0', '0', lost, '0', rejected_pending, '0', overflow);
+            res_flags <= v2_flags('0', '0', lost, '0', rejected_pending, '0', overflow);
             res_err <= "000";
             state <= T_PUSH;
           end if;

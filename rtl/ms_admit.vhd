@@ -4,7 +4,7 @@
 --
 -- Computes: for the frame's jobs offered in priority order (the live targets oldest first, then
 -- the adds of that frame), with each job's worst-case clocks c, release line r and next line n:
---   slack = max((FRAME_LINES - r + n) * LINE_CLOCKS, BLANK_CLOCKS)        (TargetDemand.slack)
+--   slack = max((FRAME_LINES - r + n - 1) * LINE_CLOCKS, BLANK_CLOCKS)    (TargetDemand.slack)
 --   fits  = sum + c <= min(min_slack, slack)                             (sum, min_slack: the jobs taken so far)
 --   a live target's job (o_add = '0'): taken if fits and fewer than MAX_TARGETS are taken, else held
 --     (plan_frame: a held job does not stop a later, smaller one);
@@ -82,7 +82,7 @@ begin
             n_taken <= 0;
           elsif offer = '1' then
             -- lines from the end of this region to the start of the next one (release <= frame lines)
-            mcand    <= resize(frame_lines - o_release, SUM_W) + o_next;
+            mcand    <= resize(frame_lines - o_release - 1, SUM_W) + o_next;
             mplier   <= line_clocks;
             acc      <= (others => '0');
             step     <= 0;

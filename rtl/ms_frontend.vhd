@@ -13,6 +13,13 @@
 --     the abandoned frame;
 --   * frame_start comes 9 clocks after the sof beat, before the first interior
 --     pixel of that frame (which needs >= 2 W + 3 beats).
+-- ad_* is the all-pixel stream av_* delayed to the frame events, for a capture on it (the
+-- multi-target core's colour slots, ms_slot_capture without INTERIOR_ONLY): frame_start and
+-- frame_error come 1 clock before the first ad pixel of the frame they start, ad_end (the stream's
+-- frame_end) in the clock of the frame's last ad pixel, 1 clock after frame_end; frame_error in or
+-- after the clock of an abandoned frame's last ad pixel.  So a frame's ad pixels and its interior
+-- pixels lie between the same frame_start and frame_end / frame_error (+ 1 clock on ad_end), and a
+-- descriptor loaded outside that clock reaches captures on both streams for the same frame.
 -- Latency: input beat of pixel (x+1, y+1) -> ip_valid of (x, y): 8 clocks
 -- (check 1, grey 2, sobel 5 after the grey; ms_sobel reads its line buffer
 -- with the position, which it gets one clock before the grey); the same for every PPC.
@@ -73,7 +80,13 @@ entity ms_frontend is
     av_valid     : out std_logic;                                       -- a pixel of the frame
     av_x         : out unsigned(COORD_W - 1 downto 0);                  -- its column (0 .. W-1)
     av_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (0 .. H-1)
-    av_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0)   -- its colour bin (all-pixel stream: PPC = 1 only)
+    av_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0);  -- its colour bin (all-pixel stream: PPC = 1 only)
+    -- the same stream delayed to the frame events (ad_valid of pixel (x, y) 9 clocks after its input beat)
+    ad_valid     : out std_logic;                                       -- a pixel of the frame
+    ad_x         : out unsigned(COORD_W - 1 downto 0);                  -- its column (0 .. W-1)
+    ad_y         : out unsigned(COORD_W - 1 downto 0);                  -- its row (0 .. H-1)
+    ad_cbin      : out std_logic_vector(3 * COLOUR_BITS - 1 downto 0);  -- its colour bin
+    ad_end       : out std_logic                                        -- pulse: good frame complete, with its last ad pixel
   );
 end entity;
 
@@ -98,6 +111,11 @@ architecture rtl of ms_frontend is
   constant EV_W : natural := 3 + ERR_CODE_W;
   type ev_pipe_t is array (1 to EVT_DELAY) of std_logic_vector(EV_W - 1 downto 0);
   signal ev : ev_pipe_t := (others => (others => '0'));
+  -- ad_*: av_* delayed by EVT_DELAY clocks
+  constant AD_W : natural := 1 + 2 * COORD_W + CB_W;
+  type ad_pipe_t is array (1 to EVT_DELAY) of std_logic_vector(AD_W - 1 downto 0);
+  signal ad : ad_pipe_t := (others => (others => '0'));
+  signal ad_end_r : std_logic := '0';
 begin
   -- pixel layout of the input (no logic: a permutation of wires)
   g_rgb : for k in 0 to PPC - 1 generate
@@ -170,6 +188,29 @@ begin
     end if;
   end process;
   error_now   <= c_err;
+
+  -- the all-pixel stream delayed to the frame events
+  p_ad : process (clk)
+  begin
+    if rising_edge(clk) then
+      ad(1) <= pv1 & std_logic_vector(x1) & std_logic_vector(y1) & cb_bin(CB_W - 1 downto 0);
+      for i in 2 to EVT_DELAY loop
+        ad(i) <= ad(i - 1);
+      end loop;
+      ad_end_r <= ev(EVT_DELAY)(EV_W - 2);
+      if rst = '1' then
+        for i in 1 to EVT_DELAY loop
+          ad(i)(AD_W - 1) <= '0';
+        end loop;
+        ad_end_r <= '0';
+      end if;
+    end if;
+  end process;
+  ad_valid <= ad(EVT_DELAY)(AD_W - 1);
+  ad_x     <= unsigned(ad(EVT_DELAY)(AD_W - 2 downto AD_W - 1 - COORD_W));
+  ad_y     <= unsigned(ad(EVT_DELAY)(CB_W + COORD_W - 1 downto CB_W));
+  ad_cbin  <= ad(EVT_DELAY)(CB_W - 1 downto 0);
+  ad_end   <= ad_end_r;
   frame_start <= ev(EVT_DELAY)(EV_W - 1);
   frame_end   <= ev(EVT_DELAY)(EV_W - 2);
   frame_error <= ev(EVT_DELAY)(EV_W - 3);

@@ -38,7 +38,8 @@
 -- D + 1 input lines after the region's last row has streamed in (the capacity rule's
 -- `release_line`).  frame_error disarms without a release.
 -- dec_log2 above LOG2_D_MAX gives D = 1 (as ms_decimate).
--- Latency: ip_valid -> we 3 clocks; the release 3 clocks after its pixel, 4 after frame_end.
+-- frame_end may come in the clock of the frame's last pixel (the all-pixel stream's av_end does).
+-- Latency: ip_valid -> we 3 clocks; the release 3 clocks after its pixel, 5 after frame_end.
 -- Cost (docs/blocks/ms_slot_capture.md): the grid mask, seven COORD_W-bit comparators, two
 -- counters, one descriptor register; no shifter, no multiplier.
 -- Throughput: 1 pixel per clock, no handshake.
@@ -69,7 +70,7 @@ entity ms_slot_capture is
     rst         : in  std_logic;                                -- synchronous reset, active high
     -- full-resolution interior pixels (ms_frontend, PPC 1)
     frame_start : in  std_logic;                                -- a frame started
-    frame_end   : in  std_logic;                                -- good frame complete (after its last pixel)
+    frame_end   : in  std_logic;                                -- good frame complete (with or after its last pixel)
     frame_error : in  std_logic;                                -- frame abandoned
     ip_valid    : in  std_logic;                                -- interior pixel
     ip_x        : in  unsigned(COORD_W - 1 downto 0);           -- its column
@@ -113,6 +114,7 @@ architecture rtl of ms_slot_capture is
   signal row_y      : unsigned(COORD_W - 1 downto 0);  -- full-resolution row of the region row being written
   -- stage 1
   signal v1, nr1, rel1, end1 : std_logic := '0';
+  signal end2       : std_logic := '0';   -- frame_end's release, one stage behind the pixels
   signal d1         : std_logic_vector(DATA_W - 1 downto 0);
   -- stage 2: region row base and column
   signal row_base   : unsigned(ADDR_W - 1 downto 0);
@@ -167,7 +169,8 @@ begin
       base2 <= base;
       col2  <= col;
       d2    <= d1;
-      rel2  <= rel1 or end1;
+      end2  <= end1;
+      rel2  <= rel1 or end2;
       -- stage 3: the slot's write port
       we       <= v2;
       wbank    <= resize(col2, BANK_W);
@@ -258,6 +261,7 @@ begin
         v1         <= '0';
         rel1       <= '0';
         end1       <= '0';
+        end2       <= '0';
         v2         <= '0';
         rel2       <= '0';
         we         <= '0';

@@ -39,9 +39,10 @@ def v2_block_generics(tp: TrackerParams | None = None, fp: FixedParams | None = 
         # one slot of the shared-engine core, at the colour engine's region (configuration v2-colour)
         "ms_slot_capture": {**{k: c[k] for k in ("LANES", "COORD_W", "REGION_MAX", "STRIDE", "ADDR_W")},
                             "DATA_W": 3 * c["COLOUR_BITS"], "LOG2_D_MAX": 4},
-        # two such slots with their region RAMs (RD_LAT 4, WR_LAT 1: core v2's region RAM) and the read port
+        # two such slots with their colour RAMs (RD_LAT 4, WR_LAT 1: core v2's region RAM) and the read port
         "ms_slot_pool": {"N_SLOTS": 2, **{k: c[k] for k in ("LANES", "COORD_W", "REGION_MAX", "STRIDE", "ADDR_W")},
-                         "DATA_W": 3 * c["COLOUR_BITS"], "LOG2_D_MAX": 4, "RD_LAT": 4, "WR_LAT": 1},
+                         "COLOUR_W": 3 * c["COLOUR_BITS"], "ORIENT": False, "LOG2_D_MAX": 4, "RD_LAT": 4,
+                         "WR_LAT": 1},
         # the capacity rule, once per core (16 targets)
         "ms_admit": {"MAX_TARGETS": 16, "CLK_W": 24, "LINE_W": 12, "LC_W": 13, "SUM_W": 28},
         # a window's worst-case pixel pass clocks (the job clocks' window term), LANES 4

@@ -8,7 +8,9 @@ random valid gaps.  Every interior pixel's (x, y, cbin, ebin, obin) is
 compared exactly with the fixed model (``ms_colour_bin``,
 ``ms_edge_bin(ms_sobel(ms_grey(frame)))`` and tracker v2's orientation bin
 ``ms_orient_bin(ms_grey(frame), ORIENT_T)``); the frame events and error codes
-are checked against the expected sequence; protocol errors (short line, long
+are checked against the expected sequence; with PPC = 1 the all-pixel stream delayed to the frame events, ``ad_*``, too: every
+pixel's (x, y, cbin) of a good frame, in order, after its ``frame_start`` (an earlier clock) and up to
+its ``ad_end`` (the same clock), a prefix of them up to ``frame_error``, none outside a frame; protocol errors (short line, long
 line, missing sof, cut frame, frame size, and with PPC > 1 a width that is not a
 multiple of PPC) are each followed by a good frame that must be processed exactly.
 
@@ -116,6 +118,8 @@ class TB:
         self.ppc = int(self.g.get("PPC", 1))
         self.ips: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin, ebin, obin)), one per pixel
         self.events: list[tuple[int, tuple]] = []    # (cycle, ("start",) | ("end",) | ("error", code))
+        self.ads: list[tuple[int, tuple]] = []       # (cycle, (x, y, cbin)) of the delayed all-pixel stream
+        self.ad_ends: list[int] = []                 # cycles of ad_end
         self.last_beat_cycle = -1
 
     @staticmethod
@@ -133,10 +137,16 @@ class TB:
         has_code = hasattr(d, "err_code")
         has_ip = hasattr(d, "ip_valid") and (self.ppc == 1 or hasattr(d, "ip_mask"))
         has_ob = hasattr(d, "ip_obin")   # (wrappers of other benches may not expose it: None then)
+        has_ad = self.ppc == 1 and hasattr(d, "ad_end")
         while True:
             await RisingEdge(d.clk)
             await ReadOnly()
             c = self.cycle()
+            if has_ad:
+                if int(d.ad_end.value):
+                    self.ad_ends.append(c)
+                if int(d.ad_valid.value):
+                    self.ads.append((c, (int(d.ad_x.value), int(d.ad_y.value), int(d.ad_cbin.value))))
             if int(d.frame_error.value):
                 self.events.append((c, ("error", int(d.err_code.value) if has_code else -1)))
             if int(d.frame_start.value):
@@ -301,7 +311,53 @@ async def run_scenario(tb: TB, gap: float, seed: int):
                                      f"difference at #{bad}: got {got[bad:bad + 3]} exp {exp[bad:bad + 3]}")
         else:
             assert got == exp[:len(got)], f"abandoned frame {i}: pixels are not a prefix of the model's"
-    tb.dut._log.info("%d frames, %d interior pixels checked, gap %.2f", len(exp_frames), len(tb.ips), gap)
+    if tb.ads or tb.ad_ends:
+        check_ad(tb, segs)
+    tb.dut._log.info("%d frames, %d interior pixels, %d all-stream pixels checked, gap %.2f", len(exp_frames),
+                     len(tb.ips), len(tb.ads), gap)
+
+
+def check_ad(tb: TB, segs) -> None:
+    """The delayed all-pixel stream against frame_start, ad_end and frame_error, as a capture on it
+    (ms_slot_capture) takes them: in one clock a pixel first, then ad_end, frame_error, frame_start (a
+    frame's pixels come in the clocks after its frame_start, up to its ad_end or frame_error; a missing
+    sof's frame_error may share the clock of the good frame's ad_end before it, which still ends it)."""
+    cb_bits = int(tb.g["COLOUR_BITS"])
+    evs = [(c, 3, "start") for c, e in tb.events if e == ("start",)]
+    evs += [(c, 2, "error") for c, e in tb.events if e[0] == "error"]
+    evs += [(c, 1, "end") for c in tb.ad_ends]
+    timeline = sorted(evs + [(c, 0, px) for c, px in tb.ads], key=lambda t: (t[0], t[1]))
+    frames: list[tuple[list, str | None]] = []
+    orphans = []
+    is_open = False
+    for c, kind, item in timeline:
+        if kind == 3:
+            frames.append(([], None))
+            is_open = True
+        elif kind in (1, 2):
+            if is_open:
+                frames[-1] = (frames[-1][0], item)
+            is_open = False
+        elif is_open:
+            frames[-1][0].append(item)
+        else:
+            orphans.append((c, item))
+    assert not orphans, f"ad pixels outside a frame: {orphans[:5]}"
+    exp = [(beats, evs) for beats, evs, _, _ in segs if ("start",) in evs]
+    assert len(frames) == len(exp), f"{len(frames)} ad frames, {len(exp)} expected"
+    for i, ((got, closed), (beats, evs)) in enumerate(zip(frames, exp)):
+        w, h = beats[0][3], beats[0][4]
+        want = []
+        for k, (data, *_rest) in enumerate(beats[:w * h]):
+            r, g_, b = (data >> 16) & 255, (data >> 8) & 255, data & 255
+            s_ = 8 - cb_bits
+            want.append((k % w, k // w, ((r >> s_) << (2 * cb_bits)) | ((g_ >> s_) << cb_bits) | (b >> s_)))
+        if evs[-1] == ("end",):
+            assert closed == "end", f"ad frame {i}: closed by {closed}"
+            assert got == want, f"ad frame {i}: {len(got)} pixels vs {len(want)}"
+        else:
+            assert closed in ("error", None), f"ad frame {i}: closed by {closed}"
+            assert got == want[:len(got)], f"abandoned ad frame {i}: not a prefix of the frame's pixels"
 
 
 @cocotb.test()
@@ -334,6 +390,11 @@ async def latency(dut):
                   end[0] - last)
     assert end[0] - last == FRAME_END_LAT, f"frame_end latency {end[0] - last} != {FRAME_END_LAT}"
     assert end[0] == last_ip + 1, "frame_end must come 1 clock after the last interior pixel"
+    if tb.ads:
+        # the delayed all-pixel stream: its last pixel and ad_end 1 clock after frame_end
+        assert tb.ad_ends == [end[0] + 1] and tb.ads[-1][0] == end[0] + 1, "ad_end not with the last ad pixel"
+        first_start = next(c for c, e in tb.events if e == ("start",))
+        assert tb.ads[0][0] == first_start + 1, "the first ad pixel must come 1 clock after frame_start"
     # throughput: interior pixels come out at PPC per clock within a line (the first beat of a
     # line carries PPC - 2 of them, the next ones PPC each)
     cyc = sorted({c for c, _ in tb.ips[:f.shape[1] - 2]})

@@ -10,8 +10,9 @@ frame it checks, value by value:
   (a region that reaches the border is an init rectangle's), each once (none for a frame without a load for it, a late load, or the rows
   after an abandoned frame's error);
 * ``released`` pulses once per captured good frame, after the region's last write, no later than 3
-  clocks after the first pixel below the region (4 after frame_end when the region reaches the
-  frame's last rows), and so before the stream reaches the capacity rule's ``release_line``;
+  clocks after the first pixel below the region (5 after frame_end when the region reaches the
+  frame's last rows; frame_end comes after the last pixel or, in half the frames, with it, as the
+  all-pixel stream's ``av_end`` does), and so before the stream reaches the capacity rule's ``release_line``;
 * ``late`` pulses for a ``load_now`` after the region's first row, and only then.
 
 Scenarios: loads between frames, in the frame_start clock and during the previous frame after its
@@ -173,6 +174,7 @@ class SlotTB:
         await ClockCycles(d.clk, 2)
         first_row_cycle: dict[int, int] = {}       # ip row -> cycle of its first pixel's edge
         end_cycle = None
+        end_with_last = rng.random() < 0.5           # frame_end in the last pixel's clock (as av_end comes)
         i = 0
         aborted = False
         for y in range(1, H - 1):
@@ -193,8 +195,13 @@ class SlotTB:
                 d.ip_x.value, d.ip_y.value = x, y
                 d.ip_data.value = int(fr.bins[y, x])
                 self.set_load(during.pop(i, None))
+                last_px = y == H - 2 and x == W - 2 and end_with_last
+                d.frame_end.value = int(last_px)
                 await RisingEdge(d.clk)
                 first_row_cycle.setdefault(y, self.cycle + 1)
+                if last_px:
+                    end_cycle = self.cycle + 1
+                    d.frame_end.value = 0
                 self.set_load(None)
                 i += 1
             if aborted:
@@ -204,7 +211,7 @@ class SlotTB:
             if n:
                 await ClockCycles(d.clk, n)
         d.ip_valid.value = 0
-        if not aborted:
+        if not aborted and end_cycle is None:
             d.frame_end.value = 1
             await RisingEdge(d.clk)
             end_cycle = self.cycle + 1
@@ -234,7 +241,7 @@ class SlotTB:
         assert not writes or rel[0] > max(c for c, *_ in writes), "released before the region's last write"
         rx, ry, rw, rh = ld.reg
         below = (ry + rh - 1) * ld.d + 1                  # the first ip row below the region
-        bound = first_row_cycle[below] + 3 if below in first_row_cycle else end_cycle + 4
+        bound = first_row_cycle[below] + 3 if below in first_row_cycle else end_cycle + 5
         assert rel[0] <= bound, f"released at {rel[0]}, after {bound}"
         # the capacity rule's release_line (input lines; ip row y streams in with input line y + 1)
         assert below + 1 <= release_line(ry, rh, ld.d, H) or below > H - 2

@@ -67,7 +67,7 @@ def _job(i: int, clocks: int, release: int = 500, nxt: int = 100, kind: str = "t
 
 def test_slack_is_the_raster_distance_and_never_below_the_blanking():
     j = _job(0, 1, release=500, nxt=100)
-    assert j.slack(T) == (1125 - 500 + 100) * 2200
+    assert j.slack(T) == (1125 - 500 + 100 - 1) * 2200
     assert _job(0, 1, release=1080, nxt=0).slack(T) == T.blank_clocks == 99_000
     assert T.frame_clocks == 2_475_000
 

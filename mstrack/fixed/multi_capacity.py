@@ -151,8 +151,12 @@ class TargetDemand:
     next_line: int
 
     def slack(self, timing: VideoTiming) -> int:
-        """Clocks from the end of this frame's region to the start of the next frame's."""
-        lines = timing.frame_lines - self.release_line + self.next_line
+        """Clocks from the end of this frame's region to the start of the next frame's: from input line
+        ``release_line`` to input line ``next_line`` of the next frame, less one line.  The region's first
+        row (at or below ``next_line``) reaches the colour capture, on the all-pixel stream, in its own
+        input line, and the release can come a few clocks into line ``release_line`` (D = 1: 13 clocks
+        after the line's first beat, rtl/ms_slot_capture.vhd): the line taken off covers both."""
+        lines = timing.frame_lines - self.release_line + self.next_line - 1
         return max(lines * timing.line_clocks, timing.blank_clocks)
 
 

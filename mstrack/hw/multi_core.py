@@ -11,7 +11,7 @@ per-object figures.  Built from per-block figures:
 * the region slot and model memories are tiled like yosys maps them (checked against yosys
   ``synth_ecp5`` of ``ms_region_ram`` / ``ms_ram_sdp`` at those sizes: :data:`YOSYS_BLOCKS`,
   :func:`yosys_check`);
-* the per-target logic (:data:`PER_TARGET`): the region capture as synthesised
+* the per-target logic (:func:`per_target`): the region captures as synthesised
   (rtl/ms_slot_capture.vhd, :data:`SLOT_CAPTURE`), the state record in LUT RAM, and an estimate of
   the write arbiter's share and the scheduler entry until that RTL exists.
 
@@ -53,18 +53,27 @@ VITIS = synth.VITIS
 #: LFE5U-85F: DP16KD, placed combinational cells (TRELLIS_COMB), flip-flops.
 LFE5U_85F = {"DP16KD": 208, "comb": 83640, "FF": 83640}
 
-#: One target's region capture, rtl/ms_slot_capture.vhd alone at the colour engine's sizes (LANES 4,
+#: One region capture, rtl/ms_slot_capture.vhd alone at the colour engine's sizes (LANES 4,
 #: REGION_MAX 256, DATA_W 9), yosys ``synth_ecp5`` / ``synth_xilinx``: docs/blocks/ms_slot_capture.md
-#: (``studies/synth_v2_blocks.py ms_slot_capture``, 2026-11-29).
-SLOT_CAPTURE = {"LUT4": 212, "FF": 178, "CCU2C": 55, "xc7_LUT": 134, "xc7_FF": 151}
+#: (``studies/synth_v2_blocks.py ms_slot_capture``, 2026-11-30).  A slot of the joint core has two: its
+#: colour and its orientation RAM (rtl/ms_slot_pool.vhd).
+SLOT_CAPTURE = {"LUT4": 229, "FF": 180, "CCU2C": 55, "xc7_LUT": 138, "xc7_FF": 153}
 #: Per target, besides its memories: the state record (core v2's ``tgt_state``, 239 bits at the default
 #: widths: :func:`mstrack.fixed.vhdl_pkg.target_state_layout_v2`) + its region and job descriptor (D,
 #: region origin and size, slot base, release / next line, clocks, kind, age: 53 bits) in LUT RAM, 16
-#: words deep (one DPR16X4 per 4 bits, for up to 16 targets); the region capture (measured:
-#: :data:`SLOT_CAPTURE`); the write arbiter's share and the scheduler's release compare (estimate, until
-#: that RTL exists: ~30 LUT4).
+#: words deep (one DPR16X4 per 4 bits, for up to 16 targets); the region captures (measured:
+#: :data:`SLOT_CAPTURE`, one per slot RAM: :func:`per_target`); the write arbiter's share and the
+#: scheduler's release compare (estimate, until that RTL exists: ~30 LUT4).
 STATE_BITS = 239 + 53
-PER_TARGET = {"LUT4": SLOT_CAPTURE["LUT4"] + 30, "FF": SLOT_CAPTURE["FF"]}
+
+
+def per_target(joint: bool) -> dict[str, int]:
+    """LUT4 and FF per target besides its memories: a capture per slot RAM (colour, and orientation
+    in the joint core) + ~30 LUT4 of scheduler entry."""
+    caps = 2 if joint else 1
+    return {"LUT4": caps * SLOT_CAPTURE["LUT4"] + 30, "FF": caps * SLOT_CAPTURE["FF"]}
+
+
 #: Added once for N > 1: the scheduler (admission adder and compare, the job queue), the result
 #: reorder buffer's control and the 4-bit target id in the result word (estimate).
 MULTI_FIXED = {"LUT4": 400, "FF": 300}
@@ -232,8 +241,9 @@ def multi_cost(n: int, mp: MultiCoreParams = MultiCoreParams(), fp: FixedParams 
     base_pool = [pool_logic(pool_rows(CORE_V2_REGION_WORDS, b), b, mp.lanes) for b in bits]
     d_pool = [sum(g[i] for g in grow) - sum(g[i] for g in base_pool) for i in (0, 1)]
     extra = n > 1
-    d_lut = d_pool[0] + (n * PER_TARGET["LUT4"] + MULTI_FIXED["LUT4"] if extra else 0)
-    d_ff = d_pool[1] + (n * PER_TARGET["FF"] + MULTI_FIXED["FF"] if extra else 0)
+    pt = per_target(mp.joint)
+    d_lut = d_pool[0] + (n * pt["LUT4"] + MULTI_FIXED["LUT4"] if extra else 0)
+    d_ff = d_pool[1] + (n * pt["FF"] + MULTI_FIXED["FF"] if extra else 0)
     lutram = (-(-n // 16) * (-(-STATE_BITS // 4) + -(-RESULT_BITS // 4)) if extra else 0)
     if fifo == 0 and extra:
         lutram += mp.lanes * -(-fifo_depth // 16) * -(-fifo_w // 4)

@@ -19,7 +19,8 @@
 --   (frame_count, rejected and overflow from the ports) and the new record.
 -- Commands, taken while idle = 1, at most one per clock: go (run the job), init_take (an init box:
 --   ms_box_clip; a box it rejects gives init_rejected, otherwise the record becomes an init pending),
---   load_take (another target's record and model), rearm (compute the geometry again).
+--   load_take (another target's record and model; an init pending is dropped: it was the previous
+--   target's, and the record does not hold one), rearm (compute the geometry again).
 -- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT); go -> res_valid:
 --   the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 --   statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean shifts
@@ -171,6 +172,9 @@ entity ms_engine is
     geo_rect_w     : out unsigned(COORD_W - 1 downto 0);
     geo_rect_h     : out unsigned(COORD_W - 1 downto 0);
     -- the frame's last column / row in decimated px when it is a border pixel at full resolution
+    -- the window diameters (decimated px) of the next job (an init's: init_capture's wd, hd)
+    geo_wd         : out unsigned(WIN_W - 1 downto 0);
+    geo_hd         : out unsigned(WIN_W - 1 downto 0);
     -- ((W - 1) mod D = 0), else all ones (ms_init_job counts border pixels with orientation 8)
     geo_last_x     : out unsigned(COORD_W - 1 downto 0);
     geo_last_y     : out unsigned(COORD_W - 1 downto 0);
@@ -933,6 +937,8 @@ begin
             con_s      <= signed(load_state(TS_SPREF - 1 downto TS_CONS));
             spread_ref <= unsigned(load_state(TS_W - 1 downto TS_SPREF));
             m_sel <= load_model;
+            init_pending <= '0';               -- an init pending was the previous target's
+            init_clipped <= '0';
             fsm <= T_PREP;                     -- its region for the next frame
           elsif rearm = '1' then
             fsm <= T_PREP;
@@ -1350,6 +1356,8 @@ begin
   geo_rect_y <= rect_y;
   geo_rect_w <= rect_w;
   geo_rect_h <= rect_h;
+  geo_wd <= wd;
+  geo_hd <= hd;
   geo_last_x <= last_x;
   geo_last_y <= last_y;
 

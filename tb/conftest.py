@@ -261,6 +261,14 @@ CI_EXTRA: dict[str, str] = {
         "test_ms_engine (the same bench and jobs on the RTL under GHDL, colour bins, marker long) and core v2's "
         "joint netlist runs, whose sequencer is ms_engine (test_tracker_v2_fastsim_long); this case: the joint "
         "bins' netlist with the init job from the slot",
+    "tb/test_ms_engine.py::test_ms_engine":
+        "test_ms_engine_pool (marker long: the same engine, scene and jobs under GHDL, colour bins, every slot "
+        "captured from the stream through ms_slot_pool instead of written by the bench); this case: the slot "
+        "written by the bench",
+    "tb/test_ms_engine_pool.py::test_ms_engine_pool_joint_verilator":
+        "test_ms_engine_pool (the same bench and jobs on the RTL under GHDL, colour bins, marker long), "
+        "test_ms_slot_pool (the orientation RAMs behind the front end) and test_ms_engine_joint_verilator (the "
+        "joint init job from a slot); this case: the joint bins' netlist with every slot captured from the stream",
     "tb/test_ms_engine.py::test_ms_engine_real_verilator":
         "test_ms_engine (the same bench on the generated scene under GHDL) and core v2's real-frame netlist runs "
         "at D = 2 (test_tracker_v2_fastsim_long); this case: the init job from a slot at D = 2",

@@ -12,7 +12,7 @@ ARGS    ?=
 export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-multi-mot test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-multi-mot test-shared-mot test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -86,6 +86,11 @@ test-fuzz-v2: setup
 # (tb/test_mstrack_drv.py::test_driver_multi_mot_sequence; not in `make test`: over an hour)
 test-multi-mot: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider tb/test_mstrack_drv.py -k mot_sequence $(ARGS)
+
+# The shared-engine multi-target core (ms_tracker_shared) on every frame and target of both MOT
+# sequences, its GHDL netlist under Verilator (part of test-extra; about 15 minutes with the build)
+test-shared-mot: setup
+	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider tb/test_ms_tracker_shared.py -k mot_sequence $(ARGS)
 
 # The constrained-random test of the multi-target core (tb/test_ms_tracker_multi.py::test_multi_fuzz:
 # commands, stream faults, result back-pressure; Verilator; CI runs seeds 1..10); replay a failing seed

@@ -106,10 +106,16 @@ begin
               raddr => raddr, rdata => rdata, px_valid => px_valid, px_x => px_x, px_y => px_y,
               px_data => px_data, px_last => px_last);
 
-  px_obin <= (others => '0') when not OR_ON else
-             to_unsigned(8, 4) when (bl_x = '1' and px_x = 0) or (bl_y = '1' and px_y = 0)
-                                    or (br_x = '1' and px_x = rel_x) or (br_y = '1' and px_y = rel_y) else
-             unsigned(px_data(DATA_W - 1 downto BIN_W));
+  -- (two generates, not one conditional: the colour bins' px_data has no orientation slice, and GHDL
+  -- refuses to synthesise the null slice even in a branch that is never taken)
+  g_ob_colour : if not OR_ON generate
+    px_obin <= (others => '0');
+  end generate;
+  g_ob_joint : if OR_ON generate
+    px_obin <= to_unsigned(8, 4) when (bl_x = '1' and px_x = 0) or (bl_y = '1' and px_y = 0)
+                                      or (br_x = '1' and px_x = rel_x) or (br_y = '1' and px_y = rel_y) else
+               unsigned(px_data(DATA_W - 1 downto BIN_W));
+  end generate;
 
   u_bg : entity work.ms_bg_model
     generic map (BIN_W => BIN_W, HALF_W => HALF_W, COORD_W => REGION_W, RING_W => RING_W, Q_W => Q_W, O_W => O_W,

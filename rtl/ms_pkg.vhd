@@ -59,8 +59,11 @@ package body ms_pkg is
   end function;
 
   function v2_flags(init, clipped, lost, err, rej, notgt, ovf : std_logic) return std_logic_vector is
+    -- bit by bit, not a concatenation: GHDL's synthesis cannot fold a concatenation of constant bits
+    variable f : std_logic_vector(7 downto 0) := (others => '0');
   begin
-    return '0' & ovf & notgt & rej & err & lost & clipped & init;
+    f(0) := init; f(1) := clipped; f(2) := lost; f(3) := err; f(4) := rej; f(5) := notgt; f(6) := ovf;
+    return f;
   end function;
 
   function v2_state_w(centre_abs_w, size_w, coord_w, share_w, con_w, spread_w : natural) return natural is

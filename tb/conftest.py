@@ -258,9 +258,18 @@ CI_EXTRA: dict[str, str] = {
         "v2's joint netlist runs with one model (test_tracker_v2_fastsim_long); this case: the joint bins' "
         "netlist with 4 models",
     "tb/test_ms_engine.py::test_ms_engine_joint_verilator":
-        "test_ms_engine (the same bench and jobs on the RTL under GHDL, colour bins, marker long) and core v2's "
-        "joint netlist runs, whose sequencer is ms_engine (test_tracker_v2_fastsim_long); this case: the joint "
-        "bins' netlist with the init job from the slot",
+        "test_ms_engine_pool (the same scene's jobs from slots under GHDL, colour bins, marker long) and core "
+        "v2's joint netlist runs, whose sequencer is ms_engine (test_tracker_v2_fastsim_long); this case: the "
+        "joint bins' netlist with the init job from the slot",
+    "tb/test_ms_tracker_shared.py::test_shared_mot_sequence":
+        "test_ms_tracker_shared and test_ms_tracker_shared_capacity (marker long: the same core and model under "
+        "GHDL: adds, removes, refusals, held targets, a short line and a cut) and test_multi_real_people (TUD "
+        "frames through the replicated-engine core); this case: every frame and target of a MOT sequence on the "
+        "shared core's netlist (its build alone is about 10 minutes)",
+    "tb/test_ms_tracker_v2_targets.py::test_tracker_v2_targets_colour":
+        "test_ms_engine_pool (the same scene's jobs on one engine from per-target slots, marker long) and "
+        "test_ms_tracker_shared (several targets on one engine behind the multi-target ports); this case: core "
+        "v2's own record and model loads (tgt_load) under GHDL",
     "tb/test_ms_engine.py::test_ms_engine":
         "test_ms_engine_pool (marker long: the same engine, scene and jobs under GHDL, colour bins, every slot "
         "captured from the stream through ms_slot_pool instead of written by the bench); this case: the slot "
@@ -270,8 +279,9 @@ CI_EXTRA: dict[str, str] = {
         "test_ms_slot_pool (the orientation RAMs behind the front end) and test_ms_engine_joint_verilator (the "
         "joint init job from a slot); this case: the joint bins' netlist with every slot captured from the stream",
     "tb/test_ms_engine.py::test_ms_engine_real_verilator":
-        "test_ms_engine (the same bench on the generated scene under GHDL) and core v2's real-frame netlist runs "
-        "at D = 2 (test_tracker_v2_fastsim_long); this case: the init job from a slot at D = 2",
+        "test_ms_engine_pool (marker long: the same engine and init job from slots under GHDL) and core v2's "
+        "real-frame netlist runs at D = 2 (test_tracker_v2_fastsim_long); this case: the init job from a slot at "
+        "D = 2",
     "tb/test_ms_init_merge.py::test_ms_init_merge_real":
         "test_ms_init_merge_synthetic[full_speed_first], test_ms_init_merge_verilator and core v2's init on real "
         "frames (marker long)",

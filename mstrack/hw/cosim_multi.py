@@ -201,6 +201,8 @@ class CoreModelMulti:
             if self.pend[k]:
                 if w["flags"] & _REJ:
                     self.alloc[k] = self.pend[k] = False
+                    if k in self.order:               # the slot is free: out of the age order
+                        self.order.remove(k)
                     self.outcomes.append(Outcome(CMD_BOX, k))
                 elif not w["flags"] & _NOT:
                     self.pend[k] = False

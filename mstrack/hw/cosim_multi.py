@@ -238,13 +238,18 @@ def diff_words(words: Sequence[dict], frames: Sequence[Sequence[dict[str, int]]]
 def frame_beats(words, fault: str | None = None) -> list[tuple[int, int, int]]:
     """The beats (data, tuser, tlast) of one frame of 24-bit words as the harness streams it: whole, or
     with a fault: ``short_line`` (row 5 three pixels short, tlast on its last), ``cut`` (the first 700
-    beats only; the next frame's start of frame cuts it)."""
+    beats only; the next frame's start of frame cuts it); ``short_line:R`` and ``cut:N`` put the short
+    line at row R, the cut after N beats."""
+    kind, _, at = (fault or "").partition(":")
+    if kind not in ("", "short_line", "cut") or (at and not at.isdigit()):
+        raise ValueError(f"fault {fault!r}: short_line[:ROW] or cut[:BEATS]")
     h, w = words.shape
+    row = int(at) if at else 5
     out = []
     for y in range(h):
-        n = w - 3 if fault == "short_line" and y == 5 else w
+        n = w - 3 if kind == "short_line" and y == row else w
         out += [(int(words[y, x]), int(x == 0 and y == 0), int(x == n - 1)) for x in range(n)]
-    return out[:700] if fault == "cut" else out
+    return out[:int(at) if at else 700] if kind == "cut" else out
 
 
 def expected_multi(frames, commands: dict[int, list[tuple]], tp: TrackerParams | None = None,

@@ -285,6 +285,20 @@ def test_multi_colour_configs_are_colour_engines(name, n):
     assert rows.index("(multi4-colour - multi1-colour)") < rows.index("(multi8-colour - multi1-colour)")
 
 
+def test_ghdl_zero_width_index_wires_dropped():
+    """GHDL 2.0's Verilog of a dynamic index into a one-element array (ms_tracker_shared with MAX_TARGETS 1):
+    the offset's wires, which nothing reads, are dropped; a read of one is refused."""
+    from mstrack.hw import hdl
+    v = ('module m (input a, output y);\n  wire n1_o;\n  wire n2_o;\n  wire n3_o;\n'
+         '  assign n1_o = "";  // trunc\n  /* x.vhd:1:2  */\n  assign n2_o = 0\'b - n1_o;\n'
+         '  assign n3_o = a;\n  assign y = n3_o;\nendmodule\n')
+    out, n = hdl.fix_ghdl_zero_width(v)
+    assert n == 2 and "n1_o" not in out and "n2_o" not in out and "assign y = n3_o;" in out
+    assert hdl.fix_ghdl_zero_width(out) == (out, 0)
+    with pytest.raises(hdl.HdlError, match="n2_o"):
+        hdl.fix_ghdl_zero_width(v.replace("assign y = n3_o;", "assign y = n2_o;"))
+
+
 def test_write_section_keeps_rows_of_other_configs(tmp_path):
     """--write of one configuration keeps the other configurations' rows (and says where they came from);
     a row of the same configuration is replaced; without keep_rows the table is replaced whole."""

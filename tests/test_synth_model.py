@@ -258,11 +258,12 @@ def test_multi_colour_configs_are_colour_engines(name, n):
     names = set(re.findall(r"^\s+(\w+)\s*:", t, re.M))
     assert "MAX_TARGETS" in names and set(g) <= names
     assert "ms_tracker_multi.vhd" in {p.name for p in synth.sources(m.top)}
+    shared = tuple(c for c in synth.CONFIGS if c.startswith("shared"))
     for other, c in synth.CONFIGS.items():
-        if other not in multi:
+        if other not in multi + shared:
             assert c.top == c.core and c.placeable and "MAX_TARGETS" not in c.generics()
             assert c.pins_top == "ms_tracker_pins"
-    assert synth.DEFAULT_CONFIGS == tuple(c for c in synth.CONFIGS if c not in multi)
+    assert synth.DEFAULT_CONFIGS == tuple(c for c in synth.CONFIGS if c not in multi + shared)
     ap = argparse.ArgumentParser()
     synth.add_arguments(ap)
     assert ap.parse_args([]).config == list(synth.DEFAULT_CONFIGS)
@@ -283,6 +284,89 @@ def test_multi_colour_configs_are_colour_engines(name, n):
             "11,000 / 12,000 / 23.0 / 2.0 |") in rows
     assert "| mstrack per added target: (multi4-colour - multi1-colour) / 3 | 1 | 9,333 | 12,333 | 23.0 | 2.0 |" in rows
     assert rows.index("(multi4-colour - multi1-colour)") < rows.index("(multi8-colour - multi1-colour)")
+
+
+def test_shared_pins_wrapper_passes_every_generic():
+    """rtl/wrappers/ms_tracker_shared_pins.vhd has exactly ms_tracker_shared's generics (names, types,
+    defaults) and passes each on by name, so the placed core is the one `mstrack synth` counts."""
+    _wrapper_passes_every_generic("ms_tracker_shared", "MAX_TARGETS", synth.SHARED_PINS_VHD, "ms_tracker_shared_pins")
+
+
+@pytest.mark.parametrize("n", [1, 2, 4, 5, 8, 16])
+def test_shared_colour_configs_are_the_simulated_core(n):
+    """Configurations "shared<N>-colour": ms_tracker_shared with MAX_TARGETS N and the generics its test bench
+    simulates it with (tb/test_ms_tracker_shared.py generics_of: the v2-colour engine, MAX_FRAME_W 2048, the
+    capacity rule at 1080p60), placed through ms_tracker_shared_pins; only when named with --config.  Every
+    generic is one of the entity's; the nextpnr pins are those of the replicated core's wrapper."""
+    import argparse
+
+    from mstrack.track.params import V2_COLOUR
+    c = synth.CONFIGS[f"shared{n}-colour"]
+    assert (c.top, c.core, c.max_targets) == ("ms_tracker_shared", "ms_tracker_v2", n) and c.v2 and c.placeable
+    assert c.pins_top == "ms_tracker_shared_pins" and c.pins_generics() == c.generics()
+    assert synth.pins_sources(c.pins_top)[-1] == synth.SHARED_PINS_VHD
+    assert "ms_tracker_shared.vhd" in {p.name for p in synth.sources(c.top)}
+    g = c.generics()
+    tb = _tb_generics_of({"slots": n, "max_frame_w": 2048, "timing": [1080, 1125, 2200], "tp": V2_COLOUR})
+    assert g == tb and list(g)[0] == "MAX_TARGETS" and g["MAX_TARGETS"] == n
+    assert g["ORIENT_T"] == -1 and (g["FRAME_LINES"], g["ACTIVE_LINES"], g["LINE_CLOCKS"]) == (1125, 1080, 2200)
+    assert {k: v for k, v in g.items() if k in synth.CONFIGS["v2-colour"].generics()} == \
+        synth.CONFIGS["v2-colour"].generics()
+    names = {n for n, _ in _vhdl_generics(synth.REPO_ROOT / "rtl" / "ms_tracker_shared.vhd", "ms_tracker_shared")}
+    assert set(g) <= names
+    assert c.name not in synth.DEFAULT_CONFIGS
+    ap = argparse.ArgumentParser()
+    synth.add_arguments(ap)
+    assert ap.parse_args(["--config", c.name]).config == [c.name]
+    assert synth.wrapper_ports(synth.SHARED_PINS_VHD, g) == synth.wrapper_ports(synth.MULTI_PINS_VHD, g)
+
+
+def _tb_generics_of(job: dict) -> dict:
+    """tb/test_ms_tracker_shared.py's generics_of, read from its source (the bench imports cocotb)."""
+    import ast
+
+    src = (synth.REPO_ROOT / "tb" / "test_ms_tracker_shared.py").read_text()
+    tree = ast.parse(src)
+    keep = [n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name in ("params_of", "generics_of")]
+    from mstrack.fixed import FixedParams
+    from mstrack.fixed.multi_capacity import MultiCoreConfig, VideoTiming
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.hw.multi_core import job_demand_generics
+    from mstrack.track.params import TrackerParams
+    ns = {"TrackerParams": TrackerParams, "FixedParams": FixedParams, "MultiCoreConfig": MultiCoreConfig,
+          "VideoTiming": VideoTiming, "CoreConfigV2": CoreConfigV2, "job_demand_generics": job_demand_generics}
+    exec(compile(ast.Module(body=keep, type_ignores=[]), "tb/test_ms_tracker_shared.py", "exec"), ns)  # noqa: S102
+    return ns["generics_of"](job)
+
+
+def test_vitis_table_per_target_of_each_core():
+    """The per-target rows ((core(N) - core(1)) / (N - 1)) pair each multi-target core with its own N = 1."""
+    one_m = {"LUT": 12000, "FF": 13000, "BRAM36": 23.0, "DSP48E1": 2}
+    eight_m = {"LUT": 89000, "FF": 97000, "BRAM36": 184.0, "DSP48E1": 16}
+    one_s = {"LUT": 14000, "FF": 15000, "BRAM36": 30.0, "DSP48E1": 2}
+    eight_s = {"LUT": 21000, "FF": 22000, "BRAM36": 100.0, "DSP48E1": 2}
+    rows = synth.vitis_table([{"config": c, "xc7": x, "generics": synth.CONFIGS[c].generics()}
+                              for c, x in (("multi1-colour", one_m), ("multi8-colour", eight_m),
+                                           ("shared1-colour", one_s), ("shared8-colour", eight_s))])
+    assert ("| mstrack per added target: (multi8-colour - multi1-colour) / 7 | 1 | 11,000 | 12,000 | 23.0 | 2.0 |"
+            in rows)
+    assert ("| mstrack per added target: (shared8-colour - shared1-colour) / 7 | 1 | 1,000 | 1,000 | 10.0 | 0.0 |"
+            in rows)
+    assert "(shared8-colour - multi1-colour)" not in rows and "(multi8-colour - shared1-colour)" not in rows
+
+
+def test_ghdl_zero_width_index_wires_dropped():
+    """GHDL 2.0's Verilog of a dynamic index into a one-element array (ms_tracker_shared with MAX_TARGETS 1):
+    the offset's wires, which nothing reads, are dropped; a read of one is refused."""
+    from mstrack.hw import hdl
+    v = ('module m (input a, output y);\n  wire n1_o;\n  wire n2_o;\n  wire n3_o;\n'
+         '  assign n1_o = "";  // trunc\n  /* x.vhd:1:2  */\n  assign n2_o = 0\'b - n1_o;\n'
+         '  assign n3_o = a;\n  assign y = n3_o;\nendmodule\n')
+    out, n = hdl.fix_ghdl_zero_width(v)
+    assert n == 2 and "n1_o" not in out and "n2_o" not in out and "assign y = n3_o;" in out
+    assert hdl.fix_ghdl_zero_width(out) == (out, 0)
+    with pytest.raises(hdl.HdlError, match="n2_o"):
+        hdl.fix_ghdl_zero_width(v.replace("assign y = n3_o;", "assign y = n2_o;"))
 
 
 def test_write_section_keeps_rows_of_other_configs(tmp_path):

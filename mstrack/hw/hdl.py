@@ -498,7 +498,7 @@ def ghdl_to_verilog(
     srcs = [Path(s).resolve() for s in (sources if sources is not None else rtl_sources(toplevel))]
     out = Path(out_path) if out_path else BUILD_DIR / "verilog" / f"{toplevel}_{_generics_tag(generics)}.v"
     out.parent.mkdir(parents=True, exist_ok=True)
-    digest = _hash_inputs(toplevel, generics, srcs, extra="fix3")
+    digest = _hash_inputs(toplevel, generics, srcs, extra="fix4")
     stamp = out.with_suffix(out.suffix + ".hash")
     if out.is_file() and stamp.is_file() and stamp.read_text().strip() == digest:
         return out
@@ -514,6 +514,9 @@ def ghdl_to_verilog(
         raise HdlError(f"ghdl --synth of {toplevel} failed (exit {r.returncode}), log {log}:\n{r.stderr[-4000:]}")
     text, nfix = fix_ghdl_verilog(r.stdout)
     notes = [f"rewrote {nfix} wide string-literal constants as N'b... literals"] if nfix else []
+    text, nzero = fix_ghdl_zero_width(text)
+    if nzero:
+        notes.append(f"dropped {nzero} unused zero-width index wires (a dynamic index into a one-element array)")
     text, boxes = fix_ghdl_blackboxes(text)
     if boxes:
         notes.append(f"dropped GHDL's empty modules of the vendor primitives {', '.join(boxes)} "
@@ -611,6 +614,30 @@ def fix_ghdl_verilog(text: str) -> tuple[str, int]:
     character (Verilator and Yosys then compute wrong values silently).  Rewrites
     them as sized binary literals (``33'b0...0111``).  Returns (text, count)."""
     return _WIDE_CONST_RE.subn(lambda m: f"{len(m.group(1))}'b{m.group(1).lower()}", text)
+
+
+_ZERO_TRUNC_RE = re.compile(r'^  assign (n\d+_o) = "";  // trunc\n', re.M)
+
+
+def fix_ghdl_zero_width(text: str) -> tuple[str, int]:
+    """Work around GHDL 2.0's Verilog writer on a dynamic index into an array of one element (e.g.
+    ``lst(i)`` with MAX_TARGETS 1): the index's offset has no bits, and GHDL prints it as
+    ``assign n1_o = "";  // trunc`` and ``assign n2_o = 0'b - n1_o;``, which Yosys and Verilator
+    refuse.  Nothing reads those wires (the element is the only one); drops them (declaration and
+    assignment) and raises :class:`HdlError` if anything else names one.  Returns (text, wires dropped)."""
+    names = _ZERO_TRUNC_RE.findall(text)
+    if not names:
+        return text, 0
+    dead = set(names)
+    for n in names:
+        dead |= set(re.findall(rf"^  assign (n\d+_o) = 0'b - {n};\n", text, re.M))
+    pat = "|".join(sorted(dead))
+    text = re.sub(rf"^  wire ({pat});\n", "", text, flags=re.M)
+    text = re.sub(rf"^  assign ({pat}) = [^\n]*\n", "", text, flags=re.M)
+    left = sorted(set(re.findall(rf"\b({pat})\b", text)))
+    if left:
+        raise HdlError(f"GHDL zero-width wires {', '.join(left)} are read: not dead index offsets")
+    return text, len(dead)
 
 
 _MODULE_RE = re.compile(r"^module (\w+)\b.*?^endmodule\n", re.M | re.S)

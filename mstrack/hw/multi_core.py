@@ -536,3 +536,22 @@ def job_demand_generics(tp: TrackerParams, fp: FixedParams | None = None, costs:
             "REGION_W": (2 * ((1 << half_w) - 1) + 2 * MARGIN_MAX + 1).bit_length(),
             "MARGIN": fp.margin, "MARGIN_MAX": MARGIN_MAX, "STEP16": sixteenths(tp.search_step, "search_step"),
             "GROW_Q16": q16(tp.scale_step), **job_clocks_generics(tp, costs, half_w)}
+
+
+# ----------------------------------------------------------------------------- rtl/ms_tracker_shared.vhd
+def shared_core_generics(tp: TrackerParams, fp: FixedParams | None = None, max_targets: int = 2,
+                         timing: VideoTiming = VideoTiming(), max_frame_w: int = 2048, rd_lat: int = 3,
+                         costs: PassCosts = PassCosts()) -> dict[str, int]:
+    """Generics of rtl/ms_tracker_shared.vhd: ``MAX_TARGETS``, core v2's (CoreConfigV2, LANES of *costs*),
+    the slot pool's ``RD_LAT``, the raster *timing* of the capacity rule and the plan's
+    :func:`job_demand_generics` (the generics tb/test_ms_tracker_shared.py simulates the core with)."""
+    from .cosim import CoreConfigV2
+    fp = fp or FixedParams()
+    g = CoreConfigV2(tp, fp, costs.lanes, max_frame_w).generics()
+    jd = job_demand_generics(tp, fp, costs)
+    t = timing
+    return {"MAX_TARGETS": max_targets, **g, "RD_LAT": rd_lat, "FRAME_LINES": t.frame_lines,
+            "ACTIVE_LINES": t.active_lines, "LINE_CLOCKS": t.line_clocks,
+            "LC_W": max(1, t.line_clocks.bit_length()), "PLAN_REGION_W": jd["REGION_W"],
+            **{k: jd[k] for k in ("GROW_Q16", "PASS_LAT", "M_TRACK", "C_TRACK", "M_LOST", "C_LOST", "C_INIT",
+                                  "SCALE_PERMILLE", "C_SCALE")}}

@@ -24,6 +24,10 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * the multi-target core (configurations ``multi<N>-colour``, N = 1, 3, 4, 8, 10, 16, only when named
   with ``--config``): ``ms_tracker_multi`` with MAX_TARGETS N engines of ``v2-colour``, placed as
   ``rtl/wrappers/ms_tracker_multi_pins.vhd`` (ECP5; the Nexus PDC has the single-target wrapper's pins).
+* the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 16, only when
+  named with ``--config``): ``ms_tracker_shared`` with MAX_TARGETS N slots around one ``v2-colour`` engine
+  (generics from :func:`mstrack.hw.multi_core.shared_core_generics`: the 1080p60 timing of the capacity rule),
+  placed as ``rtl/wrappers/ms_tracker_shared_pins.vhd``.
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
@@ -61,6 +65,14 @@ TOP_V2 = "ms_tracker_v2"
 TOP_MULTI = "ms_tracker_multi"
 MULTI_PINS_TOP = "ms_tracker_multi_pins"
 MULTI_PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_multi_pins.vhd"
+#: the shared-engine multi-target core: MAX_TARGETS slots around one core v2 engine, its own pin wrapper
+TOP_SHARED = "ms_tracker_shared"
+SHARED_PINS_TOP = "ms_tracker_shared_pins"
+SHARED_PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_shared_pins.vhd"
+#: the tops that take MAX_TARGETS, and the pin wrapper of each top (file by wrapper)
+MULTI_TOPS = (TOP_MULTI, TOP_SHARED)
+PINS_OF_TOP = {TOP_MULTI: MULTI_PINS_TOP, TOP_SHARED: SHARED_PINS_TOP}
+PINS_VHD_OF = {PINS_TOP: PINS_VHD, MULTI_PINS_TOP: MULTI_PINS_VHD, SHARED_PINS_TOP: SHARED_PINS_VHD}
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
@@ -100,7 +112,9 @@ class Config:
 
     ``top``: the entity synthesised, ``core`` unless named (``""``); ``ms_tracker_multi`` takes
     ``MAX_TARGETS`` (``max_targets``) ahead of the generics of its ``core`` engine (core v2), and is
-    placed through rtl/wrappers/ms_tracker_multi_pins.vhd."""
+    placed through rtl/wrappers/ms_tracker_multi_pins.vhd; ``ms_tracker_shared`` takes them too, then the
+    slot pool's and the capacity rule's (:func:`mstrack.hw.multi_core.shared_core_generics`, 1080p60), and
+    is placed through rtl/wrappers/ms_tracker_shared_pins.vhd."""
 
     name: str
     note: str
@@ -116,8 +130,8 @@ class Config:
     def __post_init__(self) -> None:
         if not self.top:
             object.__setattr__(self, "top", self.core)
-        assert (self.top == TOP_MULTI) == (self.max_targets > 0), "MAX_TARGETS is ms_tracker_multi's generic"
-        assert self.top == self.core or (self.top == TOP_MULTI and self.core == TOP_V2)
+        assert (self.top in MULTI_TOPS) == (self.max_targets > 0), "MAX_TARGETS is a multi-target core's generic"
+        assert self.top == self.core or (self.top in MULTI_TOPS and self.core == TOP_V2)
 
     @property
     def v2(self) -> bool:
@@ -126,13 +140,13 @@ class Config:
     @property
     def placeable(self) -> bool:
         """True when nextpnr can place it: every top has a pin wrapper."""
-        return self.top in (self.core, TOP_MULTI)
+        return self.top == self.core or self.top in MULTI_TOPS
 
     @property
     def pins_top(self) -> str:
         """The pin wrapper nextpnr places for this core (one for both presets of ms_tracker, one for
-        ms_tracker_multi)."""
-        return MULTI_PINS_TOP if self.top == TOP_MULTI else PINS_TOP
+        ms_tracker_multi, one for ms_tracker_shared)."""
+        return PINS_OF_TOP.get(self.top, PINS_TOP)
 
     def params(self) -> tuple[TrackerParams, FixedParams]:
         tp = TrackerParams(preset="v2", **self.tp) if self.v2 else TrackerParams(**self.tp)
@@ -143,6 +157,11 @@ class Config:
         if self.v2:
             from .cosim import CoreConfigV2
             assert self.ppc == 1, "core v2 takes one pixel per clock"
+            if self.top == TOP_SHARED:
+                from ..fixed.multi_capacity import PassCosts
+                from .multi_core import pass_costs, shared_core_generics
+                costs = PassCosts() if self.lanes == PassCosts().lanes else pass_costs(self.lanes)
+                return shared_core_generics(tp, fp, self.max_targets, max_frame_w=self.max_frame_w, costs=costs)
             g = CoreConfigV2(tp, fp, self.lanes, self.max_frame_w).generics()
             return {"MAX_TARGETS": self.max_targets, **g} if self.max_targets else g
         g = core_generics(tp, fp, self.lanes)
@@ -153,8 +172,8 @@ class Config:
 
     def pins_generics(self) -> dict[str, int]:
         """The generics of the pin wrapper (those of ms_tracker): :meth:`generics`, with PRESET 1 for core v2
-        (ms_tracker_multi's wrapper: its own generics)."""
-        if self.top == TOP_MULTI:
+        (the multi-target cores' wrappers: their own generics)."""
+        if self.top in MULTI_TOPS:
             return self.generics()
         return {"PRESET": 1, **self.generics()} if self.v2 else self.generics()
 
@@ -184,9 +203,17 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
                                  + (": the merger around one engine, the base of the per-target figures" if n == 1 else
                                     ": more block RAM than the LFE5U-85F has (xc7: --no-ecp5 --no-pnr)"),
              core=TOP_V2, top=TOP_MULTI, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 8, 10, 16)),
+    *(Config(f"shared{n}-colour", f"ms_tracker_shared with MAX_TARGETS {n}: {n} slot{'s' * (n > 1)} around one "
+                                  "v2-colour engine, the capacity rule at 1080p60 (placed through "
+                                  "rtl/wrappers/ms_tracker_shared_pins.vhd)"
+                                  + (": the base of the per-target figures" if n == 1 else
+                                     ": the most slots the LFE5U-85F's 208 DP16KD take (32.4 per added slot "
+                                     "from shared1-colour to shared8-colour: six would need about 210)"
+                                     if n == 5 else ""),
+             core=TOP_V2, top=TOP_SHARED, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 2, 4, 5, 8, 16)),
 )}
 #: the configurations of a plain `mstrack synth` (the multi-target core only when named with --config)
-DEFAULT_CONFIGS = tuple(n for n, c in CONFIGS.items() if c.top != TOP_MULTI)
+DEFAULT_CONFIGS = tuple(n for n, c in CONFIGS.items() if c.top not in MULTI_TOPS)
 
 
 # ----------------------------------------------------------------------------- sources
@@ -247,9 +274,9 @@ def sources(top: str, extra: Sequence[Path] = ()) -> list[Path]:
 
 
 def pins_sources(top: str = PINS_TOP) -> list[Path]:
-    """The core + its pin wrapper *top*: rtl/wrappers/ms_tracker_pins.vhd (either preset) or
-    ms_tracker_multi_pins.vhd (the wrapper always from the working tree)."""
-    return sources(top, extra=[MULTI_PINS_VHD if top == MULTI_PINS_TOP else PINS_VHD])
+    """The core + its pin wrapper *top*: rtl/wrappers/ms_tracker_pins.vhd (either preset),
+    ms_tracker_multi_pins.vhd or ms_tracker_shared_pins.vhd (the wrapper always from the working tree)."""
+    return sources(top, extra=[PINS_VHD_OF[top]])
 
 
 def wrapper_ports(vhd: Path, generics: dict[str, int]) -> set[str]:
@@ -268,10 +295,11 @@ def wrapper_ports(vhd: Path, generics: dict[str, int]) -> set[str]:
 
 def nexus_pdc(cfg: "Config") -> str:
     """The Nexus pin constraints of *cfg*'s pin wrapper: the lines of :data:`NEXUS_PDC` and (the
-    multi-target wrapper) :data:`NEXUS_MULTI_PDC` that name one of its ports (PPC 1, as the Nexus runs)."""
-    vhd = MULTI_PINS_VHD if cfg.pins_top == MULTI_PINS_TOP else PINS_VHD
+    multi-target wrappers, whose ports are the same) :data:`NEXUS_MULTI_PDC` that name one of its ports (PPC 1,
+    as the Nexus runs)."""
+    vhd = PINS_VHD_OF[cfg.pins_top]
     want = wrapper_ports(vhd, cfg.pins_generics())
-    files = (NEXUS_PDC, NEXUS_MULTI_PDC) if cfg.pins_top == MULTI_PINS_TOP else (NEXUS_PDC,)
+    files = (NEXUS_PDC, NEXUS_MULTI_PDC) if cfg.top in MULTI_TOPS else (NEXUS_PDC,)
     keep = []
     for line in "".join(f.read_text() for f in files).splitlines(keepends=True):
         m = re.search(r"\[get_ports \{?([\w\[\]]+)\}?\]", line)
@@ -1014,11 +1042,14 @@ def vitis_table(rows: Iterable[dict]) -> str:
                f"{x['LUT'] / t:,.0f} / {x['FF'] / t:,.0f} / {x['BRAM36'] / t:.1f} / {x['DSP48E1'] / t:.1f}")
         out.append(f"| mstrack {s['config']} (xc7, yosys) | {t} | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
                    f"{x['DSP48E1']} | {per} |")
-    # the cost of a target added to the multi-target core: (core(N) - core(1)) / (N - 1), for each N
-    # synthesised beside the one-slot core (the merger's fixed part counted once)
-    multi = {s["generics"]["MAX_TARGETS"]: s for s in rows if "MAX_TARGETS" in s.get("generics", {})}
-    one = multi.pop(1, None)
-    if one is not None:
+    # the cost of a target added to a multi-target core: (core(N) - core(1)) / (N - 1), for each N
+    # synthesised beside the same core's one-slot configuration (its fixed part counted once)
+    for core in MULTI_TOPS:
+        multi = {s["generics"]["MAX_TARGETS"]: s for s in rows if "MAX_TARGETS" in s.get("generics", {})
+                 and CONFIGS[s["config"]].top == core}
+        one = multi.pop(1, None)
+        if one is None:
+            continue
         for n in sorted(multi):
             a, b = one["xc7"], multi[n]["xc7"]
             d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}

@@ -2,8 +2,8 @@
 -- come first served (docs/multi_target_core.md, "Schedule").
 --
 -- Computes: each slot's `released` pulse (ms_slot_capture) enters a mask; every clock the lowest
--- slot of the mask moves into a FIFO of N_SLOTS entries; the engine pops the FIFO (q_valid /
--- q_ready).  Slots released in the same clock leave in ascending order, and a slot released later
+-- slot of the mask moves into a FIFO of N_SLOTS entries (two for one slot); the engine pops the FIFO
+-- (q_valid / q_ready).  Slots released in the same clock leave in ascending order, and a slot released later
 -- leaves after them, as long as releases of different clocks are at least N_SLOTS clocks apart: the
 -- slot captures release on the first pixel of a line, so that is one line.  A release that comes
 -- while the mask still holds an earlier one raises `merged` (for the tests; the order among them is
@@ -36,7 +36,9 @@ end entity;
 
 architecture rtl of ms_job_queue is
   constant PW : natural := 5;                              -- FIFO pointers, one bit more than 4
-  type fifo_t is array (0 to N_SLOTS - 1) of unsigned(3 downto 0);
+  -- at least two entries: GHDL 2.0's synthesis fails on a one-entry memory (N_SLOTS 1)
+  constant DEPTH : positive := maximum(2, N_SLOTS);
+  type fifo_t is array (0 to DEPTH - 1) of unsigned(3 downto 0);
   signal fifo   : fifo_t;
   signal mask   : std_logic_vector(N_SLOTS - 1 downto 0) := (others => '0');
   signal wp, rp : unsigned(PW - 1 downto 0) := (others => '0');
@@ -44,7 +46,7 @@ architecture rtl of ms_job_queue is
 
   function wrap_inc(p : unsigned) return unsigned is
   begin
-    if p = N_SLOTS - 1 then
+    if p = DEPTH - 1 then
       return to_unsigned(0, p'length);
     end if;
     return p + 1;

@@ -11,7 +11,7 @@
 -- every slot capturing its own region, and the jobs run as their slots are released (ms_job_queue, in
 -- release order; an init: ms_init_job learns the model from the slot first).  A job's word goes to
 -- ms_result_order, its new state waits beside the committed one.  When the frame has ended and its
--- last job has ended, the slots are walked in id order: each job's state is committed, and the top's
+-- last job has ended, every job's state is committed, and the slots are walked in id order: the top's
 -- words are written (held: err_code 6; a frame of another size than the target's); then the frame is
 -- closed and its words leave in ascending id.  A stream fault (or a start of frame that cuts the frame)
 -- stops the frame's jobs: the running one ends, the queued ones are dropped, the pending states are
@@ -911,6 +911,13 @@ begin
 
         when S_J_WAIT =>                                 -- every job of the frame has ended
           if arm_req = '0' and (runm and not jdone) = (runm'range => '0') and jfsm = J_IDLE then
+            for i in 0 to NT - 1 loop                    -- the frame ended good: its jobs' states commit
+              if jdone(i) = '1' then                     -- (each slot's own registers, no multiplexer)
+                recs(i) <= p_recs(i);
+                c8x_a(i) <= p_c8x(i); c8y_a(i) <= p_c8y(i); w8_a(i) <= p_w8(i); h8_a(i) <= p_h8(i);
+                fw_a(i) <= p_fw(i); fh_a(i) <= p_fh(i);
+              end if;
+            end loop;
             jrun <= '0';
             is_err <= '0';
             first_w <= '1';
@@ -948,7 +955,7 @@ begin
               side_push <= '1';
               side_nt <= '0';
               fsm <= S_SIDE;
-            elsif pinit(k) = '1' or valid(k) = '1' then    -- the job's word is in; its state commits
+            elsif pinit(k) = '1' or valid(k) = '1' then    -- the job's word and state are in
               fsm <= S_COMMIT;
             else                                         -- no target (a box the engine refused)
               side_push <= '0';
@@ -957,12 +964,9 @@ begin
             end if;
           end if;
 
-        when S_COMMIT =>                                 -- (a state of its own: GHDL 2.0's synthesis fails
-          k := idx(k_cur);                               -- on these writes under S_J_NEXT's elsif chain)
-          recs(k) <= p_recs(k);
-          c8x_a(k) <= p_c8x(k); c8y_a(k) <= p_c8y(k); w8_a(k) <= p_w8(k); h8_a(k) <= p_h8(k);
-          fw_a(k) <= p_fw(k); fh_a(k) <= p_fh(k);
-          valid(k) <= '1';
+        when S_COMMIT =>                                 -- a job's slot: tracking (a state of its own: GHDL
+          k := idx(k_cur);                               -- 2.0's synthesis failed on writes under S_J_NEXT's
+          valid(k) <= '1';                               -- elsif chain)
           pinit(k) <= '0';
           pend(k) <= '0';
           rejd(k) <= '0';

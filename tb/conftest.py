@@ -266,6 +266,9 @@ CI_EXTRA: dict[str, str] = {
         "GHDL: adds, removes, refusals, held targets, a short line and a cut) and test_multi_real_people (TUD "
         "frames through the replicated-engine core); this case: every frame and target of a MOT sequence on the "
         "shared core's netlist (its build alone is about 10 minutes)",
+    "tb/test_ms_tracker_shared.py::test_shared_held_decimated":
+        "test_ms_tracker_shared_capacity (held targets and refused adds under GHDL, marker long, every held "
+        "target at decimation 1); this case: a held target at decimation 2 on the netlist (its own build)",
     "tb/test_ms_tracker_shared.py::test_shared_joint_scene":
         "test_ms_tracker_shared (the same core, scene and model under GHDL, colour bins, marker long) and "
         "test_ms_engine_pool_joint_verilator (the joint bins' jobs from slots captured from the stream); this "

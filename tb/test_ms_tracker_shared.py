@@ -315,3 +315,19 @@ def test_shared_joint_scene():
     faults = {1: "short_line", 10: "cut"}
     m, run = run_netlist(frames, cmds, job, faults=faults, out_pause_pct=30, hblank=1500)
     assert len(run.words) >= len(frames) and run.reports
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_shared_held_decimated():
+    """A held target at decimation 2: its held word carries the decim_log2 of the job it was not given.
+    A 150 x 150 target and a small one in 320 x 200 frames, a frame period of 230 lines of 800 clocks:
+    the small target's add is refused (CMD_CYCLES) and the large one is held on every later frame."""
+    from mstrack.io.synthetic import make_multi_scene
+    frames, rows = make_multi_scene(6, 320, 200, n_targets=2, seed=2, sizes=[(150, 150), (24, 24)])
+    box = {(int(r[0]), int(r[1])): tuple(int(v) for v in r[2:6]) for r in rows}
+    cmds = {0: [("add", box[(0, 1)]), ("add", box[(0, 2)])]}
+    job = {"slots": 2, "max_frame_w": 512, "timing": [200, 230, 800], "tp": V2_COLOUR}
+    m, run = run_netlist(frames, cmds, job, out_pause_pct=20)
+    held = [w for f in m.frames for w in f if w["err_code"] == 6]
+    assert len(held) >= 4 and all(w["decim_log2"] >= 1 for w in held), held

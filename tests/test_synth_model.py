@@ -340,7 +340,8 @@ def _tb_generics_of(job: dict) -> dict:
 
 
 def test_vitis_table_per_target_of_each_core():
-    """The per-target rows ((core(N) - core(1)) / (N - 1)) pair each multi-target core with its own N = 1."""
+    """The per-target rows ((core(N) - core(1)) / (N - 1)) pair each multi-target core with its own N = 1 (or its
+    smallest N synthesised)."""
     one_m = {"LUT": 12000, "FF": 13000, "BRAM36": 23.0, "DSP48E1": 2}
     eight_m = {"LUT": 89000, "FF": 97000, "BRAM36": 184.0, "DSP48E1": 16}
     one_s = {"LUT": 14000, "FF": 15000, "BRAM36": 30.0, "DSP48E1": 2}
@@ -353,6 +354,12 @@ def test_vitis_table_per_target_of_each_core():
     assert ("| mstrack per added target: (shared8-colour - shared1-colour) / 7 | 1 | 1,000 | 1,000 | 10.0 | 0.0 |"
             in rows)
     assert "(shared8-colour - multi1-colour)" not in rows and "(multi8-colour - shared1-colour)" not in rows
+    # without the one-slot configuration, beside the smallest one synthesised: (core(N) - core(M)) / (N - M)
+    two_s = {"LUT": 15000, "FF": 16000, "BRAM36": 40.0, "DSP48E1": 2}
+    rows = synth.vitis_table([{"config": c, "xc7": x, "generics": synth.CONFIGS[c].generics()}
+                              for c, x in (("shared2-colour", two_s), ("shared8-colour", eight_s))])
+    assert ("| mstrack per added target: (shared8-colour - shared2-colour) / 6 | 1 | 1,000 | 1,000 | 10.0 | 0.0 |"
+            in rows)
 
 
 def test_ghdl_zero_width_index_wires_dropped():

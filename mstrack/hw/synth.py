@@ -1042,18 +1042,20 @@ def vitis_table(rows: Iterable[dict]) -> str:
                f"{x['LUT'] / t:,.0f} / {x['FF'] / t:,.0f} / {x['BRAM36'] / t:.1f} / {x['DSP48E1'] / t:.1f}")
         out.append(f"| mstrack {s['config']} (xc7, yosys) | {t} | {x['LUT']:,} | {x['FF']:,} | {x['BRAM36']:g} | "
                    f"{x['DSP48E1']} | {per} |")
-    # the cost of a target added to a multi-target core: (core(N) - core(1)) / (N - 1), for each N
-    # synthesised beside the same core's one-slot configuration (its fixed part counted once)
+    # the cost of a target added to a multi-target core: (core(N) - core(M)) / (N - M), for each N
+    # synthesised beside the same core's smallest configuration M (one slot where it was synthesised; its
+    # fixed part counted once)
     for core in MULTI_TOPS:
         multi = {s["generics"]["MAX_TARGETS"]: s for s in rows if "MAX_TARGETS" in s.get("generics", {})
                  and CONFIGS[s["config"]].top == core}
-        one = multi.pop(1, None)
-        if one is None:
+        if len(multi) < 2:
             continue
+        m = min(multi)
+        one = multi.pop(m)
         for n in sorted(multi):
             a, b = one["xc7"], multi[n]["xc7"]
-            d = {k: (b[k] - a[k]) / (n - 1) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
-            out.append(f"| mstrack per added target: ({multi[n]['config']} - {one['config']}) / {n - 1} | 1 | "
+            d = {k: (b[k] - a[k]) / (n - m) for k in ("LUT", "FF", "BRAM36", "DSP48E1")}
+            out.append(f"| mstrack per added target: ({multi[n]['config']} - {one['config']}) / {n - m} | 1 | "
                        f"{d['LUT']:,.0f} | {d['FF']:,.0f} | {d['BRAM36']:.1f} | {d['DSP48E1']:.1f} | "
                        f"{d['LUT']:,.0f} / {d['FF']:,.0f} / {d['BRAM36']:.1f} / {d['DSP48E1']:.1f} |")
     return "\n".join(out)

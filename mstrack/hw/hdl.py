@@ -354,6 +354,7 @@ def run_ghdl(
     seed: int | None = None,
     test_dirs: Sequence[Path | str] = (),
     test_filter: str | None = None,
+    ieee_asserts: str = "disable-at-0",
 ) -> Path:
     """Build *sources* with GHDL (VHDL-2008) and run the cocotb *test_module* on *toplevel*.
 
@@ -369,7 +370,10 @@ def run_ghdl(
       searched in ``module.testname/...``); *test_dirs*: extra dirs for the test
       module's imports (tb/ is always there);
     * *extra_env* reaches the simulator's Python, but variables already in
-      os.environ win (cocotb's runner merges os.environ over it).
+      os.environ win (cocotb's runner merges os.environ over it);
+    * *ieee_asserts*: GHDL's ``--ieee-asserts`` (the numeric_std metavalue warnings): off during the
+      reset at time 0 by default; ``"disable"`` for tops whose free-running pipelines carry
+      uninitialised values every clock until their first job (docs/hdl_flow.md).
 
     Returns the path of the JUnit results xml.
     """
@@ -408,7 +412,7 @@ def run_ghdl(
         return _run_cocotb(runner, toplevel=toplevel, test_module=test_module, build_dir=build_dir,
                            test_params=params, extra_env={"GHDL_BACKEND": backend, **(extra_env or {})},
                            waves=waves, testcase=testcase, test_args=["--std=08"],
-                           plusargs=["--ieee-asserts=disable-at-0"], seed=seed, generics=generics,
+                           plusargs=[f"--ieee-asserts={ieee_asserts}"], seed=seed, generics=generics,
                            test_filter=test_filter)
 
 

@@ -40,9 +40,11 @@ from typing import Any, Callable, Iterator, Sequence
 import numpy as np
 
 from .hw.cosim import COMPARED_FIELDS, COMPARED_FIELDS_V2, ERR_NAMES, MIN_FRAME, CoreConfig, CoreConfigV2
+from .hw.fastsim import VIDEO_MODES
 from .io.data import DataError, VideoSource
 from .fixed import FixedParams
 from .fixed.blocks import STOP_CODES, ms_box_clip, round_box
+from .fixed.multi_capacity import VideoTiming
 from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, STATUS_V2, pack_result, pack_result_v2
 from .track.params import V2_COLOUR, TrackerParams
 from .track.types import Box, Status, box_from_centre_index
@@ -393,38 +395,62 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
     return rep
 
 
+def mode_timing(name: str) -> VideoTiming:
+    """The raster of video mode *name* (:data:`mstrack.hw.fastsim.VIDEO_MODES`, one pixel per clock) as the
+    capacity rule's :class:`mstrack.fixed.multi_capacity.VideoTiming`."""
+    m = VIDEO_MODES[name]
+    w, h, hb, vb = (int(m[k]) for k in ("w", "h", "hblank", "vblank"))
+    line = w + hb
+    return VideoTiming(h, h + vb // line, line)
+
+
 #: Columns of results.csv of the multi-target core (several ``--box``): the slot id after the frame,
 #: then :data:`SIM_CSV_FIELDS_V2` (without latency: words follow one another per frame).
 SIM_CSV_FIELDS_MULTI = ("frame", "target_id", *[f for f in SIM_CSV_FIELDS_V2 if f not in ("frame", "latency")])
 
 
 def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path, slots: int,
-                  progress: bool = False, command: str = "", quick_build: bool = False) -> dict[str, Any]:
+                  progress: bool = False, command: str = "", quick_build: bool = False,
+                  shared: str | None = None) -> dict[str, Any]:
     """Several targets: the boxes added before the first frame of the multi-target core
-    ``ms_tracker_multi`` (``slots`` core v2 engines, :func:`mstrack.hw.fastsim.simulate_multi`), every
-    word compared with :func:`mstrack.hw.cosim_multi.expected_multi`; writes results.csv
-    (:data:`SIM_CSV_FIELDS_MULTI`, one row per word), overlay.mp4 and bitexact.json to ``out``
-    (*quick_build* as :func:`run_sim`)."""
+    ``ms_tracker_multi`` (``slots`` core v2 engines, :func:`mstrack.hw.fastsim.simulate_multi`), or with
+    *shared* (a video mode of :data:`mstrack.hw.fastsim.VIDEO_MODES`) ``ms_tracker_shared`` (one engine for
+    the ``slots`` slots, its capacity rule at that mode's raster); every word compared with
+    :func:`mstrack.hw.cosim_multi.expected_multi`; writes results.csv (:data:`SIM_CSV_FIELDS_MULTI`, one
+    row per word), overlay.mp4 and bitexact.json to ``out`` (*quick_build* as :func:`run_sim`).  The
+    frames stream without blanking: the shared core holds its input while a frame's jobs run, which
+    changes no word (the rule's verdicts depend on the mode's raster only)."""
+    from .fixed.multi_capacity import MultiCoreConfig
     from .hw import fastsim
     from .hw.cosim_multi import expected_multi
+    from .hw.multi_core import pass_costs, shared_core_generics
     from .multicli import draw_multi_overlay
 
     assert isinstance(job.cfg, CoreConfigV2)
     cfg = job.cfg
     g = {"MAX_TARGETS": slots, **cfg.generics()}
+    top, extra, capacity = fastsim.MULTI_TOP, None, None
+    if shared is not None:
+        timing = mode_timing(shared)
+        capacity = MultiCoreConfig(slots, timing, pass_costs(cfg.lanes))
+        sg = shared_core_generics(cfg.tp, cfg.fp, slots, timing, cfg.max_frame_w, costs=capacity.costs)
+        extra = {k: v for k, v in sg.items() if k not in g}
+        top = "ms_tracker_shared"
+        g.update(extra)
     say = (lambda m: print(f"mstrack sim: {m}", file=sys.stderr, flush=True)) if progress else (lambda m: None)
     frames = list(job.frames())
     cmds: dict[int, list[tuple]] = {0: [("add", b) for b in boxes]}
     say(f"running the fixed-point model of {slots} slots on {len(frames)} frames...")
     t1 = time.monotonic()
-    m = expected_multi(frames, cmds, cfg.tp, cfg.fp, slots, cfg.max_frame_w)
+    m = expected_multi(frames, cmds, cfg.tp, cfg.fp, slots, cfg.max_frame_w, capacity=capacity)
     t_model = time.monotonic() - t1
-    say(f"co-simulating ms_tracker_multi ({slots} engines; the first run of a generic set builds the Verilator "
-        "model, several minutes)...")
+    say(f"co-simulating {top} ({slots} slots, {'one engine' if shared else f'{slots} engines'}; the first run "
+        "of a generic set builds the Verilator model, several minutes)...")
     t0 = time.monotonic()
     run = fastsim.simulate_multi(frames, cmds, cfg.tp, cfg.fp, max_targets=slots, lanes=cfg.lanes,
                                  max_frame_w=cfg.max_frame_w, words=len(m.results), check=False,
-                                 cxx_opt=fastsim.CXX_OPT_SHORT if quick_build else fastsim.CXX_OPT)
+                                 cxx_opt=fastsim.CXX_OPT_SHORT if quick_build else fastsim.CXX_OPT,
+                                 top=top, extra_generics=extra)
     t_sim = time.monotonic() - t0
     keys = [*COMPARED_FIELDS_V2, "target_id"]
     frame_of = [job.first + i for i, fr in enumerate(m.frames) for _ in fr]
@@ -452,7 +478,7 @@ def run_sim_multi(job: SimJob, boxes: list[tuple[int, int, int, int]], out: Path
            "mismatches": len(mism), "compared_fields": keys, "model": "mstrack.hw.cosim_multi.expected_multi",
            "command": command, "source": str(job.source.path), "kind": job.source.kind, "first_frame": job.first,
            "frames_streamed": job.count, "frame_size": list(job.size), "init_boxes": [list(b) for b in boxes],
-           "slots": slots, "lanes": cfg.lanes, "generics": g,
+           "slots": slots, "lanes": cfg.lanes, "core": top, "capacity_timing": shared, "generics": g,
            "simulation": {"status": run.status, "detail": run.detail, "cycles": run.cycles,
                           "seconds": round(run.seconds, 3), "build_seconds": round(run.build_seconds, 1),
                           "wall_seconds": round(t_sim, 1)},
@@ -482,6 +508,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     if multi and preset != "v2":
         return bad("several --box (or --slots) run the multi-target core, whose engines are core v2: "
                    "leave out --preset paper")
+    if args.shared_engine and not multi:
+        return bad("--shared-engine is the multi-target core on one engine: give several --box (or --slots)")
     slots = args.slots if args.slots is not None else len(boxes)
     if multi and not 1 <= len(boxes) <= slots <= 16:
         return bad(f"--slots {slots} with {len(boxes)} --box: the multi-target core has 1 .. 16 slots, "
@@ -502,6 +530,11 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         out = Path(args.out) if args.out else Path("out/sim") / Path(args.video).resolve().name
         job = prepare(args.video, boxes[0] if boxes else None, args.frames, args.max_frames, cfg)
         more = [check_box(b, job.size, cfg) for b in boxes[1:]]
+        if args.shared_engine:
+            t = mode_timing(args.timing)
+            if job.size[0] > t.line_clocks or job.size[1] > t.active_lines:
+                return bad(f"{job.size[0]}x{job.size[1]} frames do not fit the {args.timing} raster of the capacity "
+                           "rule (--timing)")
         check_out_dir(out)
     except (DataError, ValueError) as exc:
         return bad(str(exc))
@@ -511,7 +544,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         print(f"mstrack: warning: {job.source.path}: {job.source.truncated}", file=sys.stderr)
     if multi:
         rep = run_sim_multi(job, [job.box, *more], out, slots, progress=not args.quiet,
-                            command=getattr(args, "command_line", ""), quick_build=args.quick_build)
+                            command=getattr(args, "command_line", ""), quick_build=args.quick_build,
+                            shared=args.timing if args.shared_engine else None)
         sim = rep["simulation"]
         print(f"{rep['words']} words for {job.count} frames {job.size[0]}x{job.size[1]}, {len(boxes)} targets in "
               f"{slots} slots, {sim['cycles']} clocks ({sim['status']})")
@@ -551,6 +585,13 @@ def register_cli(sub: argparse._SubParsersAction) -> None:
                         "(core v2 engine) per box")
     p.add_argument("--slots", type=_positive, metavar="N",
                    help="multi-target core with N slots (MAX_TARGETS, 1 .. 16; default: one per --box)")
+    p.add_argument("--shared-engine", action="store_true",
+                   help="several --box on one engine (ms_tracker_shared) instead of one engine per slot "
+                        "(ms_tracker_multi): a target whose job does not fit the frame is held, an add refused "
+                        "(the capacity rule at the --timing raster)")
+    p.add_argument("--timing", default="1080p60", choices=sorted(VIDEO_MODES),
+                   help="--shared-engine: the video mode whose raster (lines and clocks per frame) the capacity "
+                        "rule budgets (default 1080p60); the frames themselves stream without blanking")
     p.add_argument("--frames", type=parse_frame_range, metavar="FIRST,LAST",
                    help="stream frames FIRST..LAST (0-based, inclusive; init on FIRST); default all")
     p.add_argument("--max-frames", type=_positive, metavar="N", help="stream at most N frames")

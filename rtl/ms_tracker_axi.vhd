@@ -48,9 +48,13 @@
 -- INT_STATUS.result fires once per frame (its last word); lost / error / reacquired are set in the same
 -- clock when any word of that frame has them (one interrupt per frame tells the whole frame);
 -- RESULT_COUNT counts frames, LOST / ERROR / REJECT_COUNT words.
+-- SHARED_ENGINE = true: ms_tracker_shared in place of ms_tracker_multi (one engine runs every target's job,
+-- docs/blocks/ms_tracker_shared.md), with the same ports and registers; MULTI.shared_engine reads 1, an add
+-- can be refused at its frame by the capacity rule (a CMD_STATUS report with code 2, after the add's code 0),
+-- and a live target can be held on a frame (its word's err_code 6).
 -- Generics: those of ms_tracker (passed through; the derived widths come from
 -- mstrack.fixed.vhdl_pkg.core_generics, core v2's from mstrack.hw.cosim.CoreConfigV2.tracker_generics)
--- MAX_TARGETS (0: single target) and RESULT_STREAM.
+-- MAX_TARGETS (0: single target), SHARED_ENGINE with ms_tracker_shared's own (RD_LAT .. C_SCALE) and RESULT_STREAM.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -137,7 +141,28 @@ entity ms_tracker_axi is
     MARGIN_MAX     : natural := 255;             -- largest region margin (MARGIN + the search offset)
     SCALE_TEST_D256: natural range 0 to 255 := 13; -- PRESET 1: the gated scale test: round(256 scale_test); 0 = off (mstrack-v2-colour)
     ORIENT_T       : integer range -1 to 2047 := 64; -- PRESET 1: the joint colour x orientation bins: orient_T; -1 = off (mstrack-v2-colour)
-    MAX_TARGETS    : natural range 0 to 16 := 0;  -- 0: one target (ms_tracker); 1 .. 16: ms_tracker_multi's slots (PRESET 1)
+    MAX_TARGETS    : natural range 0 to 16 := 0;  -- 0: one target (ms_tracker); 1 .. 16: the multi-target core's slots (PRESET 1)
+    SHARED_ENGINE  : boolean := false;            -- MAX_TARGETS >= 1: false ms_tracker_multi (an engine per slot),
+                                                  -- true ms_tracker_shared (one engine for every slot)
+    -- SHARED_ENGINE only (ms_tracker_shared's; mstrack.hw.multi_core.shared_core_generics): the slot pool's
+    -- read latency, the capacity rule's video timing and the plan's job-demand constants
+    RD_LAT         : positive := 3;
+    FRAME_LINES    : natural := 1125;            -- lines per frame, blanking included
+    ACTIVE_LINES   : natural := 1080;
+    LINE_CLOCKS    : natural := 2200;            -- clocks per line
+    LC_W           : positive := 13;             -- bits of LINE_CLOCKS
+    SUM_W          : positive := 28;
+    CLK_W          : natural := 24;
+    PLAN_REGION_W  : natural := 10;
+    GROW_Q16       : natural := 6554;
+    PASS_LAT       : natural := 10;
+    M_TRACK        : natural := 21;
+    C_TRACK        : natural := 13170;
+    M_LOST         : natural := 54;
+    C_LOST         : natural := 32375;
+    C_INIT         : natural := 3534;
+    SCALE_PERMILLE : natural := 50;
+    C_SCALE        : natural := 2862;
     RESULT_STREAM  : boolean := true              -- true: m_axis_result_* carries each result word
   );
   port (
@@ -246,7 +271,7 @@ architecture rtl of ms_tracker_axi is
   signal r_valid, r_ready, r_take, r_last : std_logic;
   signal r_id     : natural range 0 to 15;                                     -- target id of r_data (multi)
   signal r_word   : std_logic_vector(RAW_W - 1 downto 0);                      -- r_data, zero-extended
-  signal c_lost, c_err, c_rej, c_reacq : std_logic;                           -- events of r_word
+  signal w_lost, w_err, w_rej, w_reacq : std_logic;                           -- events of r_word
   signal lat      : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- L (multi: RES_SEL's word)
   signal snap     : std_logic_vector(RAW_W - 1 downto 0) := (others => '0');   -- S
   signal lat_ok   : std_logic := '0';
@@ -304,7 +329,7 @@ begin
     report "ms_tracker_axi: result layout v2 and RESULT_W disagree" severity failure;
   assert COORD_W + 2 <= 16 report "ms_tracker_axi: init box registers are 16 bits" severity failure;
   assert MAX_TARGETS = 0 or (PRESET = 1 and PPC = 1)
-    report "ms_tracker_axi: MAX_TARGETS >= 1 (ms_tracker_multi) needs PRESET 1 and PPC 1" severity failure;
+    report "ms_tracker_axi: MAX_TARGETS >= 1 (ms_tracker_multi, ms_tracker_shared) needs PRESET 1 and PPC 1" severity failure;
 
   ---------------------------------------------------------------------------- registers
   u_regs : entity work.ms_tracker_regs
@@ -363,10 +388,10 @@ begin
   g_v1 : if PRESET = 0 generate
     -- tracking: the last result has none of the flags no_target, lost, error
     hw_in.STATUS.tracking.next_q      <= lat_ok and not (lat(O_FL + F_NOT) or lat(O_FL + F_LOST) or lat(O_FL + F_ERR));
-    c_lost  <= r_word(O_FL + F_LOST);
-    c_err   <= r_word(O_FL + F_ERR);
-    c_rej   <= r_word(O_FL + F_REJ);
-    c_reacq <= '0';
+    w_lost  <= r_word(O_FL + F_LOST);
+    w_err   <= r_word(O_FL + F_ERR);
+    w_rej   <= r_word(O_FL + F_REJ);
+    w_reacq <= '0';
     hw_in.RES_HEAD.frame_count.next_q <= fld(lat, O_FC, 16, 16);
     hw_in.RES_HEAD.flags.next_q       <= fld(lat, O_FL, 8, 8);
     hw_in.RES_HEAD.err_code.next_q    <= fld(lat, O_EC, 3, 3);
@@ -404,10 +429,10 @@ begin
     hw_in.STATUS.tracking.next_q <= lat_ok and not (lat(V_FL + F_NOT) or lat(V_FL + F_ERR))
                                     when st_lat = ST_OK or st_lat = ST_REACQ or st_lat = ST_INIT or st_lat = ST_CLIP
                                     else '0';
-    c_lost  <= '1' when st_new = ST_LOST else '0';
-    c_reacq <= '1' when st_new = ST_REACQ else '0';
-    c_err   <= r_word(V_FL + F_ERR);
-    c_rej   <= r_word(V_FL + F_REJ);
+    w_lost  <= '1' when st_new = ST_LOST else '0';
+    w_reacq <= '1' when st_new = ST_REACQ else '0';
+    w_err   <= r_word(V_FL + F_ERR);
+    w_rej   <= r_word(V_FL + F_REJ);
     hw_in.RES_HEAD.frame_count.next_q <= fld(lat, V_FC, 16, 16);
     hw_in.RES_HEAD.flags.next_q       <= fld(lat, V_FL, 8, 8);
     hw_in.RES_HEAD.err_code.next_q    <= fld(lat, V_EC, 3, 3);
@@ -435,6 +460,7 @@ begin
   hw_in.RES_HEAD.target_id.next_q   <= head_id;
   -- multi-target registers (single target: 0)
   hw_in.MULTI.max_targets.next_q    <= std_logic_vector(to_unsigned(MAX_TARGETS, 5));
+  hw_in.MULTI.shared_engine.next_q  <= '1' when SHARED_ENGINE and MAX_TARGETS > 0 else '0';
   hw_in.MULTI.live.next_q           <= live;
   hw_in.CMD_STATUS.pending.next_q   <= cmd_v or cmd_wait;
   hw_in.CMD_STATUS.code.next_q      <= st_code;
@@ -633,94 +659,203 @@ begin
     signal live_n    : std_logic_vector(MAX_TARGETS - 1 downto 0);
     signal sel       : natural range 0 to 15;
   begin
-    u_core : entity work.ms_tracker_multi
-      generic map (
-        MAX_TARGETS    => MAX_TARGETS,
-        MAX_FRAME_W    => MAX_FRAME_W,
-        RGB_PACKING    => RGB_PACKING,
-        LANES          => LANES,
-        COLOUR_BITS    => COLOUR_BITS,
-        EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
-        EDGE_SHIFT     => EDGE_SHIFT,
-        FEATURES       => FEATURES,
-        KERNEL_EPAN    => KERNEL_EPAN,
-        KERNEL_BITS    => KERNEL_BITS,
-        MAX_HALF       => MAX_HALF,
-        MARGIN         => MARGIN,
-        COORD_W        => COORD_W,
-        CF             => CF,
-        WI             => WI,
-        WF             => WF,
-        RF             => RF,
-        AF             => AF,
-        RHO_OUT_FRAC   => RHO_OUT_FRAC,
-        MAX_ITER       => MAX_ITER,
-        EPS2           => EPS2,
-        HALF_W         => HALF_W,
-        REGION_MAX     => REGION_MAX,
-        REGION_W       => REGION_W,
-        STRIDE         => STRIDE,
-        ADDR_W         => ADDR_W,
-        KVAL_W         => KVAL_W,
-        HIST_W         => HIST_W,
-        COUNT_W        => COUNT_W,
-        POSSUM_W       => POSSUM_W,
-        KD_W           => KD_W,
-        SQRT_IN_W      => SQRT_IN_W,
-        RHO_SUM_W      => RHO_SUM_W,
-        RATIO_Q_W      => RATIO_Q_W,
-        WEIGHT_W       => WEIGHT_W,
-        SW_W           => SW_W,
-        SWX_W          => SWX_W,
-        SHIFT_Q_W      => SHIFT_Q_W,
-        CENTRE_W       => CENTRE_W,
-        CENTRE_ABS_W   => CENTRE_ABS_W,
-        ITER_W         => ITER_W,
-        RHO_OUT_W      => RHO_OUT_W,
-        ALPHA_W        => ALPHA_W,
-        WIN_W          => WIN_W,
-        RESULT_W       => RESULT_W,
-        PAD16          => PAD16,
-        RING16         => RING16,
-        MAX_WINDOW     => MAX_WINDOW,
-        KT_W           => KT_W,
-        ST2_W          => ST2_W,
-        SHARE_W        => SHARE_W,
-        SPREAD_W       => SPREAD_W,
-        SIZE_W         => SIZE_W,
-        SCALE_W        => SCALE_W,
-        SCALE_GAIN     => SCALE_GAIN,
-        SCALE_REG      => SCALE_REG,
-        SCALE_STEP     => SCALE_STEP,
-        SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
-        WR_Q_W         => WR_Q_W,
-        CON_W          => CON_W,
-        LOSS_K         => LOSS_K,
-        REF_K          => REF_K,
-        LOSS_RHO       => LOSS_RHO,
-        LOSS_CONTRAST  => LOSS_CONTRAST,
-        CONF_LOST      => CONF_LOST,
-        CONF_UNCERTAIN => CONF_UNCERTAIN,
-        CONF_REACQUIRE => CONF_REACQUIRE,
-        SPREAD_DEFAULT => SPREAD_DEFAULT,
-        BG_Q_W         => BG_Q_W,
-        BG_O_W         => BG_O_W,
-        SEARCH_ITER    => SEARCH_ITER,
-        STEP16         => STEP16,
-        MARGIN_MAX     => MARGIN_MAX,
-        SCALE_TEST_D256=> SCALE_TEST_D256,
-        ORIENT_T       => ORIENT_T
-      )
-      port map (
-        clk => clk, rst => rst, frame_width => fw, frame_height => fh,
-        s_cmd_tvalid => cmd_v, s_cmd_tready => cmd_rdy, s_cmd_op => cmd_op, s_cmd_id => cmd_tid,
-        s_cmd_x => ib_x, s_cmd_y => ib_y, s_cmd_w => ib_w, s_cmd_h => ib_h,
-        cmd_done => cmd_done, cmd_code => cmd_code, cmd_id => cmd_rid,
-        s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
-        s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
-        m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
-        m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
-        live => live_n, busy => busy);
+    g_multi : if not SHARED_ENGINE generate
+      u_core : entity work.ms_tracker_multi
+        generic map (
+          MAX_TARGETS    => MAX_TARGETS,
+          MAX_FRAME_W    => MAX_FRAME_W,
+          RGB_PACKING    => RGB_PACKING,
+          LANES          => LANES,
+          COLOUR_BITS    => COLOUR_BITS,
+          EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
+          EDGE_SHIFT     => EDGE_SHIFT,
+          FEATURES       => FEATURES,
+          KERNEL_EPAN    => KERNEL_EPAN,
+          KERNEL_BITS    => KERNEL_BITS,
+          MAX_HALF       => MAX_HALF,
+          MARGIN         => MARGIN,
+          COORD_W        => COORD_W,
+          CF             => CF,
+          WI             => WI,
+          WF             => WF,
+          RF             => RF,
+          AF             => AF,
+          RHO_OUT_FRAC   => RHO_OUT_FRAC,
+          MAX_ITER       => MAX_ITER,
+          EPS2           => EPS2,
+          HALF_W         => HALF_W,
+          REGION_MAX     => REGION_MAX,
+          REGION_W       => REGION_W,
+          STRIDE         => STRIDE,
+          ADDR_W         => ADDR_W,
+          KVAL_W         => KVAL_W,
+          HIST_W         => HIST_W,
+          COUNT_W        => COUNT_W,
+          POSSUM_W       => POSSUM_W,
+          KD_W           => KD_W,
+          SQRT_IN_W      => SQRT_IN_W,
+          RHO_SUM_W      => RHO_SUM_W,
+          RATIO_Q_W      => RATIO_Q_W,
+          WEIGHT_W       => WEIGHT_W,
+          SW_W           => SW_W,
+          SWX_W          => SWX_W,
+          SHIFT_Q_W      => SHIFT_Q_W,
+          CENTRE_W       => CENTRE_W,
+          CENTRE_ABS_W   => CENTRE_ABS_W,
+          ITER_W         => ITER_W,
+          RHO_OUT_W      => RHO_OUT_W,
+          ALPHA_W        => ALPHA_W,
+          WIN_W          => WIN_W,
+          RESULT_W       => RESULT_W,
+          PAD16          => PAD16,
+          RING16         => RING16,
+          MAX_WINDOW     => MAX_WINDOW,
+          KT_W           => KT_W,
+          ST2_W          => ST2_W,
+          SHARE_W        => SHARE_W,
+          SPREAD_W       => SPREAD_W,
+          SIZE_W         => SIZE_W,
+          SCALE_W        => SCALE_W,
+          SCALE_GAIN     => SCALE_GAIN,
+          SCALE_REG      => SCALE_REG,
+          SCALE_STEP     => SCALE_STEP,
+          SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
+          WR_Q_W         => WR_Q_W,
+          CON_W          => CON_W,
+          LOSS_K         => LOSS_K,
+          REF_K          => REF_K,
+          LOSS_RHO       => LOSS_RHO,
+          LOSS_CONTRAST  => LOSS_CONTRAST,
+          CONF_LOST      => CONF_LOST,
+          CONF_UNCERTAIN => CONF_UNCERTAIN,
+          CONF_REACQUIRE => CONF_REACQUIRE,
+          SPREAD_DEFAULT => SPREAD_DEFAULT,
+          BG_Q_W         => BG_Q_W,
+          BG_O_W         => BG_O_W,
+          SEARCH_ITER    => SEARCH_ITER,
+          STEP16         => STEP16,
+          MARGIN_MAX     => MARGIN_MAX,
+          SCALE_TEST_D256=> SCALE_TEST_D256,
+          ORIENT_T       => ORIENT_T
+        )
+        port map (
+          clk => clk, rst => rst, frame_width => fw, frame_height => fh,
+          s_cmd_tvalid => cmd_v, s_cmd_tready => cmd_rdy, s_cmd_op => cmd_op, s_cmd_id => cmd_tid,
+          s_cmd_x => ib_x, s_cmd_y => ib_y, s_cmd_w => ib_w, s_cmd_h => ib_h,
+          cmd_done => cmd_done, cmd_code => cmd_code, cmd_id => cmd_rid,
+          s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
+          s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+          m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+          m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
+          live => live_n, busy => busy);
+    end generate;
+    g_shared : if SHARED_ENGINE generate
+      u_core : entity work.ms_tracker_shared
+        generic map (
+          MAX_TARGETS    => MAX_TARGETS,
+          MAX_FRAME_W    => MAX_FRAME_W,
+          RGB_PACKING    => RGB_PACKING,
+          LANES          => LANES,
+          COLOUR_BITS    => COLOUR_BITS,
+          EDGE_BINS_LOG2 => EDGE_BINS_LOG2,
+          EDGE_SHIFT     => EDGE_SHIFT,
+          FEATURES       => FEATURES,
+          KERNEL_EPAN    => KERNEL_EPAN,
+          KERNEL_BITS    => KERNEL_BITS,
+          MAX_HALF       => MAX_HALF,
+          MARGIN         => MARGIN,
+          COORD_W        => COORD_W,
+          CF             => CF,
+          WI             => WI,
+          WF             => WF,
+          RF             => RF,
+          AF             => AF,
+          RHO_OUT_FRAC   => RHO_OUT_FRAC,
+          MAX_ITER       => MAX_ITER,
+          EPS2           => EPS2,
+          HALF_W         => HALF_W,
+          REGION_MAX     => REGION_MAX,
+          REGION_W       => REGION_W,
+          STRIDE         => STRIDE,
+          ADDR_W         => ADDR_W,
+          KVAL_W         => KVAL_W,
+          HIST_W         => HIST_W,
+          COUNT_W        => COUNT_W,
+          POSSUM_W       => POSSUM_W,
+          KD_W           => KD_W,
+          SQRT_IN_W      => SQRT_IN_W,
+          RHO_SUM_W      => RHO_SUM_W,
+          RATIO_Q_W      => RATIO_Q_W,
+          WEIGHT_W       => WEIGHT_W,
+          SW_W           => SW_W,
+          SWX_W          => SWX_W,
+          SHIFT_Q_W      => SHIFT_Q_W,
+          CENTRE_W       => CENTRE_W,
+          CENTRE_ABS_W   => CENTRE_ABS_W,
+          ITER_W         => ITER_W,
+          RHO_OUT_W      => RHO_OUT_W,
+          ALPHA_W        => ALPHA_W,
+          WIN_W          => WIN_W,
+          RESULT_W       => RESULT_W,
+          PAD16          => PAD16,
+          RING16         => RING16,
+          MAX_WINDOW     => MAX_WINDOW,
+          KT_W           => KT_W,
+          ST2_W          => ST2_W,
+          SHARE_W        => SHARE_W,
+          SPREAD_W       => SPREAD_W,
+          SIZE_W         => SIZE_W,
+          SCALE_W        => SCALE_W,
+          SCALE_GAIN     => SCALE_GAIN,
+          SCALE_REG      => SCALE_REG,
+          SCALE_STEP     => SCALE_STEP,
+          SCALE_RATIO_Q_W=> SCALE_RATIO_Q_W,
+          WR_Q_W         => WR_Q_W,
+          CON_W          => CON_W,
+          LOSS_K         => LOSS_K,
+          REF_K          => REF_K,
+          LOSS_RHO       => LOSS_RHO,
+          LOSS_CONTRAST  => LOSS_CONTRAST,
+          CONF_LOST      => CONF_LOST,
+          CONF_UNCERTAIN => CONF_UNCERTAIN,
+          CONF_REACQUIRE => CONF_REACQUIRE,
+          SPREAD_DEFAULT => SPREAD_DEFAULT,
+          BG_Q_W         => BG_Q_W,
+          BG_O_W         => BG_O_W,
+          SEARCH_ITER    => SEARCH_ITER,
+          STEP16         => STEP16,
+          MARGIN_MAX     => MARGIN_MAX,
+          SCALE_TEST_D256=> SCALE_TEST_D256,
+          ORIENT_T       => ORIENT_T,
+          RD_LAT         => RD_LAT,
+          FRAME_LINES    => FRAME_LINES,
+          ACTIVE_LINES   => ACTIVE_LINES,
+          LINE_CLOCKS    => LINE_CLOCKS,
+          LC_W           => LC_W,
+          SUM_W          => SUM_W,
+          CLK_W          => CLK_W,
+          PLAN_REGION_W  => PLAN_REGION_W,
+          GROW_Q16       => GROW_Q16,
+          PASS_LAT       => PASS_LAT,
+          M_TRACK        => M_TRACK,
+          C_TRACK        => C_TRACK,
+          M_LOST         => M_LOST,
+          C_LOST         => C_LOST,
+          C_INIT         => C_INIT,
+          SCALE_PERMILLE => SCALE_PERMILLE,
+          C_SCALE        => C_SCALE
+        )
+        port map (
+          clk => clk, rst => rst, frame_width => fw, frame_height => fh,
+          s_cmd_tvalid => cmd_v, s_cmd_tready => cmd_rdy, s_cmd_op => cmd_op, s_cmd_id => cmd_tid,
+          s_cmd_x => ib_x, s_cmd_y => ib_y, s_cmd_w => ib_w, s_cmd_h => ib_h,
+          cmd_done => cmd_done, cmd_code => cmd_code, cmd_id => cmd_rid,
+          s_axis_tdata => s_axis_tdata, s_axis_tvalid => c_tvalid, s_axis_tready => c_tready,
+          s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+          m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+          m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
+          live => live_n, busy => busy);
+    end generate;
     r_id <= to_integer(unsigned(r_data(MULTI_W - 1 downto RESULT_W)));
     init_rdy <= '1';                                   -- (CMD.init is an add here: init_v stays 0)
     live <= std_logic_vector(resize(unsigned(live_n), 16));
@@ -822,17 +957,17 @@ begin
   begin
     if rising_edge(clk) then
       ev_res  <= r_take and r_last;                  -- once per frame
-      ev_lost <= r_take and c_lost;
-      ev_err  <= r_take and c_err;
-      ev_rej  <= r_take and c_rej;
-      ev_reacq <= r_take and c_reacq;
-      fr_lost  <= acc_lost or c_lost;
-      fr_err   <= acc_err or c_err or c_rej;
-      fr_reacq <= acc_reacq or c_reacq;
+      ev_lost <= r_take and w_lost;
+      ev_err  <= r_take and w_err;
+      ev_rej  <= r_take and w_rej;
+      ev_reacq <= r_take and w_reacq;
+      fr_lost  <= acc_lost or w_lost;
+      fr_err   <= acc_err or w_err or w_rej;
+      fr_reacq <= acc_reacq or w_reacq;
       if r_take = '1' then                           -- collect over the frame's words; clear at its last
-        acc_lost  <= (acc_lost or c_lost) and not r_last;
-        acc_err   <= (acc_err or c_err or c_rej) and not r_last;
-        acc_reacq <= (acc_reacq or c_reacq) and not r_last;
+        acc_lost  <= (acc_lost or w_lost) and not r_last;
+        acc_err   <= (acc_err or w_err or w_rej) and not r_last;
+        acc_reacq <= (acc_reacq or w_reacq) and not r_last;
       end if;
       if hw_out.RES_HEAD.frame_count.swacc = '1' then  -- read of RES_HEAD: S <= L, same clock
         snap <= lat;

@@ -1826,7 +1826,7 @@ begin
             readback_data_var(31 downto 0) := 32x"4D53544B";
         end if;
         if rd_mux_addr = 16#4# then
-            readback_data_var(7 downto 0) := 8x"3";
+            readback_data_var(7 downto 0) := 8x"4";
             readback_data_var(15 downto 8) := 8x"1";
             readback_data_var(19 downto 16) := hwif_in.VERSION.result_version.next_q;
             readback_data_var(31 downto 24) := hwif_in.VERSION.result_width.next_q;
@@ -1906,6 +1906,7 @@ begin
         end if;
         if rd_mux_addr = 16#4C# then
             readback_data_var(4 downto 0) := hwif_in.MULTI.max_targets.next_q;
+            readback_data_var(5) := hwif_in.MULTI.shared_engine.next_q;
             readback_data_var(31 downto 16) := hwif_in.MULTI.live.next_q;
         end if;
         if rd_mux_addr = 16#50# then

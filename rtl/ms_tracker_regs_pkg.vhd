@@ -199,12 +199,17 @@ package ms_tracker_regs_pkg is
         next_q : std_logic_vector(4 downto 0);
     end record;
 
+    type \ms_tracker_regs.MULTI.shared_engine_in_t\ is record
+        next_q : std_logic;
+    end record;
+
     type \ms_tracker_regs.MULTI.live_in_t\ is record
         next_q : std_logic_vector(15 downto 0);
     end record;
 
     type \ms_tracker_regs.MULTI_in_t\ is record
         max_targets : \ms_tracker_regs.MULTI.max_targets_in_t\;
+        shared_engine : \ms_tracker_regs.MULTI.shared_engine_in_t\;
         live : \ms_tracker_regs.MULTI.live_in_t\;
     end record;
 

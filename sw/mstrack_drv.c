@@ -40,6 +40,8 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
     dev->max_targets = 0;
     dev->target_mask = 0;
     dev->box_rejected = 0;
+    dev->add_refused = 0;
+    dev->shared_engine = 0;
     if (RD(dev, ID) != MSTRACK_MAGIC) {
         return MSTRACK_ERR_ID;
     }
@@ -50,7 +52,9 @@ int mstrack_init(mstrack_dev_t *dev, uintptr_t base, uint32_t width, uint32_t he
     }
     dev->result_version = FIELD(v, VERSION, RESULT_VERSION);
     if (FIELD(v, VERSION, MAP_MINOR) >= 3u) {
-        dev->max_targets = FIELD(RD(dev, MULTI), MULTI, MAX_TARGETS);
+        uint32_t m = RD(dev, MULTI);
+        dev->max_targets = FIELD(m, MULTI, MAX_TARGETS);
+        dev->shared_engine = FIELD(m, MULTI, SHARED_ENGINE);   /* 0 before map minor 4 */
     }
     if (width < 3u || height < 3u || width > FIELD(RD(dev, FORMAT), FORMAT, MAX_FRAME_W) || height > 0xFFFFu) {
         return MSTRACK_ERR_ARG;
@@ -118,6 +122,7 @@ int mstrack_add(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h
         return MSTRACK_ERR_FULL;
     }
     dev->box_rejected &= ~(1u << slot);
+    dev->add_refused &= ~(1u << slot);
     if (id != NULL) {
         *id = slot;
     }
@@ -297,6 +302,8 @@ uint32_t mstrack_irq_handler(mstrack_dev_t *dev, mstrack_result_t *r)
         uint32_t v = RD(dev, CMD_STATUS);
         if (FIELD(v, CMD_STATUS, CODE) == 3u) {
             dev->box_rejected |= 1u << FIELD(v, CMD_STATUS, ID);
+        } else if (FIELD(v, CMD_STATUS, CODE) == 2u) {
+            dev->add_refused |= 1u << FIELD(v, CMD_STATUS, ID);
         }
     }
     if ((st & MSTRACK_IRQ_RESULT) && dev->max_targets != 0u) {

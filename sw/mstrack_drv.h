@@ -112,6 +112,9 @@ typedef struct {
     uint32_t max_targets;  /* MULTI.max_targets: target slots; 0 a single-target core */
     uint32_t target_mask;  /* ids with a word in the last frame read (mstrack_read_frame) */
     uint32_t box_rejected; /* ids whose add box the core rejected (CMD_STATUS code 3 seen by the handler) */
+    uint32_t add_refused;  /* ids whose add the capacity rule refused at its frame (CMD_STATUS code 2 seen by
+                              the handler; cores with MULTI.shared_engine) */
+    uint32_t shared_engine; /* MULTI.shared_engine: one engine serves every target (mstrack_init sets it) */
     mstrack_result_v2_t target[MSTRACK_MAX_TARGETS]; /* the last frame's word of each id in target_mask */
 } mstrack_dev_t;
 
@@ -133,7 +136,10 @@ void mstrack_enable(mstrack_dev_t *dev, uint32_t irq_mask);
  * between frames (from the next frame); waits for the report (polling CMD_STATUS) and gives the
  * target's id.  Returns MSTRACK_OK, MSTRACK_ERR_FULL (no free slot), MSTRACK_ERR_ARG,
  * MSTRACK_ERR_TIMEOUT or MSTRACK_ERR_SINGLE.  A box the core rejects later (it does not clip into the
- * frame) is reported by the handler in dev->box_rejected, and its id is free again. */
+ * frame) is reported by the handler in dev->box_rejected, and its id is free again.  On a core with one
+ * engine for every target (dev->shared_engine), an add whose job would not fit its frame is refused at
+ * that frame: the handler reports it in dev->add_refused, and its id is free again.  CMD_STATUS keeps
+ * the last report only: give at most one add per frame where such a report must not be missed. */
 int mstrack_add(mstrack_dev_t *dev, int32_t x, int32_t y, uint32_t w, uint32_t h, uint32_t *id);
 
 /* Multi-target cores: remove target id (between frames).  Returns MSTRACK_OK, MSTRACK_ERR_ARG (id not

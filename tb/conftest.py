@@ -266,6 +266,10 @@ CI_EXTRA: dict[str, str] = {
         "GHDL: adds, removes, refusals, held targets, a short line and a cut) and test_multi_real_people (TUD "
         "frames through the replicated-engine core); this case: every frame and target of a MOT sequence on the "
         "shared core's netlist (its build alone is about 10 minutes)",
+    "tb/test_sim_cli.py::test_sim_shared_engine":
+        "test_sim_several_boxes (the same command path and checks with the replicated-engine core, marker long) "
+        "and tb/test_mstrack_drv.py::test_driver_against_shared_core (ms_tracker_shared's netlist bit-exact with "
+        "the capacity rule's model, marker long); this case: `mstrack sim --shared-engine` (its own build)",
     "tb/test_ms_tracker_shared.py::test_shared_held_decimated":
         "test_ms_tracker_shared_capacity (held targets and refused adds under GHDL, marker long, every held "
         "target at decimation 1); this case: a held target at decimation 2 on the netlist (its own build)",

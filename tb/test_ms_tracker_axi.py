@@ -264,7 +264,7 @@ async def check_identification(tb: TB, check) -> None:
     """ID, VERSION, CONFIG, CONFIG_V2 and FORMAT against the job's generics."""
     g, v2 = tb.g, tb.v2
     check("ID", await tb.rd("ID"), {"magic": 0x4D53544B})
-    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 3, "result_version": 2 if v2 else 1,
+    check("VERSION", await tb.rd("VERSION"), {"map_major": 1, "map_minor": 4, "result_version": 2 if v2 else 1,
                                               "result_width": g["RESULT_W"]})
     check("CONFIG", await tb.rd("CONFIG"), {"preset": int(v2), "features": g["FEATURES"], "kernel_epan": g["KERNEL_EPAN"],
                                             "result_stream": int(tb.job["result_stream"]), "lanes": g["LANES"],

@@ -109,6 +109,67 @@ def test_driver_against_multi_target_core():
     assert min(b["cycle"] - a["cycle"] for a, b in zip(run.stream, run.stream[1:])) == 65
 
 
+@pytest.mark.long
+@pytest.mark.verilator
+def test_driver_against_shared_core():
+    """ms_tracker_axi with SHARED_ENGINE (ms_tracker_shared: one colour engine for three slots, MAX_FRAME_W
+    1024) on TUD-Stadtmitte (640 x 480), 10 frames, streamed at the raster its capacity rule is built for:
+    520 lines of 1,200 clocks (hblank 560, vblank 40 lines), a budget that takes two of these people a
+    frame.  The driver, a CPU 8 idle clocks per access slower than the bus, and a result stream sink that
+    idles 64 clocks after each word.  Before frame 0 three people added: all three reported taken (code 0),
+    the third refused at frame 0 by the capacity rule (code 2, seen by the handler: dev.add_refused, its
+    slot free again); before frame 2 a box outside the frame added in that slot (rejected by the engine,
+    code 3: dev.box_rejected); before frame 4 the first person removed and the refused one added again (id
+    0; held by the rule from frame 5 on, err_code 6 words); before frame 6 another person added (id 2, taken:
+    three live); before frame 8 one more (refused: no free slot, MSTRACK_ERR_FULL).  Every target's word of
+    every frame read by the handler, and every word of the stream, against CoreModelMulti with the capacity
+    rule, fed the commands where they landed; MULTI.shared_engine read by mstrack_init."""
+    from mstrack.fixed import FixedParams
+    from mstrack.fixed.blocks import round_box
+    from mstrack.fixed.multi_capacity import MultiCoreConfig, VideoTiming
+    from mstrack.hw import drvsim
+    from mstrack.hw.cosim_multi import CMD_BOX, CMD_CYCLES, expected_multi
+    from mstrack.hw.multi_core import pass_costs
+    from mstrack.io.mot import load_mot_sequence
+    from mstrack.track.params import V2_COLOUR
+    seq_dir = Path(__file__).resolve().parents[2] / "shared" / "data" / "multi" / "TUD-Stadtmitte"
+    if not seq_dir.is_dir():
+        pytest.skip(f"{seq_dir} not found: the shared-engine driver run needs ../shared/data/multi")
+    seq = load_mot_sequence(seq_dir)
+    tp = TrackerParams(preset="v2", **V2_COLOUR)
+    frames = [seq.frame(i) for i in range(10)]
+    timing = VideoTiming(480, 520, 1200)
+
+    def box(frame, pid):
+        return round_box(*seq.boxes_at(frame)[pid].as_tuple())
+    ops = [(0, "add", "p1", box(0, 1)), (0, "add", "p4", box(0, 4)), (0, "add", "p7", box(0, 7)),
+           (2, "add", "off", (2000, -500, 10, 10)),
+           (4, "remove", "p1"), (4, "add", "p7b", box(4, 7)),
+           (6, "add", "p2", box(6, 2)), (8, "add", "p3", box(8, 3))]
+    run = drvsim.simulate_driver_multi(frames, ops, tp, FixedParams(), max_targets=3, max_frame_w=1024, io_gap=8,
+                                       result_gap=64, shared=timing, hblank=1200 - 640, vblank=40 * 1200)
+    cmds = run.commands(3)
+    assert sorted(cmds) == [0, 2, 4, 6, 8]
+    model = expected_multi(frames, cmds, tp, FixedParams(), 3, 1024,
+                           capacity=MultiCoreConfig(3, timing, pass_costs(4)))
+    diffs = drvsim.check_run_multi(run, model, 3)
+    assert not diffs, "\n".join(diffs[:10])
+    assert run.shared_engine == 1
+    assert [o["rc"] for o in run.ops] == [0, 0, 0, 0, 0, 0, 0, -5]
+    # the model's later reports: the third add refused at frame 0, the box rejected at frame 2
+    assert [(o.code, o.target_id) for o in model.outcomes if o.code in (CMD_CYCLES, CMD_BOX)] == [(2, 2), (3, 2)]
+    assert [f["add_refused"] for f in run.frames] == [0b100] * 2 + [0] * 8   # cleared by the next add given id 2
+    assert [f["box_rejected"] for f in run.frames] == [0] * 2 + [0b100] * 4 + [0] * 4
+    held = [(i, w["target_id"]) for i, f in enumerate(model.frames) for w in f if w["err_code"] == 6]
+    assert held and all(k == 0 and i >= 5 for i, k in held)
+    assert [f["mask"] for f in run.frames][-1] == 0b111
+    assert run.stream is not None and len(run.stream) == len(model.results)
+    assert max(run.handler_clocks()) < 2000
+    print(f"shared engine: {len(run.frames)} frames, {len(model.results)} words ({len(held)} held), "
+          f"{run.cycles} clocks in {run.seconds:.0f} s (build {run.build_seconds:.0f} s), handler up to "
+          f"{max(run.handler_clocks())} clocks, bit-exact")
+
+
 @pytest.mark.extra
 @pytest.mark.verilator
 @pytest.mark.parametrize("name", ["TUD-Stadtmitte", "PETS09-S3MF1"])

@@ -335,3 +335,43 @@ def test_sim_several_boxes(tmp_path, capsys):
     assert [(r["frame"], r["target_id"]) for r in got] == [(str(i), str(k)) for i in range(6) for k in range(3)]
     rep = json.loads((out / "bitexact.json").read_text())
     assert rep["bit_exact"] and rep["slots"] == 3 and rep["files"]["video"]
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_sim_shared_engine(tmp_path, capsys):
+    """`mstrack sim --shared-engine` with three --box in four slots on the generated scene: ms_tracker_shared
+    (one colour engine), its capacity rule at the 720p60 raster, every word bit-exact with CoreModelMulti
+    with that rule; bitexact.json names the core and the raster.  A frame larger than the raster is bad
+    input (exit 2, one line)."""
+    from mstrack.io.synthetic import make_multi_scene
+    frames, rows = make_multi_scene(6, 96, 80, n_targets=4, seed=3)
+    folder = tmp_path / "img"
+    folder.mkdir()
+    for i, f in enumerate(frames):
+        cv2.imwrite(str(folder / f"{i:04d}.png"), f)
+    boxes = [",".join(str(int(v)) for v in r[2:6]) for r in rows if r[0] == 0][:3]
+    out = tmp_path / "shared"
+    argv = ["sim", str(folder), *[f"--box={b}" for b in boxes], "--slots", "4", "--shared-engine", "--timing",
+            "720p60", "--colour", "--max-frame-width", "1024", "--quick-build", "--out", str(out), "--quiet"]
+    rc = cli.main(argv)
+    cap = capsys.readouterr()
+    assert rc == 0, cap.out + cap.err
+    assert "bit-exact: yes (18 words, 0 differ" in cap.out
+    rep = json.loads((out / "bitexact.json").read_text())
+    assert rep["bit_exact"] and rep["core"] == "ms_tracker_shared" and rep["capacity_timing"] == "720p60"
+    assert rep["generics"]["FRAME_LINES"] == 750 and rep["generics"]["LINE_CLOCKS"] == 1650
+    with open(out / "results.csv") as fh:
+        got = list(csv.DictReader(fh))
+    assert [(r["frame"], r["target_id"]) for r in got] == [(str(i), str(k)) for i in range(6) for k in range(3)]
+    # bad input: the frames do not fit the raster; one box only
+    big = tmp_path / "big"
+    big.mkdir()
+    cv2.imwrite(str(big / "0000.png"), np.zeros((800, 96, 3), np.uint8))
+    rc = cli.main(["sim", str(big), "--box=1,1,10,10", "--box=20,20,10,10", "--shared-engine", "--timing", "720p60",
+                   "--out", str(tmp_path / "b1"), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "do not fit the 720p60 raster" in err[0], err
+    rc = cli.main(["sim", str(folder), "--box=1,1,10,10", "--shared-engine", "--out", str(tmp_path / "b2"), "--quiet"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "--shared-engine" in err[0], err

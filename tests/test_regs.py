@@ -32,7 +32,7 @@ def test_register_map():
     assert m["RES_HEAD"].offset < m["RES_CX"].offset
     v2_space = range(0x70, 0x80)
     assert [r.name for r in m.values() if r.offset in v2_space] == ["RES_W8", "RES_H8", "RES_CONF", "RES_STATE"]
-    assert m["VERSION"].fields["map_minor"].reset == 3 and m["VERSION"].fields["map_major"].reset == 1
+    assert m["VERSION"].fields["map_minor"].reset == 4 and m["VERSION"].fields["map_major"].reset == 1
     raw = [m[f"RES_RAW{i}"].offset for i in range(5)]
     assert raw == list(range(raw[0], raw[0] + 20, 4))
     assert 5 * 32 >= max(result_width(), result_width_v2())
@@ -119,16 +119,27 @@ def test_register_fields_hold_result_fields_v2():
 
 def test_wrapper_takes_every_core_generic():
     """ms_tracker_axi has every generic of ms_tracker (so `mstrack hdl config`'s generic map fits it too)
-    and passes each to the core under the same name; its own: MAX_TARGETS (ms_tracker_multi's slots, passed
-    to that core) and RESULT_STREAM."""
+    and passes each to the core under the same name; its own: MAX_TARGETS (the multi-target core's slots),
+    SHARED_ENGINE, ms_tracker_shared's own generics (passed to that core under the same names) and
+    RESULT_STREAM."""
     from mstrack.hw.hdl_config import entity_generics
+
+    def generics(entity: str) -> list[str]:
+        text = re.sub(r"--[^\n]*", "", (regs.REPO / "rtl" / f"{entity}.vhd").read_text())
+        decl = re.search(rf"entity\s+{entity}\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
+        assert decl, entity
+        return re.findall(r"(\w+)\s*:\s*(?:natural|integer|boolean|positive)\b", decl.group(1), re.I)
     text = re.sub(r"--[^\n]*", "", (regs.REPO / "rtl" / "ms_tracker_axi.vhd").read_text())
-    decl = re.search(r"entity\s+ms_tracker_axi\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
-    assert decl
-    names = re.findall(r"(\w+)\s*:\s*(?:natural|integer|boolean)\b", decl.group(1), re.I)
+    names = generics("ms_tracker_axi")
     core = entity_generics()
-    assert [n for n in names if n not in ("RESULT_STREAM", "MAX_TARGETS")] == core
+    shared_own = [n for n in generics("ms_tracker_shared") if n not in core and n != "MAX_TARGETS"]
+    assert "FRAME_LINES" in shared_own and "C_SCALE" in shared_own
+    own = ("RESULT_STREAM", "MAX_TARGETS", "SHARED_ENGINE", *shared_own)
+    assert [n for n in names if n not in own] == core
+    assert set(own) <= set(names)
     assert re.search(r"\bMAX_TARGETS\s*=>\s*MAX_TARGETS\b", text)
+    for n in shared_own:
+        assert re.search(rf"\b{n}\s*=>\s*{n}\b", text), f"{n} not passed to ms_tracker_shared"
     for n in core:
         assert re.search(rf"\b{n}\s*=>\s*{n}\b", text), f"{n} not passed to ms_tracker"
 

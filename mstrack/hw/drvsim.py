@@ -28,6 +28,7 @@ import numpy as np
 from . import fastsim, hdl
 from .cosim import COMPARED_FIELDS, COMPARED_FIELDS_V2, CoreConfig, CoreConfigV2, diff_fields
 from ..fixed import FixedParams
+from ..fixed.multi_capacity import VideoTiming
 from ..fixed.vhdl_pkg import RESULT_FLAGS, STATUS_V2, unpack_result, unpack_result_multi, unpack_result_v2
 from ..track.params import TrackerParams
 
@@ -100,27 +101,38 @@ class DriverRun(_HarnessRun):
         return [r["handled_cycle"] - r["irq_cycle"] for r in self.results]
 
 
-def axi_generics(cfg: CoreConfig | CoreConfigV2, max_targets: int = 0, result_stream: bool = False) -> dict[str, int]:
+def axi_generics(cfg: CoreConfig | CoreConfigV2, max_targets: int = 0, result_stream: bool = False,
+                 shared: VideoTiming | None = None) -> dict[str, int]:
     """The generics of ms_tracker_axi for *cfg*: those of ms_tracker, results through the registers
     only (RESULT_STREAM false, as a CPU-only integration builds it; *result_stream*: true, the
     m_axis_result stream as well); *max_targets* >= 1: the multi-target core with that many slots
-    (core v2)."""
+    (core v2), an engine per slot (ms_tracker_multi), or with *shared* (the capacity rule's video timing)
+    one engine for every slot (ms_tracker_shared, ``SHARED_ENGINE``, its generics from
+    :func:`mstrack.hw.multi_core.shared_core_generics`)."""
     g: dict[str, int] = dict(cfg.tracker_generics() if isinstance(cfg, CoreConfigV2) else cfg.generics())
     g["RESULT_STREAM"] = int(result_stream)
     if max_targets:
         if not isinstance(cfg, CoreConfigV2) or not 1 <= max_targets <= 16:
             raise ValueError("a multi-target core is core v2 with 1 .. 16 slots")
         g["MAX_TARGETS"] = max_targets
+    if shared is not None:
+        if not max_targets:
+            raise ValueError("a shared engine needs max_targets >= 1")
+        from .multi_core import pass_costs, shared_core_generics
+        sg = shared_core_generics(cfg.tp, cfg.fp, max_targets, shared, cfg.max_frame_w,
+                                  costs=pass_costs(cfg.lanes))
+        g["SHARED_ENGINE"] = 1
+        g.update({k: v for k, v in sg.items() if k not in g})
     return g
 
 
 def build_driver(cfg: CoreConfig | CoreConfigV2, verbose: bool = False, max_targets: int = 0,
-                 result_stream: bool = False) -> tuple[Path, float]:
-    """Build (or find in the cache) the driver harness for *cfg* (*max_targets*, *result_stream* as
-    :func:`axi_generics`): (executable, seconds spent building)."""
+                 result_stream: bool = False, shared: VideoTiming | None = None) -> tuple[Path, float]:
+    """Build (or find in the cache) the driver harness for *cfg* (*max_targets*, *result_stream*,
+    *shared* as :func:`axi_generics`): (executable, seconds spent building)."""
     import time
-    g = axi_generics(cfg, max_targets, result_stream)
-    vg = {k: (v != 0) if k == "RESULT_STREAM" else v for k, v in g.items()}
+    g = axi_generics(cfg, max_targets, result_stream, shared)
+    vg = {k: (v != 0) if k in ("RESULT_STREAM", "SHARED_ENGINE") else v for k, v in g.items()}
     t0 = time.monotonic()
     net_dir = fastsim.FASTSIM_DIR / f"netlist_{fastsim._generics_hash(g)}_{TOP}"
     with fastsim._lock(net_dir.with_suffix(".lock")):
@@ -271,12 +283,13 @@ class DriverMultiRun(_HarnessRun):
     """Outcome of a driver co-simulation of a multi-target core (:func:`simulate_driver_multi`).
 
     ``frames``: one dict per result interrupt: ``mask`` (the driver's ``target_mask``), ``irq``,
-    ``irq_cycle``, ``handled_cycle``, ``frame_count`` (RES_MASK's), ``box_rejected`` (the driver's
-    ``dev.box_rejected`` after the handler) and ``words``: ``{id: {"word", "fields",
+    ``irq_cycle``, ``handled_cycle``, ``frame_count`` (RES_MASK's), ``box_rejected``, ``add_refused`` (the
+    driver's ``dev.box_rejected``, ``dev.add_refused`` after the handler) and ``words``: ``{id: {"word", "fields",
     "driver"}}`` (the raw word read again, Python's decode of it, the driver's ``target[id]``).
     ``ops``: each ``mstrack_add`` / ``mstrack_remove`` the harness called: ``label``, ``op``, ``rc``, ``id``
     (add), ``before`` / ``after`` (frames whose first pixel had been taken before the call / at its
-    return).  ``box_rejected``, ``live``: the driver's ``dev.box_rejected`` and ``mstrack_live`` at the end.
+    return).  ``box_rejected``, ``live``, ``add_refused``, ``shared_engine``: the driver's ``dev.box_rejected``,
+    ``mstrack_live``, ``dev.add_refused`` and ``dev.shared_engine`` at the end.
     ``stream``: with a result stream sink (:func:`simulate_driver_multi` *result_gap*), each beat it
     took: its fields (:func:`mstrack.fixed.vhdl_pkg.unpack_result_multi`) with ``word`` (the raw word, the
     target id at its top bits), ``last`` and ``cycle``; ``None`` without one.
@@ -285,6 +298,8 @@ class DriverMultiRun(_HarnessRun):
     ops: list[dict] = field(default_factory=list)
     box_rejected: int = 0
     live: int = 0
+    add_refused: int = 0
+    shared_engine: int = 0
     stream: list[dict] | None = None
 
     def handler_clocks(self) -> list[int]:
@@ -320,7 +335,7 @@ def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMu
         if p[0] == "M":
             run.frames.append({"mask": int(p[2]), "irq": int(p[3]), "irq_cycle": int(p[4]),
                                "handled_cycle": int(p[5]), "frame_count": int(p[6]), "box_rejected": int(p[7]),
-                               "words": {}})
+                               "add_refused": int(p[8]), "words": {}})
         elif p[0] == "W":
             word = int(p[3], 16)
             drv = {k: int(v) for k, v in (kv.split("=", 1) for kv in p[4:])}
@@ -332,7 +347,7 @@ def _parse_multi(out: Path, ops: Sequence[tuple], g: dict[str, int]) -> DriverMu
         elif p[0] == "X":
             run.ops.append({"op": "remove", "label": p[1], "rc": int(p[2]), "before": int(p[3]), "after": int(p[4])})
         elif p[0] == "J":
-            run.box_rejected, run.live = int(p[1]), int(p[2])
+            run.box_rejected, run.live, run.add_refused, run.shared_engine = map(int, p[1:5])
         elif p[0] == "T":
             if run.stream is None:
                 run.stream = []
@@ -345,8 +360,8 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
                           fp: FixedParams | None = None, *, max_targets: int = 2, lanes: int | None = None,
                           max_frame_w: int = 2048, hblank: int = 0, vblank: int = 0, io_gap: int = 0,
                           irq_mask: int | None = None, watchdog: int = 4_000_000, tail: int = 200,
-                          result_gap: int | None = None, workdir: Path | str | None = None,
-                          check: bool = True) -> DriverMultiRun:
+                          result_gap: int | None = None, shared: VideoTiming | None = None,
+                          workdir: Path | str | None = None, check: bool = True) -> DriverMultiRun:
     """Run the driver against ms_tracker_axi with ``MAX_TARGETS`` = *max_targets* (core v2 engines, the
     parameters *tp*, default tracker v2) on *frames*.  *ops*: ``(frame, "add", label, (x, y, w, h))`` or
     ``(frame, "remove", label)``, in order: the harness calls ``mstrack_add`` / ``mstrack_remove`` (the id
@@ -356,7 +371,9 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
     with every frame's words read (unless ``check`` is false).  *result_gap*: None, results through the
     registers only (``RESULT_STREAM`` false); an int >= 0, the core built with its result stream too and
     a sink that takes a beat, then holds ``tready`` low *result_gap* clocks (``run.stream``): the words
-    of a frame then come that far apart, as behind a slow DMA."""
+    of a frame then come that far apart, as behind a slow DMA.  *shared*: the core with one engine for
+    every slot (ms_tracker_shared, ``SHARED_ENGINE``) and this video timing in its capacity rule; None,
+    an engine per slot (ms_tracker_multi)."""
     from ..fixed.vhdl_pkg import DEFAULT_LANES
     cfg = CoreConfigV2(tp or TrackerParams(preset="v2"), fp or FixedParams(), lanes=lanes or DEFAULT_LANES,
                        max_frame_w=max_frame_w)
@@ -383,7 +400,7 @@ def simulate_driver_multi(frames: Sequence[np.ndarray], ops: Sequence[tuple], tp
             lines.append(f"op {fr} remove {label}")
         else:
             raise ValueError(f"op {what!r}: add or remove")
-    exe, build_s = build_driver(cfg, max_targets=max_targets, result_stream=result_gap is not None)
+    exe, build_s = build_driver(cfg, max_targets=max_targets, result_stream=result_gap is not None, shared=shared)
     res, n = _run_harness(exe, frames, max_frame_w, lines, workdir, lambda out: _parse_multi(out, ops, g))
     run = cast(DriverMultiRun, res)
     _finish(run, build_s, check, f"{len(run.frames)} frames of {n}")
@@ -412,25 +429,27 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
 
     * ``mstrack_init`` and the enable returned MSTRACK_OK, no bus error;
     * each add / remove returned what the model's report says (the id of an add; MSTRACK_ERR_FULL for a
-      refused add, MSTRACK_ERR_ARG for a remove of an id not live);
+      refused add, MSTRACK_ERR_ARG for a remove of an id not live); the reports that come later (a box
+      the engine rejects, an add the capacity rule refuses at its frame) are not the command's return;
     * one result interrupt per frame; its target mask is the ids of the model's words without
       ``no_target``; each target's raw word equals the model's word field by field (target id included),
       and the driver's fields (read from the RES_* registers) equal the raw word's;
     * the interrupt bits: result always; lost / reacquired / error exactly when a word of the frame has
       status lost / reacquired / flag error or rejected (the command bit is not compared: it follows the
       command reports, which the handler sees whenever they come);
-    * the counters (frames, lost / error / rejected words) and, at the end, the live slots and the
-      rejected boxes the handler saw (a subset of the model's);
+    * the counters (frames, lost / error / rejected words) and, at the end, the live slots, the
+      rejected boxes and the refused adds the handler saw (subsets of the model's: CMD_STATUS keeps the
+      last report only);
     * with a result stream sink (``run.stream``): its beats are the model's words, frame by frame, field
       by field (target id included), ``tlast`` on each frame's last.
     """
-    from .cosim_multi import CMD_BOX, CMD_OK, diff_words
+    from .cosim_multi import CMD_BOX, CMD_CYCLES, CMD_OK, diff_words
     out = []
     if run.calls != {"init": 0, "start": 0}:
         out.append(f"driver calls returned {run.calls} (MSTRACK_OK = 0)")
     if run.bus_errors:
         out.append(f"{run.bus_errors} register accesses answered SLVERR")
-    reports = [o for o in model.outcomes if o.code != CMD_BOX]
+    reports = [o for o in model.outcomes if o.code not in (CMD_BOX, CMD_CYCLES)]
     issued = []
     ids: dict[str, int] = {}
     for o in run.ops:                         # the commands the core was given (a remove of a failed add was not)
@@ -491,6 +510,9 @@ def check_run_multi(run: DriverMultiRun, model, max_targets: int) -> list[str]:
     boxed = sum(1 << o.target_id for o in model.outcomes if o.code == CMD_BOX)
     if run.box_rejected & ~boxed:
         out.append(f"rejected boxes {run.box_rejected:#x} not in the model's {boxed:#x}")
+    refused = sum(1 << o.target_id for o in model.outcomes if o.code == CMD_CYCLES)
+    if run.add_refused & ~refused:
+        out.append(f"refused adds {run.add_refused:#x} not in the model's {refused:#x}")
     if run.stream is not None:
         out += [f"result stream: {d}" for d in diff_words(run.stream, model.frames)]
     return out

@@ -44,10 +44,11 @@
 //                                                   one per handler call that saw a result: the
 //                                                   driver's decoded fields (mstrack_result_v2_t
 //                                                   for result word v2, mstrack_result_t for v1)
-//   M <index> <mask> <irq bits> <irq_cycle> <handled_cycle> <frame_count> <box_rejected>
+//   M <index> <mask> <irq bits> <irq_cycle> <handled_cycle> <frame_count> <box_rejected> <add_refused>
 //                                                   multi: one per result interrupt: the driver's
 //                                                   dev.target_mask, RES_MASK's frame_count, the
-//                                                   driver's dev.box_rejected after the handler
+//                                                   driver's dev.box_rejected and dev.add_refused
+//                                                   after the handler
 //   W <index> <id> <raw word, hex> <key=value ...>  multi: each target of that frame: the driver's
 //                                                   dev.target[id] and the raw word (read again
 //                                                   with mstrack_read_target, mstrack_read_raw)
@@ -56,7 +57,9 @@
 //                                                   frames whose first pixel had been taken before
 //                                                   the call and at its return
 //   X <label> <rc> <started before> <started after> multi: mstrack_remove
-//   J <box_rejected> <live>                         multi, at the end: dev.box_rejected, mstrack_live
+//   J <box_rejected> <live> <add_refused> <shared_engine>
+//                                                   multi, at the end: dev.box_rejected, mstrack_live,
+//                                                   dev.add_refused, dev.shared_engine
 //   Q <irq bits> <cycle>                            a handler call without a result bit
 //   T <tlast> <tdata, hex, MSB first> <cycle>       result_gap >= 0: each beat the sink took
 //   C results lost errors rejected dropped          mstrack_read_counters at the end
@@ -384,8 +387,8 @@ int main(int argc, char** argv) {
             const uint32_t st = mstrack_irq_handler(&dev, &r);
             if ((st & MSTRACK_IRQ_RESULT) && multi) {
                 uint32_t fc = FIELD_RES_MASK_FC(mstrack_io_read32(MS_RES_MASK_ADDR));
-                std::fprintf(o, "M %lld %u %u %lld %lld %u %u\n", n_read, dev.target_mask, st, irq_cycle, s.cycle, fc,
-                             dev.box_rejected);
+                std::fprintf(o, "M %lld %u %u %lld %lld %u %u %u\n", n_read, dev.target_mask, st, irq_cycle, s.cycle,
+                             fc, dev.box_rejected, dev.add_refused);
                 for (uint32_t id = 0; id < MSTRACK_MAX_TARGETS; ++id) {
                     if (!(dev.target_mask & (1u << id))) continue;
                     mstrack_result_v2_t again;
@@ -442,7 +445,8 @@ int main(int argc, char** argv) {
         mstrack_read_counters(&dev, &c);
         mstrack_stop(&dev);
         std::fprintf(o, "C %u %u %u %u %u\n", c.results, c.lost, c.errors, c.rejected, c.dropped);
-        if (multi) std::fprintf(o, "J %u %u\n", dev.box_rejected, mstrack_live(&dev));
+        if (multi) std::fprintf(o, "J %u %u %u %u\n", dev.box_rejected, mstrack_live(&dev), dev.add_refused,
+                                dev.shared_engine);
         if (s.bus_timeout) {
             status = "bus_timeout";
             detail = "a register access at the end was not answered";

@@ -107,21 +107,23 @@ def test_multi_pins_wrapper_synthesises(tmp_path):
         "s_axis_tvalid": ("input", 1), "s_axis_tready": ("output", 1), "s_axis_tlast": ("input", 1),
         "s_axis_tuser": ("input", 1), "res_valid": ("output", 1), "res_dout": ("output", 1),
         "res_last": ("output", 1), "live": ("output", 2), "busy": ("output", 1)}, ports
-    assert re.search(r"^\s+ms_tracker_multi_2_\w+ u_core \(", v, re.M), "the core with MAX_TARGETS 2"
+    assert re.search(r"^\s+ms_tracker_multi_2_\w+ g_multi_u_core \(", v, re.M), "the core with MAX_TARGETS 2"
     assert len(re.findall(r"^\s+ms_tracker_v2_\w+ g_eng_n\d+_u_eng \(", v, re.M)) == 2, "one engine per slot"
 
 
 @pytest.mark.ghdl
 @pytest.mark.parametrize("n", [1, 2])
 def test_shared_pins_wrapper_synthesises(tmp_path, n):
-    """GHDL synthesis of rtl/wrappers/ms_tracker_shared_pins.vhd (what `mstrack synth --config shared<N>-colour`
-    places) with 1 and 2 slots: it elaborates (with one slot too: hdl.fix_ghdl_zero_width), its Verilog module
-    has exactly the pins of the replicated core's wrapper, and it holds one engine."""
+    """GHDL synthesis of rtl/wrappers/ms_tracker_multi_pins.vhd with SHARED_ENGINE (what `mstrack synth
+    --config shared<N>-colour` places) with 1 and 2 slots: it elaborates (with one slot too:
+    hdl.fix_ghdl_zero_width), its Verilog module has the pins of the replicated core's, and it holds
+    ms_tracker_shared, one engine."""
     from mstrack.hw import hdl
     g = {**synth.CONFIGS["shared4-colour"].pins_generics(), "MAX_TARGETS": n}
-    v = hdl.ghdl_to_verilog(synth.SHARED_PINS_TOP, g, synth.pins_sources(synth.SHARED_PINS_TOP),
-                            out_path=tmp_path / f"{synth.SHARED_PINS_TOP}.v").read_text()
-    head = re.search(rf"module {synth.SHARED_PINS_TOP}\s*\((.*?)\);", v, re.S)
+    assert g["SHARED_ENGINE"] is True
+    v = hdl.ghdl_to_verilog(synth.MULTI_PINS_TOP, g, synth.pins_sources(synth.MULTI_PINS_TOP),
+                            out_path=tmp_path / f"{synth.MULTI_PINS_TOP}.v").read_text()
+    head = re.search(rf"module {synth.MULTI_PINS_TOP}\s*\((.*?)\);", v, re.S)
     assert head, "no wrapper module in GHDL's output"
     ports = {m.group(3): (m.group(1), int(m.group(2)) + 1 if m.group(2) else 1)
              for m in re.finditer(r"(input|output)\s+(?:\[(\d+):0\]\s+)?(\w+)", head.group(1))}
@@ -132,6 +134,7 @@ def test_shared_pins_wrapper_synthesises(tmp_path, n):
         "s_axis_tvalid": ("input", 1), "s_axis_tready": ("output", 1), "s_axis_tlast": ("input", 1),
         "s_axis_tuser": ("input", 1), "res_valid": ("output", 1), "res_dout": ("output", 1),
         "res_last": ("output", 1), "live": ("output", n), "busy": ("output", 1)}, ports
-    assert re.search(rf"^\s+ms_tracker_shared_{n}_\w+ u_core \(", v, re.M), f"the core with MAX_TARGETS {n}"
+    assert re.search(rf"^\s+ms_tracker_shared_{n}_\w+ g_shared_u_core \(", v, re.M), f"the core with MAX_TARGETS {n}"
+    assert not re.search(r"^module ms_tracker_multi_\d", v, re.M), "the replicated core left out"
     assert len(re.findall(r"^\s+ms_engine_\w+ \w+ \(", v, re.M)) == 1, "one engine for every slot"
     assert '= "";' not in v and not re.search(r"\b0'b", v), "GHDL's zero-width wires left in"

@@ -188,22 +188,28 @@ def _vhdl_generics(path, entity) -> list[tuple[str, str]]:
     return [(n, " ".join(d.split())) for n, d in re.findall(r"^\s+(\w+)\s*:([^;]*?)\s*(?:;|\)\s*;?\s*$)", t, re.M)]
 
 
-def _wrapper_passes_every_generic(core: str, first: str, wrapper_vhd, wrapper: str) -> list[tuple[str, str]]:
+def _wrapper_passes_every_generic(core: str, first: str, wrapper_vhd, wrapper: str,
+                                  more: int = 0) -> list[tuple[str, str]]:
     """Assert that pin wrapper *wrapper* has exactly the generics of rtl/<core>.vhd (the first one *first*)
-    and maps each by name; returns the core's generics."""
+    and then *more* of its own, and maps each of the core's by name; returns the core's generics."""
     import re
     gen = _vhdl_generics(synth.REPO_ROOT / "rtl" / f"{core}.vhd", core)
     assert len(gen) > 70 and gen[0][0] == first
-    assert _vhdl_generics(wrapper_vhd, wrapper) == gen
+    wg = _vhdl_generics(wrapper_vhd, wrapper)
+    assert wg[:len(gen)] == gen and len(wg) == len(gen) + more
     body = wrapper_vhd.read_text()
     assert all(re.search(rf"^\s+{n}\s+=> {n}\b", body, re.M) for n, _ in gen)
     return gen
 
 
 def test_multi_pins_wrapper_passes_every_generic():
-    """rtl/wrappers/ms_tracker_multi_pins.vhd has exactly ms_tracker_multi's generics (names, types,
-    defaults) and passes each on by name, so the placed core is the one `mstrack synth` counts."""
-    _wrapper_passes_every_generic("ms_tracker_multi", "MAX_TARGETS", synth.MULTI_PINS_VHD, "ms_tracker_multi_pins")
+    """rtl/wrappers/ms_tracker_multi_pins.vhd has ms_tracker_multi's generics (names, types, defaults), then
+    SHARED_ENGINE and ms_tracker_shared's own (test_multi_pins_wrapper_passes_every_shared_generic), and
+    passes each on by name, so the placed core is the one `mstrack synth` counts."""
+    shared = _vhdl_generics(synth.REPO_ROOT / "rtl" / "ms_tracker_shared.vhd", "ms_tracker_shared")
+    multi = _vhdl_generics(synth.REPO_ROOT / "rtl" / "ms_tracker_multi.vhd", "ms_tracker_multi")
+    _wrapper_passes_every_generic("ms_tracker_multi", "MAX_TARGETS", synth.MULTI_PINS_VHD, "ms_tracker_multi_pins",
+                                  more=1 + len(shared) - len(multi))
 
 
 def test_v2_configs_are_the_v2_trackers():
@@ -286,25 +292,36 @@ def test_multi_colour_configs_are_colour_engines(name, n):
     assert rows.index("(multi4-colour - multi1-colour)") < rows.index("(multi8-colour - multi1-colour)")
 
 
-def test_shared_pins_wrapper_passes_every_generic():
-    """rtl/wrappers/ms_tracker_shared_pins.vhd has exactly ms_tracker_shared's generics (names, types,
-    defaults) and passes each on by name, so the placed core is the one `mstrack synth` counts."""
-    _wrapper_passes_every_generic("ms_tracker_shared", "MAX_TARGETS", synth.SHARED_PINS_VHD, "ms_tracker_shared_pins")
+def test_multi_pins_wrapper_passes_every_shared_generic():
+    """rtl/wrappers/ms_tracker_multi_pins.vhd has, after ms_tracker_multi's generics, SHARED_ENGINE and
+    ms_tracker_shared's own (names, types, defaults), and passes every generic of ms_tracker_shared on by
+    name in its SHARED_ENGINE branch, so the placed shared core is the one `mstrack synth` counts."""
+    import re
+    multi = _vhdl_generics(synth.REPO_ROOT / "rtl" / "ms_tracker_multi.vhd", "ms_tracker_multi")
+    shared = _vhdl_generics(synth.REPO_ROOT / "rtl" / "ms_tracker_shared.vhd", "ms_tracker_shared")
+    own = [g for g in shared if g[0] not in {n for n, _ in multi}]
+    assert own and own[0][0] == "RD_LAT" and [g for g in shared if g not in own] == multi
+    wrapper = _vhdl_generics(synth.MULTI_PINS_VHD, "ms_tracker_multi_pins")
+    assert wrapper[:len(multi)] == multi and wrapper[len(multi)][0] == "SHARED_ENGINE"
+    assert wrapper[len(multi) + 1:] == own
+    body = synth.MULTI_PINS_VHD.read_text()
+    branch = body[body.index("g_shared : if SHARED_ENGINE generate"):]
+    assert all(re.search(rf"^\s+{n}\s+=> {n}\b", branch, re.M) for n, _ in shared)
 
 
 @pytest.mark.parametrize("n", [1, 2, 4, 5, 8, 16])
 def test_shared_colour_configs_are_the_simulated_core(n):
     """Configurations "shared<N>-colour": ms_tracker_shared with MAX_TARGETS N and the generics its test bench
     simulates it with (tb/test_ms_tracker_shared.py generics_of: the v2-colour engine, MAX_FRAME_W 2048, the
-    capacity rule at 1080p60), placed through ms_tracker_shared_pins; only when named with --config.  Every
-    generic is one of the entity's; the nextpnr pins are those of the replicated core's wrapper."""
+    capacity rule at 1080p60), placed through ms_tracker_multi_pins with SHARED_ENGINE; only when named with
+    --config.  Every generic is one of the entity's."""
     import argparse
 
     from mstrack.track.params import V2_COLOUR
     c = synth.CONFIGS[f"shared{n}-colour"]
     assert (c.top, c.core, c.max_targets) == ("ms_tracker_shared", "ms_tracker_v2", n) and c.v2 and c.placeable
-    assert c.pins_top == "ms_tracker_shared_pins" and c.pins_generics() == c.generics()
-    assert synth.pins_sources(c.pins_top)[-1] == synth.SHARED_PINS_VHD
+    assert c.pins_top == "ms_tracker_multi_pins" and c.pins_generics() == {**c.generics(), "SHARED_ENGINE": True}
+    assert synth.pins_sources(c.pins_top)[-1] == synth.MULTI_PINS_VHD
     assert "ms_tracker_shared.vhd" in {p.name for p in synth.sources(c.top)}
     g = c.generics()
     tb = _tb_generics_of({"slots": n, "max_frame_w": 2048, "timing": [1080, 1125, 2200], "tp": V2_COLOUR})
@@ -318,7 +335,6 @@ def test_shared_colour_configs_are_the_simulated_core(n):
     ap = argparse.ArgumentParser()
     synth.add_arguments(ap)
     assert ap.parse_args(["--config", c.name]).config == [c.name]
-    assert synth.wrapper_ports(synth.SHARED_PINS_VHD, g) == synth.wrapper_ports(synth.MULTI_PINS_VHD, g)
 
 
 def _tb_generics_of(job: dict) -> dict:

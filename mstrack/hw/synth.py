@@ -27,7 +27,7 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 16, only when
   named with ``--config``): ``ms_tracker_shared`` with MAX_TARGETS N slots around one ``v2-colour`` engine
   (generics from :func:`mstrack.hw.multi_core.shared_core_generics`: the 1080p60 timing of the capacity rule),
-  placed as ``rtl/wrappers/ms_tracker_shared_pins.vhd``.
+  placed as ``rtl/wrappers/ms_tracker_multi_pins.vhd`` with ``SHARED_ENGINE`` true.
 
 Cycle model (:func:`pass_cycles`, :func:`engine_cycles`, :func:`frame_latency`): the block
 latencies of docs/blocks/*.md and the controller states of rtl/ms_meanshift.vhd, checked
@@ -67,12 +67,10 @@ MULTI_PINS_TOP = "ms_tracker_multi_pins"
 MULTI_PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_multi_pins.vhd"
 #: the shared-engine multi-target core: MAX_TARGETS slots around one core v2 engine, its own pin wrapper
 TOP_SHARED = "ms_tracker_shared"
-SHARED_PINS_TOP = "ms_tracker_shared_pins"
-SHARED_PINS_VHD = REPO_ROOT / "rtl" / "wrappers" / "ms_tracker_shared_pins.vhd"
 #: the tops that take MAX_TARGETS, and the pin wrapper of each top (file by wrapper)
 MULTI_TOPS = (TOP_MULTI, TOP_SHARED)
-PINS_OF_TOP = {TOP_MULTI: MULTI_PINS_TOP, TOP_SHARED: SHARED_PINS_TOP}
-PINS_VHD_OF = {PINS_TOP: PINS_VHD, MULTI_PINS_TOP: MULTI_PINS_VHD, SHARED_PINS_TOP: SHARED_PINS_VHD}
+PINS_OF_TOP = {TOP_MULTI: MULTI_PINS_TOP, TOP_SHARED: MULTI_PINS_TOP}
+PINS_VHD_OF = {PINS_TOP: PINS_VHD, MULTI_PINS_TOP: MULTI_PINS_VHD}
 
 #: Device of the Fmax runs and the 1080p60 timing the core must keep up with.
 DEVICE, PACKAGE = "85k", "CABGA381"
@@ -114,7 +112,7 @@ class Config:
     ``MAX_TARGETS`` (``max_targets``) ahead of the generics of its ``core`` engine (core v2), and is
     placed through rtl/wrappers/ms_tracker_multi_pins.vhd; ``ms_tracker_shared`` takes them too, then the
     slot pool's and the capacity rule's (:func:`mstrack.hw.multi_core.shared_core_generics`, 1080p60), and
-    is placed through rtl/wrappers/ms_tracker_shared_pins.vhd."""
+    is placed through the same wrapper with ``SHARED_ENGINE`` true."""
 
     name: str
     note: str
@@ -145,7 +143,7 @@ class Config:
     @property
     def pins_top(self) -> str:
         """The pin wrapper nextpnr places for this core (one for both presets of ms_tracker, one for
-        ms_tracker_multi, one for ms_tracker_shared)."""
+        both multi-target cores)."""
         return PINS_OF_TOP.get(self.top, PINS_TOP)
 
     def params(self) -> tuple[TrackerParams, FixedParams]:
@@ -172,7 +170,9 @@ class Config:
 
     def pins_generics(self) -> dict[str, int]:
         """The generics of the pin wrapper (those of ms_tracker): :meth:`generics`, with PRESET 1 for core v2
-        (the multi-target cores' wrappers: their own generics)."""
+        (the multi-target cores' wrapper: the core's generics, ``SHARED_ENGINE`` true for ms_tracker_shared)."""
+        if self.top == TOP_SHARED:
+            return {**self.generics(), "SHARED_ENGINE": True}
         if self.top in MULTI_TOPS:
             return self.generics()
         return {"PRESET": 1, **self.generics()} if self.v2 else self.generics()
@@ -205,7 +205,7 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
              core=TOP_V2, top=TOP_MULTI, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 8, 10, 16)),
     *(Config(f"shared{n}-colour", f"ms_tracker_shared with MAX_TARGETS {n}: {n} slot{'s' * (n > 1)} around one "
                                   "v2-colour engine, the capacity rule at 1080p60 (placed through "
-                                  "rtl/wrappers/ms_tracker_shared_pins.vhd)"
+                                  "rtl/wrappers/ms_tracker_multi_pins.vhd, SHARED_ENGINE true)"
                                   + (": the base of the per-target figures" if n == 1 else
                                      ": the most slots the LFE5U-85F's 208 DP16KD take (32.4 per added slot "
                                      "from shared1-colour to shared8-colour: six would need about 210)"
@@ -274,8 +274,8 @@ def sources(top: str, extra: Sequence[Path] = ()) -> list[Path]:
 
 
 def pins_sources(top: str = PINS_TOP) -> list[Path]:
-    """The core + its pin wrapper *top*: rtl/wrappers/ms_tracker_pins.vhd (either preset),
-    ms_tracker_multi_pins.vhd or ms_tracker_shared_pins.vhd (the wrapper always from the working tree)."""
+    """The core + its pin wrapper *top*: rtl/wrappers/ms_tracker_pins.vhd (either preset) or
+    ms_tracker_multi_pins.vhd (both multi-target cores; the wrapper always from the working tree)."""
     return sources(top, extra=[PINS_VHD_OF[top]])
 
 

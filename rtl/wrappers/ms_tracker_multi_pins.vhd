@@ -1,4 +1,5 @@
--- ms_tracker_multi_pins: ms_tracker_multi with few pins, for place-and-route (Fmax) runs only.
+-- ms_tracker_multi_pins: a multi-target core with few pins, for place-and-route (Fmax) runs only:
+-- ms_tracker_multi, or with SHARED_ENGINE ms_tracker_shared (the two cores have the same ports).
 --
 -- Computes nothing of its own, as rtl/wrappers/ms_tracker_pins.vhd for the single-target core: the video
 -- stream ports stay as they are; frame_width, frame_height and the command come from a serial
@@ -8,17 +9,18 @@
 -- (RESULT_W + 4 bits: result word v2 and the id) is shifted out one bit per clock, LSB first, on
 -- res_dout while res_valid is high, with its tlast on res_last.  Every result bit stays observable, so
 -- synthesis removes nothing of the core.
--- Latency / throughput / handshake: those of ms_tracker_multi, plus RESULT_W + 4 clocks to shift a
+-- Latency / throughput / handshake: those of the core, plus RESULT_W + 4 clocks to shift a
 -- result word out (the core's word is taken when the shifter is empty; the core holds the next ones).
--- Generics: exactly those of ms_tracker_multi, passed through (the same names and defaults).
--- Flow: mstrack/hw/synth.py (configuration multi4-colour), docs/performance.md.
+-- Generics: exactly those of ms_tracker_multi, then SHARED_ENGINE and ms_tracker_shared's own (RD_LAT ..
+-- C_SCALE), passed through (the same names and defaults).
+-- Flow: mstrack/hw/synth.py (configurations multi<N>-colour, shared<N>-colour), docs/performance.md.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
 
 entity ms_tracker_multi_pins is
   generic (
-    MAX_TARGETS    : positive range 1 to 16 := 2;   -- target slots (engines)
+    MAX_TARGETS    : positive range 1 to 16 := 2;   -- target slots
     MAX_FRAME_W    : natural := 2048;     -- widest frame
     RGB_PACKING    : natural := 0;        -- s_axis_tdata layout (as ms_tracker)
     LANES          : natural := 4;        -- pixels per clock of a pixel pass
@@ -102,7 +104,28 @@ entity ms_tracker_multi_pins is
     -- default tracker v2's 64): -1 = off (colour bins alone: mstrack-v2-colour, bit for bit);
     -- >= 0: a pixel's bin is 9 colour + ms_orient_bin(grey, ORIENT_T) (4,608 bins: N_ORIENT 9 banks of
     -- the histogram, the bin pass, the model and T; a 4-bit orientation region RAM beside the colour one)
-    ORIENT_T        : integer range -1 to 2047 := 64
+    ORIENT_T        : integer range -1 to 2047 := 64;
+    SHARED_ENGINE   : boolean := false;   -- false ms_tracker_multi (an engine per slot), true ms_tracker_shared
+    -- SHARED_ENGINE only (ms_tracker_shared's own generics):
+    -- the slots (ms_slot_pool): RAM read latency (the pool's read port adds its multiplexer)
+    RD_LAT          : positive := 3;
+    -- the capacity rule (mstrack.fixed.multi_capacity.MultiCoreConfig: VideoTiming and PassCosts)
+    FRAME_LINES     : natural := 1125;    -- lines per frame, blanking included
+    ACTIVE_LINES    : natural := 1080;
+    LINE_CLOCKS     : natural := 2200;    -- clocks per line
+    LC_W            : positive := 13;     -- bits of LINE_CLOCKS
+    SUM_W           : positive := 28;     -- sums of clocks, slacks
+    CLK_W           : natural := 24;      -- a job's clocks
+    PLAN_REGION_W   : natural := 10;      -- ms_job_demand's region widths (mstrack.hw.multi_core.job_demand_generics)
+    GROW_Q16        : natural := 6554;
+    PASS_LAT        : natural := 10;
+    M_TRACK         : natural := 21;
+    C_TRACK         : natural := 13170;
+    M_LOST          : natural := 54;
+    C_LOST          : natural := 32375;
+    C_INIT          : natural := 3534;
+    SCALE_PERMILLE  : natural := 50;
+    C_SCALE         : natural := 2862
   );
   port (
     clk           : in  std_logic;                      -- core clock
@@ -111,10 +134,10 @@ entity ms_tracker_multi_pins is
     cfg_din       : in  std_logic;                      -- configuration bit in
     cmd_valid     : in  std_logic;                      -- command (from the chain) valid
     cmd_ready     : out std_logic;                      -- command taken
-    cmd_done      : out std_logic;                      -- an outcome (as ms_tracker_multi)
+    cmd_done      : out std_logic;                      -- an outcome (as the core)
     cmd_code      : out std_logic_vector(1 downto 0);
     cmd_id        : out std_logic_vector(3 downto 0);
-    s_axis_tdata  : in  std_logic_vector(23 downto 0);  -- video in (as ms_tracker_multi)
+    s_axis_tdata  : in  std_logic_vector(23 downto 0);  -- video in (as the core)
     s_axis_tvalid : in  std_logic;
     s_axis_tready : out std_logic;
     s_axis_tlast  : in  std_logic;
@@ -154,98 +177,211 @@ begin
     end if;
   end process;
 
-  u_core : entity work.ms_tracker_multi
-    generic map (
-      MAX_TARGETS     => MAX_TARGETS,
-      MAX_FRAME_W     => MAX_FRAME_W,
-      RGB_PACKING     => RGB_PACKING,
-      LANES           => LANES,
-      COLOUR_BITS     => COLOUR_BITS,
-      EDGE_BINS_LOG2  => EDGE_BINS_LOG2,
-      EDGE_SHIFT      => EDGE_SHIFT,
-      FEATURES        => FEATURES,
-      KERNEL_EPAN     => KERNEL_EPAN,
-      KERNEL_BITS     => KERNEL_BITS,
-      MAX_HALF        => MAX_HALF,
-      MARGIN          => MARGIN,
-      COORD_W         => COORD_W,
-      CF              => CF,
-      WI              => WI,
-      WF              => WF,
-      RF              => RF,
-      AF              => AF,
-      RHO_OUT_FRAC    => RHO_OUT_FRAC,
-      MAX_ITER        => MAX_ITER,
-      EPS2            => EPS2,
-      HALF_W          => HALF_W,
-      REGION_MAX      => REGION_MAX,
-      REGION_W        => REGION_W,
-      STRIDE          => STRIDE,
-      ADDR_W          => ADDR_W,
-      KVAL_W          => KVAL_W,
-      HIST_W          => HIST_W,
-      COUNT_W         => COUNT_W,
-      POSSUM_W        => POSSUM_W,
-      KD_W            => KD_W,
-      SQRT_IN_W       => SQRT_IN_W,
-      RHO_SUM_W       => RHO_SUM_W,
-      RATIO_Q_W       => RATIO_Q_W,
-      WEIGHT_W        => WEIGHT_W,
-      SW_W            => SW_W,
-      SWX_W           => SWX_W,
-      SHIFT_Q_W       => SHIFT_Q_W,
-      CENTRE_W        => CENTRE_W,
-      CENTRE_ABS_W    => CENTRE_ABS_W,
-      ITER_W          => ITER_W,
-      RHO_OUT_W       => RHO_OUT_W,
-      ALPHA_W         => ALPHA_W,
-      WIN_W           => WIN_W,
-      RESULT_W        => RESULT_W,
-      PAD16           => PAD16,
-      RING16          => RING16,
-      MAX_WINDOW      => MAX_WINDOW,
-      KT_W            => KT_W,
-      ST2_W           => ST2_W,
-      SHARE_W         => SHARE_W,
-      SPREAD_W        => SPREAD_W,
-      SIZE_W          => SIZE_W,
-      SCALE_W         => SCALE_W,
-      SCALE_GAIN      => SCALE_GAIN,
-      SCALE_REG       => SCALE_REG,
-      SCALE_STEP      => SCALE_STEP,
-      SCALE_RATIO_Q_W => SCALE_RATIO_Q_W,
-      WR_Q_W          => WR_Q_W,
-      CON_W           => CON_W,
-      LOSS_K          => LOSS_K,
-      REF_K           => REF_K,
-      LOSS_RHO        => LOSS_RHO,
-      LOSS_CONTRAST   => LOSS_CONTRAST,
-      CONF_LOST       => CONF_LOST,
-      CONF_UNCERTAIN  => CONF_UNCERTAIN,
-      CONF_REACQUIRE  => CONF_REACQUIRE,
-      SPREAD_DEFAULT  => SPREAD_DEFAULT,
-      BG_Q_W          => BG_Q_W,
-      BG_O_W          => BG_O_W,
-      SEARCH_ITER     => SEARCH_ITER,
-      STEP16          => STEP16,
-      MARGIN_MAX      => MARGIN_MAX,
-      SCALE_TEST_D256 => SCALE_TEST_D256,
-      ORIENT_T        => ORIENT_T
-    )
-    port map (
-      clk => clk, rst => rst,
-      frame_width  => unsigned(fld(cfg, 0, COORD_W)),
-      frame_height => unsigned(fld(cfg, 1, COORD_W)),
-      s_cmd_tvalid => cmd_valid, s_cmd_tready => cmd_ready,
-      s_cmd_op => cfg(6 * F_W), s_cmd_id => unsigned(cfg(6 * F_W + 4 downto 6 * F_W + 1)),
-      s_cmd_x => signed(fld(cfg, 2, COORD_W + 2)), s_cmd_y => signed(fld(cfg, 3, COORD_W + 2)),
-      s_cmd_w => unsigned(fld(cfg, 4, COORD_W + 1)), s_cmd_h => unsigned(fld(cfg, 5, COORD_W + 1)),
-      cmd_done => cmd_done, cmd_code => code, cmd_id => id,
-      s_axis_tdata => s_axis_tdata, s_axis_tvalid => s_axis_tvalid, s_axis_tready => s_axis_tready,
-      s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
-      m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
-      m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
-      live => live, busy => busy);
+  g_multi : if not SHARED_ENGINE generate
+    u_core : entity work.ms_tracker_multi
+      generic map (
+        MAX_TARGETS     => MAX_TARGETS,
+        MAX_FRAME_W     => MAX_FRAME_W,
+        RGB_PACKING     => RGB_PACKING,
+        LANES           => LANES,
+        COLOUR_BITS     => COLOUR_BITS,
+        EDGE_BINS_LOG2  => EDGE_BINS_LOG2,
+        EDGE_SHIFT      => EDGE_SHIFT,
+        FEATURES        => FEATURES,
+        KERNEL_EPAN     => KERNEL_EPAN,
+        KERNEL_BITS     => KERNEL_BITS,
+        MAX_HALF        => MAX_HALF,
+        MARGIN          => MARGIN,
+        COORD_W         => COORD_W,
+        CF              => CF,
+        WI              => WI,
+        WF              => WF,
+        RF              => RF,
+        AF              => AF,
+        RHO_OUT_FRAC    => RHO_OUT_FRAC,
+        MAX_ITER        => MAX_ITER,
+        EPS2            => EPS2,
+        HALF_W          => HALF_W,
+        REGION_MAX      => REGION_MAX,
+        REGION_W        => REGION_W,
+        STRIDE          => STRIDE,
+        ADDR_W          => ADDR_W,
+        KVAL_W          => KVAL_W,
+        HIST_W          => HIST_W,
+        COUNT_W         => COUNT_W,
+        POSSUM_W        => POSSUM_W,
+        KD_W            => KD_W,
+        SQRT_IN_W       => SQRT_IN_W,
+        RHO_SUM_W       => RHO_SUM_W,
+        RATIO_Q_W       => RATIO_Q_W,
+        WEIGHT_W        => WEIGHT_W,
+        SW_W            => SW_W,
+        SWX_W           => SWX_W,
+        SHIFT_Q_W       => SHIFT_Q_W,
+        CENTRE_W        => CENTRE_W,
+        CENTRE_ABS_W    => CENTRE_ABS_W,
+        ITER_W          => ITER_W,
+        RHO_OUT_W       => RHO_OUT_W,
+        ALPHA_W         => ALPHA_W,
+        WIN_W           => WIN_W,
+        RESULT_W        => RESULT_W,
+        PAD16           => PAD16,
+        RING16          => RING16,
+        MAX_WINDOW      => MAX_WINDOW,
+        KT_W            => KT_W,
+        ST2_W           => ST2_W,
+        SHARE_W         => SHARE_W,
+        SPREAD_W        => SPREAD_W,
+        SIZE_W          => SIZE_W,
+        SCALE_W         => SCALE_W,
+        SCALE_GAIN      => SCALE_GAIN,
+        SCALE_REG       => SCALE_REG,
+        SCALE_STEP      => SCALE_STEP,
+        SCALE_RATIO_Q_W => SCALE_RATIO_Q_W,
+        WR_Q_W          => WR_Q_W,
+        CON_W           => CON_W,
+        LOSS_K          => LOSS_K,
+        REF_K           => REF_K,
+        LOSS_RHO        => LOSS_RHO,
+        LOSS_CONTRAST   => LOSS_CONTRAST,
+        CONF_LOST       => CONF_LOST,
+        CONF_UNCERTAIN  => CONF_UNCERTAIN,
+        CONF_REACQUIRE  => CONF_REACQUIRE,
+        SPREAD_DEFAULT  => SPREAD_DEFAULT,
+        BG_Q_W          => BG_Q_W,
+        BG_O_W          => BG_O_W,
+        SEARCH_ITER     => SEARCH_ITER,
+        STEP16          => STEP16,
+        MARGIN_MAX      => MARGIN_MAX,
+        SCALE_TEST_D256 => SCALE_TEST_D256,
+        ORIENT_T        => ORIENT_T
+      )
+      port map (
+        clk => clk, rst => rst,
+        frame_width  => unsigned(fld(cfg, 0, COORD_W)),
+        frame_height => unsigned(fld(cfg, 1, COORD_W)),
+        s_cmd_tvalid => cmd_valid, s_cmd_tready => cmd_ready,
+        s_cmd_op => cfg(6 * F_W), s_cmd_id => unsigned(cfg(6 * F_W + 4 downto 6 * F_W + 1)),
+        s_cmd_x => signed(fld(cfg, 2, COORD_W + 2)), s_cmd_y => signed(fld(cfg, 3, COORD_W + 2)),
+        s_cmd_w => unsigned(fld(cfg, 4, COORD_W + 1)), s_cmd_h => unsigned(fld(cfg, 5, COORD_W + 1)),
+        cmd_done => cmd_done, cmd_code => code, cmd_id => id,
+        s_axis_tdata => s_axis_tdata, s_axis_tvalid => s_axis_tvalid, s_axis_tready => s_axis_tready,
+        s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+        m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+        m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
+        live => live, busy => busy);
+  end generate;
+  g_shared : if SHARED_ENGINE generate
+    u_core : entity work.ms_tracker_shared
+      generic map (
+        MAX_TARGETS     => MAX_TARGETS,
+        MAX_FRAME_W     => MAX_FRAME_W,
+        RGB_PACKING     => RGB_PACKING,
+        LANES           => LANES,
+        COLOUR_BITS     => COLOUR_BITS,
+        EDGE_BINS_LOG2  => EDGE_BINS_LOG2,
+        EDGE_SHIFT      => EDGE_SHIFT,
+        FEATURES        => FEATURES,
+        KERNEL_EPAN     => KERNEL_EPAN,
+        KERNEL_BITS     => KERNEL_BITS,
+        MAX_HALF        => MAX_HALF,
+        MARGIN          => MARGIN,
+        COORD_W         => COORD_W,
+        CF              => CF,
+        WI              => WI,
+        WF              => WF,
+        RF              => RF,
+        AF              => AF,
+        RHO_OUT_FRAC    => RHO_OUT_FRAC,
+        MAX_ITER        => MAX_ITER,
+        EPS2            => EPS2,
+        HALF_W          => HALF_W,
+        REGION_MAX      => REGION_MAX,
+        REGION_W        => REGION_W,
+        STRIDE          => STRIDE,
+        ADDR_W          => ADDR_W,
+        KVAL_W          => KVAL_W,
+        HIST_W          => HIST_W,
+        COUNT_W         => COUNT_W,
+        POSSUM_W        => POSSUM_W,
+        KD_W            => KD_W,
+        SQRT_IN_W       => SQRT_IN_W,
+        RHO_SUM_W       => RHO_SUM_W,
+        RATIO_Q_W       => RATIO_Q_W,
+        WEIGHT_W        => WEIGHT_W,
+        SW_W            => SW_W,
+        SWX_W           => SWX_W,
+        SHIFT_Q_W       => SHIFT_Q_W,
+        CENTRE_W        => CENTRE_W,
+        CENTRE_ABS_W    => CENTRE_ABS_W,
+        ITER_W          => ITER_W,
+        RHO_OUT_W       => RHO_OUT_W,
+        ALPHA_W         => ALPHA_W,
+        WIN_W           => WIN_W,
+        RESULT_W        => RESULT_W,
+        PAD16           => PAD16,
+        RING16          => RING16,
+        MAX_WINDOW      => MAX_WINDOW,
+        KT_W            => KT_W,
+        ST2_W           => ST2_W,
+        SHARE_W         => SHARE_W,
+        SPREAD_W        => SPREAD_W,
+        SIZE_W          => SIZE_W,
+        SCALE_W         => SCALE_W,
+        SCALE_GAIN      => SCALE_GAIN,
+        SCALE_REG       => SCALE_REG,
+        SCALE_STEP      => SCALE_STEP,
+        SCALE_RATIO_Q_W => SCALE_RATIO_Q_W,
+        WR_Q_W          => WR_Q_W,
+        CON_W           => CON_W,
+        LOSS_K          => LOSS_K,
+        REF_K           => REF_K,
+        LOSS_RHO        => LOSS_RHO,
+        LOSS_CONTRAST   => LOSS_CONTRAST,
+        CONF_LOST       => CONF_LOST,
+        CONF_UNCERTAIN  => CONF_UNCERTAIN,
+        CONF_REACQUIRE  => CONF_REACQUIRE,
+        SPREAD_DEFAULT  => SPREAD_DEFAULT,
+        BG_Q_W          => BG_Q_W,
+        BG_O_W          => BG_O_W,
+        SEARCH_ITER     => SEARCH_ITER,
+        STEP16          => STEP16,
+        MARGIN_MAX      => MARGIN_MAX,
+        SCALE_TEST_D256 => SCALE_TEST_D256,
+        ORIENT_T        => ORIENT_T,
+        RD_LAT          => RD_LAT,
+        FRAME_LINES     => FRAME_LINES,
+        ACTIVE_LINES    => ACTIVE_LINES,
+        LINE_CLOCKS     => LINE_CLOCKS,
+        LC_W            => LC_W,
+        SUM_W           => SUM_W,
+        CLK_W           => CLK_W,
+        PLAN_REGION_W   => PLAN_REGION_W,
+        GROW_Q16        => GROW_Q16,
+        PASS_LAT        => PASS_LAT,
+        M_TRACK         => M_TRACK,
+        C_TRACK         => C_TRACK,
+        M_LOST          => M_LOST,
+        C_LOST          => C_LOST,
+        C_INIT          => C_INIT,
+        SCALE_PERMILLE  => SCALE_PERMILLE,
+        C_SCALE         => C_SCALE
+      )
+      port map (
+        clk => clk, rst => rst,
+        frame_width  => unsigned(fld(cfg, 0, COORD_W)),
+        frame_height => unsigned(fld(cfg, 1, COORD_W)),
+        s_cmd_tvalid => cmd_valid, s_cmd_tready => cmd_ready,
+        s_cmd_op => cfg(6 * F_W), s_cmd_id => unsigned(cfg(6 * F_W + 4 downto 6 * F_W + 1)),
+        s_cmd_x => signed(fld(cfg, 2, COORD_W + 2)), s_cmd_y => signed(fld(cfg, 3, COORD_W + 2)),
+        s_cmd_w => unsigned(fld(cfg, 4, COORD_W + 1)), s_cmd_h => unsigned(fld(cfg, 5, COORD_W + 1)),
+        cmd_done => cmd_done, cmd_code => code, cmd_id => id,
+        s_axis_tdata => s_axis_tdata, s_axis_tvalid => s_axis_tvalid, s_axis_tready => s_axis_tready,
+        s_axis_tlast => s_axis_tlast, s_axis_tuser => s_axis_tuser,
+        m_axis_result_tdata => r_data, m_axis_result_tvalid => r_valid,
+        m_axis_result_tready => r_ready, m_axis_result_tlast => r_last,
+        live => live, busy => busy);
+  end generate;
   cmd_code <= std_logic_vector(code);
   cmd_id <= std_logic_vector(id);
 

@@ -12,7 +12,7 @@ ARGS    ?=
 export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
 unexport PYTHONDONTWRITEBYTECODE
 
-.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-multi-mot test-shared-mot test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
+.PHONY: regs setup demo typecheck test test-fuzz test-fuzz-v2 test-fuzz-multi test-fuzz-shared test-multi-mot test-shared-mot test-sim test-synth test-long test-extra test-sim-only test-synth-only test-latest lock eval results clean synth hdl-files
 
 setup:
 	bash tools/setup.sh
@@ -91,6 +91,14 @@ test-multi-mot: setup
 # sequences, its GHDL netlist under Verilator (part of test-extra; about 15 minutes with the build)
 test-shared-mot: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider tb/test_ms_tracker_shared.py -k mot_sequence $(ARGS)
+
+# The constrained-random test of the shared-engine core (tb/test_ms_tracker_shared.py::test_shared_fuzz:
+# commands, stream faults, result back-pressure, line gaps, the capacity rule at a short frame period;
+# its netlist under Verilator; CI runs seeds 1..10); replay a failing seed with
+# `make test-fuzz-shared SEEDS=<seed> N=1`.
+test-fuzz-shared: setup
+	MSTRACK_FUZZ=$(SEEDS):$(N) MSTRACK_REQUIRE_TOOLS=1 \
+	  $(PY) -m pytest -q -s -p no:cacheprovider tb/test_ms_tracker_shared.py -k test_shared_fuzz $(ARGS)
 
 # The constrained-random test of the multi-target core (tb/test_ms_tracker_multi.py::test_multi_fuzz:
 # commands, stream faults, result back-pressure; Verilator; CI runs seeds 1..10); replay a failing seed

@@ -338,3 +338,68 @@ def test_shared_held_decimated():
     m, run = run_netlist(frames, cmds, job, out_pause_pct=20)
     held = [w for f in m.frames for w in f if w["err_code"] == 6]
     assert len(held) >= 4 and all(w["decim_log2"] >= 1 for w in held), held
+
+
+#: the fuzz's core: SCENE_JOB's three slots and colour bins, with CAPACITY_JOB's frame period (90 lines of
+#: 1,000 clocks), so the rule holds targets and refuses adds on many frames
+FUZZ_JOB = {"slots": 3, "max_frame_w": 128, "timing": [80, 90, 1000], "tp": V2_COLOUR}
+#: the seeds `make test` runs (MSTRACK_FUZZ's default): (first, count)
+CI_FUZZ_SEEDS = (1, 10)
+
+
+def fuzz_case(seed: int) -> tuple:
+    """Seed -> (frames, commands, faults, result back-pressure %, hblank): the multi-target core's fuzz case
+    (tb/test_ms_tracker_multi.py fuzz_case: a generated 4-target scene of 8 frames, adds, removes of any id,
+    boxes off the frame, short lines and cuts) and, from the same seed, 0 or 400 idle clocks after each
+    line (so jobs run while their frame streams)."""
+    from test_ms_tracker_multi import fuzz_case as multi_case
+    frames, cmds, faults, pause = multi_case(seed)
+    return frames, cmds, faults, pause, random.Random(seed * 7919).choice((0, 0, 400))
+
+
+def test_shared_fuzz_ci_seeds_cover_every_kind():
+    """The fuzz seeds of `make test` together have every report code (taken, refused on a full core or a
+    remove not live, refused by the capacity rule, a box the engine rejects), held targets, both fault kinds,
+    result back-pressure and line gaps (the model's outcomes; no simulation)."""
+    from mstrack.hw.cosim_multi import CMD_BOX, CMD_CYCLES, CMD_OK, CMD_REFUSED
+    codes: set[int] = set()
+    held = 0
+    kinds: set[str] = set()
+    pauses, gaps = set(), set()
+    for seed in range(CI_FUZZ_SEEDS[0], sum(CI_FUZZ_SEEDS)):
+        frames, cmds, faults, pause, hblank = fuzz_case(seed)
+        tp, fp, cap = params_of(FUZZ_JOB)
+        m = expected_multi(frames, cmds, tp, fp, FUZZ_JOB["slots"], FUZZ_JOB["max_frame_w"], faults, capacity=cap)
+        codes |= {o.code for o in m.outcomes}
+        held += sum(w["err_code"] == 6 for f in m.frames for w in f)
+        kinds |= set(faults.values())
+        pauses.add(pause)
+        gaps.add(hblank)
+    assert {CMD_OK, CMD_REFUSED, CMD_CYCLES, CMD_BOX} <= codes, codes
+    assert held >= 10 and kinds == {"short_line", "cut"} and max(pauses) > 0 and gaps == {0, 400}
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_shared_fuzz():
+    """Constrained-random commands, faults, back-pressure and line gaps (fuzz_case) on the netlist, seeds
+    MSTRACK_FUZZ=first:count (default CI_FUZZ_SEEDS, 1:10 in make test; `make test-fuzz-shared` runs 200):
+    every word, tlast and report bit-exact with the model with the capacity rule."""
+    import os
+    first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "%d:%d" % CI_FUZZ_SEEDS).split(":"))
+    stats = {"words": 0, "held": 0, "commands": 0, "faults": 0, "refused": 0, "cycles": 0, "box": 0}
+    for seed in range(first, first + count):
+        frames, cmds, faults, pause, hblank = fuzz_case(seed)
+        try:
+            m, _ = run_netlist(frames, cmds, FUZZ_JOB, faults=faults, out_pause_pct=pause, hblank=hblank)
+        except AssertionError as exc:
+            raise AssertionError(f"seed {seed} (replay: make test-fuzz-shared SEEDS={seed} N=1): {exc}") from exc
+        stats["words"] += len(m.results)
+        stats["held"] += sum(w["err_code"] == 6 for f in m.frames for w in f)
+        stats["commands"] += sum(len(v) for v in cmds.values())
+        stats["faults"] += len(faults)
+        stats["refused"] += sum(o.code == 1 for o in m.outcomes)
+        stats["cycles"] += sum(o.code == 2 for o in m.outcomes)
+        stats["box"] += sum(o.code == 3 for o in m.outcomes)
+    print(f"\nshared fuzz seeds {first}..{first + count - 1}: {stats}")
+

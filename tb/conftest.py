@@ -82,7 +82,7 @@ CI_EXTRA: dict[str, str] = {
         "size change); this case checks the netlist under Verilator on real frames, lost state included "
         "(its own build)",
     "tb/test_mstrack_drv.py::test_driver_against_paper_core":
-        "test_driver_against_core_v2 (the same driver, harness and AXI4-Lite wrapper, PRESET 1) and "
+        "test_driver_against_shared_core (the same driver, harness and AXI4-Lite wrapper, PRESET 1) and "
         "tests/test_sw_driver.py (the driver's decoding of result word v1 against Python's, value by value); "
         "this case: the PRESET 0 netlist of the wrapper under the driver (its own Verilator build)",
     "tb/test_ms_tracker_multi.py::test_multi_one_slot_is_core_v2":
@@ -90,10 +90,20 @@ CI_EXTRA: dict[str, str] = {
         "faults included) and the 3-slot netlist's tests, whose engines are ms_tracker_v2; this case: the "
         "MAX_TARGETS 1 netlist (its own Verilator build) against core v2's words on 30 Girl frames",
     "tb/test_ms_tracker_multi.py::test_multi_real_people":
-        "tb/test_mstrack_drv.py::test_driver_against_multi_target_core (the same engines behind ms_tracker_axi on "
-        "12 TUD-Stadtmitte frames: people added, removed and added in a freed slot, every word of every target "
-        "bit-exact) and test_multi_generated_scene / test_multi_fuzz (the core's own ports); this case: 16 TUD "
-        "frames, 3 slots",
+        "test_multi_fuzz (the same netlist on generated scenes: adds, removes, refusals, faults) and "
+        "tb/test_mstrack_drv.py::test_driver_against_shared_core / tb/test_ms_tracker_shared.py::"
+        "test_shared_w63_real_people (TUD-Stadtmitte frames through the colour engine behind the same ports: "
+        "people added, removed and added in a freed slot, every word of every target bit-exact); this case: 16 "
+        "TUD frames, 3 slots of the replicated-engine core",
+    "tb/test_mstrack_drv.py::test_driver_against_multi_target_core":
+        "test_driver_against_shared_core (the same driver, harness and ms_tracker_axi around the shared-engine "
+        "core, whose registers and result banks are the same code: TUD-Stadtmitte, refused adds, a rejected box, "
+        "a slow result sink) and tb/test_ms_tracker_multi.py::test_multi_fuzz (the replicated-engine core's "
+        "netlist); this case: the replicated-engine core behind the driver (its own build)",
+    "tb/test_ms_tracker_shared.py::test_ms_tracker_shared_capacity":
+        "test_shared_fuzz (marker long: the same core, the same frame period of 90 lines of 1,000 clocks, held "
+        "targets and adds refused by the rule on every CI seed, its netlist bit-exact with the model); this case: "
+        "the RTL under GHDL on the generated scene",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Girl]":
         "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 500 frames at 128 x 96 (D = 1)",
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[Subway]":
@@ -107,8 +117,8 @@ CI_EXTRA: dict[str, str] = {
     "tb/test_ms_tracker_v2.py::test_tracker_v2_fastsim_long[ball1_vot]":
         "test_tracker_v2_fastsim_long[Couple] and [Crossing] (the same build, the default joint core, bit-exact: losses and re-acquisitions, input gaps and result back-pressure, D = 4); this case: 105 frames",
     "tb/test_mstrack_drv.py::test_driver_against_core_v2":
-        "tb/test_mstrack_drv.py::test_driver_against_multi_target_core (the same driver through the AXI4-Lite bus of "
-        "ms_tracker_axi, core v2 engines, 1080p60 blanking, every word bit-exact), tb/test_ms_tracker_axi.py::"
+        "tb/test_mstrack_drv.py::test_driver_against_shared_core (the same driver through the AXI4-Lite bus of "
+        "ms_tracker_axi, a core v2 engine, every word bit-exact), tb/test_ms_tracker_axi.py::"
         "test_axi_v2_synthetic (the PRESET 1 wrapper: registers, interrupts, counters, every result) and "
         "tests/test_sw_driver.py (the v2 decode and handler on the host); this case: 30 Deer frames, its own build",
     "tb/test_ms_bin_pass.py::test_ms_bin_pass_orient_ghdl[epan_colour_lat4_orient9]":

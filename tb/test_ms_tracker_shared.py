@@ -40,7 +40,7 @@ def params_of(job: dict) -> tuple[TrackerParams, FixedParams, MultiCoreConfig]:
     tp = TrackerParams(**{"preset": "v2", **job.get("tp", {})})
     t = job["timing"]
     cap = MultiCoreConfig(max_targets=job["slots"], timing=VideoTiming(t[0], t[1], t[2]))
-    return tp, FixedParams(), cap
+    return tp, FixedParams(**job.get("fp", {})), cap
 
 
 def scene_of(job: dict):
@@ -309,6 +309,32 @@ def test_shared_mot_sequence(name):
     m, run = run_netlist(frames, cmds, job, out_pause_pct=10)
     adds = sum(op == "add" for c in cmds.values() for op, _ in c)
     assert adds == len(seq.tracks) and len(m.results) >= len(frames)
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_shared_w63_real_people():
+    """The configuration that fits eight targets on the LFE5U-85F (`mstrack synth --config shared8-colour-w63`:
+    max_window 63, MAX_HALF 31 and COORD_W 11, so a slot is 160 x 160 px): TUD-Stadtmitte (640 x 480), 12 frames, four slots and people
+    61 to 76 px wide and 200 to 250 px tall, so every window is decimated (D = 4 or 8); three people added
+    before frame 0, a fourth before frame 4, the second removed before frame 8 and another person added in
+    its slot; the capacity rule at 1080p60; 20 % result back-pressure.  Every word and report bit-exact."""
+    from mstrack.fixed.blocks import round_box
+    from mstrack.io.mot import load_mot_sequence
+    if not (MULTI / "TUD-Stadtmitte").is_dir():
+        pytest.skip(f"{MULTI / 'TUD-Stadtmitte'} not found: the real multi-target runs need ../shared/data/multi")
+    seq = load_mot_sequence(MULTI / "TUD-Stadtmitte")
+    frames = [seq.frame(i) for i in range(12)]
+
+    def box(f, pid):
+        return round_box(*seq.boxes_at(f)[pid].as_tuple())
+    cmds = {0: [("add", box(0, 1)), ("add", box(0, 4)), ("add", box(0, 7))], 4: [("add", box(4, 2))],
+            8: [("remove", 1), ("add", box(8, 8))]}
+    job = {"slots": 4, "max_frame_w": 1024, "timing": [1080, 1125, 2200], "tp": {**V2_COLOUR, "max_window": 63},
+           "fp": {"max_half": 31, "coord_bits": 11}}
+    m, run = run_netlist(frames, cmds, job, out_pause_pct=20)
+    assert [len(f) for f in m.frames] == [3] * 4 + [4] * 8
+    assert {w["decim_log2"] for f in m.frames for w in f} >= {2, 3}
 
 
 @pytest.mark.long

@@ -337,6 +337,23 @@ def test_shared_colour_configs_are_the_simulated_core(n):
     assert ap.parse_args(["--config", c.name]).config == [c.name]
 
 
+@pytest.mark.parametrize("n", [1, 8, 10, 14])
+def test_shared_w63_configs_are_the_simulated_core(n):
+    """Configurations "shared<N>-colour-w63": ms_tracker_shared with the generics tb/test_ms_tracker_shared.py's
+    generics_of gives tracker v2-colour with max_window 63, MAX_HALF 31 and COORD_W 11 (test_shared_w63_real_people
+    runs them on real frames at MAX_FRAME_W 1024), MAX_FRAME_W 1920: a slot of 160 rows of 40 words, the
+    rule at 1080p60."""
+    from mstrack.track.params import V2_COLOUR
+    c = synth.CONFIGS[f"shared{n}-colour-w63"]
+    assert (c.top, c.max_targets, c.max_frame_w) == ("ms_tracker_shared", n, 1920) and c.placeable
+    g = c.generics()
+    tb = _tb_generics_of({"slots": n, "max_frame_w": 1920, "timing": [1080, 1125, 2200],
+                          "tp": {**V2_COLOUR, "max_window": 63}, "fp": {"max_half": 31, "coord_bits": 11}})
+    assert g == tb
+    assert (g["MAX_WINDOW"], g["MAX_HALF"], g["COORD_W"], g["REGION_MAX"], g["STRIDE"]) == (63, 31, 11, 160, 40)
+    assert c.name not in synth.DEFAULT_CONFIGS
+
+
 def _tb_generics_of(job: dict) -> dict:
     """tb/test_ms_tracker_shared.py's generics_of, read from its source (the bench imports cocotb)."""
     import ast

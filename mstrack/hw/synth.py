@@ -24,8 +24,9 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * the multi-target core (configurations ``multi<N>-colour``, N = 1, 3, 4, 8, 10, 16, only when named
   with ``--config``): ``ms_tracker_multi`` with MAX_TARGETS N engines of ``v2-colour``, placed as
   ``rtl/wrappers/ms_tracker_multi_pins.vhd`` (ECP5; the Nexus PDC has the single-target wrapper's pins).
-* the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 16, only when
-  named with ``--config``): ``ms_tracker_shared`` with MAX_TARGETS N slots around one ``v2-colour`` engine
+* the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 16, and
+  ``shared<N>-colour-w63``, max_window 63, N = 1, 8, 10, 14, only when named with ``--config``):
+  ``ms_tracker_shared`` with MAX_TARGETS N slots around one ``v2-colour`` engine
   (generics from :func:`mstrack.hw.multi_core.shared_core_generics`: the 1080p60 timing of the capacity rule),
   placed as ``rtl/wrappers/ms_tracker_multi_pins.vhd`` with ``SHARED_ENGINE`` true.
 
@@ -211,6 +212,16 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
                                      "from shared1-colour to shared8-colour: six would need about 210)"
                                      if n == 5 else ""),
              core=TOP_V2, top=TOP_SHARED, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 2, 4, 5, 8, 16)),
+    *(Config(f"shared{n}-colour-w63", f"shared{n}-colour with max_window 63 (tracker parameter), MAX_HALF 31, "
+                                      "COORD_W 11 and MAX_FRAME_W 1920 (frames up to 1920 x 2047): a slot of 160 x "
+                                      "160 px, larger targets decimated sooner"
+                                      + (": the base of the per-target figures" if n == 1 else
+                                         ": eight targets on the LFE5U-85F" if n == 8 else
+                                         ": the size of AMD Vitis Vision MeanShift's 10-object kernel" if n == 10 else
+                                         ": the most slots the cost model fits in the LFE5U-85F"),
+             core=TOP_V2, top=TOP_SHARED, max_targets=n, tp={**V2_COLOUR, "max_window": 63},
+             fp={"max_half": 31, "coord_bits": 11}, max_frame_w=1920)
+      for n in (1, 8, 10, 14)),
 )}
 #: the configurations of a plain `mstrack synth` (the multi-target core only when named with --config)
 DEFAULT_CONFIGS = tuple(n for n, c in CONFIGS.items() if c.top not in MULTI_TOPS)

@@ -272,6 +272,59 @@ def test_realtime_multi_1080p60():
     assert not any(stalls) and not misses, f"stalls {stalls}; latencies {lat}:\n" + "\n".join(misses)
 
 
+#: the shared-engine core at 1080p60: SHARED_RT_N slots, the boxes of test_realtime_multi_1080p60 (the rider,
+#: then boxes whose window is the largest), the capacity rule at 1080p60.  MSTRACK_RT_SHARED_N changes N.
+SHARED_RT_N = int(os.environ.get("MSTRACK_RT_SHARED_N", "8"))
+#: the configurations: mstrack synth's shared<N>-colour (max_window 127) and shared<N>-colour-w63
+SHARED_RT_CONFIGS = {"colour": ({}, {}, 2048), "colour-w63": ({"max_window": 63}, {"max_half": 31, "coord_bits": 11}, 1920)}
+
+
+@pytest.mark.extra
+@pytest.mark.verilator
+@pytest.mark.parametrize("config", sorted(SHARED_RT_CONFIGS))
+def test_realtime_shared_1080p60(config):
+    """ms_tracker_shared with SHARED_RT_N (8) slots, one colour engine, at 1080p60 timing on MotorRolling
+    upscaled, every slot given a target at the largest window before the first frame: every word
+    bit-exact with CoreModelMulti with the capacity rule at 1080p60 (the held targets too), and the
+    measure of real time: input stalls and each frame's last word against the next frame's first pixel.
+    Today's schedule closes the input at a start of frame until the previous frame's last job has ended;
+    the capacity rule admits jobs that run into the next frame's raster (its raster slack), so the
+    input can stall: this run measures by how much (reported, docs/blocks/ms_tracker_shared.md), and fails
+    only on a word that differs.  `make test-extra`."""
+    from mstrack.fixed.multi_capacity import MultiCoreConfig, VideoTiming
+    from mstrack.hw.cosim_multi import diff_words, expected_multi
+    from mstrack.hw.multi_core import pass_costs, shared_core_generics
+    from mstrack.hw.cosim import CoreConfigV2
+    from mstrack.track.params import V2_COLOUR
+    tpk, fpk, max_w = SHARED_RT_CONFIGS[config]
+    frames, rider = _motor_rolling_hd(MULTI_RT_FRAMES, "the shared-engine real-time check")
+    boxes = multi_rt_boxes(rider, SHARED_RT_N)  # type: ignore[arg-type]
+    cmds = {0: [("add", b) for b in boxes]}
+    tp, fp = TrackerParams(preset="v2", **V2_COLOUR, **tpk), FixedParams(**fpk)
+    cap = MultiCoreConfig(SHARED_RT_N, VideoTiming(), pass_costs(DEFAULT_LANES))
+    m = expected_multi(frames, cmds, tp, fp, SHARED_RT_N, max_w, capacity=cap)
+    core = CoreConfigV2(tp, fp, DEFAULT_LANES, max_w).generics()
+    extra = {k: v for k, v in shared_core_generics(tp, fp, SHARED_RT_N, VideoTiming(), max_w, costs=cap.costs).items()
+             if k not in core and k != "MAX_TARGETS"}
+    run = fastsim.simulate_multi(frames, cmds, tp, fp, max_targets=SHARED_RT_N, lanes=DEFAULT_LANES,
+                                 max_frame_w=max_w, hblank=HBLANK, vblank=VBLANK, lead=VBLANK,
+                                 words=len(m.results), top="ms_tracker_shared", extra_generics=extra,
+                                 watchdog=20_000_000)
+    mism = diff_words(run.words, m.frames)
+    lat, misses = multi_frame_times(run, BUDGET)
+    stalls = [f["stall_cycles"] for f in run.frames]
+    held = [sum(w["err_code"] == 6 for w in fr) for fr in m.frames]
+    _report(f"realtime_shared{SHARED_RT_N}_{config}_1080p60", {
+        "source": f"MotorRolling {V2_RT_START}-{V2_RT_START + MULTI_RT_FRAMES - 1} x3", "slots": SHARED_RT_N,
+        "config": config, "frames": len(frames), "boxes": [list(b) for b in boxes], "budget_clocks": BUDGET,
+        "held_per_frame": held, "refused": [o.target_id for o in m.outcomes if o.code == 2],
+        "latency_clocks": lat, "worst_latency_clocks": max(lat) if lat else None, "stall_cycles": stalls,
+        "cycles": run.cycles, "seconds": round(run.seconds, 2), "build_seconds": round(run.build_seconds, 1),
+        "mismatches": mism[:20], "realtime_misses": misses})
+    assert not mism, "DUT differs from the model:\n" + "\n".join(mism[:10])
+    assert len(run.frames) == len(frames)
+
+
 def _lanes_720p60() -> list:
     lanes = [int(v) for v in os.environ.get("MSTRACK_RT720_LANES", str(DEFAULT_LANES)).split(",")]
     miss = pytest.mark.xfail(

@@ -3,11 +3,14 @@
 -- ms_tracker_multi.  Executable specification: mstrack.hw.cosim_multi.CoreModelMulti with the capacity
 -- rule (capacity = MultiCoreConfig(MAX_TARGETS, VideoTiming(ACTIVE_LINES, FRAME_LINES, LINE_CLOCKS))).
 --
--- Schedule (this version): at a frame's start of frame the input waits while the frame is planned:
--- the live targets, oldest first, by ms_frame_plan (each tracked or held), then the init pending after
--- a fault and the adds taken since the last frame (the engine's init geometry, the init job's clocks
--- from ms_job_clocks, check_add in ms_frame_plan: taken, or refused with CMD_CYCLES); each target with a
--- job has its slot's capture loaded (the region, or the init rectangle).  The frame then streams in,
+-- Schedule (this version): the live targets are planned, oldest first, by ms_frame_plan (each tracked
+-- or held) as soon as the previous frame is closed, in the blanking, with the frame size of the ports
+-- then; a remove, a stream fault's words or another frame size at the start of frame plan them again
+-- when the start of frame comes, and the input waits for it.  At the start of frame the init pending
+-- after a fault and the adds taken since the last frame are checked while the input waits (the
+-- engine's init geometry, the init job's clocks from ms_job_clocks, check_add in ms_frame_plan: taken,
+-- or refused with CMD_CYCLES); a frame without them goes in at once.  Each target with a job has its
+-- slot's capture loaded (the region, or the init rectangle).  The frame then streams in,
 -- every slot capturing its own region, and the jobs run as their slots are released (ms_job_queue, in
 -- release order; an init: ms_init_job learns the model from the slot first).  A job's word goes to
 -- ms_result_order, its new state waits beside the committed one.  When the frame has ended and its
@@ -229,6 +232,12 @@ architecture rtl of ms_tracker_shared is
   signal jrun    : std_logic := '0';                            -- the frame's jobs may start
   signal arm_req : std_logic := '0';                            -- a frame opened: set its masks, then jrun
   signal cut_pend : std_logic := '0';                           -- a cut frame's fault is still to come
+  -- the plan in the blanking: the live targets' plan runs as soon as the previous frame is closed; it
+  -- holds (plan_ok) until a remove, a stream fault's words or the start of frame; pl_fw / pl_fh: the
+  -- frame size it planned with (a start of frame with another size is planned again)
+  signal plan_ok, early : std_logic := '0';
+  signal pl_fw, pl_fh : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal direct : std_logic;                                    -- a start of frame can go in at once
   signal q_flush : std_logic := '0';
   signal q_valid, q_ready : std_logic;
   signal q_slot  : unsigned(3 downto 0);
@@ -359,7 +368,12 @@ begin
   size_ok <= '1' when frame_width >= 3 and frame_height >= 3 and frame_width <= MAX_FRAME_W else '0';
   -- a start of frame waits for the frame's plan (S_OPEN takes it); other beats flow while a frame is
   -- open, and between frames in S_IDLE (a beat without a start of frame: ms_stream_check reports it)
+  -- a planned frame without adds to check goes in from S_IDLE at once (no stall at its start)
+  direct <= '1' when fsm = S_IDLE and plan_ok = '1' and waiting = (waiting'range => '0')
+                     and pinit = (pinit'range => '0') and open_in = '0' and ev_end = '0' and ev_err = '0'
+                     and s_cmd_tvalid = '0' and frame_width = pl_fw and frame_height = pl_fh else '0';
   s_ready <= '1' when rst = '0' and ((fsm = S_OPEN and s_axis_tuser = '1')
+                                      or (direct = '1' and s_axis_tuser = '1')
                                       or (fsm = S_STREAM and open_in = '1' and s_axis_tuser = '0')
                                       or (fsm = S_IDLE and open_in = '0' and s_axis_tuser = '0'
                                           and s_cmd_tvalid = '0' and ev_end = '0' and ev_err = '0'))
@@ -505,8 +519,8 @@ begin
     port map (clk => clk, rst => rst, frame_lines => to_unsigned(FRAME_LINES, COORD_W),
               line_clocks => to_unsigned(LINE_CLOCKS, LC_W),
               blank_clocks => to_unsigned((FRAME_LINES - ACTIVE_LINES) * LINE_CLOCKS, SUM_W),
-              start => pl_start, n_live => to_unsigned(n_live, 5), frame_w => frame_width,
-              frame_h => frame_height, busy => pl_busy, st_req => st_req, st_index => st_index,
+              start => pl_start, n_live => to_unsigned(n_live, 5), frame_w => pl_fw,
+              frame_h => pl_fh, busy => pl_busy, st_req => st_req, st_index => st_index,
               st_valid => st_valid_r, st_slot => st_slot, st_w8 => st_w8, st_h8 => st_h8, st_c8x => st_c8x,
               st_c8y => st_c8y, st_lost => st_lost, p_valid => p_valid, p_slot => p_slot, p_taken => p_taken,
               p_log2_d => p_l2d, p_reg_x => p_reg_x, p_reg_y => p_reg_y, p_reg_w => p_reg_w, p_reg_h => p_reg_h,
@@ -692,6 +706,7 @@ begin
             if s_cmd_op = '1' then                       -- remove
               id_r <= s_cmd_id;
               code_r <= "01";
+              plan_ok <= '0';                            -- the live targets change: plan again
               for i in 0 to NT - 1 loop
                 if to_integer(s_cmd_id) = i and alloc(i) = '1' then
                   alloc(i) <= '0'; pend(i) <= '0'; waiting(i) <= '0'; pinit(i) <= '0'; valid(i) <= '0';
@@ -726,6 +741,7 @@ begin
           elsif ev_err = '1' then
             if jfsm = J_IDLE and jrun = '0' then         -- the failed frame's last job has ended
               ev_err <= '0';
+              plan_ok <= '0';
               is_err <= '1';
               err_r <= ev_code;
               j <= 0;
@@ -741,9 +757,37 @@ begin
           elsif ev_end = '1' then
             ev_end <= '0';
             fsm <= S_J_WAIT;
+          elsif beat = '1' and s_axis_tuser = '1' then  -- planned, no adds: the start of frame goes in
+            arm_req <= '1';
+            q_flush <= '1';
+            plan_ok <= '0';
+            fsm <= S_STREAM;
           elsif s_axis_tvalid = '1' and s_axis_tuser = '1' and fe_busy = '0' and jfsm = J_IDLE then
-            j <= 0;
+            if plan_ok = '1' and frame_width = pl_fw and frame_height = pl_fh then
+              n := 0;                                    -- planned: the adds to check
+              for i in 0 to NT - 1 loop
+                if waiting(i) = '1' then
+                  n := n + 1;
+                end if;
+              end loop;
+              n_cnt <= n_ord - n;
+              j <= 0;
+              pass_b <= '0';
+              fsm <= S_ADDS;
+            else
+              j <= 0;
+              n_live <= 0;
+              early <= '0';
+              pl_fw <= frame_width;
+              pl_fh <= frame_height;
+              fsm <= S_LIST;
+            end if;
+          elsif plan_ok = '0' and open_in = '0' and fe_busy = '0' and jfsm = J_IDLE then
+            j <= 0;                                      -- the next frame's plan, in the blanking
             n_live <= 0;
+            early <= '1';
+            pl_fw <= frame_width;
+            pl_fh <= frame_height;
             fsm <= S_LIST;
           end if;
 
@@ -780,7 +824,11 @@ begin
               hold_l2d(k) <= p_l2d;
             end if;
           end if;
-          if plan_done = '1' then
+          if plan_done = '1' and early = '1' then        -- planned in the blanking: wait for the frame
+            early <= '0';
+            plan_ok <= '1';
+            fsm <= S_IDLE;
+          elsif plan_done = '1' then
             n := 0;
             for i in 0 to NT - 1 loop
               if waiting(i) = '1' then
@@ -884,6 +932,7 @@ begin
 
         when S_OPEN =>                                   -- the start of frame goes in
           if beat = '1' then
+            plan_ok <= '0';
             arm_req <= '1';
             q_flush <= '1';                              -- a cut frame's jobs not started are dropped
             fsm <= S_STREAM;
@@ -903,6 +952,10 @@ begin
               cut_pend <= fe_busy;
               j <= 0;                                    -- the next frame's plan
               n_live <= 0;
+              early <= '0';
+              plan_ok <= '0';
+              pl_fw <= frame_width;
+              pl_fh <= frame_height;
               fsm <= S_LIST;
             end if;
           elsif open_in = '0' and fe_busy = '0' then     -- the frame was abandoned, its fault reported
@@ -1079,6 +1132,8 @@ begin
         jrun <= '0';
         arm_req <= '0';
         cut_pend <= '0';
+        plan_ok <= '0';
+        early <= '0';
         runm <= (others => '0');
       end if;
     end if;

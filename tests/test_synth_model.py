@@ -292,7 +292,7 @@ def test_shared_pins_wrapper_passes_every_generic():
     _wrapper_passes_every_generic("ms_tracker_shared", "MAX_TARGETS", synth.SHARED_PINS_VHD, "ms_tracker_shared_pins")
 
 
-@pytest.mark.parametrize("n", [1, 2, 4, 5, 8, 16])
+@pytest.mark.parametrize("n", [1, 2, 4, 5, 8, 10, 16])
 def test_shared_colour_configs_are_the_simulated_core(n):
     """Configurations "shared<N>-colour": ms_tracker_shared with MAX_TARGETS N and the generics its test bench
     simulates it with (tb/test_ms_tracker_shared.py generics_of: the v2-colour engine, MAX_FRAME_W 2048, the

@@ -309,7 +309,7 @@ def test_multi_pins_wrapper_passes_every_shared_generic():
     assert all(re.search(rf"^\s+{n}\s+=> {n}\b", branch, re.M) for n, _ in shared)
 
 
-@pytest.mark.parametrize("n", [1, 2, 4, 5, 8, 16])
+@pytest.mark.parametrize("n", [1, 2, 4, 5, 8, 10, 16])
 def test_shared_colour_configs_are_the_simulated_core(n):
     """Configurations "shared<N>-colour": ms_tracker_shared with MAX_TARGETS N and the generics its test bench
     simulates it with (tb/test_ms_tracker_shared.py generics_of: the v2-colour engine, MAX_FRAME_W 2048, the

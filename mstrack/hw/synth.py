@@ -24,7 +24,7 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
 * the multi-target core (configurations ``multi<N>-colour``, N = 1, 3, 4, 8, 10, 16, only when named
   with ``--config``): ``ms_tracker_multi`` with MAX_TARGETS N engines of ``v2-colour``, placed as
   ``rtl/wrappers/ms_tracker_multi_pins.vhd`` (ECP5; the Nexus PDC has the single-target wrapper's pins).
-* the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 16, and
+* the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 10, 16, and
   ``shared<N>-colour-w63``, max_window 63, N = 1, 8, 10, 14, only when named with ``--config``):
   ``ms_tracker_shared`` with MAX_TARGETS N slots around one ``v2-colour`` engine
   (generics from :func:`mstrack.hw.multi_core.shared_core_generics`: the 1080p60 timing of the capacity rule),
@@ -209,9 +209,11 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
                                   "rtl/wrappers/ms_tracker_multi_pins.vhd, SHARED_ENGINE true)"
                                   + (": the base of the per-target figures" if n == 1 else
                                      ": the most slots the LFE5U-85F's 208 DP16KD take (32.4 per added slot "
-                                     "from shared1-colour to shared8-colour: six would need about 210)"
-                                     if n == 5 else ""),
-             core=TOP_V2, top=TOP_SHARED, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 2, 4, 5, 8, 16)),
+                                     "from shared1-colour to shared8-colour: six would need 219)"
+                                     if n == 5 else
+                                     ": the size of AMD Vitis Vision MeanShift's 10-object kernel (xc7: --no-ecp5 "
+                                     "--no-pnr; more block RAM than the LFE5U-85F has)" if n == 10 else ""),
+             core=TOP_V2, top=TOP_SHARED, max_targets=n, tp=dict(V2_COLOUR)) for n in (1, 2, 4, 5, 8, 10, 16)),
     *(Config(f"shared{n}-colour-w63", f"shared{n}-colour with max_window 63 (tracker parameter), MAX_HALF 31, "
                                       "COORD_W 11 and MAX_FRAME_W 1920 (frames up to 1920 x 2047): a slot of 160 x "
                                       "160 px, larger targets decimated sooner"

@@ -349,6 +349,18 @@ architecture rtl of ms_tracker_shared is
                    to_unsigned(0, 17), st, to_unsigned(0, ITER_W), "00", dl, to_unsigned(0, 4), flags, err, fc);
   end function;
 
+  -- the number of set bits of v
+  function ones(v : std_logic_vector) return natural is
+    variable n : natural := 0;
+  begin
+    for i in v'range loop
+      if v(i) = '1' then
+        n := n + 1;
+      end if;
+    end loop;
+    return n;
+  end function;
+
   -- the lowest set bit of v, or -1
   function lowest(v : std_logic_vector) return integer is
   begin
@@ -563,7 +575,6 @@ begin
     variable fl : std_logic_vector(7 downto 0);
     variable notg : std_logic;
     variable m : std_logic_vector(NT - 1 downto 0);
-    variable n : natural range 0 to NT;
     variable rel : unsigned(COORD_W downto 0);
 
     -- slot s leaves the age order (a remove, a refused add, a box the engine refused)
@@ -764,13 +775,7 @@ begin
             fsm <= S_STREAM;
           elsif s_axis_tvalid = '1' and s_axis_tuser = '1' and fe_busy = '0' and jfsm = J_IDLE then
             if plan_ok = '1' and frame_width = pl_fw and frame_height = pl_fh then
-              n := 0;                                    -- planned: the adds to check
-              for i in 0 to NT - 1 loop
-                if waiting(i) = '1' then
-                  n := n + 1;
-                end if;
-              end loop;
-              n_cnt <= n_ord - n;
+              n_cnt <= n_ord - ones(waiting);            -- planned: the adds to check
               j <= 0;
               pass_b <= '0';
               fsm <= S_ADDS;
@@ -829,13 +834,7 @@ begin
             plan_ok <= '1';
             fsm <= S_IDLE;
           elsif plan_done = '1' then
-            n := 0;
-            for i in 0 to NT - 1 loop
-              if waiting(i) = '1' then
-                n := n + 1;
-              end if;
-            end loop;
-            n_cnt <= n_ord - n;
+            n_cnt <= n_ord - ones(waiting);
             j <= 0;
             pass_b <= '0';
             fsm <= S_ADDS;

@@ -309,6 +309,18 @@ def test_sim_preset_v2_real(tmp_path, capsys):
         assert int(got["latency"]) > 0
 
 
+def _scene_folder(tmp_path: Path) -> tuple[Path, list[str]]:
+    """The generated 4-target scene (6 frames, 96 x 80) as an image folder, and three of its frame-0 boxes
+    as --box values."""
+    from mstrack.io.synthetic import make_multi_scene
+    frames, rows = make_multi_scene(6, 96, 80, n_targets=4, seed=3)
+    folder = tmp_path / "img"
+    folder.mkdir()
+    for i, f in enumerate(frames):
+        cv2.imwrite(str(folder / f"{i:04d}.png"), f)
+    return folder, [",".join(str(int(v)) for v in r[2:6]) for r in rows if r[0] == 0][:3]
+
+
 @pytest.mark.long
 @pytest.mark.verilator
 def test_sim_several_boxes(tmp_path, capsys):
@@ -316,13 +328,7 @@ def test_sim_several_boxes(tmp_path, capsys):
     --max-frame-width 1024 --quick-build (the -O1 build of tb/test_ms_tracker_multi.py): the multi-target core
     ms_tracker_multi, every word bit-exact with CoreModelMulti, results.csv one row per word with the
     target's slot, the overlay written."""
-    from mstrack.io.synthetic import make_multi_scene
-    frames, rows = make_multi_scene(6, 96, 80, n_targets=4, seed=3)
-    folder = tmp_path / "img"
-    folder.mkdir()
-    for i, f in enumerate(frames):
-        cv2.imwrite(str(folder / f"{i:04d}.png"), f)
-    boxes = [",".join(str(int(v)) for v in r[2:6]) for r in rows if r[0] == 0][:3]
+    folder, boxes = _scene_folder(tmp_path)
     out = tmp_path / "multi"
     argv = ["sim", str(folder), *[f"--box={b}" for b in boxes], "--colour", "--max-frame-width", "1024",
             "--quick-build", "--out", str(out), "--quiet"]
@@ -344,13 +350,7 @@ def test_sim_shared_engine(tmp_path, capsys):
     (one colour engine), its capacity rule at the 720p60 raster, every word bit-exact with CoreModelMulti
     with that rule; bitexact.json names the core and the raster.  A frame larger than the raster is bad
     input (exit 2, one line)."""
-    from mstrack.io.synthetic import make_multi_scene
-    frames, rows = make_multi_scene(6, 96, 80, n_targets=4, seed=3)
-    folder = tmp_path / "img"
-    folder.mkdir()
-    for i, f in enumerate(frames):
-        cv2.imwrite(str(folder / f"{i:04d}.png"), f)
-    boxes = [",".join(str(int(v)) for v in r[2:6]) for r in rows if r[0] == 0][:3]
+    folder, boxes = _scene_folder(tmp_path)
     out = tmp_path / "shared"
     argv = ["sim", str(folder), *[f"--box={b}" for b in boxes], "--slots", "4", "--shared-engine", "--timing",
             "720p60", "--colour", "--max-frame-width", "1024", "--quick-build", "--out", str(out), "--quiet"]

@@ -40,11 +40,10 @@ from typing import Any, Callable, Iterator, Sequence
 import numpy as np
 
 from .hw.cosim import COMPARED_FIELDS, COMPARED_FIELDS_V2, ERR_NAMES, MIN_FRAME, CoreConfig, CoreConfigV2
-from .hw.fastsim import VIDEO_MODES
+from .hw.fastsim import VIDEO_MODES, mode_timing
 from .io.data import DataError, VideoSource
 from .fixed import FixedParams
 from .fixed.blocks import STOP_CODES, ms_box_clip, round_box
-from .fixed.multi_capacity import VideoTiming
 from .fixed.vhdl_pkg import DEFAULT_LANES, RESULT_FLAGS, STATUS_V2, pack_result, pack_result_v2
 from .track.params import V2_COLOUR, TrackerParams
 from .track.types import Box, Status, box_from_centre_index
@@ -393,15 +392,6 @@ def run_sim(job: SimJob, out: Path, model: ModelFn | None = None, progress: bool
            "listed": listed}
     (out / "bitexact.json").write_text(json.dumps(rep, indent=1) + "\n")
     return rep
-
-
-def mode_timing(name: str) -> VideoTiming:
-    """The raster of video mode *name* (:data:`mstrack.hw.fastsim.VIDEO_MODES`, one pixel per clock) as the
-    capacity rule's :class:`mstrack.fixed.multi_capacity.VideoTiming`."""
-    m = VIDEO_MODES[name]
-    w, h, hb, vb = (int(m[k]) for k in ("w", "h", "hblank", "vblank"))
-    line = w + hb
-    return VideoTiming(h, h + vb // line, line)
 
 
 #: Columns of results.csv of the multi-target core (several ``--box``): the slot id after the frame,

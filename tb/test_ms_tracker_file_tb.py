@@ -173,6 +173,24 @@ def test_config_package_v2_analyses(tmp_path):
         raise HdlError(r.stderr)
 
 
+def test_config_axi_shared_elaborates(tmp_path):
+    """`mstrack hdl config --top ms_tracker_axi --max-targets 8 --shared-engine` (the w63 choices): the
+    generics elaborate ms_tracker_axi with ms_tracker_shared inside, and the package (boolean
+    constants) analyses."""
+    from mstrack.hw.hdl import HdlError, rtl_sources, run_ghdl_plain
+    from mstrack.hw.hdl_config import BOOLEAN_GENERICS, CoreChoices, derive, render
+    cfg = derive(CoreChoices(preset="v2", colour=True, max_frame_width=1920, max_target=63, coord_bits=11,
+                             top="ms_tracker_axi", max_targets=8, shared_engine=True))
+    g = {k: ("true" if v else "false") if k in BOOLEAN_GENERICS else v for k, v in cfg.generics.items()}
+    run_ghdl_plain("ms_tracker_axi", rtl_sources("ms_tracker_axi"), g, build_name="ms_tracker_axi_elab",
+                   elab_only=True)
+    pkg = tmp_path / "ms_tracker_config_pkg.vhd"
+    pkg.write_text(render(cfg, "package"))
+    r = subprocess.run(["ghdl", "-a", "--std=08", f"--workdir={tmp_path}", str(pkg)], capture_output=True, text=True)
+    if r.returncode:
+        raise HdlError(r.stderr)
+
+
 @pytest.mark.parametrize("generic,value,message", [
     ("REGION_W", 7, "ms_tracker: REGION_W = 7, expected bits_for(REGION_MAX) = 8"),
     ("STRIDE", 47, "ms_tracker: STRIDE = 47, expected ceil(REGION_MAX / LANES) = 48"),

@@ -136,6 +136,16 @@ def test_choices_map_to_model_parameters(choices, tp, fp, lanes):
     (dict(features="depth"), "features 'depth' unknown"),
     (dict(kernel="gauss"), "kernel 'gauss' unknown"),
     (dict(rgb_packing="bgr"), "rgb packing 'bgr' unknown"),
+    (dict(top="ms_tracker_apb"), "top 'ms_tracker_apb' unknown"),
+    (dict(preset="v2", max_targets=4), "ms_tracker_axi's (--top ms_tracker_axi)"),
+    (dict(preset="v2", result_stream=False), "ms_tracker_axi's (--top ms_tracker_axi)"),
+    (dict(top="ms_tracker_axi", max_targets=4), "the multi-target core is core v2 (--preset v2)"),
+    (dict(top="ms_tracker_axi", preset="v2", max_targets=17), "17 targets: the multi-target core has 1 .. 16 slots"),
+    (dict(top="ms_tracker_axi", preset="v2", shared_engine=True), "give --max-targets 1 .. 16"),
+    (dict(top="ms_tracker_axi", preset="v2", max_targets=8, shared_engine=True, timing="1080i50"),
+     "video timing '1080i50' unknown"),
+    (dict(top="ms_tracker_axi", preset="v2", max_targets=8, coord_bits=11, max_frame_width=1920),
+     "core v2 is built for COORD_W 12"),
 ])
 def test_impossible_choices_refused(choices, reason):
     with pytest.raises(ConfigError) as e:
@@ -222,3 +232,60 @@ def test_core_v2_vhdl_defaults_are_the_models():
     eng = _vhdl_defaults(TRACKER_VHD.with_name("ms_tracker_v2.vhd"), "ms_tracker_v2")
     assert set(keys) <= set(eng)
     assert {k: eng[k] for k in keys} == {k: want[k] for k in keys}
+
+
+#: the choices of an integrator who builds eight colour targets on one engine at 1080p60 behind
+#: AXI4-Lite, windows up to 63 px: the configuration `mstrack synth --config shared8-colour-w63` measures
+W63_AXI = dict(preset="v2", colour=True, max_frame_width=1920, max_target=63, coord_bits=11, top="ms_tracker_axi",
+               max_targets=8, shared_engine=True, timing="1080p60")
+
+
+def test_axi_shared_engine_is_what_the_driver_and_synthesis_build():
+    """`--top ms_tracker_axi --max-targets N --shared-engine`: the generics of ms_tracker_axi that the C
+    driver's co-simulation builds (drvsim.axi_generics) and, for the w63 choices, those of the
+    synthesised configuration shared8-colour-w63; every name is a generic of ms_tracker_axi."""
+    from mstrack.hw.drvsim import axi_generics
+    from mstrack.hw.fastsim import mode_timing
+    from mstrack.hw.synth import CONFIGS
+    from mstrack.track.params import V2_COLOUR
+    g = derive(CoreChoices(**W63_AXI)).generics
+    tp = TrackerParams(preset="v2", **{**V2_COLOUR, "max_window": 63})
+    cfg = CoreConfigV2(tp, FixedParams(max_half=31, coord_bits=11), 4, 1920)
+    want = axi_generics(cfg, 8, True, shared=mode_timing("1080p60"))
+    assert {k: g[k] for k in want} == want
+    assert g["SHARED_ENGINE"] == 1 and g["MAX_TARGETS"] == 8 and g["COORD_W"] == 11 and g["RESULT_STREAM"] == 1
+    assert g["FRAME_LINES"] == 1125 and g["ACTIVE_LINES"] == 1080 and g["LINE_CLOCKS"] == 2200
+    synth = CONFIGS["shared8-colour-w63"].pins_generics()
+    assert {k: g[k] for k in synth} == {k: int(v) for k, v in synth.items()}
+    assert set(g) <= set(entity_generics(entity="ms_tracker_axi"))
+    # another raster: the rule's lines and clocks follow it
+    g30 = derive(CoreChoices(**{**W63_AXI, "timing": "720p60"})).generics
+    assert (g30["ACTIVE_LINES"], g30["FRAME_LINES"], g30["LINE_CLOCKS"]) == (720, 750, 1650)
+
+
+def test_axi_engine_per_slot_and_single_target():
+    """ms_tracker_axi without a shared engine: MAX_TARGETS slots with an engine each, or one target
+    (MAX_TARGETS 0), SHARED_ENGINE false; the paper core behind the registers keeps PRESET 0."""
+    g = derive(CoreChoices(preset="v2", top="ms_tracker_axi", max_targets=3, result_stream=False)).generics
+    assert (g["MAX_TARGETS"], g["SHARED_ENGINE"], g["RESULT_STREAM"]) == (3, 0, 0)
+    assert "FRAME_LINES" not in g
+    p = derive(CoreChoices(top="ms_tracker_axi")).generics
+    assert (p["PRESET"], p["MAX_TARGETS"], p["SHARED_ENGINE"]) == (0, 0, 0)
+
+
+def test_cli_axi_package_has_boolean_generics(tmp_path):
+    """The package of ms_tracker_axi: boolean constants for SHARED_ENGINE / RESULT_STREAM, the generic
+    map for ms_tracker_axi, the choices in its header."""
+    out = tmp_path / "axi_pkg.vhd"
+    argv = ["hdl", "config", "--preset", "v2", "--colour", "--max-frame-width", "1920", "--max-target", "63",
+            "--coord-bits", "11", "--top", "ms_tracker_axi", "--max-targets", "8", "--shared-engine",
+            "--no-result-stream", "--out", str(out)]
+    assert main(argv) == 0
+    text = out.read_text()
+    assert re.search(r"constant C_SHARED_ENGINE +: boolean := true;", text)
+    assert re.search(r"constant C_RESULT_STREAM +: boolean := false;", text)
+    assert re.search(r"constant C_MAX_TARGETS +: natural := 8;", text)
+    assert "u_tracker : entity work.ms_tracker_axi" in text
+    assert "8 target slot(s), one shared engine, capacity rule at 1080p60, result stream off" in text
+    gm = render(derive(CoreChoices(**W63_AXI)), "generic-map")
+    assert re.search(r"SHARED_ENGINE +=> true", gm) and re.search(r"RESULT_STREAM +=> true", gm)

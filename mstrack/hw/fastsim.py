@@ -39,6 +39,7 @@ import numpy as np
 from . import hdl
 from .cosim import COMPARED_FIELDS, CoreConfig, CoreConfigV2, diff_fields, frame_words
 from ..fixed import FixedParams
+from ..fixed.multi_capacity import VideoTiming
 from ..fixed.vhdl_pkg import unpack_result
 from ..track.params import TrackerParams
 
@@ -62,6 +63,16 @@ VIDEO_MODES: dict[str, dict[str, int | float]] = {
     "2160p60": {"w": 3840, "h": 2160, "mhz": 594.0, "hblank": 560, "vblank": 90 * 4400},
 }
 
+
+
+def mode_timing(name: str) -> VideoTiming:
+    """The raster of video mode *name* (:data:`VIDEO_MODES`, one pixel per clock) as the capacity rule's
+    :class:`mstrack.fixed.multi_capacity.VideoTiming` (the shared-engine core's ACTIVE_LINES,
+    FRAME_LINES, LINE_CLOCKS)."""
+    m = VIDEO_MODES[name]
+    w, h, hb, vb = (int(m[k]) for k in ("w", "h", "hblank", "vblank"))
+    line = w + hb
+    return VideoTiming(h, h + vb // line, line)
 
 
 def video_mode(name: str, ppc: int = 1) -> dict[str, int | float]:
@@ -523,4 +534,5 @@ def compare(results: Sequence[dict], expected: Sequence[dict],
 
 __all__ = [
     "FastsimRun", "FastsimError", "MultiRun", "simulate_multi", "build_multi", "HD1080P60", "VIDEO_MODES",
+    "mode_timing",
     "build", "simulate", "run_fastsim", "compare", "default_watchdog"]

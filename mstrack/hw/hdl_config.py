@@ -1,8 +1,9 @@
 """Configuration of the core from user-level choices: ``mstrack hdl config``.
 
 An integrator chooses what the system needs (preset, widest frame, largest target, pixels per
-clock, features, kernel, pixel packing); :func:`derive` turns the choices into every generic of
-``ms_tracker`` (PRESET 0 the paper core, 1 core v2; the derived widths come from
+clock, features, kernel, pixel packing; behind AXI4-Lite: the targets, one engine per target or one
+shared engine and its video timing); :func:`derive` turns the choices into every generic of
+``ms_tracker`` or ``ms_tracker_axi`` (PRESET 0 the paper core, 1 core v2; the derived widths come from
 :func:`mstrack.fixed.vhdl_pkg.core_generics`, core v2's from
 :meth:`mstrack.hw.cosim.CoreConfigV2.tracker_generics`, the single sources of truth) and refuses
 impossible combinations with a one-line reason (:class:`ConfigError`).  The RTL checks the same relations at elaboration (``ms_tracker``,
@@ -14,6 +15,8 @@ that uses them, as a comment to paste), a plain generic map, or JSON::
     mstrack hdl config --max-frame-width 1920 --max-target 127 --lanes 4 --out ms_tracker_config_pkg.vhd
     mstrack hdl config --kernel epanechnikov --format generic-map
     mstrack hdl config --preset v2 --max-frame-width 1920 --out ms_tracker_config_pkg.vhd
+    mstrack hdl config --preset v2 --colour --max-frame-width 1920 --top ms_tracker_axi --max-targets 8 \
+        --shared-engine --timing 1080p60 --max-target 63 --coord-bits 11 --format generic-map
 
 docs/packaging.md, "Configuration", lists the choices and the refusals.
 """
@@ -30,6 +33,7 @@ from typing import Any
 from ..fixed.formats import FixedParams
 from ..fixed.vhdl_pkg import DEFAULT_LANES, core_generics
 from ..track.params import V2_COLOUR, TrackerParams
+from .fastsim import VIDEO_MODES, mode_timing
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 TRACKER_VHD = REPO_ROOT / "rtl" / "ms_tracker.vhd"
@@ -61,6 +65,12 @@ V2_BG_WIDTHS = {"BG_Q_W": 14, "BG_O_W": 17}
 #: COORD_W of core v2 (ms_tracker_v2 packs result word v2 in 160 bits for COORD_W 12)
 V2_COORD_BITS = 12
 FORMATS = ("package", "generic-map", "json")
+#: the top levels: the core alone, or behind AXI4-Lite (registers, interrupt, the C driver)
+TOPS = ("ms_tracker", "ms_tracker_axi")
+#: generics of type boolean (ms_tracker_axi); 0 / 1 in :attr:`CoreConfiguration.generics`
+BOOLEAN_GENERICS = ("SHARED_ENGINE", "RESULT_STREAM")
+#: COORD_W of the shared-engine core: 12, or 11 (frames up to 2047 px high: a smaller slot, REGION_MAX)
+SHARED_COORD_BITS = (11, 12)
 
 
 class ConfigError(ValueError):
@@ -105,6 +115,22 @@ class CoreChoices:
         Preset v2 only: the gated scale test's relative size step (TrackerParams scale_test with
         scale_test_gate), generic SCALE_TEST_D256 = round(256 scale_test); None (default): the
         tracker's (mstrack-v2 0.05, mstrack-v2-colour 0 = off).
+    top : {"ms_tracker", "ms_tracker_axi"}
+        The entity configured: the core alone, or behind AXI4-Lite (the register map of
+        docs/integration.md, the C driver); ms_tracker_axi has every generic of ms_tracker and its own.
+    max_targets : int
+        ms_tracker_axi, preset v2: 0 one target (ms_tracker), 1 .. 16 the multi-target core's slots
+        (MAX_TARGETS).
+    shared_engine : bool
+        With max_targets: one engine for every slot (ms_tracker_shared, SHARED_ENGINE) instead of an
+        engine per slot (ms_tracker_multi); its capacity rule is built for the video timing ``timing``.
+    timing : str
+        shared_engine: the video mode the capacity rule plans each frame for
+        (:data:`mstrack.hw.fastsim.VIDEO_MODES`, one pixel per clock: ACTIVE_LINES, FRAME_LINES,
+        LINE_CLOCKS).
+    result_stream : bool
+        ms_tracker_axi: the result words on m_axis_result as well as in the registers (RESULT_STREAM);
+        false for a CPU-only integration.
     """
 
     max_frame_width: int = 2048
@@ -119,6 +145,11 @@ class CoreChoices:
     ppc: int = 1
     scale_test: float | None = None
     colour: bool = False
+    top: str = "ms_tracker"
+    max_targets: int = 0
+    shared_engine: bool = False
+    timing: str = "1080p60"
+    result_stream: bool = True
 
 
 @dataclass(frozen=True)
@@ -136,6 +167,7 @@ def derive(c: CoreChoices) -> CoreConfiguration:
     """Every generic of ms_tracker for the choices ``c``; :class:`ConfigError` with the reason if impossible."""
     if c.preset not in PRESETS:
         raise ConfigError(f"preset {c.preset!r} unknown (one of {', '.join(PRESETS)})")
+    _check_top(c)
     v2 = c.preset == "v2"
     features = c.features if c.features is not None else ("colour" if v2 else "fused")
     if features not in FEATURES:
@@ -169,7 +201,7 @@ def derive(c: CoreChoices) -> CoreConfiguration:
                               f"{V2_MAX_TARGET} decimated px (larger targets are tracked on a decimated frame)")
         if c.scale_test is not None and not 0 <= c.scale_test <= 0.5:
             raise ConfigError(f"scale test {c.scale_test}: 0 (off) or a relative size step up to 0.5")
-        if c.coord_bits != V2_COORD_BITS:
+        if c.coord_bits != V2_COORD_BITS and not (c.shared_engine and c.coord_bits in SHARED_COORD_BITS):
             raise ConfigError(f"COORD_W {c.coord_bits}: core v2 is built for COORD_W {V2_COORD_BITS} (frames up to "
                               "4095 px; result word v2 of 160 bits)")
     elif c.scale_test is not None:
@@ -207,7 +239,7 @@ def derive(c: CoreChoices) -> CoreConfiguration:
             "RGB_PACKING": RGB_PACKINGS[c.rgb_packing][0], "PPC": c.ppc}
     base = core_generics(tp, fp, c.lanes)
     if not v2:
-        return CoreConfiguration(c, tp, fp, {**head, **base})
+        return CoreConfiguration(c, tp, fp, _axi_generics(c, tp, fp, {**head, **base}))
     from .cosim import CoreConfigV2
     try:
         gv2 = {**CoreConfigV2(tp, fp, c.lanes, c.max_frame_width).tracker_generics(), **V2_BG_WIDTHS}
@@ -217,22 +249,63 @@ def derive(c: CoreChoices) -> CoreConfiguration:
     missing = set(gv2) - set(g)
     if missing:    # CoreConfigV2 sets a generic this module does not know: keep the two in step
         raise RuntimeError(f"core v2 generics not in V2_GENERICS: {sorted(missing)}")
-    return CoreConfiguration(c, tp, fp, g)
+    return CoreConfiguration(c, tp, fp, _axi_generics(c, tp, fp, g))
 
 
-def entity_generics(path: Path = TRACKER_VHD) -> list[str]:
-    """Names of the generics of ms_tracker, in declaration order (read from the VHDL)."""
+def _check_top(c: CoreChoices) -> None:
+    """The choices of the top level that do not depend on the tracker (one-line refusals)."""
+    if c.top not in TOPS:
+        raise ConfigError(f"top {c.top!r} unknown (one of {', '.join(TOPS)})")
+    if c.top == "ms_tracker" and (c.max_targets or c.shared_engine or not c.result_stream):
+        raise ConfigError("several targets, a shared engine and the result stream's choice are ms_tracker_axi's "
+                          "(--top ms_tracker_axi)")
+    if not 0 <= c.max_targets <= 16:
+        raise ConfigError(f"{c.max_targets} targets: the multi-target core has 1 .. 16 slots")
+    if c.max_targets and c.preset != "v2":
+        raise ConfigError("several targets: the multi-target core is core v2 (--preset v2)")
+    if c.shared_engine and not c.max_targets:
+        raise ConfigError("a shared engine serves the slots of the multi-target core: give --max-targets 1 .. 16")
+    if c.shared_engine and c.timing not in VIDEO_MODES:
+        raise ConfigError(f"video timing {c.timing!r} unknown (one of {', '.join(VIDEO_MODES)})")
+
+
+def _axi_generics(c: CoreChoices, tp: TrackerParams, fp: FixedParams, g: dict[str, int]) -> dict[str, int]:
+    """ms_tracker's generics *g*, with ms_tracker_axi's own when ``c.top`` is ms_tracker_axi
+    (:func:`mstrack.hw.drvsim.axi_generics`'s: MAX_TARGETS, SHARED_ENGINE and the shared engine's from
+    :func:`mstrack.hw.multi_core.shared_core_generics`, RESULT_STREAM)."""
+    if c.top == "ms_tracker":
+        return g
+    out = {**g, "MAX_TARGETS": c.max_targets, "SHARED_ENGINE": int(c.shared_engine)}
+    if c.shared_engine:
+        from .multi_core import pass_costs, shared_core_generics
+        sg = shared_core_generics(tp, fp, c.max_targets, mode_timing(c.timing), c.max_frame_width,
+                                  costs=pass_costs(c.lanes))
+        out.update({k: v for k, v in sg.items() if k not in out})
+    out["RESULT_STREAM"] = int(c.result_stream)
+    return out
+
+
+def entity_generics(path: Path = TRACKER_VHD, entity: str = "ms_tracker") -> list[str]:
+    """Names of the generics of *entity* (ms_tracker, or ms_tracker_axi in its own file), in declaration
+    order (read from the VHDL)."""
+    if entity != "ms_tracker" and path == TRACKER_VHD:
+        path = TRACKER_VHD.with_name(f"{entity}.vhd")
     text = re.sub(r"--[^\n]*", "", path.read_text())
-    m = re.search(r"entity\s+ms_tracker\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
+    m = re.search(rf"entity\s+{entity}\s+is\s+generic\s*\((.*?)\)\s*;\s*port", text, re.S | re.I)
     if not m:
         raise RuntimeError(f"no generic clause found in {path}")
-    return re.findall(r"(\w+)\s*:\s*(?:natural|integer)\b", m.group(1), re.I)
+    return re.findall(r"(\w+)\s*:\s*(?:natural|integer|positive|boolean)\b", m.group(1), re.I)
+
+
+def _value(k: str, v: int) -> str:
+    """A generic's value as VHDL text (booleans: true / false)."""
+    return ("true" if v else "false") if k in BOOLEAN_GENERICS else str(v)
 
 
 def generic_map(g: dict[str, int], prefix: str = "", indent: str = "    ") -> str:
     """``generic map (...)`` text: NAME => value, or NAME => <prefix>NAME when ``prefix`` is given."""
     width = max(len(k) for k in g)
-    items = [f"{indent}{k:<{width}} => {prefix + k if prefix else v}" for k, v in g.items()]
+    items = [f"{indent}{k:<{width}} => {prefix + k if prefix else _value(k, v)}" for k, v in g.items()]
     return "generic map (\n" + ",\n".join(items) + "\n)"
 
 
@@ -240,7 +313,7 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
     c = cfg.choices
     g = cfg.generics
     lines = [f"GENERATED by `{command}`; do not edit (regenerate instead).",
-             "mstrack configuration of ms_tracker (docs/packaging.md, \"Configuration\"):",
+             f"mstrack configuration of {c.top} (docs/packaging.md, \"Configuration\"):",
              f"  frames up to {c.max_frame_width} px wide, {(1 << c.coord_bits) - 1} px high (COORD_W {c.coord_bits});",
              (f"  targets up to {2 * g['MAX_HALF'] + 1} px (MAX_HALF {g['MAX_HALF']}), search margin {c.margin} px;"
               if c.preset != "v2" else
@@ -251,7 +324,12 @@ def _header(cfg: CoreConfiguration, command: str, comment: str) -> list[str]:
                 f"SCALE_TEST_D256 {g['SCALE_TEST_D256']})" if c.preset == "v2" else "") + ";",
              f"  s_axis_tdata {RGB_PACKINGS[c.rgb_packing][1]}, {c.ppc} pixel(s) per clock (PPC);",
              f"  result word {g['RESULT_W']} bits (fields: mstrack.fixed.vhdl_pkg.result_layout"
-             f"{'_v2' if c.preset == 'v2' else ''})."]
+             f"{'_v2' if c.preset == 'v2' else ''})" + (";" if c.top != "ms_tracker" else ".")]
+    if c.top != "ms_tracker":
+        lines.append("  behind AXI4-Lite (docs/integration.md), " + (
+            f"{c.max_targets} target slot(s), " + (f"one shared engine, capacity rule at {c.timing}" if c.shared_engine
+                                                   else "an engine per slot") if c.max_targets else "one target")
+            + f", result stream {'on' if c.result_stream else 'off'}.")
     return [f"{comment} {ln}".rstrip() for ln in lines]
 
 
@@ -270,13 +348,16 @@ def render(cfg: CoreConfiguration, fmt: str = "package", name: str = "ms_tracker
     width = max(len(k) for k in g) + 3      # "C_" + the longest name + one blank
     out = _header(cfg, command, "--")
     out += ["--", "-- Use: compile this file before the core's instance, then", "--   use work." + name + ".all;",
-            "--   u_tracker : entity work.ms_tracker"]
+            f"--   u_tracker : entity work.{cfg.choices.top}"]
     out += ["--   " + ln for ln in generic_map(g, prefix="C_", indent="  ").splitlines()]
     out += [f"package {name} is"]
-    out += [f"  constant {'C_' + k:<{width}}: {'integer' if k in INTEGER_GENERICS else 'natural'} := {v};"
-            for k, v in g.items()]
+    out += [f"  constant {'C_' + k:<{width}}: {_type(k)} := {_value(k, v)};" for k, v in g.items()]
     out += [f"end package {name};", ""]
     return "\n".join(out)
+
+
+def _type(k: str) -> str:
+    return "boolean" if k in BOOLEAN_GENERICS else "integer" if k in INTEGER_GENERICS else "natural"
 
 
 # ----------------------------------------------------------------------------- CLI
@@ -307,6 +388,18 @@ def add_config_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--colour", action="store_true",
                    help="preset v2: tracker mstrack-v2-colour (colour bins alone, ORIENT_T -1: a smaller, "
                         "faster core than mstrack-v2's joint colour x orientation bins)")
+    p.add_argument("--top", choices=TOPS, default=d.top,
+                   help="the entity configured: ms_tracker (default) or ms_tracker_axi (behind AXI4-Lite, the C "
+                        "driver; docs/integration.md)")
+    p.add_argument("--max-targets", type=int, default=d.max_targets,
+                   help="ms_tracker_axi, --preset v2: target slots of the multi-target core (MAX_TARGETS 1 .. 16; "
+                        "default 0: one target)")
+    p.add_argument("--shared-engine", action="store_true",
+                   help="with --max-targets: one engine for every slot (ms_tracker_shared) instead of one per slot")
+    p.add_argument("--timing", choices=tuple(VIDEO_MODES), default=d.timing,
+                   help=f"--shared-engine: the video mode its capacity rule plans for (default {d.timing})")
+    p.add_argument("--no-result-stream", action="store_true",
+                   help="ms_tracker_axi: results through the registers only (RESULT_STREAM false)")
     p.add_argument("--format", choices=FORMATS, default="package", help="output (default: VHDL package)")
     p.add_argument("--name", default="ms_tracker_config_pkg", help="package name (--format package)")
     p.add_argument("--out", help="output file (default: standard output)")
@@ -316,7 +409,9 @@ def run_config(args: argparse.Namespace) -> int:
     choices = CoreChoices(max_frame_width=args.max_frame_width, max_target=args.max_target, lanes=args.lanes,
                           features=args.features, kernel=args.kernel, preset=args.preset, margin=args.margin,
                           coord_bits=args.coord_bits, rgb_packing=args.rgb_packing, ppc=args.ppc,
-                          scale_test=args.scale_test, colour=args.colour)
+                          scale_test=args.scale_test, colour=args.colour, top=args.top,
+                          max_targets=args.max_targets, shared_engine=args.shared_engine, timing=args.timing,
+                          result_stream=not args.no_result_stream)
     cfg = derive(choices)
     command = getattr(args, "command_line", None) or "mstrack hdl config"
     text = render(cfg, args.format, args.name, command)

@@ -6,16 +6,19 @@
 -- Schedule (this version): the live targets are planned, oldest first, by ms_frame_plan (each tracked
 -- or held) as soon as the previous frame is closed, in the blanking, with the frame size of the ports
 -- then; a remove, a stream fault's words or another frame size at the start of frame plan them again
--- when the start of frame comes, and the input waits for it.  At the start of frame the init pending
--- after a fault and the adds taken since the last frame are checked while the input waits (the
--- engine's init geometry, the init job's clocks from ms_job_clocks, check_add in ms_frame_plan: taken,
--- or refused with CMD_CYCLES); a frame without them goes in at once.  Each target with a job has its
+-- when the start of frame comes, and the input waits for it.  Once the plan holds, the inits pending
+-- after a fault and each add taken are checked against it in the blanking (the engine's init geometry,
+-- the init job's clocks from ms_job_clocks, check_add in ms_frame_plan: taken, or refused with
+-- CMD_CYCLES); the verdicts are tentative until the start of frame, which reports and frees the refused
+-- adds (a clock or two each) and goes in; adds taken too late to be checked, or a plan made again (a
+-- remove, a fault's words, another frame size), are checked at the start of frame while the input
+-- waits.  A frame with nothing left to check goes in at once.  Each target with a job has its
 -- slot's capture loaded (the region, or the init rectangle).  The frame then streams in,
 -- every slot capturing its own region, and the jobs run as their slots are released (ms_job_queue, in
 -- release order; an init: ms_init_job learns the model from the slot first).  A job's word goes to
 -- ms_result_order, its new state waits beside the committed one.  When the frame has ended and its
--- last job has ended, every job's state is committed, and the slots are walked in id order: the top's
--- words are written (held: err_code 6; a frame of another size than the target's); then the frame is
+-- last job has ended, every job's state is committed, and the slots are walked in id order (two clocks a
+-- slot: its flags are read into registers, then decided on): the top's words are written (held: err_code 6; a frame of another size than the target's); then the frame is
 -- closed and its words leave in ascending id.  A stream fault (or a start of frame that cuts the frame)
 -- stops the frame's jobs: the running one ends, the queued ones are dropped, the pending states are
 -- dropped, and every live target gets an error word from its committed state.  No live target: slot
@@ -222,7 +225,7 @@ architecture rtl of ms_tracker_shared is
   signal rej_flag : std_logic := '0';
   signal fcount  : unsigned(15 downto 0) := (others => '0');
 
-  type state_t is (S_IDLE, S_LIST, S_PLAN, S_ADDS, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
+  type state_t is (S_IDLE, S_LIST, S_PLAN, S_ADDS, S_A_DROP, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
                    S_OPEN, S_STREAM, S_J_WAIT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
   signal fsm     : state_t := S_IDLE;
   -- the jobs: run as their regions are released, while the frame streams
@@ -238,6 +241,13 @@ architecture rtl of ms_tracker_shared is
   signal plan_ok, early : std_logic := '0';
   signal pl_fw, pl_fh : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal direct : std_logic;                                    -- a start of frame can go in at once
+  -- the adds checked in the blanking: once the plan holds, the inits pending and each add taken are
+  -- checked against it at once (chk_early), their verdicts tentative until the start of frame: eacc an
+  -- add taken (or a box the engine refused), eref an add refused, reported and freed at the start of
+  -- frame; chk_ok: the inits pending are checked.  A new plan (S_LIST) or a stream fault's words undo them
+  -- (the adds wait again), so the verdicts are those of the check at the start of frame
+  signal eacc, eref : std_logic_vector(NT - 1 downto 0) := (others => '0');
+  signal chk_ok, chk_early : std_logic := '0';
   signal q_flush : std_logic := '0';
   signal q_valid, q_ready : std_logic;
   signal q_slot  : unsigned(3 downto 0);
@@ -245,6 +255,7 @@ architecture rtl of ms_tracker_shared is
   signal j       : natural range 0 to NT := 0;                   -- list / slot index
   signal pass_b  : std_logic := '0';                            -- the adds' second pass (the waiting ones)
   signal k_cur   : slot_t := (others => '0');
+  signal a_rd    : std_logic := '0';                            -- S_LIST / S_ADDS: k_cur holds entry j's slot
   signal out_mask : std_logic_vector(NT - 1 downto 0) := (others => '0');
   signal first_w : std_logic := '0';
   signal rej_any : std_logic := '0';
@@ -253,6 +264,12 @@ architecture rtl of ms_tracker_shared is
   signal side_w  : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
   signal side_push : std_logic := '0';                          -- S_SIDE: push side_w (else only bookkeeping)
   signal side_nt : std_logic := '0';                            -- the slot's word has no_target
+  -- the slot walk (S_J_NEXT, S_E_NEXT) decides on registers: slot j's flags and word fields are read
+  -- in one clock (pf_ok '0'), used in the next (pf_ok '1')
+  signal pf_ok, pf_alloc, pf_valid, pf_pinit, pf_held, pf_rejd, pf_size : std_logic := '0';
+  signal pf_c8x, pf_c8y : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
+  signal pf_w8, pf_h8 : unsigned(SIZE_W - 1 downto 0) := (others => '0');
+  signal pf_l2d : unsigned(2 downto 0) := (others => '0');
 
   -- input
   signal open_in, in_frame : std_logic := '0';
@@ -382,7 +399,8 @@ begin
   -- open, and between frames in S_IDLE (a beat without a start of frame: ms_stream_check reports it)
   -- a planned frame without adds to check goes in from S_IDLE at once (no stall at its start)
   direct <= '1' when fsm = S_IDLE and plan_ok = '1' and waiting = (waiting'range => '0')
-                     and pinit = (pinit'range => '0') and open_in = '0' and ev_end = '0' and ev_err = '0'
+                     and eref = (eref'range => '0') and (pinit = (pinit'range => '0') or chk_ok = '1')
+                     and open_in = '0' and ev_end = '0' and ev_err = '0'
                      and s_cmd_tvalid = '0' and frame_width = pl_fw and frame_height = pl_fh else '0';
   s_ready <= '1' when rst = '0' and ((fsm = S_OPEN and s_axis_tuser = '1')
                                       or (direct = '1' and s_axis_tuser = '1')
@@ -573,22 +591,43 @@ begin
     variable kj : natural range 0 to NT - 1;                -- the job runner's slot
     variable kk : integer;
     variable fl : std_logic_vector(7 downto 0);
-    variable notg : std_logic;
+    variable refd : std_logic;                             -- S_ADDS: the add was refused in the blanking
     variable m : std_logic_vector(NT - 1 downto 0);
     variable rel : unsigned(COORD_W downto 0);
 
-    -- slot s leaves the age order (a remove, a refused add, a box the engine refused)
+    -- slot s leaves the age order (a remove, a refused add, a box the engine refused): the entries after
+    -- it move up one place (a slot is in the order at most once)
     procedure drop_ord(s : slot_t) is
-      variable c : natural range 0 to NT;
+      variable gone : std_logic;
     begin
-      c := 0;
+      gone := '0';
       for q in 0 to NT - 1 loop
-        if q < n_ord and ord(q) /= s then
-          ord(c) <= ord(q);
-          c := c + 1;
+        if q < n_ord and ord(q) = s then
+          gone := '1';
+        end if;
+        if gone = '1' and q < NT - 1 then
+          ord(q) <= ord(q + 1);
         end if;
       end loop;
-      n_ord <= c;
+      if gone = '1' then
+        n_ord <= n_ord - 1;
+      end if;
+    end procedure;
+
+    -- the adds checked in the blanking wait again (their plan is gone)
+    procedure undo_checks is
+    begin
+      for i in 0 to NT - 1 loop
+        if eacc(i) = '1' then
+          waiting(i) <= '1'; pinit(i) <= '0'; rejd(i) <= '0';
+        end if;
+        if eref(i) = '1' then
+          waiting(i) <= '1';
+        end if;
+      end loop;
+      eacc <= (others => '0');
+      eref <= (others => '0');
+      chk_ok <= '0';
     end procedure;
   begin
     if rising_edge(clk) then
@@ -605,6 +644,16 @@ begin
       ro_valid <= '0';
       ro_close <= '0';
       q_flush <= '0';
+      -- slot j's reads for the walk (j = NT: nothing to read)
+      pf_ok <= '0';
+      if j < NT then
+        k := j;
+        pf_alloc <= alloc(k); pf_valid <= valid(k); pf_pinit <= pinit(k); pf_held <= held(k);
+        pf_rejd <= rejd(k);
+        pf_size <= '1' when fr_w /= fw_a(k) or fr_h /= fh_a(k) else '0';
+        pf_c8x <= c8x_a(k); pf_c8y <= c8y_a(k); pf_w8 <= w8_a(k); pf_h8 <= h8_a(k);
+        pf_l2d <= hold_l2d(k);
+      end if;
       -- frame events of the front end (the last one of each kind is kept: one frame at a time)
       if fe_end = '1' then
         ev_end <= '1';
@@ -721,7 +770,7 @@ begin
               for i in 0 to NT - 1 loop
                 if to_integer(s_cmd_id) = i and alloc(i) = '1' then
                   alloc(i) <= '0'; pend(i) <= '0'; waiting(i) <= '0'; pinit(i) <= '0'; valid(i) <= '0';
-                  rejd(i) <= '0'; held(i) <= '0';
+                  rejd(i) <= '0'; held(i) <= '0'; eacc(i) <= '0'; eref(i) <= '0';
                   c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
                   w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
                   code_r <= "00";
@@ -753,6 +802,7 @@ begin
             if jfsm = J_IDLE and jrun = '0' then         -- the failed frame's last job has ended
               ev_err <= '0';
               plan_ok <= '0';
+              undo_checks;
               is_err <= '1';
               err_r <= ev_code;
               j <= 0;
@@ -760,7 +810,7 @@ begin
               m := alloc and valid;
               out_mask <= m;
               rej_any <= rej_flag;
-              if rejd /= (rejd'range => '0') then
+              if (rejd and not eacc) /= (rejd'range => '0') then
                 rej_any <= '1';
               end if;
               fsm <= S_E_NEXT;
@@ -768,16 +818,19 @@ begin
           elsif ev_end = '1' then
             ev_end <= '0';
             fsm <= S_J_WAIT;
-          elsif beat = '1' and s_axis_tuser = '1' then  -- planned, no adds: the start of frame goes in
+          elsif beat = '1' and s_axis_tuser = '1' then  -- planned, adds checked: the start of frame goes in
             arm_req <= '1';
             q_flush <= '1';
             plan_ok <= '0';
+            eacc <= (others => '0');                     -- the verdicts hold
+            chk_ok <= '0';
             fsm <= S_STREAM;
           elsif s_axis_tvalid = '1' and s_axis_tuser = '1' and fe_busy = '0' and jfsm = J_IDLE then
             if plan_ok = '1' and frame_width = pl_fw and frame_height = pl_fh then
-              n_cnt <= n_ord - ones(waiting);            -- planned: the adds to check
+              n_cnt <= n_ord - ones(waiting) - ones(eref);  -- planned: the adds left to check, the refusals
               j <= 0;
-              pass_b <= '0';
+              pass_b <= chk_ok;
+              chk_early <= '0';
               fsm <= S_ADDS;
             else
               j <= 0;
@@ -794,20 +847,33 @@ begin
             pl_fw <= frame_width;
             pl_fh <= frame_height;
             fsm <= S_LIST;
+          elsif plan_ok = '1' and (waiting /= (waiting'range => '0')
+                                   or (pinit /= (pinit'range => '0') and chk_ok = '0'))
+                and open_in = '0' and fe_busy = '0' and jfsm = J_IDLE then
+            n_cnt <= n_ord - ones(waiting) - ones(eref);  -- the adds taken, checked in the blanking
+            j <= 0;
+            pass_b <= chk_ok;
+            chk_early <= '1';
+            fsm <= S_ADDS;
           end if;
 
         ------------------------------------------------------------ the frame's plan
         when S_LIST =>                                   -- the live targets in age order
-          if j < n_ord then
-            k := idx(ord(j));
+          if j < n_ord and a_rd = '0' then               -- (two clocks an entry: its slot, then its flags)
+            k_cur <= ord(j);
+            a_rd <= '1';
+          elsif j < n_ord then
+            a_rd <= '0';
+            k := idx(k_cur);
             if valid(k) = '1' and pinit(k) = '0' then
-              lst(n_live) <= ord(j);
+              lst(n_live) <= k_cur;
               n_live <= n_live + 1;
             end if;
             j <= j + 1;
           elsif pl_busy = '0' then
             held <= (others => '0');
             job <= (others => '0');
+            undo_checks;
             pl_start <= '1';
             fsm <= S_PLAN;
           end if;
@@ -837,26 +903,55 @@ begin
             n_cnt <= n_ord - ones(waiting);
             j <= 0;
             pass_b <= '0';
+            chk_early <= '0';
             fsm <= S_ADDS;
           end if;
 
         when S_ADDS =>                                   -- the inits pending, then the adds waiting
-          if j < n_ord then
-            k := idx(ord(j));
+          if j < n_ord and a_rd = '0' then               -- (two clocks an entry: its slot, then its flags)
             k_cur <= ord(j);
-            if (pass_b = '0' and pinit(k) = '1') or (pass_b = '1' and waiting(k) = '1') then
-              cmd_load <= '1';                             -- an empty record, the target's model
-              c_state <= (others => '0');
-              c_model <= resize(ord(j), clog2(NT));
-              fsm <= S_A_LOAD;
+            a_rd <= '1';
+          elsif j < n_ord then
+            a_rd <= '0';
+            k := idx(k_cur);
+            refd := '0';                                 -- eref(k) (a loop: GHDL 2.0's synthesis failed on
+            for i in 0 to NT - 1 loop                    -- the indexed read)
+              if i = k and eref(i) = '1' then
+                refd := '1';
+              end if;
+            end loop;
+            if pass_b = '1' and refd = '1' and chk_early = '0' then
+              fsm <= S_A_DROP;                           -- refused in the blanking: reported and freed now
+            else
+              if (pass_b = '0' and pinit(k) = '1') or (pass_b = '1' and waiting(k) = '1') then
+                cmd_load <= '1';                           -- an empty record, the target's model
+                c_state <= (others => '0');
+                c_model <= resize(k_cur, clog2(NT));
+                fsm <= S_A_LOAD;
+              end if;
+              j <= j + 1;
             end if;
-            j <= j + 1;
           elsif pass_b = '0' then
             pass_b <= '1';
             j <= 0;
+          elsif chk_early = '1' then                     -- checked in the blanking: wait for the frame
+            chk_early <= '0';
+            chk_ok <= '1';
+            fsm <= S_IDLE;
           else
             fsm <= S_OPEN;
           end if;
+
+        when S_A_DROP =>                                 -- an add refused in the blanking
+          k := idx(k_cur);
+          alloc(k) <= '0'; pend(k) <= '0';
+          eref(k) <= '0';
+          rej_flag <= '1';
+          done_r <= '1';
+          code_r <= "10";
+          id_r <= k_cur;
+          drop_ord(k_cur);                               -- the next entry moves into place j
+          fsm <= S_ADDS;
 
         when S_A_LOAD =>
           if e_geo_done = '1' then
@@ -872,6 +967,7 @@ begin
           if e_init_rej = '1' then                       -- the engine refuses the box: reported by its word
             rejd(k) <= '1';
             waiting(k) <= '0';
+            eacc(k) <= chk_early and pass_b;
             n_cnt <= n_cnt + 1;
             fsm <= S_ADDS;
           elsif e_geo_done = '1' then
@@ -906,6 +1002,7 @@ begin
               pinit(k) <= '1';
               waiting(k) <= '0';
               job(k) <= '1';
+              eacc(k) <= chk_early and pass_b;
               c8x_a(k) <= e_c8x; c8y_a(k) <= e_c8y; w8_a(k) <= e_w8; h8_a(k) <= e_h8;
               if pass_b = '1' then
                 n_cnt <= n_cnt + 1;
@@ -917,6 +1014,9 @@ begin
               cap_y0 <= shift_left(rect_y, idx(l2d));
               cap_x1 <= shift_left(rect_x + rect_w, idx(l2d));
               cap_y1 <= shift_left(rect_y + rect_h, idx(l2d));
+            elsif chk_early = '1' then                   -- refused in the blanking: at the start of frame
+              eref(k) <= '1';
+              waiting(k) <= '0';
             else                                         -- refused: the slot is free again
               alloc(k) <= '0'; pend(k) <= '0'; waiting(k) <= '0';
               rej_flag <= '1';
@@ -932,6 +1032,8 @@ begin
         when S_OPEN =>                                   -- the start of frame goes in
           if beat = '1' then
             plan_ok <= '0';
+            eacc <= (others => '0');                     -- the verdicts hold
+            chk_ok <= '0';
             arm_req <= '1';
             q_flush <= '1';                              -- a cut frame's jobs not started are dropped
             fsm <= S_STREAM;
@@ -988,26 +1090,26 @@ begin
               rej_flag <= '0';
               fsm <= S_IDLE;
             end if;
+          elsif pf_ok = '0' then
+            pf_ok <= '1';                                -- slot j's reads
           else
-            k := j;
             k_cur <= to_unsigned(j, 4);
-            fl := v2_flags('0', '0', '0', '1', rejd(k) or (first_w and rej_any), not valid(k), '0');
-            if alloc(k) = '0' then
+            fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
+            if pf_alloc = '0' then
               j <= j + 1;
-            elsif (valid(k) = '1' or pinit(k) = '1') and (fr_w /= fw_a(k) or fr_h /= fh_a(k)) then
-              side_w <= top_word(c8x_a(k), c8y_a(k), w8_a(k), h8_a(k), ST_ERROR, to_unsigned(0, 3), fl,
+            elsif (pf_valid = '1' or pf_pinit = '1') and pf_size = '1' then
+              side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl,
                                  ERR_SIZE_CHANGED, fcount);
-              side_push <= valid(k);
-              side_nt <= not valid(k);
+              side_push <= pf_valid;
+              side_nt <= not pf_valid;
               fsm <= S_SIDE;
-            elsif held(k) = '1' and valid(k) = '1' then
-              fl := v2_flags('0', '0', '0', '1', rejd(k) or (first_w and rej_any), '0', '0');
-              side_w <= top_word(c8x_a(k), c8y_a(k), w8_a(k), h8_a(k), ST_ERROR, hold_l2d(k), fl,
-                                 ERR_CAPACITY, fcount);
+            elsif pf_held = '1' and pf_valid = '1' then
+              fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), '0', '0');
+              side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, pf_l2d, fl, ERR_CAPACITY, fcount);
               side_push <= '1';
               side_nt <= '0';
               fsm <= S_SIDE;
-            elsif pinit(k) = '1' or valid(k) = '1' then    -- the job's word and state are in
+            elsif pf_pinit = '1' or pf_valid = '1' then    -- the job's word and state are in
               fsm <= S_COMMIT;
             else                                         -- no target (a box the engine refused)
               side_push <= '0';
@@ -1070,15 +1172,15 @@ begin
                 fsm <= S_IDLE;
               end if;
             end if;
+          elsif pf_ok = '0' then
+            pf_ok <= '1';                                -- slot j's reads
           else
-            k := j;
             k_cur <= to_unsigned(j, 4);
-            fl := v2_flags('0', '0', '0', '1', rejd(k) or (first_w and rej_any), not valid(k), '0');
-            side_w <= top_word(c8x_a(k), c8y_a(k), w8_a(k), h8_a(k), ST_ERROR, to_unsigned(0, 3), fl, err_r,
-                               fcount);
-            side_push <= alloc(k) and valid(k);
-            side_nt <= not valid(k);
-            if alloc(k) = '0' then
+            fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
+            side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, err_r, fcount);
+            side_push <= pf_alloc and pf_valid;
+            side_nt <= not pf_valid;
+            if pf_alloc = '0' then
               j <= j + 1;
             else
               fsm <= S_SIDE;
@@ -1133,6 +1235,11 @@ begin
         cut_pend <= '0';
         plan_ok <= '0';
         early <= '0';
+        eacc <= (others => '0');
+        eref <= (others => '0');
+        chk_ok <= '0';
+        chk_early <= '0';
+        a_rd <= '0';
         runm <= (others => '0');
       end if;
     end if;

@@ -100,6 +100,11 @@ CI_EXTRA: dict[str, str] = {
         "core, whose registers and result banks are the same code: TUD-Stadtmitte, refused adds, a rejected box, "
         "a slow result sink) and tb/test_ms_tracker_multi.py::test_multi_fuzz (the replicated-engine core's "
         "netlist); this case: the replicated-engine core behind the driver (its own build)",
+    "tb/test_ms_tracker_shared.py::test_ms_tracker_shared_early_checks":
+        "test_shared_early_checks_no_stall (marker long: the same job on the netlist, bit-exact, no start of frame "
+        "waits for the checks) and test_shared_fuzz (commands 3,000 clocks apart and blanking on CI seeds: adds "
+        "checked in the blanking, verdicts undone by a remove); this case: the RTL under GHDL, counting the "
+        "checks in the blanking, their refusals and the verdicts undone from the core's own signals",
     "tb/test_ms_tracker_shared.py::test_ms_tracker_shared_capacity":
         "test_shared_fuzz (marker long: the same core, the same frame period of 90 lines of 1,000 clocks, held "
         "targets and adds refused by the rule on every CI seed, its netlist bit-exact with the model); this case: "

@@ -77,6 +77,8 @@ async def shared_core(dut):
     words: list[dict] = []
     reports: list[tuple[int, int]] = []
     late_faults: list[int] = []
+    early = {"runs": 0, "refused": 0, "undone": 0}           # the adds' checks in the blanking
+    prev = {"ce": 0, "ea": 0, "er": 0, "wt": 0}
     pause = job.get("out_pause_pct", 0) / 100
 
     async def monitor():
@@ -91,6 +93,12 @@ async def shared_core(dut):
                 reports.append((int(dut.cmd_code.value), int(dut.cmd_id.value)))
             if int(dut.fe_error.value) and dut.jdone.value.to_unsigned():
                 late_faults.append(len(words))          # a fault after some job of its frame has ended
+            ce, ea, er, wt = (int(dut.chk_early.value), dut.eacc.value.to_unsigned(), dut.eref.value.to_unsigned(),
+                              dut.waiting.value.to_unsigned())
+            early["runs"] += ce and not prev["ce"]           # a check in the blanking begins
+            early["refused"] += bin(er & ~prev["er"]).count("1")   # an add refused there (tentatively)
+            early["undone"] += bin((prev["ea"] | prev["er"]) & wt & ~prev["wt"]).count("1")  # waits again
+            prev.update(ce=ce, ea=ea, er=er, wt=wt)
 
     async def consumer():
         while True:
@@ -116,12 +124,16 @@ async def shared_core(dut):
             if ok:
                 break
         dut.s_cmd_tvalid.value = 0
+        if job.get("cmd_gap"):                             # idle clocks after a command (a slow CPU)
+            await ClockCycles(dut.clk, job["cmd_gap"])
 
     limit = job.get("watchdog", 300_000)
     gaps = {int(k): v for k, v in job.get("line_gaps", {}).items()}
     for i, fr in enumerate(frames):
         for op, arg in cmds.get(i, []):
             await command(op, arg)
+        if job.get("vblank"):                              # idle clocks before the start of frame
+            await ClockCycles(dut.clk, job["vblank"])
         prev_last = 0
         for data, user, last in frame_beats(frame_words(fr), faults.get(i)):
             await FallingEdge(dut.clk)
@@ -166,6 +178,9 @@ async def shared_core(dut):
         assert len(late_faults) >= job["min_late"], f"faults after a job's end: {late_faults}"
     if job.get("min_held"):
         assert held >= job["min_held"], f"only {held} targets held"
+    dut._log.info("checks in the blanking: %s", early)
+    for k in ("runs", "refused", "undone"):
+        assert early[k] >= job.get("min_early", {}).get(k, 0), f"checks in the blanking: {early}"
 
 
 # ----------------------------------------------------------------------------- pytest side
@@ -196,6 +211,17 @@ SCENE_JOB = {"scene": {"n": 12, "w": 96, "h": 80, "targets": 4, "seed": 3}, "slo
 CAPACITY_JOB = {**SCENE_JOB, "timing": [80, 90, 1000], "faults": {}, "out_pause_pct": 0, "min_held": 10,
                 "cmds": [[0, "add", [0, 1]], [0, "add", [0, 2]], [0, "add", [0, 3]], [3, "add", [3, 4]],
                          [5, "remove", 0], [6, "add", [6, 4]]]}
+
+
+#: the capacity case with a slow CPU and the blanking of a camera: 3,000 idle clocks after each command and
+#: 20,000 before each start of frame, so the adds are checked in the blanking as they are taken; on frame 3
+#: an add is followed by a remove, on frame 6 a box the engine refuses by a remove: their verdicts are undone
+#: by the new plan and checked again; refusals of the blanking are reported at the start of frame
+EARLY_JOB = {**CAPACITY_JOB, "cmd_gap": 3000, "vblank": 20000, "min_held": 0,
+             "min_early": {"runs": 4, "refused": 1, "undone": 1},
+             "cmds": [[0, "add", [0, 1]], [0, "add", [0, 2]], [0, "add", [0, 3]], [3, "add", [3, 4]],
+                      [3, "remove", 0], [5, "add", [5, 1]], [6, "add", [200, 200, 10, 10]], [6, "remove", 1],
+                      [8, "add", [8, 2]], [8, "add", [8, 3]]]}
 
 
 def _run_ghdl(job: dict, waves: bool) -> None:
@@ -236,10 +262,36 @@ def test_ms_tracker_shared_late_fault(hdl_waves):
 
 @pytest.mark.long
 @pytest.mark.ghdl
+def test_ms_tracker_shared_early_checks(hdl_waves):
+    """Adds checked in the blanking as they are taken: tentative verdicts, refusals reported at the start of
+    frame, verdicts undone by a remove's new plan; every word and report as the model's (checked at the
+    start of frame)."""
+    _run_ghdl(EARLY_JOB, hdl_waves)
+
+
+@pytest.mark.long
+@pytest.mark.ghdl
 def test_ms_tracker_shared_capacity(hdl_waves):
     """Held targets and refused adds: the plan's verdicts in the words and reports."""
     job = CAPACITY_JOB
     _run_ghdl(job, hdl_waves)
+
+
+@pytest.mark.long
+@pytest.mark.verilator
+def test_shared_early_checks_no_stall():
+    """EARLY_JOB on the netlist with the blanking of a camera: a frame period (7,680 clocks of pixels and
+    100,000 of blanking, before the first frame too) longer than the rule's (90 lines of 1,000 clocks), so the
+    jobs the rule admits end in their blanking, and 3,000 clocks after each command.  Every word and report
+    bit-exact, and every start of frame goes in with at most a clock of stall per slot and two per add
+    refused in the blanking, plus two (the checks ran before it; the refusals are reported at it)."""
+    frames, cmds = scene_of(EARLY_JOB)
+    m, run = run_netlist(frames, cmds, EARLY_JOB, vblank=100_000, cmd_gap=3000, lead=100_000)
+    stalls = [f["stall_cycles"] for f in run.frames]
+    refused = sum(o.code == 2 for o in m.outcomes)
+    print(f"\nstalls {stalls}, {refused} refused")
+    assert refused >= 1, m.outcomes
+    assert max(stalls) <= 2 + EARLY_JOB["slots"] + 2 * refused, f"stalls per frame {stalls}"
 
 
 # ----------------------------------------------------------------------------- the netlist on real sequences
@@ -271,7 +323,7 @@ def mot_commands(seq, slots: int) -> dict[int, list[tuple]]:
 
 
 def run_netlist(frames, cmds, job: dict, faults: dict[int, str] | None = None, out_pause_pct: int = 0,
-                hblank: int = 0):
+                hblank: int = 0, vblank: int = 0, cmd_gap: int = 0, lead: int = 0):
     """ms_tracker_shared's GHDL netlist under Verilator (mstrack.hw.fastsim.simulate_multi with the
     multi-target harness) against CoreModelMulti with the capacity rule: every word and report."""
     from mstrack.hw import fastsim
@@ -285,7 +337,7 @@ def run_netlist(frames, cmds, job: dict, faults: dict[int, str] | None = None, o
                                "SCALE_PERMILLE", "C_SCALE")}
     run = fastsim.simulate_multi(list(frames), cmds, tp, fp, max_targets=job["slots"], max_frame_w=job["max_frame_w"],
                                  words=len(m.results), out_pause_pct=out_pause_pct, faults=faults, top=TOP,
-                                 hblank=hblank,
+                                 hblank=hblank, vblank=vblank, cmd_gap=cmd_gap, lead=lead,
                                  extra_generics=extra, watchdog=8_000_000, cxx_opt=fastsim.CXX_OPT_SHORT)
     diffs = diff_words(run.words, m.frames)
     assert not diffs, "\n".join(diffs[:10])
@@ -374,13 +426,17 @@ CI_FUZZ_SEEDS = (1, 10)
 
 
 def fuzz_case(seed: int) -> tuple:
-    """Seed -> (frames, commands, faults, result back-pressure %, hblank): the multi-target core's fuzz case
-    (tb/test_ms_tracker_multi.py fuzz_case: a generated 4-target scene of 8 frames, adds, removes of any id,
-    boxes off the frame, short lines and cuts) and, from the same seed, 0 or 400 idle clocks after each
-    line (so jobs run while their frame streams)."""
+    """Seed -> (frames, commands, faults, result back-pressure %, hblank, vblank, cmd_gap): the multi-target
+    core's fuzz case (tb/test_ms_tracker_multi.py fuzz_case: a generated 4-target scene of 8 frames, adds,
+    removes of any id, boxes off the frame, short lines and cuts) and, from the same seed, 0 or 400 idle
+    clocks after each line (so jobs run while their frame streams), 0, 2,000 or 20,000 after each frame (the
+    harness gives a frame's commands as the blanking begins: with 20,000 the adds are checked in the
+    blanking, with 2,000 the start of frame may come while they are) and 0 or 3,000 after each command (an
+    add checked before the next command: a remove after it undoes its verdict)."""
     from test_ms_tracker_multi import fuzz_case as multi_case
     frames, cmds, faults, pause = multi_case(seed)
-    return frames, cmds, faults, pause, random.Random(seed * 7919).choice((0, 0, 400))
+    return (frames, cmds, faults, pause, random.Random(seed * 7919).choice((0, 0, 400)),
+            random.Random(seed * 104729).choice((0, 2000, 20000)), random.Random(seed * 15485863).choice((0, 3000)))
 
 
 def test_shared_fuzz_ci_seeds_cover_every_kind():
@@ -391,9 +447,11 @@ def test_shared_fuzz_ci_seeds_cover_every_kind():
     codes: set[int] = set()
     held = 0
     kinds: set[str] = set()
-    pauses, gaps = set(), set()
+    pauses, gaps, blanks = set(), set(), set()
+    undo = 0                                             # an add, then another command, checked in the blanking
     for seed in range(CI_FUZZ_SEEDS[0], sum(CI_FUZZ_SEEDS)):
-        frames, cmds, faults, pause, hblank = fuzz_case(seed)
+        frames, cmds, faults, pause, hblank, vblank, cmd_gap = fuzz_case(seed)
+        undo += bool(vblank and cmd_gap) * sum(len(v) == 2 and v[0][0] == "add" for v in cmds.values())
         tp, fp, cap = params_of(FUZZ_JOB)
         m = expected_multi(frames, cmds, tp, fp, FUZZ_JOB["slots"], FUZZ_JOB["max_frame_w"], faults, capacity=cap)
         codes |= {o.code for o in m.outcomes}
@@ -401,8 +459,10 @@ def test_shared_fuzz_ci_seeds_cover_every_kind():
         kinds |= set(faults.values())
         pauses.add(pause)
         gaps.add(hblank)
+        blanks.add(vblank)
     assert {CMD_OK, CMD_REFUSED, CMD_CYCLES, CMD_BOX} <= codes, codes
     assert held >= 10 and kinds == {"short_line", "cut"} and max(pauses) > 0 and gaps == {0, 400}
+    assert blanks == {0, 2000, 20000} and undo >= 2, (blanks, undo)
 
 
 @pytest.mark.long
@@ -415,9 +475,10 @@ def test_shared_fuzz():
     first, count = (int(v) for v in os.environ.get("MSTRACK_FUZZ", "%d:%d" % CI_FUZZ_SEEDS).split(":"))
     stats = {"words": 0, "held": 0, "commands": 0, "faults": 0, "refused": 0, "cycles": 0, "box": 0}
     for seed in range(first, first + count):
-        frames, cmds, faults, pause, hblank = fuzz_case(seed)
+        frames, cmds, faults, pause, hblank, vblank, cmd_gap = fuzz_case(seed)
         try:
-            m, _ = run_netlist(frames, cmds, FUZZ_JOB, faults=faults, out_pause_pct=pause, hblank=hblank)
+            m, _ = run_netlist(frames, cmds, FUZZ_JOB, faults=faults, out_pause_pct=pause, hblank=hblank,
+                               vblank=vblank, cmd_gap=cmd_gap)
         except AssertionError as exc:
             raise AssertionError(f"seed {seed} (replay: make test-fuzz-shared SEEDS={seed} N=1): {exc}") from exc
         stats["words"] += len(m.results)

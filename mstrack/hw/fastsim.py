@@ -444,11 +444,12 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
                    hblank: int = 0, vblank: int = 0, lead: int = 0, out_pause_pct: int = 0, seed: int = 1,
                    words: int | None = None, watchdog: int = 4_000_000, workdir: Path | str | None = None,
                    check: bool = True, faults: dict[int, str] | None = None, cxx_opt: str = CXX_OPT,
-                   top: str = MULTI_TOP, extra_generics: dict[str, int] | None = None) -> MultiRun:
+                   top: str = MULTI_TOP, extra_generics: dict[str, int] | None = None, cmd_gap: int = 0) -> MultiRun:
     """Stream *frames* through the verilated ms_tracker_multi, with *commands* given before the frames
     they are keyed by: ``{frame: [("add", (x, y, w, h)) | ("remove", id), ...]}`` (a key of len(frames):
     after the last frame).  *hblank* / *vblank*: idle clocks after each line / frame; *lead*: idle clocks
-    after frame 0's commands, before its first pixel.  *words*: result words to wait for (default: one per frame at least).
+    after frame 0's commands, before its first pixel; *cmd_gap*: idle clocks after each command taken before
+    the next one (a slow CPU).  *words*: result words to wait for (default: one per frame at least).
     *faults*: ``{frame: "short_line" | "cut"}`` stream faults (as :func:`mstrack.hw.cosim_multi.frame_beats`).
     *cxx_opt*: the build's C++ optimisation (as :func:`build`; ``-O1`` builds in about half the time of -O3 for
     short runs).  *top*, *extra_generics*: as :func:`build_multi`.  Raise :class:`FastsimError` when the
@@ -465,7 +466,7 @@ def simulate_multi(frames: Sequence[np.ndarray], commands: dict[int, list[tuple]
         n, w, h = _write_pixels(frames, wd / "pixels.bin")
         lines = [f"width {w}", f"height {h}", f"frames {n}", f"pixels {wd / 'pixels.bin'}", f"hblank {hblank}",
                  f"vblank {vblank}", f"lead {lead}", f"out_pause_pct {out_pause_pct}", f"seed {seed}",
-                 f"words {words if words is not None else n}", f"watchdog {watchdog}"]
+                 f"words {words if words is not None else n}", f"watchdog {watchdog}", f"cmd_gap {cmd_gap}"]
         for fr, kind in sorted((faults or {}).items()):
             if kind not in ("short_line", "cut"):
                 raise ValueError(f"fault {kind!r}: short_line or cut")

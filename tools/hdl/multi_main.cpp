@@ -14,6 +14,8 @@
 //   hblank, vblank                  tvalid-low clocks after each line / extra after each frame
 //   lead                            tvalid-low clocks before the first frame, after its commands
 //                                   (the vertical blanking a camera gives before it; default 0)
+//   cmd_gap                         idle clocks after each command taken before the next one of the
+//                                   same frame is given (a CPU that issues commands slowly; default 0)
 //   out_pause_pct, seed             random m_axis_result_tready = 0 (percent), its seed
 //   words                           result words to wait for
 //   watchdog                        stop when no word has come for this many clocks after the last
@@ -90,7 +92,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "job needs width, height, frames and pixels\n");
         return 2;
     }
-    const long long hblank = num("hblank", 0), vblank = num("vblank", 0);
+    const long long hblank = num("hblank", 0), vblank = num("vblank", 0), cmd_gap = num("cmd_gap", 0);
     const int out_pause = static_cast<int>(num("out_pause_pct", 0));
     const long long n_words = num("words", 0), watchdog = num("watchdog", 4000000), tail = num("tail", 200);
     std::FILE* pix_f = std::fopen(job.str("pixels").c_str(), "rb");
@@ -129,6 +131,7 @@ int main(int argc, char** argv) {
     // the width of the current row: three pixels short on row 5 of a short_line frame
     auto row_w = [&]() -> long long { return (y == 5 && fault_of(f) == "short_line") ? W - 3 : W; };
     std::size_t next_cmd = 0;
+    long long cmd_wait = 0;                     // cmd_gap clocks left before the next command
     bool frame_loaded = false;
     std::string status = "done", detail;
     std::vector<FrameTimes> times(static_cast<std::size_t>(n_frames));
@@ -139,7 +142,10 @@ int main(int argc, char** argv) {
         // ---- inputs of this clock: a command of the next frame first, then the video
         bool cmd_valid = false, s_valid = false;
         const bool at_frame_start = (x == 0 && y == 0);
-        if (next_cmd < cmds.size() && at_frame_start && cmds[next_cmd].frame <= f) {
+        const bool cmd_due = next_cmd < cmds.size() && at_frame_start && cmds[next_cmd].frame <= f;
+        if (cmd_due && cmd_wait > 0) {
+            --cmd_wait;
+        } else if (cmd_due) {
             const Cmd& c = cmds[next_cmd];
             cmd_valid = true;
             top.s_cmd_op = static_cast<uint8_t>(c.op);
@@ -185,6 +191,7 @@ int main(int argc, char** argv) {
         if (cmd_fire) {
             std::fprintf(o, "T %lld %zu %lld\n", f, next_cmd, cycle);
             ++next_cmd;
+            cmd_wait = cmd_gap;
             last_event = cycle;
         }
         if (s_valid && f < n_frames) {

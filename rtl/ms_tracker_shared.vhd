@@ -333,7 +333,7 @@ architecture rtl of ms_tracker_shared is
   signal st_slot  : unsigned(3 downto 0) := (others => '0');
   signal st_w8, st_h8 : unsigned(COORD_W + 7 downto 0) := (others => '0');
   signal st_c8x, st_c8y : unsigned(COORD_W + CF - 1 downto 0) := (others => '0');
-  signal st_lost, st_valid_r : std_logic := '0';
+  signal st_lost, st_valid_r, st_pend : std_logic := '0';
   signal p_l2d    : unsigned(2 downto 0);
   signal p_reg_x, p_reg_y : unsigned(COORD_W - 1 downto 0);
   signal p_reg_w, p_reg_h : unsigned(PLAN_REGION_W - 1 downto 0);
@@ -341,6 +341,8 @@ architecture rtl of ms_tracker_shared is
   signal a_code   : unsigned(1 downto 0);
   signal a_clocks : unsigned(CLK_W - 1 downto 0) := (others => '0');
   signal a_release, a_next : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal g_x0, g_y0, g_x1, g_y1, g_next : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal g_rel : unsigned(COORD_W downto 0) := (others => '0');
   signal jc_start, jc_done : std_logic := '0';
   signal jc_clocks : unsigned(CLK_W - 1 downto 0);
 
@@ -593,7 +595,6 @@ begin
     variable fl : std_logic_vector(7 downto 0);
     variable refd : std_logic;                             -- S_ADDS: the add was refused in the blanking
     variable m : std_logic_vector(NT - 1 downto 0);
-    variable rel : unsigned(COORD_W downto 0);
 
     -- slot s leaves the age order (a remove, a refused add, a box the engine refused): the entries after
     -- it move up one place (a slot is in the order at most once)
@@ -644,6 +645,14 @@ begin
       ro_valid <= '0';
       ro_close <= '0';
       q_flush <= '0';
+      -- an add's init rectangle in frame px, its release and next line (the engine's geometry holds from
+      -- geo_done until the check's verdict, hundreds of clocks later: registered here every clock)
+      g_x0 <= shift_left(rect_x, idx(l2d));
+      g_y0 <= shift_left(rect_y, idx(l2d));
+      g_x1 <= shift_left(rect_x + rect_w, idx(l2d));
+      g_y1 <= shift_left(rect_y + rect_h, idx(l2d));
+      g_rel <= shift_left(resize(rect_y + rect_h, COORD_W + 1), idx(l2d)) + 1;
+      g_next <= shift_left(reg_y, idx(l2d));
       -- slot j's reads for the walk (j = NT: nothing to read)
       pf_ok <= '0';
       if j < NT then
@@ -747,15 +756,20 @@ begin
           end if;
       end case;
       -- the plan asks for the k-th oldest live target's state
+      -- (two clocks: the slot, then its state)
       if st_req = '1' then
-        k := idx(lst(idx(st_index)));
         st_slot <= lst(idx(st_index));
+        st_pend <= '1';
+      end if;
+      if st_pend = '1' then
+        k := idx(st_slot);
         st_w8 <= resize(w8_a(k), COORD_W + 8);
         st_h8 <= resize(h8_a(k), COORD_W + 8);
         st_c8x <= resize(c8x_a(k), COORD_W + CF);
         st_c8y <= resize(c8y_a(k), COORD_W + CF);
         st_lost <= recs(k)(1);
         st_valid_r <= '1';
+        st_pend <= '0';
       end if;
 
       case fsm is
@@ -978,13 +992,12 @@ begin
         when S_A_CLK =>
           if jc_done = '1' then
             a_clocks <= jc_clocks;
-            rel := shift_left(resize(rect_y + rect_h, COORD_W + 1), idx(l2d)) + 1;
-            if rel > resize(fh_a(idx(k_cur)), COORD_W + 1) then
+            if g_rel > resize(fh_a(idx(k_cur)), COORD_W + 1) then
               a_release <= fh_a(idx(k_cur));
             else
-              a_release <= resize(rel, COORD_W);
+              a_release <= resize(g_rel, COORD_W);
             end if;
-            a_next <= shift_left(reg_y, idx(l2d));
+            a_next <= g_next;
             a_full <= '1' when n_cnt >= NT else '0';
             fsm <= S_A_OFFER;
           end if;
@@ -1010,10 +1023,7 @@ begin
               cap_load <= '1';
               cap_slot <= resize(k_cur, SW);
               cap_l2d <= l2d;
-              cap_x0 <= shift_left(rect_x, idx(l2d));
-              cap_y0 <= shift_left(rect_y, idx(l2d));
-              cap_x1 <= shift_left(rect_x + rect_w, idx(l2d));
-              cap_y1 <= shift_left(rect_y + rect_h, idx(l2d));
+              cap_x0 <= g_x0; cap_y0 <= g_y0; cap_x1 <= g_x1; cap_y1 <= g_y1;
             elsif chk_early = '1' then                   -- refused in the blanking: at the start of frame
               eref(k) <= '1';
               waiting(k) <= '0';
@@ -1240,6 +1250,7 @@ begin
         chk_ok <= '0';
         chk_early <= '0';
         a_rd <= '0';
+        st_pend <= '0';
         runm <= (others => '0');
       end if;
     end if;

@@ -184,9 +184,11 @@ def _base_params(tracker: str) -> tuple[TrackerParams, dict[str, Any]]:
         raise ValueError(f"explore runs mstrack trackers; unknown {tracker!r}; known: {', '.join(known)}")
     if tracker == "mstrack-v2":
         kw: dict[str, Any] = {"preset": "v2"}
-    elif tracker == "mstrack-v2-colour":
+    elif tracker in ("mstrack-v2-colour", "mstrack-v2-colour-w63"):
         from .track.params import V2_COLOUR
         kw = {"preset": "v2", **V2_COLOUR}
+        if tracker.endswith("-w63"):    # the tracker parameter; a grid's fp keys set the fixed widths
+            kw["max_window"] = 63
     else:
         _, feat, ker = tracker.split("-")
         kw = {"preset": "paper", "features": canonical("features", feat), "kernel": canonical("kernel", ker)}

@@ -611,8 +611,9 @@ def test_registered_v2_trackers():
     """``mstrack-v2`` (make results, mstrack eval / bench / explore) builds the default tracker v2, the
     joint tracker's options and loss thresholds (V2_JOINT), in both models, and tracks the scene of
     test_fixed_v2_joint_gate_tracks_like_float exactly as those options given by hand do;
-    ``mstrack-v2-colour`` builds V2_COLOUR's (ORIENT_T 0, no scale test) and tracks differently; the
-    former name ``mstrack-v2-joint`` is refused with its new name."""
+    ``mstrack-v2-colour`` builds V2_COLOUR's (ORIENT_T 0, no scale test) and tracks differently;
+    ``mstrack-v2-colour-w63`` adds max_window 63 and, in the fixed model, the shared8-colour-w63 build's
+    MAX_HALF 31 and COORD_W 11; the former name ``mstrack-v2-joint`` is refused with its new name."""
     from mstrack.eval.evaluate import V2_COLOUR, V2_JOINT, make_tracker
     from mstrack.explore import _base_params
     frames, gt = _scene()
@@ -629,6 +630,10 @@ def test_registered_v2_trackers():
         assert c.params == TrackerParams(preset="v2", **V2_COLOUR) and c.params.orient_T == 0, model
         colour = [c.init(frames[0], tuple(gt[0]))] + [c.update(f) for f in frames[1:]]
         assert colour != got, model
+        w = make_tracker("mstrack-v2-colour-w63", model)   # the shared8-colour-w63 build's tracker
+        assert w.params == TrackerParams(preset="v2", **V2_COLOUR, max_window=63), model
+        if model == "fixed":
+            assert (w._impl.fixed.max_half, w._impl.fixed.coord_bits) == (31, 11)
     with pytest.raises(ValueError, match="is now 'mstrack-v2'"):
         make_tracker("mstrack-v2-joint")
     tp, kw = _base_params("mstrack-v2")

@@ -47,11 +47,15 @@ CACHE_VERSION = 3
 MODELS = ("float", "fixed")
 
 
-def _mstrack(features: str | None, kernel: str, preset: str = "paper", **extra: Any) -> Callable[[str], Any]:
+def _mstrack(features: str | None, kernel: str, preset: str = "paper", fixed: dict[str, Any] | None = None,
+             **extra: Any) -> Callable[[str], Any]:
+    """A factory of mstrack.Tracker; *fixed*: FixedParams fields given to the fixed model only."""
     def make(model: str = "float") -> Any:
         from ..track.tracker import Tracker  # imported late: written separately, may be absent
-        return Tracker(model=model, features=features, kernel=kernel, preset=preset, **extra)  # type: ignore[arg-type]
-    more = "".join(f", {k}={v!r}" for k, v in extra.items())
+        more_fp = dict(fixed or {}) if model == "fixed" else {}
+        return Tracker(model=model, features=features, kernel=kernel, preset=preset,  # type: ignore[arg-type]
+                       **extra, **more_fp)
+    more = "".join(f", {k}={v!r}" for k, v in {**extra, **(fixed or {})}.items())
     make.__doc__ = f"mstrack.Tracker(preset={preset!r}, features={features!r}, kernel={kernel!r}{more})"
     return make
 
@@ -67,6 +71,10 @@ def _baseline(fn: Callable[[], Any]) -> Callable[[str], Any]:
 TRACKERS: dict[str, Callable[[str], Any]] = {
     "mstrack-v2": _mstrack(None, "flat", "v2"),
     "mstrack-v2-colour": _mstrack(None, "flat", "v2", **V2_COLOUR),
+    # the tracker of the shared-engine core's eight-target build (mstrack synth --config shared8-colour-w63):
+    # windows up to 63 decimated px; the fixed model with that build's MAX_HALF 31 and COORD_W 11
+    "mstrack-v2-colour-w63": _mstrack(None, "flat", "v2", fixed={"max_half": 31, "coord_bits": 11}, **V2_COLOUR,
+                                      max_window=63),
     "mstrack-fused-flat": _mstrack("fused", "flat"),
     "mstrack-colour-flat": _mstrack("colour", "flat"),
     "mstrack-edge-flat": _mstrack("edge", "flat"),

@@ -12,7 +12,8 @@
 -- CMD_CYCLES); the verdicts are tentative until the start of frame, which reports and frees the refused
 -- adds (a clock or two each) and goes in; adds taken too late to be checked, or a plan made again (a
 -- remove, a fault's words, another frame size), are checked at the start of frame while the input
--- waits.  A frame with nothing left to check goes in at once.  Each target with a job has its
+-- waits.  A frame with nothing left to check goes in at once.  A frame size on the ports other than the
+-- plan's, in the blanking, plans again there (and undoes the checks).  Each target with a job has its
 -- slot's capture loaded (the region, or the init rectangle).  The frame then streams in,
 -- every slot capturing its own region, and the jobs run as their slots are released (ms_job_queue, in
 -- release order; an init: ms_init_job learns the model from the slot first).  A job's word goes to
@@ -861,6 +862,8 @@ begin
             pl_fw <= frame_width;
             pl_fh <= frame_height;
             fsm <= S_LIST;
+          elsif plan_ok = '1' and (frame_width /= pl_fw or frame_height /= pl_fh) then
+            plan_ok <= '0';                              -- the frame size changed since the plan: plan again
           elsif plan_ok = '1' and (waiting /= (waiting'range => '0')
                                    or (pinit /= (pinit'range => '0') and chk_ok = '0'))
                 and open_in = '0' and fe_busy = '0' and jfsm = J_IDLE then

@@ -270,19 +270,18 @@ def _check_top(c: CoreChoices) -> None:
 
 
 def _axi_generics(c: CoreChoices, tp: TrackerParams, fp: FixedParams, g: dict[str, int]) -> dict[str, int]:
-    """ms_tracker's generics *g*, with ms_tracker_axi's own when ``c.top`` is ms_tracker_axi
-    (:func:`mstrack.hw.drvsim.axi_generics`'s: MAX_TARGETS, SHARED_ENGINE and the shared engine's from
-    :func:`mstrack.hw.multi_core.shared_core_generics`, RESULT_STREAM)."""
+    """ms_tracker's generics *g*, with ms_tracker_axi's own when ``c.top`` is ms_tracker_axi: those of
+    :func:`mstrack.hw.drvsim.axi_generics` (RESULT_STREAM, MAX_TARGETS, SHARED_ENGINE and the shared
+    engine's), MAX_TARGETS and SHARED_ENGINE always given."""
     if c.top == "ms_tracker":
         return g
-    out = {**g, "MAX_TARGETS": c.max_targets, "SHARED_ENGINE": int(c.shared_engine)}
-    if c.shared_engine:
-        from .multi_core import pass_costs, shared_core_generics
-        sg = shared_core_generics(tp, fp, c.max_targets, mode_timing(c.timing), c.max_frame_width,
-                                  costs=pass_costs(c.lanes))
-        out.update({k: v for k, v in sg.items() if k not in out})
-    out["RESULT_STREAM"] = int(c.result_stream)
-    return out
+    from .cosim import CoreConfig, CoreConfigV2
+    from .drvsim import axi_generics
+    cfg = (CoreConfigV2(tp, fp, c.lanes, c.max_frame_width) if c.preset == "v2"
+           else CoreConfig(tp, fp, c.lanes, c.max_frame_width))
+    own = axi_generics(cfg, c.max_targets, c.result_stream, mode_timing(c.timing) if c.shared_engine else None)
+    return {**g, "MAX_TARGETS": c.max_targets, "SHARED_ENGINE": int(c.shared_engine),
+            **{k: v for k, v in own.items() if k not in g}}
 
 
 def entity_generics(path: Path = TRACKER_VHD, entity: str = "ms_tracker") -> list[str]:

@@ -187,6 +187,9 @@ entity ms_engine is
     m_t_all        : in  std_logic_vector(8 * boolean'pos(ORIENT_T >= 0) downto 0);
     -- the region memory (colour bins; orientation bins with ORIENT_T >= 0), RAM_LAT clocks
     ram_addr       : out std_logic_vector(LANES * ADDR_W - 1 downto 0);
+    -- ram_addr of the next clock (combinational, ms_pixel_pass): for a memory that registers the
+    -- address once more in front of its RAMs (ms_slot_pool), RAM_LAT + 1 clocks from ram_addr_next
+    ram_addr_next  : out std_logic_vector(LANES * ADDR_W - 1 downto 0);
     ram_data       : in  std_logic_vector(LANES * 3 * COLOUR_BITS - 1 downto 0);
     ram_obin       : in  std_logic_vector(LANES * 4 - 1 downto 0);
     -- the result word (result word v2; its frame_count, rejected and overflow from these inputs)
@@ -594,7 +597,8 @@ begin
               lo_x_in => ms_lo_x, lo_y_in => ms_lo_y, start => eng_start,
               learn => '0', start_cx => eng_cx, start_cy => eng_cy, busy => c_busy, done => c_done,
               res_cx => c_cx, res_cy => c_cy, res_s => c_s, res_iter => c_iter, res_stop => c_stop,
-              res_k => c_k, ram_addr => ram_addr, ram_data => ram_data, ram_obin => ram_obin,
+              res_k => c_k, ram_addr => ram_addr, ram_addr_next => ram_addr_next, ram_data => ram_data,
+              ram_obin => ram_obin,
               single => eng_single, max_it => eng_max_it,
               q_ext_we => q_we_one, q_ext_addr => unsigned(ms_out_tag), q_ext_data => ms_out_qw,
               q_ext_all_we => q_we_all, q_ext_all_data => ms_out_qw_all,

@@ -108,6 +108,7 @@ entity ms_meanshift is
     res_k     : out unsigned(HIST_W - 1 downto 0);                -- K (learn mode)
     -- region RAM read port (one address per bank, data 1 clock later)
     ram_addr  : out std_logic_vector(LANES * ADDR_W - 1 downto 0);
+    ram_addr_next : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- ram_addr of the next clock (ms_pixel_pass)
     ram_data  : in  std_logic_vector(LANES * BIN_W - 1 downto 0);
     ram_obin  : in  std_logic_vector(LANES * 4 - 1 downto 0) := (others => '0');  -- N_ORIENT > 1: orientation
                                                                   -- bin per bank (lane l at l*4), as ram_data
@@ -205,7 +206,8 @@ begin
     port map (clk => clk, rst => rst, ready => pp_ready, start => pp_start, win_x => win_x, win_y => win_y,
               ex => ex, ey => ey, kt_we => kt_we, kt_addr => kt_addr, kt_ta => kt_ta,
               kt_tb => kt_tb, kt_ka => kt_ka, kt_kb => kt_kb, kt_xr => kt_xr, kd_d => kd_d,
-              ram_addr => ram_addr, ram_data => ram_data, ram_obin => ram_obin, done => pp_done,
+              ram_addr => ram_addr, ram_addr_next => ram_addr_next, ram_data => ram_data, ram_obin => ram_obin,
+              done => pp_done,
               bin_rd_en => bin_rd_en, bin_rd_addr => bin_rd_addr, bin_rd_valid => bin_rd_valid,
               bin_h => bin_h, bin_n => bin_n, bin_sx => bin_sx, bin_sy => bin_sy,
               bin_h_all => bin_h_all, bin_n_all => bin_n_all, bin_sx_all => bin_sx_all, bin_sy_all => bin_sy_all,

@@ -30,6 +30,10 @@
 -- ram_addr is out, for ms_target_stats (v2), which reads the same beat's bins from ram_data one
 -- clock later (so with RAM_LAT = 1 only; ms_tracker_v2 delays the tap RAM_LAT - 1 clocks); wires from the
 -- scan's registers, the pass itself is unchanged.
+-- ram_addr_next: what ram_addr holds at the next clock (ms_window_scan's out_addr_next), for a read
+-- port that registers the address once more in front of its RAMs (ms_slot_pool): such a port reads
+-- ram_addr_next with one clock more of latency and returns the data when a RAM_LAT port behind
+-- ram_addr would.
 -- N_ORIENT > 1 (tracker v2's joint colour x orientation bins, joint bin = N_ORIENT u + o): ram_obin
 -- carries each lane's orientation bin o (0 .. N_ORIENT - 1, 4 bits per lane) from an orientation
 -- region RAM read at the same address with the same latency as ram_data; it travels beside the
@@ -85,6 +89,7 @@ entity ms_pixel_pass is
     kd_d         : in  unsigned(KD_W - 1 downto 0);                  -- D = w^2 h^2 (unused: row-extent mask)
     -- region RAM read port (bank l at l*ADDR_W / l*BIN_W)
     ram_addr     : out std_logic_vector(LANES * ADDR_W - 1 downto 0);  -- per bank word address
+    ram_addr_next : out std_logic_vector(LANES * ADDR_W - 1 downto 0); -- ram_addr of the next clock (combinational)
     ram_data     : in  std_logic_vector(LANES * BIN_W - 1 downto 0);   -- per bank bin, RAM_LAT clocks after ram_addr
     ram_obin     : in  std_logic_vector(LANES * 4 - 1 downto 0) := (others => '0');  -- N_ORIENT > 1: per bank
                                                                      -- orientation bin (lane l at l*4), as ram_data
@@ -117,6 +122,7 @@ architecture rtl of ms_pixel_pass is
   -- scan outputs (cycle t)
   signal sc_valid, sc_last : std_logic;
   signal sc_addr           : unsigned(ADDR_W - 1 downto 0);
+  signal sc_addr_next      : unsigned(ADDR_W - 1 downto 0);
   signal sc_dx, sc_dy      : signed(D_W - 1 downto 0);
   signal sc_mask           : std_logic_vector(LANES - 1 downto 0);
 
@@ -140,7 +146,7 @@ begin
     port map (
       clk => clk, rst => rst, kt_we => kt_we, kt_addr => kt_addr, kt_xr => kt_xr,
       start => start, win_x => win_x, win_y => win_y, ex => ex, ey => ey,
-      busy => open, out_valid => sc_valid, out_addr => sc_addr, out_dx => sc_dx, out_dy => sc_dy,
+      busy => open, out_valid => sc_valid, out_addr => sc_addr, out_addr_next => sc_addr_next, out_dx => sc_dx, out_dy => sc_dy,
       out_mask => sc_mask, out_last => sc_last);
 
   -- scan tap: the scan's registered outputs, unchanged (no logic added to the pass)
@@ -152,6 +158,7 @@ begin
 
   g_addr : for l in 0 to LANES - 1 generate
     ram_addr((l + 1) * ADDR_W - 1 downto l * ADDR_W) <= std_logic_vector(sc_addr);
+    ram_addr_next((l + 1) * ADDR_W - 1 downto l * ADDR_W) <= std_logic_vector(sc_addr_next);
   end generate;
 
   g_kernel : for l in 0 to LANES - 1 generate

@@ -5,8 +5,12 @@
 -- Computes: slot s holds mstrack.fixed.blocks_v2.ms_slot_capture(bins, D_s, region_s) of the last
 -- region captured into it, for bins = the colour bins and (ORIENT) the orientation bins (layout
 -- slot_words: region pixel (rx, ry) at bank rx mod LANES, word ry * STRIDE + rx / LANES); the read
--- port returns, RD_LAT + 1 clocks after (rd_slot, raddr), the words at raddr(b) of every bank b of
+-- port returns, RD_LAT + 2 clocks after (rd_slot, raddr), the words at raddr(b) of every bank b of
 -- slot rd_slot, colour on rdata and orientation on robin.
+-- Read address: each slot registers raddr in its own copy, loaded only in the clocks rd_slot selects
+-- it, in front of its RAMs.  The copies are what the placer spreads over the die beside their block
+-- RAMs: the shared read address no longer drives every slot RAM's address and enable pins itself.
+-- A reader that has its address a clock early (ms_engine's ram_addr_next) sees RD_LAT + 1.
 -- Streams (docs/multi_target_core.md, "Border pixels"): the colour RAM is captured from ms_frontend's
 -- all-pixel stream delayed to the frame events (ad_*, every pixel, the frame's border included), the
 -- orientation RAM from its interior stream (ip_*, no border pixel: INTERIOR_ONLY).  Both captures take
@@ -26,11 +30,13 @@
 -- Every slot sees every pixel: a pixel inside k regions is written k times, each slot through its
 -- own RAMs' write ports, so nothing waits.
 -- Latency: a pixel -> its slot RAM's write port 3 clocks (ms_slot_capture), + WR_LAT into the RAM;
--- read: RD_LAT clocks in the slot RAMs + 1 registered multiplexer stage.  A read issued in a slot's
--- released clock or later sees its region (WR_LAT 0; with WR_LAT 1 a clock later).
+-- read: 1 address register per slot + RD_LAT clocks in the slot RAMs + 1 registered multiplexer
+-- stage.  A read issued in a slot's released clock or later sees its region (WR_LAT 0; with WR_LAT 1
+-- a clock later).
 -- Throughput: 1 pixel per clock on each stream; LANES words of each RAM per clock out.
 -- Cost: N_SLOTS x (one or two ms_slot_capture + their ms_region_ram of REGION_MAX x STRIDE words per
--- bank) + the N_SLOTS-way read multiplexer (docs/blocks/ms_slot_pool.md).
+-- bank + LANES x ADDR_W address flip-flops) + the N_SLOTS-way read multiplexer
+-- (docs/blocks/ms_slot_pool.md).
 -- Reset: synchronous, active high (the captures; the RAMs keep their contents).
 library ieee;
 use ieee.std_logic_1164.all;
@@ -82,7 +88,7 @@ entity ms_slot_pool is
     -- the engine's read port
     rd_slot     : in  unsigned(bits_for(N_SLOTS - 1) - 1 downto 0);     -- slot to read
     raddr       : in  std_logic_vector(LANES * ADDR_W - 1 downto 0);    -- word of bank b at slice b
-    rdata       : out std_logic_vector(LANES * COLOUR_W - 1 downto 0);  -- colour, RD_LAT + 1 clocks later
+    rdata       : out std_logic_vector(LANES * COLOUR_W - 1 downto 0);  -- colour, RD_LAT + 2 clocks later
     robin       : out std_logic_vector(LANES * 4 - 1 downto 0)          -- orientation (ORIENT; else 0)
   );
 end entity;
@@ -91,7 +97,7 @@ architecture rtl of ms_slot_pool is
   constant SEL_W : natural := bits_for(N_SLOTS - 1);
   type cdata_arr is array (0 to N_SLOTS - 1) of std_logic_vector(LANES * COLOUR_W - 1 downto 0);
   type odata_arr is array (0 to N_SLOTS - 1) of std_logic_vector(LANES * 4 - 1 downto 0);
-  type sel_arr is array (1 to RD_LAT) of unsigned(SEL_W - 1 downto 0);
+  type sel_arr is array (1 to RD_LAT + 1) of unsigned(SEL_W - 1 downto 0);
   signal slot_c : cdata_arr;
   signal slot_o : odata_arr := (others => (others => '0'));
   signal sel_d  : sel_arr;
@@ -105,8 +111,20 @@ begin
     signal c_waddr, o_waddr : unsigned(ADDR_W - 1 downto 0);
     signal c_wdata : std_logic_vector(COLOUR_W - 1 downto 0);
     signal o_wdata : std_logic_vector(3 downto 0);
+    signal s_raddr : std_logic_vector(LANES * ADDR_W - 1 downto 0) := (others => '0');
   begin
     s_load <= load when load_slot = to_unsigned(s, SEL_W) else '0';
+
+    -- this slot's copy of the read address (loaded while rd_slot selects it, so the copies differ
+    -- and synthesis keeps one per slot)
+    p_raddr : process (clk)
+    begin
+      if rising_edge(clk) then
+        if rd_slot = to_unsigned(s, SEL_W) then
+          s_raddr <= raddr;
+        end if;
+      end if;
+    end process;
 
     u_cap_c : entity work.ms_slot_capture
       generic map (LANES => LANES, COORD_W => COORD_W, REGION_MAX => REGION_MAX, STRIDE => STRIDE,
@@ -121,7 +139,7 @@ begin
     u_ram_c : entity work.ms_region_ram
       generic map (LANES => LANES, DEPTH => REGION_MAX * STRIDE, DATA_W => COLOUR_W, ADDR_W => ADDR_W,
                    RD_LAT => RD_LAT, WR_LAT => WR_LAT)
-      port map (clk => clk, we => c_we, wbank => c_wbank, waddr => c_waddr, wdata => c_wdata, raddr => raddr,
+      port map (clk => clk, we => c_we, wbank => c_wbank, waddr => c_waddr, wdata => c_wdata, raddr => s_raddr,
                 rdata => slot_c(s));
 
     g_orient : if ORIENT generate
@@ -138,7 +156,7 @@ begin
       u_ram_o : entity work.ms_region_ram
         generic map (LANES => LANES, DEPTH => REGION_MAX * STRIDE, DATA_W => 4, ADDR_W => ADDR_W,
                      RD_LAT => RD_LAT, WR_LAT => WR_LAT)
-        port map (clk => clk, we => o_we, wbank => o_wbank, waddr => o_waddr, wdata => o_wdata, raddr => raddr,
+        port map (clk => clk, we => o_we, wbank => o_wbank, waddr => o_waddr, wdata => o_wdata, raddr => s_raddr,
                   rdata => slot_o(s));
     end generate;
 
@@ -148,18 +166,19 @@ begin
     late(s)     <= c_late or o_late;
   end generate;
 
-  -- the read multiplexer: rd_slot delayed with the RAMs' read, then one registered selection
+  -- the read multiplexer: rd_slot delayed with the address copy and the RAMs' read, then one
+  -- registered selection
   p_rd : process (clk)
   begin
     if rising_edge(clk) then
       sel_d(1) <= rd_slot;
-      for i in 2 to RD_LAT loop
+      for i in 2 to RD_LAT + 1 loop
         sel_d(i) <= sel_d(i - 1);
       end loop;
       rdata <= (others => '0');
       robin <= (others => '0');
       for s in 0 to N_SLOTS - 1 loop
-        if sel_d(RD_LAT) = to_unsigned(s, SEL_W) then
+        if sel_d(RD_LAT + 1) = to_unsigned(s, SEL_W) then
           rdata <= slot_c(s);
           if ORIENT then
             robin <= slot_o(s);

@@ -184,6 +184,9 @@ architecture rtl of ms_tracker_shared is
   constant OR_ON   : boolean := ORIENT_T >= 0;
   constant N_OR    : natural := 8 * boolean'pos(OR_ON) + 1;
   constant DATA_W  : natural := BIN_W + 4 * boolean'pos(OR_ON);
+  -- the slot pool's read latency is RD_LAT + 2 (address copy, RAMs, multiplexer): the init job's; the
+  -- engine gives its address a clock early (ram_addr_next) and sees RAM_LAT = RD_LAT + 1
+  constant POOL_LAT : positive := RD_LAT + 2;
   constant RAM_LAT : positive := RD_LAT + 1;
   constant ST_OK    : unsigned(2 downto 0) := "000";
   constant ST_ERROR : unsigned(2 downto 0) := "110";
@@ -230,7 +233,7 @@ architecture rtl of ms_tracker_shared is
                    S_OPEN, S_STREAM, S_J_WAIT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
   signal fsm     : state_t := S_IDLE;
   -- the jobs: run as their regions are released, while the frame streams
-  type jstate_t is (J_IDLE, J_LOAD, J_INIT, J_IJ, J_WORD, J_END);
+  type jstate_t is (J_IDLE, J_SEL, J_LOAD, J_INIT, J_IJ, J_WORD, J_END);
   signal jfsm    : jstate_t := J_IDLE;
   signal j_slot  : slot_t := (others => '0');
   signal jrun    : std_logic := '0';                            -- the frame's jobs may start
@@ -296,7 +299,7 @@ architecture rtl of ms_tracker_shared is
   signal cap_x0, cap_y0, cap_x1, cap_y1 : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal released : std_logic_vector(NT - 1 downto 0);
   signal rd_slot  : unsigned(SW - 1 downto 0) := (others => '0');
-  signal raddr, e_raddr, j_raddr : std_logic_vector(LANES * ADDR_W - 1 downto 0);
+  signal raddr, e_raddr, e_raddr_next, j_raddr : std_logic_vector(LANES * ADDR_W - 1 downto 0);
   signal p_cbin   : std_logic_vector(LANES * BIN_W - 1 downto 0);
   signal p_obin   : std_logic_vector(LANES * 4 - 1 downto 0);
   signal j_rdata  : std_logic_vector(LANES * DATA_W - 1 downto 0);
@@ -479,7 +482,9 @@ begin
               fx0 => cap_x0, fy0 => cap_y0, fx1 => cap_x1, fy1 => cap_y1, armed => open, pending => open,
               released => released, late => open, rd_slot => rd_slot, raddr => raddr, rdata => p_cbin,
               robin => p_obin);
-  raddr <= j_raddr when j_busy = '1' else e_raddr;
+  -- the init job and the engine never read in the same clocks: the engine's passes start after the
+  -- init job's done, and the job's reads end before it
+  raddr <= j_raddr when j_busy = '1' else e_raddr_next;
   g_lane : for b in 0 to LANES - 1 generate
     j_rdata(b * DATA_W + BIN_W - 1 downto b * DATA_W) <= p_cbin((b + 1) * BIN_W - 1 downto b * BIN_W);
     g_or : if OR_ON generate
@@ -498,7 +503,7 @@ begin
   ---------------------------------------------------------------------------- the engine
   u_job : entity work.ms_init_job
     generic map (LANES => LANES, STRIDE => STRIDE, ADDR_W => ADDR_W, REGION_W => REGION_W, COORD_W => COORD_W,
-                 RD_LAT => RAM_LAT, BIN_W => BIN_W, N_ORIENT => N_OR, HALF_W => HALF_W, RING_W => 5,
+                 RD_LAT => POOL_LAT, BIN_W => BIN_W, N_ORIENT => N_OR, HALF_W => HALF_W, RING_W => 5,
                  Q_W => BG_Q_W, O_W => BG_O_W, KD_W => KD_W, MODELS => NT)
     port map (clk => clk, rst => rst, start => ij_start, rect_w => resize(rect_w, REGION_W),
               rect_h => resize(rect_h, REGION_W), cx => resize(bg_cx - rect_x, REGION_W),
@@ -537,7 +542,7 @@ begin
               geo_rect_x => rect_x, geo_rect_y => rect_y, geo_rect_w => rect_w, geo_rect_h => rect_h,
               geo_wd => geo_wd, geo_hd => geo_hd, geo_last_x => last_x, geo_last_y => last_y,
               m_sel => m_sel, m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all,
-              m_t_all => m_t_all, ram_addr => e_raddr, ram_data => p_cbin, ram_obin => p_obin,
+              m_t_all => m_t_all, ram_addr => e_raddr, ram_addr_next => e_raddr_next, ram_data => p_cbin, ram_obin => p_obin,
               res_valid => e_res_valid, res_ready => e_res_ready, res_data => e_res,
               word_fcount => fcount, word_rejected => e_word_rej, word_overflow => '0', busy => e_busy);
   busy <= e_busy;
@@ -704,15 +709,18 @@ begin
             kj := idx(q_slot);
             j_slot <= q_slot;
             rd_slot <= resize(q_slot, SW);
-            cmd_load <= '1';
-            c_state <= recs(kj);
-            if pinit(kj) = '1' then
-              c_state <= (others => '0');
-            end if;
-            c_model <= resize(q_slot, clog2(NT));
             e_word_rej <= '1' when rej_any = '1' and lowest(out_mask) = kj else '0';
-            jfsm <= J_LOAD;
+            jfsm <= J_SEL;
           end if;
+        when J_SEL =>                                    -- the record selected from the registered slot
+          kj := idx(j_slot);
+          cmd_load <= '1';
+          c_state <= recs(kj);
+          if pinit(kj) = '1' then
+            c_state <= (others => '0');
+          end if;
+          c_model <= resize(j_slot, clog2(NT));
+          jfsm <= J_LOAD;
         when J_LOAD =>
           if e_geo_done = '1' then
             kj := idx(j_slot);

@@ -30,6 +30,9 @@
 -- beat registers load stage B.
 -- Latency: the first beat is valid SCAN_LAT = 3 clocks after the clock edge
 -- that samples start = '1' (two cycles fill the row pipeline).
+-- out_addr_next: the address out_addr takes at the next edge (the D input of its register,
+-- combinational): a read port with one more register in front of the RAM (a copy per memory, where
+-- the memories sit) reads out_addr_next and returns the data at the same clock as from out_addr.
 -- Throughput: one beat (LANES pixels) per clock; no back-pressure.
 -- Handshake: `start` is a one-cycle pulse, ignored while busy = '1'.  win_y and ey
 -- must be stable from the clock before start on (the first row's base
@@ -70,6 +73,7 @@ entity ms_window_scan is
     busy     : out std_logic;                                -- scan in progress (set-up or beats)
     out_valid : out std_logic;                               -- beat valid
     out_addr : out unsigned(ADDR_W - 1 downto 0);            -- RAM word address of the beat (all banks)
+    out_addr_next : out unsigned(ADDR_W - 1 downto 0);       -- out_addr of the next clock (combinational)
     out_dx   : out signed(REGION_W downto 0);                -- dx of lane 0 (lane l: out_dx + l)
     out_dy   : out signed(REGION_W downto 0);                -- dy of the beat's row
     out_mask : out std_logic_vector(LANES - 1 downto 0);     -- lane l inside the row extent (|out_dx + l| <= XR[|dy|])
@@ -116,6 +120,7 @@ architecture rtl of ms_window_scan is
   signal fm_b, lm_b   : std_logic_vector(LANES - 1 downto 0) := (others => '0');  -- lanes inside in the first / last group
   -- beat registers = outputs
   signal addr         : unsigned(ADDR_W - 1 downto 0) := (others => '0');
+  signal addr_next    : unsigned(ADDR_W - 1 downto 0);
   signal rem_g        : unsigned(REGION_W - 1 downto 0) := (others => '0');   -- groups left in the row after this beat
   signal dxb, dyr     : signed(D_W - 1 downto 0) := (others => '0');
   signal valid, last  : std_logic := '0';
@@ -203,7 +208,6 @@ begin
           ld  := true;
         else
           rem_g <= rem_g - 1;
-          addr  <= addr + 1;
           dxb   <= dxb + LANES;
           if rem_g = 1 then
             mask <= lm_row;
@@ -218,7 +222,6 @@ begin
 
       if ld then                     -- first beat of the next row
         valid <= '1';
-        addr  <= addr_b;
         dxb   <= dx_b;
         dyr   <= dy_n;
         rem_g <= ngm1_b;
@@ -269,6 +272,8 @@ begin
         end if;
       end if;
 
+      addr <= addr_next;
+
       if rst = '1' then
         state <= S_IDLE;
         valid <= '0';
@@ -277,9 +282,16 @@ begin
     end if;
   end process;
 
+  -- the beat address register's next value: stage B's first address on a row's first beat (S_LOAD,
+  -- or S_RUN at the end of a row), + 1 on the row's other beats, else held (p_scan's conditions)
+  addr_next <= addr_b when state = S_LOAD or (state = S_RUN and last = '0' and rem_g = 0) else
+               addr + 1 when state = S_RUN and last = '0' else
+               addr;
+
   busy      <= '0' when state = S_IDLE else '1';
   out_valid <= valid;
   out_addr  <= addr;
+  out_addr_next <= addr_next;
   out_dx    <= dxb;
   out_dy    <= dyr;
   out_mask  <= mask;

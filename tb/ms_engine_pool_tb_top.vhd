@@ -3,8 +3,8 @@
 -- all-pixel stream, orientation RAMs from the interior stream) -> one read port, shared by ms_init_job
 -- (while it is busy) and ms_engine with SLOT_INIT (one model per target).  The bench loads each slot's
 -- capture with the engine's geometry, streams the frame, then runs every target's job from its slot
--- (rd_slot).  The pool's read port has RD_LAT + 1 clocks of latency: the engine's RAM_LAT and the init
--- job's RD_LAT.
+-- (rd_slot).  The pool's read port has RD_LAT + 2 clocks of latency: the init job's RD_LAT; the
+-- engine reads its ram_addr_next, a clock early, and sees RAM_LAT = RD_LAT + 1.
 library ieee;
 use ieee.std_logic_1164.all;
 use ieee.numeric_std.all;
@@ -166,8 +166,11 @@ architecture rtl of ms_engine_pool_tb_top is
   constant OR_ON  : boolean := ORIENT_T >= 0;
   constant N_OR   : natural := 8 * boolean'pos(OR_ON) + 1;
   constant DATA_W : natural := BIN_W + 4 * boolean'pos(OR_ON);
+  -- the slot pool's read latency is RD_LAT + 2 (address copy, RAMs, multiplexer): the init job's; the
+  -- engine gives its address a clock early (ram_addr_next) and sees RAM_LAT = RD_LAT + 1
+  constant POOL_LAT : positive := RD_LAT + 2;
   constant RAM_LAT : positive := RD_LAT + 1;
-  signal raddr, e_raddr, j_raddr : std_logic_vector(LANES * ADDR_W - 1 downto 0);
+  signal raddr, e_raddr, e_raddr_next, j_raddr : std_logic_vector(LANES * ADDR_W - 1 downto 0);
   signal rdata    : std_logic_vector(LANES * DATA_W - 1 downto 0);
   signal e_cbin   : std_logic_vector(LANES * BIN_W - 1 downto 0);
   signal e_obin   : std_logic_vector(LANES * 4 - 1 downto 0);
@@ -208,7 +211,9 @@ begin
               fx0 => cap_x0, fy0 => cap_y0, fx1 => cap_x1, fy1 => cap_y1, armed => open, pending => open,
               released => released, late => late, rd_slot => rd_slot, raddr => raddr, rdata => e_cbin,
               robin => e_obin);
-  raddr <= j_raddr when j_busy = '1' else e_raddr;
+  -- the init job and the engine never read in the same clocks: the engine's passes start after the
+  -- init job's done, and the job's reads end before it
+  raddr <= j_raddr when j_busy = '1' else e_raddr_next;
   -- ms_init_job takes a pixel as {orientation, colour bin} per lane
   g_lane : for b in 0 to LANES - 1 generate
     rdata(b * DATA_W + BIN_W - 1 downto b * DATA_W) <= e_cbin((b + 1) * BIN_W - 1 downto b * BIN_W);
@@ -219,7 +224,7 @@ begin
 
   u_job : entity work.ms_init_job
     generic map (LANES => LANES, STRIDE => STRIDE, ADDR_W => ADDR_W, REGION_W => REGION_W, COORD_W => COORD_W,
-                 RD_LAT => RAM_LAT,
+                 RD_LAT => POOL_LAT,
                  BIN_W => BIN_W, N_ORIENT => N_OR, HALF_W => HALF_W, RING_W => 5, Q_W => BG_Q_W,
                  O_W => BG_O_W, KD_W => KD_W, MODELS => MODELS)
     port map (clk => clk, rst => rst, start => ij_start, rect_w => resize(rect_w, REGION_W),
@@ -264,7 +269,7 @@ begin
               geo_rect_x => rect_x, geo_rect_y => rect_y, geo_rect_w => rect_w, geo_rect_h => rect_h,
               geo_last_x => last_x, geo_last_y => last_y, geo_wd => geo_wd, geo_hd => geo_hd,
               m_sel => m_sel, m_rd_addr => m_rd_addr, m_qn => m_qn, m_t => m_t, m_qn_all => m_qn_all,
-              m_t_all => m_t_all, ram_addr => e_raddr, ram_data => e_cbin, ram_obin => e_obin,
+              m_t_all => m_t_all, ram_addr => e_raddr, ram_addr_next => e_raddr_next, ram_data => e_cbin, ram_obin => e_obin,
               res_valid => res_valid, res_ready => res_ready, res_data => res_data,
               word_fcount => word_fcount, word_rejected => '0', word_overflow => '0', busy => open);
   geo_bg_cx <= bg_cx;

@@ -69,6 +69,8 @@ class TB:
         self.ram_lat = c.get("RAM_LAT", 1)
         self.no = c.get("N_ORIENT", 1)          # > 1: mem holds joint bins no u + o (ram_data u, ram_obin o)
         self.mem = [dict() for _ in range(self.L)]
+        self.next_bad: list[tuple[int, int, int]] = []   # (edge, ram_addr_next before, ram_addr)
+        self.edges = 0
         dut.rst.value = Immediate(1)
         for name in ("start", "kt_we", "bin_rd_en"):
             getattr(dut, name).value = Immediate(0)
@@ -80,9 +82,14 @@ class TB:
         L, aw, bw = self.L, self.aw, self.bw
         amask = (1 << aw) - 1
         pipe = [(0, 0)] * self.ram_lat     # (bins, orientations); pipe[0]: read at this edge; pipe[-1]: on ram_data now
+        nxt = None                         # ram_addr_next sampled at the edge before: ram_addr now
         while True:
             await RisingEdge(self.dut.clk)
             a = int(self.dut.ram_addr.value)
+            if nxt is not None and nxt != a:
+                self.next_bad.append((self.edges, nxt, a))
+            nxt = int(self.dut.ram_addr_next.value)
+            self.edges += 1
             d = o = 0
             for lane in range(L):
                 v = self.mem[lane].get((a >> (lane * aw)) & amask, 0)
@@ -260,6 +267,9 @@ async def check_passes(dut, n_passes: int, runs: bool, throttle: bool, seed: int
     got = await tb.read_bins(None)
     for name in ("H", "N", "SX", "SY"):
         assert not got[name].any(), f"{name} not cleared"
+    # ram_addr_next is, at every clock, the ram_addr of the next one
+    assert not tb.next_bad, f"ram_addr_next differs from the next clock's ram_addr at {tb.next_bad[:4]}"
+    dut._log.info("ram_addr_next = the next clock's ram_addr on %d clocks", tb.edges - 1)
 
 
 # ---------------------------------------------------------------- cocotb tests

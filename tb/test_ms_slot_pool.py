@@ -55,7 +55,7 @@ class PoolTB:
         self.addr_w, self.rmax = int(g["ADDR_W"]), int(g["REGION_MAX"])
         self.cbits, self.orient_t = int(g["COLOUR_BITS"]), int(g["ORIENT_T"])
         self.orient = str(g["ORIENT"]).lower() in ("true", "1")
-        self.lat = int(g["RD_LAT"]) + 1
+        self.lat = int(g["RD_LAT"]) + 2
         for s in ("rst", "in_valid", "in_sof", "in_eol", "load", "load_now"):
             getattr(dut, s).value = Immediate(0)
         for s in ("in_data", "dec_log2", "fx0", "fy0", "fx1", "fy1", "load_slot", "rd_slot", "raddr"):

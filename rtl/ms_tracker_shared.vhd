@@ -227,9 +227,15 @@ architecture rtl of ms_tracker_shared is
   signal n_live  : natural range 0 to NT := 0;
   signal n_cnt   : natural range 0 to NT + 1 := 0;               -- check_add's n_live
   signal rej_flag : std_logic := '0';
+  -- a command taken in S_IDLE, carried out in S_CMD (its slot's registers written from registers)
+  signal cm_op   : std_logic := '0';
+  signal cm_id   : unsigned(3 downto 0) := (others => '0');
+  signal cm_x, cm_y : signed(COORD_W + 1 downto 0) := (others => '0');
+  signal cm_w, cm_h : unsigned(COORD_W downto 0) := (others => '0');
+  signal cm_fw, cm_fh : unsigned(COORD_W - 1 downto 0) := (others => '0');
   signal fcount  : unsigned(15 downto 0) := (others => '0');
 
-  type state_t is (S_IDLE, S_LIST, S_PLAN, S_ADDS, S_A_DROP, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
+  type state_t is (S_IDLE, S_CMD, S_LIST, S_PLAN, S_ADDS, S_A_DROP, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
                    S_OPEN, S_STREAM, S_J_WAIT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
   signal fsm     : state_t := S_IDLE;
   -- the jobs: run as their regions are released, while the frame streams
@@ -785,42 +791,10 @@ begin
         ------------------------------------------------------------ between frames
         when S_IDLE =>
           if s_cmd_tvalid = '1' and open_in = '0' and ev_end = '0' and ev_err = '0' then
-            done_r <= '1';
-            if s_cmd_op = '1' then                       -- remove
-              id_r <= s_cmd_id;
-              code_r <= "01";
-              plan_ok <= '0';                            -- the live targets change: plan again
-              for i in 0 to NT - 1 loop
-                if to_integer(s_cmd_id) = i and alloc(i) = '1' then
-                  alloc(i) <= '0'; pend(i) <= '0'; waiting(i) <= '0'; pinit(i) <= '0'; valid(i) <= '0';
-                  rejd(i) <= '0'; held(i) <= '0'; eacc(i) <= '0'; eref(i) <= '0';
-                  c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
-                  w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
-                  code_r <= "00";
-                  drop_ord(to_unsigned(i, 4));
-                end if;
-              end loop;
-            else                                         -- add: the lowest free slot
-              kk := -1;
-              for i in NT - 1 downto 0 loop
-                if alloc(i) = '0' then
-                  kk := i;
-                end if;
-              end loop;
-              if kk < 0 then
-                code_r <= "01";
-                id_r <= (others => '0');
-                rej_flag <= '1';
-              else
-                alloc(kk) <= '1'; pend(kk) <= '1'; waiting(kk) <= '1';
-                bx_a(kk) <= s_cmd_x; by_a(kk) <= s_cmd_y; bw_a(kk) <= s_cmd_w; bh_a(kk) <= s_cmd_h;
-                fw_a(kk) <= frame_width; fh_a(kk) <= frame_height;
-                ord(n_ord) <= to_unsigned(kk, 4);
-                n_ord <= n_ord + 1;
-                code_r <= "00";
-                id_r <= to_unsigned(kk, 4);
-              end if;
-            end if;
+            cm_op <= s_cmd_op; cm_id <= s_cmd_id;        -- taken; carried out in the next clock
+            cm_x <= s_cmd_x; cm_y <= s_cmd_y; cm_w <= s_cmd_w; cm_h <= s_cmd_h;
+            cm_fw <= frame_width; cm_fh <= frame_height;
+            fsm <= S_CMD;
           elsif ev_err = '1' then
             if jfsm = J_IDLE and jrun = '0' then         -- the failed frame's last job has ended
               ev_err <= '0';
@@ -880,6 +854,45 @@ begin
             pass_b <= chk_ok;
             chk_early <= '1';
             fsm <= S_ADDS;
+          end if;
+
+        when S_CMD =>                                    -- the command taken in S_IDLE: its slot's registers
+          done_r <= '1';
+          fsm <= S_IDLE;
+          if cm_op = '1' then                            -- remove
+            id_r <= cm_id;
+            code_r <= "01";
+            plan_ok <= '0';                            -- the live targets change: plan again
+            for i in 0 to NT - 1 loop
+              if to_integer(cm_id) = i and alloc(i) = '1' then
+                alloc(i) <= '0'; pend(i) <= '0'; waiting(i) <= '0'; pinit(i) <= '0'; valid(i) <= '0';
+                rejd(i) <= '0'; held(i) <= '0'; eacc(i) <= '0'; eref(i) <= '0';
+                c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
+                w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
+                code_r <= "00";
+                drop_ord(to_unsigned(i, 4));
+              end if;
+            end loop;
+          else                                         -- add: the lowest free slot
+            kk := -1;
+            for i in NT - 1 downto 0 loop
+              if alloc(i) = '0' then
+                kk := i;
+              end if;
+            end loop;
+            if kk < 0 then
+              code_r <= "01";
+              id_r <= (others => '0');
+              rej_flag <= '1';
+            else
+              alloc(kk) <= '1'; pend(kk) <= '1'; waiting(kk) <= '1';
+              bx_a(kk) <= cm_x; by_a(kk) <= cm_y; bw_a(kk) <= cm_w; bh_a(kk) <= cm_h;
+              fw_a(kk) <= cm_fw; fh_a(kk) <= cm_fh;
+              ord(n_ord) <= to_unsigned(kk, 4);
+              n_ord <= n_ord + 1;
+              code_r <= "00";
+              id_r <= to_unsigned(kk, 4);
+            end if;
           end if;
 
         ------------------------------------------------------------ the frame's plan

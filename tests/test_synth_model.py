@@ -84,6 +84,44 @@ def test_netlist_names_and_critical_path(tmp_path):
     assert synth.path_summary(cp) == "flag -> u_sub.cnt"
 
 
+LATE_NETLIST = NETLIST.replace("""  assign flag = n5_q; // (signal)
+""", """  assign flag = n5_q; // (signal)
+  reg [7:0] n7_q;
+  reg [3:0] n8_q;
+  wire [3:0] n9_o;
+  initial begin
+    recs = n7_q; // (isignal)
+  end
+  assign n9_o = recs[7:4];
+""")
+
+
+def test_late_endpoints_group_by_vhdl_name(tmp_path):
+    v = tmp_path / "top.v"
+    v.write_text(LATE_NETLIST)
+    n = synth.NetlistNames(v, "top")
+    assert n.vhdl("n7_q_TRELLIS_FF_Q_2") == "recs"          # a signal with an initial value
+    assert n.vhdl("n9_o_TRELLIS_FF_Q") == "recs"            # a slice of it
+    period = 1000 / synth.TARGET_FMAX_MHZ
+
+    def ep(cell: str, port: str, arrival: float) -> dict:
+        return {"cell": cell, "port": port, "delay": [arrival / 2, arrival], "event": "posedge clk"}
+    rep = {"detailed_net_timings": [
+        {"net": "a", "endpoints": [ep("n7_q_TRELLIS_FF_Q_2", "CE", period), ep("n9_o_TRELLIS_FF_Q", "LSR", period + 1),
+                                   ep("u_sub.n12_q_TRELLIS_FF_Q_3", "DI", period + 0.5)]},
+        {"net": "b", "endpoints": [ep("n5_q_TRELLIS_FF_Q", "DI", period - 1.0),      # in time
+                                   ep("u_sub.n12_q_TRELLIS_FF_Q_1", "CE", period - 0.2)]}]}
+    rows = synth.late_endpoints(rep, n)
+    assert [(r["name"], r["endpoints"]) for r in rows] == [("recs", 2), ("u_sub.cnt", 2)]
+    assert rows[0]["ports"] == {"CE": 1, "LSR": 1} and rows[0]["worst_ns"] == round(period + 1, 3)
+    # without the setup time an arrival at the period, or 0.2 ns before it, is in time
+    assert [(r["name"], r["endpoints"]) for r in synth.late_endpoints(rep, n, setup_ns=0.0)] == [
+        ("recs", 1), ("u_sub.cnt", 1)]
+    table = synth.late_table(rows)
+    assert "| `recs` | 2 |" in table and table.endswith("| all (2 groups) | 4 | | |")
+    assert synth.late_endpoints({"detailed_net_timings": []}) == []
+
+
 def test_write_section_replaces_in_place(tmp_path):
     p = tmp_path / "perf.md"
     p.write_text("# P\n\n<!-- perf-x:begin -->\nold\n<!-- perf-x:end -->\n\ntail\n")

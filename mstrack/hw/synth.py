@@ -336,7 +336,11 @@ class NetlistNames:
 
     _MOD_RE = re.compile(r"^module (\w+)", re.M)
     _INST_RE = re.compile(r"^\s*(\w+) (\w+) \($", re.M)
-    _SIG_RE = re.compile(r"^\s*assign (\w+) = (n\d+_[oq]);\s*// \(signal\)", re.M)
+    # a signal (``assign s = n5_q; // (signal)``), or one with an initial value, which GHDL writes in
+    # an initial block (``s = n5_q; // (isignal)``)
+    _SIG_RE = re.compile(r"^\s*(?:assign )?(\w+) = (n\d+_[oq]);\s*// \(i?signal\)", re.M)
+    # a slice of a signal (one element of an array signal): ``assign n6825_o = recs[231:0];``
+    _SLICE_RE = re.compile(r"^\s*assign (n\d+_o) = ([A-Za-z]\w*)\[[^\]]*\];", re.M)
 
     def __init__(self, verilog: Path | str, top: str) -> None:
         text = Path(verilog).read_text(errors="replace")
@@ -348,7 +352,8 @@ class NetlistNames:
         for i, m in enumerate(heads):
             body = text[m.end(): heads[i + 1].start() if i + 1 < len(heads) else len(text)]
             self.inst[m.group(1)] = {b: a for a, b in self._INST_RE.findall(body) if a in names}
-            self.sig[m.group(1)] = {n: v for v, n in self._SIG_RE.findall(body)}
+            self.sig[m.group(1)] = {n: v for n, v in self._SLICE_RE.findall(body) if not re.fullmatch(r"n\d+_[oq]", v)}
+            self.sig[m.group(1)].update({n: v for v, n in self._SIG_RE.findall(body)})
 
     def vhdl(self, name: str) -> str:
         parts = name.split(".")
@@ -399,6 +404,46 @@ def critical_path(report: dict, names: NetlistNames | None = None) -> dict[str, 
     return {"total_ns": round(logic + routing, 3), "logic_ns": round(logic, 3), "routing_ns": round(routing, 3),
             "source": nm(first), "sink": nm(last), "source_module": names.module_of(first) if names else None,
             "sink_module": names.module_of(last) if names else None, "steps": steps}
+
+
+#: the primitive part of a nextpnr cell name after the net or signal yosys named it from
+_PRIM_RE = re.compile(r"_(TRELLIS|LUT4|PFUMX|L6MUX21|DP16KD|CCU2C|MULT18X18D|ALU54B|DCCA)\w*$")
+
+
+def late_endpoints(report: dict, names: NetlistNames | None = None, freq_mhz: float = TARGET_FMAX_MHZ,
+                   setup_ns: float = 0.29) -> list[dict[str, Any]]:
+    """The endpoints (register and block RAM inputs) of a nextpnr ``--report`` written with
+    ``--detailed-timing-report`` whose latest arrival misses *freq_mhz*: arrival > 1000 / freq_mhz -
+    *setup_ns* (a TRELLIS_FF's setup as nextpnr reports it).  Grouped by the VHDL signal or instance of
+    the endpoint's cell (:class:`NetlistNames`; else the cell name without its primitive suffix), most
+    endpoints first: ``[{"name", "endpoints", "worst_ns", "ports": {port: count}}]``.  The arrival is
+    nextpnr's, from the launching clock edge; clock skew is not subtracted."""
+    limit = 1000.0 / freq_mhz - setup_ns
+    groups: dict[str, dict[str, Any]] = {}
+    for net in report.get("detailed_net_timings", []):
+        for ep in net.get("endpoints", []):
+            arrival = max(ep.get("delay", [0.0]))
+            if arrival <= limit:
+                continue
+            cell = ep["cell"]
+            name = names.vhdl(cell) if names else cell
+            name = _PRIM_RE.sub("", name)
+            g = groups.setdefault(name, {"name": name, "endpoints": 0, "worst_ns": 0.0, "ports": {}})
+            g["endpoints"] += 1
+            g["worst_ns"] = round(max(g["worst_ns"], arrival), 3)
+            g["ports"][ep.get("port", "?")] = g["ports"].get(ep.get("port", "?"), 0) + 1
+    return sorted(groups.values(), key=lambda g: (-g["endpoints"], g["name"]))
+
+
+def late_table(rows: Sequence[dict[str, Any]], n: int = 15) -> str:
+    """Markdown table of :func:`late_endpoints`' first *n* groups and the total."""
+    total = sum(r["endpoints"] for r in rows)
+    lines = ["| signal or instance | late endpoints | latest arrival (ns) | inputs |", "|---|---:|---:|---|"]
+    for r in rows[:n]:
+        ports = ", ".join(f"{p} {c}" for p, c in sorted(r["ports"].items(), key=lambda kv: -kv[1]))
+        lines.append(f"| `{r['name']}` | {r['endpoints']:,} | {r['worst_ns']:.2f} | {ports} |")
+    lines.append(f"| all ({len(rows)} groups) | {total:,} | | |")
+    return "\n".join(lines)
 
 
 def run_nextpnr(synth_dir: Path | str, seed: int, freq_mhz: float = FREQ_MHZ, family: str = "ecp5",
@@ -1190,11 +1235,30 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     help="no tools: tables from build/synth/summary_<config>.json of earlier runs")
     ap.add_argument("--write", action="store_true", help=f"rewrite the tables in {PERF_MD.relative_to(REPO_ROOT)} (rows of other "
                     "configurations already there are kept, with a note of their command)")
+    ap.add_argument("--late-endpoints", metavar="REPORT", default=None,
+                    help="print the endpoints of a nextpnr --report written with --detailed-timing-report "
+                         f"that miss {TARGET_FMAX_MHZ} MHz, grouped by VHDL name (with --netlist)")
+    ap.add_argument("--netlist", metavar="V", default=None,
+                    help="--late-endpoints: the GHDL Verilog of the placed netlist, for the VHDL names")
+    ap.add_argument("--netlist-top", metavar="MODULE", default=None,
+                    help="--late-endpoints: the netlist's top module (default: the file's name)")
     ap.add_argument("--v2-budget", action="store_true",
                     help="tracker v2 worst-case clocks per frame (with --write: into docs/fixed_point.md)")
 
 
 def run(args: argparse.Namespace) -> int:
+    if getattr(args, "late_endpoints", None):
+        report = json.loads(Path(args.late_endpoints).read_text())
+        if "detailed_net_timings" not in report:
+            print(f"error: {args.late_endpoints} has no detailed_net_timings (nextpnr --detailed-timing-report)",
+                  file=sys.stderr)
+            return 2
+        names = None
+        if args.netlist:
+            v = Path(args.netlist)
+            names = NetlistNames(v, args.netlist_top or v.name.split(".")[0])
+        print(late_table(late_endpoints(report, names)))
+        return 0
     if getattr(args, "v2_budget", False):
         print(v2_budget_table())
         if args.write:

@@ -122,6 +122,19 @@ def test_late_endpoints_group_by_vhdl_name(tmp_path):
     assert synth.late_endpoints({"detailed_net_timings": []}) == []
 
 
+def test_late_endpoints_cli(tmp_path, capsys):
+    v = tmp_path / "top.v"
+    v.write_text(LATE_NETLIST)
+    rep = tmp_path / "report.json"
+    rep.write_text(json.dumps({"detailed_net_timings": [{"net": "a", "endpoints": [
+        {"cell": "n9_o_TRELLIS_FF_Q", "port": "CE", "delay": [1.0, 9.0]}]}]}))
+    assert synth.main(["--late-endpoints", str(rep), "--netlist", str(v)]) == 0
+    assert "| `recs` | 1 | 9.00 | CE 1 |" in capsys.readouterr().out
+    rep.write_text(json.dumps({"critical_paths": []}))                 # written without the detail
+    assert synth.main(["--late-endpoints", str(rep)]) == 2
+    assert "--detailed-timing-report" in capsys.readouterr().err
+
+
 def test_write_section_replaces_in_place(tmp_path):
     p = tmp_path / "perf.md"
     p.write_text("# P\n\n<!-- perf-x:begin -->\nold\n<!-- perf-x:end -->\n\ntail\n")

@@ -1240,8 +1240,6 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                          f"that miss {TARGET_FMAX_MHZ} MHz, grouped by VHDL name (with --netlist)")
     ap.add_argument("--netlist", metavar="V", default=None,
                     help="--late-endpoints: the GHDL Verilog of the placed netlist, for the VHDL names")
-    ap.add_argument("--netlist-top", metavar="MODULE", default=None,
-                    help="--late-endpoints: the netlist's top module (default: the file's name)")
     ap.add_argument("--v2-budget", action="store_true",
                     help="tracker v2 worst-case clocks per frame (with --write: into docs/fixed_point.md)")
 
@@ -1253,10 +1251,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"error: {args.late_endpoints} has no detailed_net_timings (nextpnr --detailed-timing-report)",
                   file=sys.stderr)
             return 2
-        names = None
-        if args.netlist:
-            v = Path(args.netlist)
-            names = NetlistNames(v, args.netlist_top or v.name.split(".")[0])
+        v = Path(args.netlist) if args.netlist else None
+        names = NetlistNames(v, v.stem) if v else None       # GHDL names the file after its top, as run_nextpnr reads it
         print(late_table(late_endpoints(report, names)))
         return 0
     if getattr(args, "v2_budget", False):

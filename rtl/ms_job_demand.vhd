@@ -176,16 +176,16 @@ begin
         jc_have <= '1';
       end if;
       case state is
-        when S_IDLE =>
+        when S_IDLE =>                         -- the inputs every clock (their enable is the state
+          w8_r <= w8; h8_r <= h8; cx_r <= c8x; cy_r <= c8y; lost_r <= lost; fw_r <= frame_w; fh_r <= frame_h;
+          fw_m1 <= frame_w - 1; fh_m1 <= frame_h - 1;  -- alone): held from start's clock on
+          acc_w <= (others => '0'); acc_h <= (others => '0'); gb <= 0;
+          mc_w <= resize(w8, S8_W + G_W); mc_h <= resize(h8, S8_W + G_W);
+          g_sh <= to_unsigned(G, G_W);
+          half_max <= (others => '0');
+          pass <= 0;
           if start = '1' then
-            w8_r <= w8; h8_r <= h8; cx_r <= c8x; cy_r <= c8y; lost_r <= lost; fw_r <= frame_w; fh_r <= frame_h;
-            fw_m1 <= frame_w - 1; fh_m1 <= frame_h - 1;
-            acc_w <= (others => '0'); acc_h <= (others => '0'); gb <= 0;
-            mc_w <= resize(w8, S8_W + G_W); mc_h <= resize(h8, S8_W + G_W);
-            g_sh <= to_unsigned(G, G_W);
-            half_max <= (others => '0');
             jc_have <= '0';
-            pass <= 0;
             state <= S_GROW;
           end if;
 

@@ -217,6 +217,12 @@ architecture rtl of ms_tracker_shared is
   signal hold_l2d : l2d_arr := (others => (others => '0'));
   -- a job's outcome, pending until its frame's words are sent (committed then, dropped on a fault)
   signal runm, jdone : std_logic_vector(NT - 1 downto 0) := (others => '0');
+  -- registered per-slot write enables: a job's outcome into its pending registers (the clock after
+  -- J_END), the frame's commit (S_J_CMT), an add's box (S_CMD), a remove's clears (S_CMD)
+  signal pw_m, cmt_m, cm_add, cm_rm : std_logic_vector(NT - 1 downto 0) := (others => '0');
+  signal cm_kk   : unsigned(3 downto 0) := (others => '0');     -- the add's slot (the lowest free one)
+  signal cm_full : std_logic := '0';                             -- no free slot
+  signal j_oh    : std_logic_vector(NT - 1 downto 0) := (others => '0');  -- the job's slot, one-hot
   signal p_recs  : rec_arr := (others => (others => '0'));
   signal p_c8x, p_c8y : cen_arr := (others => (others => '0'));
   signal p_w8, p_h8 : size_arr := (others => (others => '0'));
@@ -236,7 +242,7 @@ architecture rtl of ms_tracker_shared is
   signal fcount  : unsigned(15 downto 0) := (others => '0');
 
   type state_t is (S_IDLE, S_CMD, S_LIST, S_PLAN, S_ADDS, S_A_DROP, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
-                   S_OPEN, S_STREAM, S_J_WAIT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
+                   S_OPEN, S_STREAM, S_J_WAIT, S_J_CMT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
   signal fsm     : state_t := S_IDLE;
   -- the jobs: run as their regions are released, while the frame streams
   type jstate_t is (J_IDLE, J_SEL, J_LOAD, J_INIT, J_IJ, J_WORD, J_END);
@@ -607,6 +613,7 @@ begin
     variable fl : std_logic_vector(7 downto 0);
     variable refd : std_logic;                             -- S_ADDS: the add was refused in the blanking
     variable m : std_logic_vector(NT - 1 downto 0);
+    variable r : std_logic_vector(TS_W - 1 downto 0);
 
     -- slot s leaves the age order (a remove, a refused add, a box the engine refused): the entries after
     -- it move up one place (a slot is in the order at most once)
@@ -665,6 +672,32 @@ begin
       g_y1 <= shift_left(rect_y + rect_h, idx(l2d));
       g_rel <= shift_left(resize(rect_y + rect_h, COORD_W + 1), idx(l2d)) + 1;
       g_next <= shift_left(reg_y, idx(l2d));
+      -- the per-slot writes, each under its own registered enable (no decode of the sequencer's state
+      -- in a clock enable that fans out to a slot's whole record)
+      for i in 0 to NT - 1 loop
+        if pw_m(i) = '1' then                            -- a job's outcome, pending (the engine holds it)
+          p_recs(i) <= e_rec;
+          p_c8x(i) <= e_c8x; p_c8y(i) <= e_c8y; p_w8(i) <= e_w8; p_h8(i) <= e_h8;
+          p_fw(i) <= e_fw; p_fh(i) <= e_fh;
+        end if;
+        if cmt_m(i) = '1' then                           -- the frame ended good: its jobs' states commit
+          recs(i) <= p_recs(i);
+          c8x_a(i) <= p_c8x(i); c8y_a(i) <= p_c8y(i); w8_a(i) <= p_w8(i); h8_a(i) <= p_h8(i);
+          fw_a(i) <= p_fw(i); fh_a(i) <= p_fh(i);
+        end if;
+        if cm_add(i) = '1' then                          -- an add's box
+          bx_a(i) <= cm_x; by_a(i) <= cm_y; bw_a(i) <= cm_w; bh_a(i) <= cm_h;
+          fw_a(i) <= cm_fw; fh_a(i) <= cm_fh;
+        end if;
+        if cm_rm(i) = '1' then                           -- a remove's clears
+          c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
+          w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
+        end if;
+      end loop;
+      pw_m <= (others => '0');
+      cmt_m <= (others => '0');
+      cm_add <= (others => '0');
+      cm_rm <= (others => '0');
       -- slot j's reads for the walk (j = NT: nothing to read)
       pf_ok <= '0';
       if j < NT then
@@ -714,17 +747,22 @@ begin
           if q_valid = '1' and q_ready = '1' then
             kj := idx(q_slot);
             j_slot <= q_slot;
+            for i in 0 to NT - 1 loop
+              j_oh(i) <= '1' when i = kj else '0';
+            end loop;
             rd_slot <= resize(q_slot, SW);
             e_word_rej <= '1' when rej_any = '1' and lowest(out_mask) = kj else '0';
             jfsm <= J_SEL;
           end if;
         when J_SEL =>                                    -- the record selected from the registered slot
-          kj := idx(j_slot);
-          cmd_load <= '1';
-          c_state <= recs(kj);
-          if pinit(kj) = '1' then
-            c_state <= (others => '0');
-          end if;
+          cmd_load <= '1';                               -- (an AND-OR under the one-hot slot; an init
+          r := (others => '0');                          -- pending loads an empty record)
+          for i in 0 to NT - 1 loop
+            if j_oh(i) = '1' and pinit(i) = '0' then
+              r := r or recs(i);
+            end if;
+          end loop;
+          c_state <= r;
           c_model <= resize(j_slot, clog2(NT));
           jfsm <= J_LOAD;
         when J_LOAD =>
@@ -758,12 +796,10 @@ begin
             jfsm <= J_END;
           end if;
         when J_END =>
-          if e_idle = '1' then
-            for i in 0 to NT - 1 loop                  -- (per slot registers, not a memory)
-              if i = idx(j_slot) then
-                p_recs(i) <= e_rec;
-                p_c8x(i) <= e_c8x; p_c8y(i) <= e_c8y; p_w8(i) <= e_w8; p_h8(i) <= e_h8;
-                p_fw(i) <= e_fw; p_fh(i) <= e_fh;
+          if e_idle = '1' then                           -- its outcome pending the next clock (pw_m)
+            pw_m <= j_oh;
+            for i in 0 to NT - 1 loop
+              if j_oh(i) = '1' then
                 jdone(i) <= '1';
               end if;
             end loop;
@@ -794,6 +830,22 @@ begin
             cm_op <= s_cmd_op; cm_id <= s_cmd_id;        -- taken; carried out in the next clock
             cm_x <= s_cmd_x; cm_y <= s_cmd_y; cm_w <= s_cmd_w; cm_h <= s_cmd_h;
             cm_fw <= frame_width; cm_fh <= frame_height;
+            kk := -1;                                    -- an add's slot: the lowest free one
+            for i in NT - 1 downto 0 loop
+              if alloc(i) = '0' then
+                kk := i;
+              end if;
+            end loop;
+            cm_full <= '1';
+            cm_kk <= (others => '0');
+            if kk >= 0 then
+              cm_full <= '0';
+              cm_kk <= to_unsigned(kk, 4);
+            end if;
+            for i in 0 to NT - 1 loop
+              cm_add(i) <= '1' when s_cmd_op = '0' and i = kk else '0';
+              cm_rm(i) <= '1' when s_cmd_op = '1' and to_integer(s_cmd_id) = i and alloc(i) = '1' else '0';
+            end loop;
             fsm <= S_CMD;
           elsif ev_err = '1' then
             if jfsm = J_IDLE and jrun = '0' then         -- the failed frame's last job has ended
@@ -863,35 +915,31 @@ begin
             id_r <= cm_id;
             code_r <= "01";
             plan_ok <= '0';                            -- the live targets change: plan again
-            for i in 0 to NT - 1 loop
-              if to_integer(cm_id) = i and alloc(i) = '1' then
+            for i in 0 to NT - 1 loop                    -- (the record's clears: cm_rm, above)
+              if cm_rm(i) = '1' then
                 alloc(i) <= '0'; pend(i) <= '0'; waiting(i) <= '0'; pinit(i) <= '0'; valid(i) <= '0';
                 rejd(i) <= '0'; held(i) <= '0'; eacc(i) <= '0'; eref(i) <= '0';
-                c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
-                w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
-                code_r <= "00";
-                drop_ord(to_unsigned(i, 4));
               end if;
             end loop;
-          else                                         -- add: the lowest free slot
-            kk := -1;
-            for i in NT - 1 downto 0 loop
-              if alloc(i) = '0' then
-                kk := i;
-              end if;
-            end loop;
-            if kk < 0 then
+            if cm_rm /= (cm_rm'range => '0') then
+              code_r <= "00";
+              drop_ord(cm_id);
+            end if;
+          else                                         -- add: the lowest free slot (its box: cm_add, above)
+            if cm_full = '1' then
               code_r <= "01";
               id_r <= (others => '0');
               rej_flag <= '1';
             else
-              alloc(kk) <= '1'; pend(kk) <= '1'; waiting(kk) <= '1';
-              bx_a(kk) <= cm_x; by_a(kk) <= cm_y; bw_a(kk) <= cm_w; bh_a(kk) <= cm_h;
-              fw_a(kk) <= cm_fw; fh_a(kk) <= cm_fh;
-              ord(n_ord) <= to_unsigned(kk, 4);
+              for i in 0 to NT - 1 loop
+                if cm_add(i) = '1' then
+                  alloc(i) <= '1'; pend(i) <= '1'; waiting(i) <= '1';
+                end if;
+              end loop;
+              ord(n_ord) <= cm_kk;
               n_ord <= n_ord + 1;
               code_r <= "00";
-              id_r <= to_unsigned(kk, 4);
+              id_r <= cm_kk;
             end if;
           end if;
 
@@ -917,17 +965,17 @@ begin
           end if;
 
         when S_PLAN =>
+          cap_slot <= resize(p_slot, SW);                -- the descriptor every clock, taken with cap_load
+          cap_l2d <= p_l2d;                              -- (its enable is the state alone)
+          cap_x0 <= shift_left(p_reg_x, idx(p_l2d));
+          cap_y0 <= shift_left(p_reg_y, idx(p_l2d));
+          cap_x1 <= shift_left(p_reg_x + resize(p_reg_w, COORD_W), idx(p_l2d));
+          cap_y1 <= shift_left(p_reg_y + resize(p_reg_h, COORD_W), idx(p_l2d));
           if p_valid = '1' then
             k := idx(p_slot);
             if p_taken = '1' then
               job(k) <= '1';
               cap_load <= '1';
-              cap_slot <= resize(p_slot, SW);
-              cap_l2d <= p_l2d;
-              cap_x0 <= shift_left(p_reg_x, idx(p_l2d));
-              cap_y0 <= shift_left(p_reg_y, idx(p_l2d));
-              cap_x1 <= shift_left(p_reg_x + resize(p_reg_w, COORD_W), idx(p_l2d));
-              cap_y1 <= shift_left(p_reg_y + resize(p_reg_h, COORD_W), idx(p_l2d));
             else
               held(k) <= '1';
               hold_l2d(k) <= p_l2d;
@@ -1033,6 +1081,9 @@ begin
           end if;
 
         when S_A_CODE =>
+          cap_slot <= resize(k_cur, SW);                 -- the descriptor every clock, taken with cap_load
+          cap_l2d <= l2d;
+          cap_x0 <= g_x0; cap_y0 <= g_y0; cap_x1 <= g_x1; cap_y1 <= g_y1;
           if a_done = '1' then
             k := idx(k_cur);
             if a_code = "00" or pass_b = '0' then        -- accepted (an init pending keeps its verdict)
@@ -1045,9 +1096,6 @@ begin
                 n_cnt <= n_cnt + 1;
               end if;
               cap_load <= '1';
-              cap_slot <= resize(k_cur, SW);
-              cap_l2d <= l2d;
-              cap_x0 <= g_x0; cap_y0 <= g_y0; cap_x1 <= g_x1; cap_y1 <= g_y1;
             elsif chk_early = '1' then                   -- refused in the blanking: at the start of frame
               eref(k) <= '1';
               waiting(k) <= '0';
@@ -1099,19 +1147,16 @@ begin
 
         when S_J_WAIT =>                                 -- every job of the frame has ended
           if arm_req = '0' and (runm and not jdone) = (runm'range => '0') and jfsm = J_IDLE then
-            for i in 0 to NT - 1 loop                    -- the frame ended good: its jobs' states commit
-              if jdone(i) = '1' then                     -- (each slot's own registers, no multiplexer)
-                recs(i) <= p_recs(i);
-                c8x_a(i) <= p_c8x(i); c8y_a(i) <= p_c8y(i); w8_a(i) <= p_w8(i); h8_a(i) <= p_h8(i);
-                fw_a(i) <= p_fw(i); fh_a(i) <= p_fh(i);
-              end if;
-            end loop;
-            jrun <= '0';
+            cmt_m <= jdone;                              -- the frame ended good: its jobs' states commit
+            jrun <= '0';                                 -- in S_J_CMT (cmt_m, above)
             is_err <= '0';
             first_w <= '1';
             j <= 0;
-            fsm <= S_J_NEXT;
+            fsm <= S_J_CMT;
           end if;
+
+        when S_J_CMT =>                                  -- the commit's clock: the walk reads after it
+          fsm <= S_J_NEXT;
 
         when S_J_NEXT =>                                 -- slot j's word of the frame
           if j = NT then

@@ -280,6 +280,10 @@ architecture rtl of ms_tracker_shared is
   signal side_w  : std_logic_vector(RESULT_W - 1 downto 0) := (others => '0');
   signal side_push : std_logic := '0';                          -- S_SIDE: push side_w (else only bookkeeping)
   signal side_nt : std_logic := '0';                            -- the slot's word has no_target
+  -- the word to ms_result_order, loaded every clock: side_w in the walk (wsel: the state of the clock
+  -- before was one of the walk's), else the engine's word; ro_valid says when it is taken
+  signal wsel    : std_logic := '0';
+  signal sg_ok   : std_logic := '0';                            -- S_SINGLE: side_w holds its word
   -- the slot walk (S_J_NEXT, S_E_NEXT) decides on registers: slot j's flags and word fields are read
   -- in one clock (pf_ok '0'), used in the next (pf_ok '1')
   signal pf_ok, pf_alloc, pf_valid, pf_pinit, pf_held, pf_rejd, pf_size : std_logic := '0';
@@ -663,6 +667,16 @@ begin
       st_valid_r <= '0';
       ro_valid <= '0';
       ro_close <= '0';
+      wsel <= '1' when fsm = S_J_CMT or fsm = S_J_NEXT or fsm = S_COMMIT or fsm = S_SIDE or fsm = S_E_NEXT
+              or fsm = S_SINGLE else '0';
+      if wsel = '1' then
+        ro_word <= side_w;
+        ro_id <= k_cur;
+      else
+        ro_word <= e_res;
+        ro_id <= j_slot;
+      end if;
+      sg_ok <= '0';
       q_flush <= '0';
       -- an add's init rectangle in frame px, its release and next line (the engine's geometry holds from
       -- geo_done until the check's verdict, hundreds of clocks later: registered here every clock)
@@ -765,13 +779,13 @@ begin
           c_state <= r;
           c_model <= resize(j_slot, clog2(NT));
           jfsm <= J_LOAD;
-        when J_LOAD =>
+        when J_LOAD =>                                   -- (the init's box every clock: the engine takes it
+          kj := idx(j_slot);                             -- with cmd_init)
+          c_init_x <= bx_a(kj); c_init_y <= by_a(kj); c_init_w <= bw_a(kj); c_init_h <= bh_a(kj);
+          c_init_fw <= fw_a(kj); c_init_fh <= fh_a(kj);
           if e_geo_done = '1' then
-            kj := idx(j_slot);
             if pinit(kj) = '1' then
               cmd_init <= '1';
-              c_init_x <= bx_a(kj); c_init_y <= by_a(kj); c_init_w <= bw_a(kj); c_init_h <= bh_a(kj);
-              c_init_fw <= fw_a(kj); c_init_fh <= fh_a(kj);
               jfsm <= J_INIT;
             else
               cmd_go <= '1';
@@ -789,10 +803,8 @@ begin
             jfsm <= J_WORD;
           end if;
         when J_WORD =>
-          if e_res_valid = '1' then
+          if e_res_valid = '1' then                      -- (ro_word, ro_id: the engine's, above)
             ro_valid <= '1';
-            ro_id <= j_slot;
-            ro_word <= e_res;
             jfsm <= J_END;
           end if;
         when J_END =>
@@ -1039,12 +1051,12 @@ begin
           drop_ord(k_cur);                               -- the next entry moves into place j
           fsm <= S_ADDS;
 
-        when S_A_LOAD =>
+        when S_A_LOAD =>                                 -- (the add's box every clock, as in J_LOAD)
+          k := idx(k_cur);
+          c_init_x <= bx_a(k); c_init_y <= by_a(k); c_init_w <= bw_a(k); c_init_h <= bh_a(k);
+          c_init_fw <= fw_a(k); c_init_fh <= fh_a(k);
           if e_geo_done = '1' then
-            k := idx(k_cur);
             cmd_init <= '1';
-            c_init_x <= bx_a(k); c_init_y <= by_a(k); c_init_w <= bw_a(k); c_init_h <= bh_a(k);
-            c_init_fw <= fw_a(k); c_init_fh <= fh_a(k);
             fsm <= S_A_INIT;
           end if;
 
@@ -1159,6 +1171,13 @@ begin
           fsm <= S_J_NEXT;
 
         when S_J_NEXT =>                                 -- slot j's word of the frame
+          fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
+          if (pf_valid = '1' or pf_pinit = '1') and pf_size = '1' then  -- side_w every clock (its enable
+            side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl,  -- the state
+                               ERR_SIZE_CHANGED, fcount);                                     -- alone)
+          else
+            side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, pf_l2d, fl, ERR_CAPACITY, fcount);
+          end if;
           if j = NT then
             if out_mask = (out_mask'range => '0') then
               fsm <= S_SINGLE;
@@ -1173,18 +1192,13 @@ begin
             pf_ok <= '1';                                -- slot j's reads
           else
             k_cur <= to_unsigned(j, 4);
-            fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
             if pf_alloc = '0' then
               j <= j + 1;
             elsif (pf_valid = '1' or pf_pinit = '1') and pf_size = '1' then
-              side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl,
-                                 ERR_SIZE_CHANGED, fcount);
-              side_push <= pf_valid;
+              side_push <= pf_valid;                     -- side_w: the frame size's error word
               side_nt <= not pf_valid;
               fsm <= S_SIDE;
-            elsif pf_held = '1' and pf_valid = '1' then
-              fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), '0', '0');
-              side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, pf_l2d, fl, ERR_CAPACITY, fcount);
+            elsif pf_held = '1' and pf_valid = '1' then  -- side_w: the capacity's error word
               side_push <= '1';
               side_nt <= '0';
               fsm <= S_SIDE;
@@ -1209,10 +1223,8 @@ begin
 
         when S_SIDE =>                                   -- a word of the top, and the slot's bookkeeping
           k := idx(k_cur);
-          if side_push = '1' then
+          if side_push = '1' then                        -- (ro_word, ro_id: side_w and k_cur, above)
             ro_valid <= '1';
-            ro_id <= k_cur;
-            ro_word <= side_w;
             first_w <= '0';
           end if;
           if pend(k) = '1' then
@@ -1236,6 +1248,8 @@ begin
 
         ------------------------------------------------------------ a stream fault: one error word per live target
         when S_E_NEXT =>
+          fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
+          side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, err_r, fcount);
           if j = NT then
             if out_mask = (out_mask'range => '0') then
               fsm <= S_SINGLE;
@@ -1255,8 +1269,6 @@ begin
             pf_ok <= '1';                                -- slot j's reads
           else
             k_cur <= to_unsigned(j, 4);
-            fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
-            side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, err_r, fcount);
             side_push <= pf_alloc and pf_valid;
             side_nt <= not pf_valid;
             if pf_alloc = '0' then
@@ -1266,23 +1278,27 @@ begin
             end if;
           end if;
 
-        when S_SINGLE =>                                 -- no live target: slot 0's word alone
-          if ro_close_ready = '1' then
+        when S_SINGLE =>                                 -- no live target: slot 0's word alone (into side_w
+          k_cur <= (others => '0');                      -- every clock, sent from the second clock on)
+          if is_err = '1' then
+            fl := v2_flags('0', '0', '0', '1', rej_any or rejd(0), '1', '0');
+            side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl, err_r,
+                               fcount);
+          elsif pinit(0) = '1' and alloc(0) = '1' and (fr_w /= fw_a(0) or fr_h /= fh_a(0)) then
+            fl := v2_flags('0', '0', '0', '1', rej_any, '1', '0');
+            side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
+                               ERR_SIZE_CHANGED, fcount);
+          else
+            fl := v2_flags('0', '0', '0', '0', rej_any, '1', '0');
+            side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_OK, to_unsigned(0, 3), fl, "000", fcount);
+          end if;
+          sg_ok <= '1';
+          if ro_close_ready = '1' and sg_ok = '1' then
             if is_err = '1' then
-              fl := v2_flags('0', '0', '0', '1', rej_any or rejd(0), '1', '0');
-              ro_word <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl, err_r,
-                                  fcount);
               cut_pend <= '0';
-            elsif pinit(0) = '1' and alloc(0) = '1' and (fr_w /= fw_a(0) or fr_h /= fh_a(0)) then
-              fl := v2_flags('0', '0', '0', '1', rej_any, '1', '0');
-              ro_word <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
-                                  ERR_SIZE_CHANGED, fcount);
-            else
-              fl := v2_flags('0', '0', '0', '0', rej_any, '1', '0');
-              ro_word <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_OK, to_unsigned(0, 3), fl, "000", fcount);
             end if;
+            sg_ok <= '0';
             ro_valid <= '1';
-            ro_id <= (others => '0');
             ro_close <= '1';
             ro_mask <= (others => '0');
             ro_mask(0) <= '1';

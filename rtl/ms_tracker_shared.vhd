@@ -218,11 +218,13 @@ architecture rtl of ms_tracker_shared is
   -- a job's outcome, pending until its frame's words are sent (committed then, dropped on a fault)
   signal runm, jdone : std_logic_vector(NT - 1 downto 0) := (others => '0');
   -- registered per-slot write enables: a job's outcome into its pending registers (the clock after
-  -- J_END), the frame's commit (S_J_CMT), an add's box (S_CMD), a remove's clears (S_CMD)
-  signal pw_m, cmt_m, cm_add, cm_rm : std_logic_vector(NT - 1 downto 0) := (others => '0');
+  -- J_END), the frame's commit (S_J_CMT), an add's box (S_CMD), a remove's clears (S_CMD), an add
+  -- accepted: its centre and size (the clock after S_A_CODE's verdict)
+  signal pw_m, cmt_m, cm_add, cm_rm, ac_m : std_logic_vector(NT - 1 downto 0) := (others => '0');
   signal cm_kk   : unsigned(3 downto 0) := (others => '0');     -- the add's slot (the lowest free one)
   signal cm_full : std_logic := '0';                             -- no free slot
   signal j_oh    : std_logic_vector(NT - 1 downto 0) := (others => '0');  -- the job's slot, one-hot
+  signal j_ld    : std_logic_vector(NT - 1 downto 0) := (others => '0');  -- j_oh, not an init pending
   signal p_recs  : rec_arr := (others => (others => '0'));
   signal p_c8x, p_c8y : cen_arr := (others => (others => '0'));
   signal p_w8, p_h8 : size_arr := (others => (others => '0'));
@@ -703,6 +705,9 @@ begin
           bx_a(i) <= cm_x; by_a(i) <= cm_y; bw_a(i) <= cm_w; bh_a(i) <= cm_h;
           fw_a(i) <= cm_fw; fh_a(i) <= cm_fh;
         end if;
+        if ac_m(i) = '1' then                            -- an add accepted (the engine holds its geometry)
+          c8x_a(i) <= e_c8x; c8y_a(i) <= e_c8y; w8_a(i) <= e_w8; h8_a(i) <= e_h8;
+        end if;
         if cm_rm(i) = '1' then                           -- a remove's clears
           c8x_a(i) <= (others => '0'); c8y_a(i) <= (others => '0');
           w8_a(i) <= (others => '0'); h8_a(i) <= (others => '0');
@@ -712,6 +717,7 @@ begin
       cmt_m <= (others => '0');
       cm_add <= (others => '0');
       cm_rm <= (others => '0');
+      ac_m <= (others => '0');
       -- slot j's reads for the walk (j = NT: nothing to read)
       pf_ok <= '0';
       if j < NT then
@@ -763,6 +769,7 @@ begin
             j_slot <= q_slot;
             for i in 0 to NT - 1 loop
               j_oh(i) <= '1' when i = kj else '0';
+              j_ld(i) <= '1' when i = kj and pinit(i) = '0' else '0';
             end loop;
             rd_slot <= resize(q_slot, SW);
             e_word_rej <= '1' when rej_any = '1' and lowest(out_mask) = kj else '0';
@@ -770,9 +777,9 @@ begin
           end if;
         when J_SEL =>                                    -- the record selected from the registered slot
           cmd_load <= '1';                               -- (an AND-OR under the one-hot slot; an init
-          r := (others => '0');                          -- pending loads an empty record)
+          r := (others => '0');                          -- pending loads an empty record: j_ld)
           for i in 0 to NT - 1 loop
-            if j_oh(i) = '1' and pinit(i) = '0' then
+            if j_ld(i) = '1' then
               r := r or recs(i);
             end if;
           end loop;
@@ -1103,7 +1110,9 @@ begin
               waiting(k) <= '0';
               job(k) <= '1';
               eacc(k) <= chk_early and pass_b;
-              c8x_a(k) <= e_c8x; c8y_a(k) <= e_c8y; w8_a(k) <= e_w8; h8_a(k) <= e_h8;
+              for i in 0 to NT - 1 loop                  -- its centre and size the next clock (ac_m)
+                ac_m(i) <= '1' when i = k else '0';
+              end loop;
               if pass_b = '1' then
                 n_cnt <= n_cnt + 1;
               end if;

@@ -388,7 +388,7 @@ def test_shared_colour_configs_are_the_simulated_core(n):
     assert ap.parse_args(["--config", c.name]).config == [c.name]
 
 
-@pytest.mark.parametrize("n", [1, 8, 10, 14])
+@pytest.mark.parametrize("n", [1, 4, 8, 10, 14])
 def test_shared_w63_configs_are_the_simulated_core(n):
     """Configurations "shared<N>-colour-w63": ms_tracker_shared with the generics tb/test_ms_tracker_shared.py's
     generics_of gives tracker v2-colour with max_window 63, MAX_HALF 31 and COORD_W 11 (test_shared_w63_real_people

@@ -25,7 +25,7 @@ Flow per configuration (generics from :func:`mstrack.fixed.vhdl_pkg.core_generic
   with ``--config``): ``ms_tracker_multi`` with MAX_TARGETS N engines of ``v2-colour``, placed as
   ``rtl/wrappers/ms_tracker_multi_pins.vhd`` (ECP5; the Nexus PDC has the single-target wrapper's pins).
 * the shared-engine multi-target core (configurations ``shared<N>-colour``, N = 1, 2, 4, 5, 8, 10, 16, and
-  ``shared<N>-colour-w63``, max_window 63, N = 1, 8, 10, 14, only when named with ``--config``):
+  ``shared<N>-colour-w63``, max_window 63, N = 1, 4, 8, 10, 14, only when named with ``--config``):
   ``ms_tracker_shared`` with MAX_TARGETS N slots around one ``v2-colour`` engine
   (generics from :func:`mstrack.hw.multi_core.shared_core_generics`: the 1080p60 timing of the capacity rule),
   placed as ``rtl/wrappers/ms_tracker_multi_pins.vhd`` with ``SHARED_ENGINE`` true.
@@ -219,11 +219,13 @@ CONFIGS: dict[str, Config] = {c.name: c for c in (
                                       "160 px, larger targets decimated sooner"
                                       + (": the base of the per-target figures" if n == 1 else
                                          ": eight targets on the LFE5U-85F" if n == 8 else
+                                         ": four targets, what the cost model fits in the Nexus LIFCL-40's 84 "
+                                         "EBR (--nexus --no-ecp5)" if n == 4 else
                                          ": the size of AMD Vitis Vision MeanShift's 10-object kernel" if n == 10 else
                                          ": the most slots the cost model fits in the LFE5U-85F"),
              core=TOP_V2, top=TOP_SHARED, max_targets=n, tp={**V2_COLOUR, "max_window": 63},
              fp={"max_half": 31, "coord_bits": 11}, max_frame_w=1920)
-      for n in (1, 8, 10, 14)),
+      for n in (1, 4, 8, 10, 14)),
 )}
 #: the configurations of a plain `mstrack synth` (the multi-target core only when named with --config)
 DEFAULT_CONFIGS = tuple(n for n, c in CONFIGS.items() if c.top not in MULTI_TOPS)

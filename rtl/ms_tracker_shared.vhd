@@ -275,6 +275,7 @@ architecture rtl of ms_tracker_shared is
   signal k_cur   : slot_t := (others => '0');
   signal a_rd    : std_logic := '0';                            -- S_LIST / S_ADDS: k_cur holds entry j's slot
   signal out_mask : std_logic_vector(NT - 1 downto 0) := (others => '0');
+  signal om_any  : std_logic := '0';                            -- out_mask has a slot (registered with it)
   signal first_w : std_logic := '0';
   signal rej_any : std_logic := '0';
   signal is_err  : std_logic := '0';                            -- the merged frame is a stream fault's
@@ -678,6 +679,19 @@ begin
         ro_word <= e_res;
         ro_id <= j_slot;
       end if;
+      -- the close mask every clock (ms_result_order takes it with ro_close): the frame's slots, or slot 0
+      -- alone in S_SINGLE (sg_ok: out_mask is empty there)
+      ro_mask <= out_mask;
+      ro_mask(0) <= out_mask(0) or sg_ok;
+      -- the job's record every clock, an AND-OR under j_ld (set from J_IDLE to J_SEL, else empty): the
+      -- engine takes it with cmd_load, the clock after J_SEL or S_ADDS (an add's empty record)
+      r := (others => '0');
+      for i in 0 to NT - 1 loop
+        if j_ld(i) = '1' then
+          r := r or recs(i);
+        end if;
+      end loop;
+      c_state <= r;
       sg_ok <= '0';
       q_flush <= '0';
       -- an add's init rectangle in frame px, its release and next line (the engine's geometry holds from
@@ -754,6 +768,7 @@ begin
           runm(i) <= job(i) and not held(i) and m(i);
         end loop;
         out_mask <= m;
+        om_any <= '1' when m /= (m'range => '0') else '0';
         rej_any <= rej_flag;
         if rejd /= (rejd'range => '0') then
           rej_any <= '1';
@@ -776,14 +791,8 @@ begin
             jfsm <= J_SEL;
           end if;
         when J_SEL =>                                    -- the record selected from the registered slot
-          cmd_load <= '1';                               -- (an AND-OR under the one-hot slot; an init
-          r := (others => '0');                          -- pending loads an empty record: j_ld)
-          for i in 0 to NT - 1 loop
-            if j_ld(i) = '1' then
-              r := r or recs(i);
-            end if;
-          end loop;
-          c_state <= r;
+          cmd_load <= '1';                               -- (c_state, above: an AND-OR under the one-hot
+          j_ld <= (others => '0');                       -- slot; an init pending loads an empty record)
           c_model <= resize(j_slot, clog2(NT));
           jfsm <= J_LOAD;
         when J_LOAD =>                                   -- (the init's box every clock: the engine takes it
@@ -877,6 +886,7 @@ begin
               first_w <= '1';
               m := alloc and valid;
               out_mask <= m;
+              om_any <= '1' when m /= (m'range => '0') else '0';
               rej_any <= rej_flag;
               if (rejd and not eacc) /= (rejd'range => '0') then
                 rej_any <= '1';
@@ -1029,9 +1039,8 @@ begin
               fsm <= S_A_DROP;                           -- refused in the blanking: reported and freed now
             else
               if (pass_b = '0' and pinit(k) = '1') or (pass_b = '1' and waiting(k) = '1') then
-                cmd_load <= '1';                           -- an empty record, the target's model
-                c_state <= (others => '0');
-                c_model <= resize(k_cur, clog2(NT));
+                cmd_load <= '1';                           -- an empty record (j_ld is clear: c_state),
+                c_model <= resize(k_cur, clog2(NT));       -- the target's model
                 fsm <= S_A_LOAD;
               end if;
               j <= j + 1;
@@ -1188,11 +1197,10 @@ begin
             side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, pf_l2d, fl, ERR_CAPACITY, fcount);
           end if;
           if j = NT then
-            if out_mask = (out_mask'range => '0') then
+            if om_any = '0' then
               fsm <= S_SINGLE;
             elsif ro_close_ready = '1' then
-              ro_close <= '1';
-              ro_mask <= out_mask;
+              ro_close <= '1';                           -- (ro_mask: out_mask, above)
               fcount <= fcount + 1;
               rej_flag <= '0';
               fsm <= S_IDLE;
@@ -1260,11 +1268,10 @@ begin
           fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
           side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, err_r, fcount);
           if j = NT then
-            if out_mask = (out_mask'range => '0') then
+            if om_any = '0' then
               fsm <= S_SINGLE;
             elsif ro_close_ready = '1' then
-              ro_close <= '1';
-              ro_mask <= out_mask;
+              ro_close <= '1';                           -- (ro_mask: out_mask, above)
               fcount <= fcount + 1;
               rej_flag <= '0';
               cut_pend <= '0';                           -- a cut frame's words are out: the next one's jobs
@@ -1308,9 +1315,7 @@ begin
             end if;
             sg_ok <= '0';
             ro_valid <= '1';
-            ro_close <= '1';
-            ro_mask <= (others => '0');
-            ro_mask(0) <= '1';
+            ro_close <= '1';                             -- (ro_mask: slot 0, above)
             fcount <= fcount + 1;
             rej_flag <= '0';
             if is_err = '1' and (open_in = '1' or fe_busy = '1') then
@@ -1326,6 +1331,7 @@ begin
         alloc <= (others => '0'); pend <= (others => '0'); waiting <= (others => '0');
         pinit <= (others => '0'); valid <= (others => '0'); rejd <= (others => '0');
         held <= (others => '0'); job <= (others => '0');
+        j_ld <= (others => '0');
         c8x_a <= (others => (others => '0')); c8y_a <= (others => (others => '0'));
         w8_a <= (others => (others => '0')); h8_a <= (others => (others => '0'));
         n_ord <= 0;

@@ -287,6 +287,7 @@ architecture rtl of ms_tracker_shared is
   -- before was one of the walk's), else the engine's word; ro_valid says when it is taken
   signal wsel    : std_logic := '0';
   signal sg_ok   : std_logic := '0';                            -- S_SINGLE: side_w holds its word
+  signal sgl     : std_logic := '0';                            -- the sequencer is in S_SINGLE
   -- the slot walk (S_J_NEXT, S_E_NEXT) decides on registers: slot j's flags and word fields are read
   -- in one clock (pf_ok '0'), used in the next (pf_ok '1')
   signal pf_ok, pf_alloc, pf_valid, pf_pinit, pf_held, pf_rejd, pf_size : std_logic := '0';
@@ -692,6 +693,33 @@ begin
         end if;
       end loop;
       c_state <= r;
+      -- the walk's word every clock (no decode of the sequencer's state in its enable): S_SINGLE's (sgl),
+      -- else S_E_NEXT's (is_err) or S_J_NEXT's from slot j's registered reads; ro_word takes it in the
+      -- clock after the state that decides (wsel)
+      if sgl = '1' then                                  -- no live target: slot 0's word alone
+        if is_err = '1' then
+          fl := v2_flags('0', '0', '0', '1', rej_any or rejd(0), '1', '0');
+          side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl, err_r,
+                             fcount);
+        elsif pinit(0) = '1' and alloc(0) = '1' and (fr_w /= fw_a(0) or fr_h /= fh_a(0)) then
+          fl := v2_flags('0', '0', '0', '1', rej_any, '1', '0');
+          side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
+                             ERR_SIZE_CHANGED, fcount);
+        else
+          fl := v2_flags('0', '0', '0', '0', rej_any, '1', '0');
+          side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_OK, to_unsigned(0, 3), fl, "000", fcount);
+        end if;
+      else
+        fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
+        if is_err = '1' then                             -- a stream fault's word
+          side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, err_r, fcount);
+        elsif (pf_valid = '1' or pf_pinit = '1') and pf_size = '1' then  -- the frame size's
+          side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, ERR_SIZE_CHANGED,
+                             fcount);
+        else                                             -- the capacity's
+          side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, pf_l2d, fl, ERR_CAPACITY, fcount);
+        end if;
+      end if;
       sg_ok <= '0';
       q_flush <= '0';
       -- an add's init rectangle in frame px, its release and next line (the engine's geometry holds from
@@ -1188,16 +1216,10 @@ begin
         when S_J_CMT =>                                  -- the commit's clock: the walk reads after it
           fsm <= S_J_NEXT;
 
-        when S_J_NEXT =>                                 -- slot j's word of the frame
-          fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
-          if (pf_valid = '1' or pf_pinit = '1') and pf_size = '1' then  -- side_w every clock (its enable
-            side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl,  -- the state
-                               ERR_SIZE_CHANGED, fcount);                                     -- alone)
-          else
-            side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, pf_l2d, fl, ERR_CAPACITY, fcount);
-          end if;
+        when S_J_NEXT =>                                 -- slot j's word of the frame (side_w, above)
           if j = NT then
             if om_any = '0' then
+              sgl <= '1';
               fsm <= S_SINGLE;
             elsif ro_close_ready = '1' then
               ro_close <= '1';                           -- (ro_mask: out_mask, above)
@@ -1264,11 +1286,10 @@ begin
           end if;
 
         ------------------------------------------------------------ a stream fault: one error word per live target
-        when S_E_NEXT =>
-          fl := v2_flags('0', '0', '0', '1', pf_rejd or (first_w and rej_any), not pf_valid, '0');
-          side_w <= top_word(pf_c8x, pf_c8y, pf_w8, pf_h8, ST_ERROR, to_unsigned(0, 3), fl, err_r, fcount);
+        when S_E_NEXT =>                                 -- (side_w, above)
           if j = NT then
             if om_any = '0' then
+              sgl <= '1';
               fsm <= S_SINGLE;
             elsif ro_close_ready = '1' then
               ro_close <= '1';                           -- (ro_mask: out_mask, above)
@@ -1294,26 +1315,15 @@ begin
             end if;
           end if;
 
-        when S_SINGLE =>                                 -- no live target: slot 0's word alone (into side_w
-          k_cur <= (others => '0');                      -- every clock, sent from the second clock on)
-          if is_err = '1' then
-            fl := v2_flags('0', '0', '0', '1', rej_any or rejd(0), '1', '0');
-            side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl, err_r,
-                               fcount);
-          elsif pinit(0) = '1' and alloc(0) = '1' and (fr_w /= fw_a(0) or fr_h /= fh_a(0)) then
-            fl := v2_flags('0', '0', '0', '1', rej_any, '1', '0');
-            side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_ERROR, to_unsigned(0, 3), fl,
-                               ERR_SIZE_CHANGED, fcount);
-          else
-            fl := v2_flags('0', '0', '0', '0', rej_any, '1', '0');
-            side_w <= top_word(c8x_a(0), c8y_a(0), w8_a(0), h8_a(0), ST_OK, to_unsigned(0, 3), fl, "000", fcount);
-          end if;
+        when S_SINGLE =>                                 -- no live target: slot 0's word alone (side_w,
+          k_cur <= (others => '0');                      -- above: sent from the second clock on)
           sg_ok <= '1';
           if ro_close_ready = '1' and sg_ok = '1' then
             if is_err = '1' then
               cut_pend <= '0';
             end if;
             sg_ok <= '0';
+            sgl <= '0';
             ro_valid <= '1';
             ro_close <= '1';                             -- (ro_mask: slot 0, above)
             fcount <= fcount + 1;
@@ -1328,6 +1338,7 @@ begin
 
       if rst = '1' then
         fsm <= S_IDLE;
+        sgl <= '0';
         alloc <= (others => '0'); pend <= (others => '0'); waiting <= (others => '0');
         pinit <= (others => '0'); valid <= (others => '0'); rejd <= (others => '0');
         held <= (others => '0'); job <= (others => '0');

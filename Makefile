@@ -131,9 +131,9 @@ eval: setup
 
 results: setup
 	$(VENV)/bin/mstrack eval $(DATASET) --out out/eval_float --quiet
-	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
-	$(VENV)/bin/mstrack eval $(VALIDATION) --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt --out out/eval_float_validation --quiet
-	$(VENV)/bin/mstrack eval $(VALIDATION) --model fixed --trackers mstrack-v2,mstrack-v2-colour --out out/eval_fixed_validation --quiet
+	$(VENV)/bin/mstrack eval $(DATASET) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-v2-colour-w63,mstrack-fused-flat,mstrack-colour-flat,mstrack-edge-flat,mstrack-fused-epan,mstrack-colour-epan,mstrack-edge-epan --out out/eval_fixed --quiet
+	$(VENV)/bin/mstrack eval $(VALIDATION) --trackers mstrack-v2,mstrack-v2-colour,mstrack-v2-colour-w63,opencv-csrt --out out/eval_float_validation --quiet
+	$(VENV)/bin/mstrack eval $(VALIDATION) --model fixed --trackers mstrack-v2,mstrack-v2-colour,mstrack-v2-colour-w63 --out out/eval_fixed_validation --quiet
 	$(MAKE) --no-print-directory results-multi
 	$(PY) tools/results_doc.py $(DATASET) $(VALIDATION)
 

@@ -12,12 +12,13 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 RUNS = {"float": REPO / "out" / "eval_float", "fixed": REPO / "out" / "eval_fixed"}
-#: the validation set's runs (`make results`: v2, v2-colour and CSRT; not the paper trackers)
+#: the validation set's runs (`make results`: v2, v2-colour, v2-colour-w63 and CSRT; not the paper trackers)
 RUNS_VAL = {"float": REPO / "out" / "eval_float_validation", "fixed": REPO / "out" / "eval_fixed_validation"}
 DOCS = REPO / "docs"
 DATA = REPO.parent / "shared" / "data"
 SETS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-colour", "float"),
-                 ("mstrack-v2-colour", "fixed"), ("opencv-csrt", "float"))
+                 ("mstrack-v2-colour", "fixed"), ("mstrack-v2-colour-w63", "float"),
+                 ("mstrack-v2-colour-w63", "fixed"), ("opencv-csrt", "float"))
 
 
 def section(md: str, title: str) -> str:
@@ -37,7 +38,8 @@ def tools(md: str) -> str:
 
 
 LOSS_TRACKERS = (("mstrack-v2", "float"), ("mstrack-v2", "fixed"), ("mstrack-v2-colour", "float"),
-                 ("mstrack-v2-colour", "fixed"), ("mstrack-fused-flat", "float"),
+                 ("mstrack-v2-colour", "fixed"), ("mstrack-v2-colour-w63", "float"),
+                 ("mstrack-v2-colour-w63", "fixed"), ("mstrack-fused-flat", "float"),
                  ("mstrack-fused-flat", "fixed"), ("mstrack-colour-flat", "float"))
 
 
@@ -179,10 +181,11 @@ def sets_section(dev_root: Path, val_root: Path) -> list[str]:
            "both together, never per sequence; CI tests use the dev set only.  AUC and P@20 frame-weighted, "
            "and the plain mean of the per-sequence figures; loss flag: recall / false alarms of `ok` as in "
            "the loss table.  Commands: the two above and",
-           "`mstrack eval ../shared/data/validation --trackers mstrack-v2,mstrack-v2-colour,opencv-csrt "
-           "--out out/eval_float_validation --quiet`,",
-           "`mstrack eval ../shared/data/validation --model fixed --trackers mstrack-v2,mstrack-v2-colour "
-           "--out out/eval_fixed_validation --quiet` (all four run by `make results`; their reports: "
+           "`mstrack eval ../shared/data/validation --trackers "
+           "mstrack-v2,mstrack-v2-colour,mstrack-v2-colour-w63,opencv-csrt --out out/eval_float_validation --quiet`,",
+           "`mstrack eval ../shared/data/validation --model fixed --trackers "
+           "mstrack-v2,mstrack-v2-colour,mstrack-v2-colour-w63 --out out/eval_fixed_validation --quiet` "
+           "(all four run by `make results`; their reports: "
            "[results/float_validation/report.md](results/float_validation/report.md), "
            "[results/fixed_validation/report.md](results/fixed_validation/report.md)).", "",
            "| tracker | set | sequences | AUC | P@20 | mean AUC | mean P@20 | loss recall / false alarms |",
@@ -363,9 +366,13 @@ def main(argv: list[str] | None = None) -> int:
             "* **mstrack-v2-colour** (`mstrack.track.params.V2_COLOUR`; "
             "`mstrack hdl config --preset v2 --colour`: ORIENT_T -1) is tracker v2 on the 512 colour bins "
             "alone, without the scale test: lower AUC and mean over sequences (0.527, below CSRT's), a "
-            "weaker loss flag, but twice the float speed and a smaller, faster core (133.96 MHz).  It "
+            "weaker loss flag, but twice the float speed and a smaller, faster core (134.75 MHz).  It "
             "follows a uniform target's growth that the default's gated scale test vetoes "
             "(tests/test_float_v2.py::test_scale_followed_default).",
+            "* **mstrack-v2-colour-w63** is mstrack-v2-colour with windows up to 63 decimated px "
+            "(`max_window=63`; fixed model with MAX_HALF 31 and COORD_W 11, so larger targets are decimated "
+            "sooner): the tracker of the shared-engine core's eight-target build "
+            "(`mstrack synth --config shared8-colour-w63`, docs/performance.md \"max_window 63\").",
             "* **Fusion does not pay on this set (paper preset).** In the run above, colour alone beats the fused "
             "tracker. The 16-bin gradient-magnitude histogram discriminates poorly (edge alone is the "
             "weakest mstrack variant): the background next to a target often has an edge histogram much "

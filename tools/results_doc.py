@@ -337,7 +337,7 @@ def main(argv: list[str] | None = None) -> int:
         for f in ("report.md", "report.json", "success.png", "precision.png"):
             shutil.copy(run / f, dst / f)
         md = rep.read_text()
-        out += [f"## {'Float reference and OpenCV baselines' if name == 'float' else 'Fixed-point model (= the RTL cores: mstrack-v2 core v2, ORIENT_T 64; mstrack-v2-colour core v2 with ORIENT_T -1)'}",
+        out += [f"## {'Float reference and OpenCV baselines' if name == 'float' else 'Fixed-point model (= the RTL cores: mstrack-v2 core v2, ORIENT_T 64; mstrack-v2-colour core v2 with ORIENT_T -1; mstrack-v2-colour-w63 the shared-engine core in its w63 builds)'}",
                 "", command(md), "", tools(md), "", section(md, "Overall"), "",
                 f"Per sequence and per attribute: [results/{name}/report.md](results/{name}/report.md). "
                 f"Machine-readable: `results/{name}/report.json`.", "",
@@ -366,7 +366,7 @@ def main(argv: list[str] | None = None) -> int:
             "* **mstrack-v2-colour** (`mstrack.track.params.V2_COLOUR`; "
             "`mstrack hdl config --preset v2 --colour`: ORIENT_T -1) is tracker v2 on the 512 colour bins "
             "alone, without the scale test: lower AUC and mean over sequences (0.527, below CSRT's), a "
-            "weaker loss flag, but twice the float speed and a smaller, faster core (134.75 MHz).  It "
+            "weaker loss flag, and a smaller, faster core (134.75 MHz).  It "
             "follows a uniform target's growth that the default's gated scale test vetoes "
             "(tests/test_float_v2.py::test_scale_followed_default).",
             "* **mstrack-v2-colour-w63** is mstrack-v2-colour with windows up to 63 decimated px "

@@ -20,8 +20,9 @@
 -- Commands, taken while idle = 1, at most one per clock: go (run the job), init_take (an init box:
 --   ms_box_clip; a box it rejects gives init_rejected, otherwise the record becomes an init pending),
 --   load_take (another target's record and model; an init pending is dropped: it was the previous
---   target's, and the record does not hold one), rearm (compute the geometry again).
--- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT); go -> res_valid:
+--   target's, and the record does not hold one; load_state is sampled with load_take and written into
+--   the record the next clock), rearm (compute the geometry again).
+-- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT, + 1 after a load); go -> res_valid:
 --   the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
 --   statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean shifts
 --   with their confidence; the gated scale test adds about 2 x (tables + Qw load + one pass) on a
@@ -220,11 +221,14 @@ architecture rtl of ms_engine is
 
   type tstate_t is (T_PREP, T_DEC, T_DEC_WAIT, T_SIZE, T_SIZE_WAIT, T_BOX, T_BOX1, T_BOX2, T_RECT0, T_RECT1,
                     T_RECT2, T_RECT3,
-                    T_REGION_WAIT, T_IDLE, T_CLIP, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
+                    T_REGION_WAIT, T_IDLE, T_LOAD, T_CLIP, T_TABLES, T_QLOAD, T_RUN, T_C0, T_C1, T_C2,
                     T_CNEXT, T_STATS0, T_STATS, T_CONF,
                     T_DECIDE, T_ST_SIZE, T_ST_WS, T_ST_WS_WAIT, T_ST_FIT, T_ST_RUN, T_ST_RHO, T_ST_NEXT,
                     T_ST_GATE, T_SCALE, T_RESIZE, T_RESULT, T_PUSH);
   signal fsm : tstate_t := T_PREP;
+  -- load_state registered every clock: T_LOAD writes the record from it (the clock after load_take), so
+  -- the record's enable is T_LOAD's decode, not T_IDLE's command priority
+  signal ld_st : std_logic_vector(load_state'range) := (others => '0');
 
   -- target state (one record per target)
   signal target_valid, init_pending, init_clipped : std_logic := '0';
@@ -768,6 +772,7 @@ begin
       ql_v1 <= '0';
       init_rejected <= '0';
       geo_done <= '0';
+      ld_st <= load_state;
       -- the best start point so far (wide search): taken the clock after T_C2 decided it
       best_take <= '0';
       if best_take = '1' then
@@ -923,30 +928,33 @@ begin
             in_fw <= init_fw; in_fh <= init_fh;
             bc_valid <= '1';
             fsm <= T_CLIP;
-          elsif load_take = '1' then           -- another target: its state, its model
-            target_valid  <= load_state(0);
-            lost_st       <= load_state(1);
-            reported_lost <= load_state(2);
-            c8x        <= unsigned(load_state(TS_C8Y - 1 downto TS_C8X));
-            c8y        <= unsigned(load_state(TS_W8 - 1 downto TS_C8Y));
-            w8         <= unsigned(load_state(TS_H8 - 1 downto TS_W8));
-            h8         <= unsigned(load_state(TS_W0 - 1 downto TS_H8));
-            w0_8       <= unsigned(load_state(TS_FW - 1 downto TS_W0));
-            tgt_w      <= unsigned(load_state(TS_FH - 1 downto TS_FW));
-            tgt_h      <= unsigned(load_state(TS_RREF - 1 downto TS_FH));
-            rho_ref    <= unsigned(load_state(TS_SREF - 1 downto TS_RREF));
-            share_ref  <= unsigned(load_state(TS_RHO0 - 1 downto TS_SREF));
-            rho0       <= unsigned(load_state(TS_RHOS - 1 downto TS_RHO0));
-            rho_s      <= signed(load_state(TS_CONS - 1 downto TS_RHOS));
-            con_s      <= signed(load_state(TS_SPREF - 1 downto TS_CONS));
-            spread_ref <= unsigned(load_state(TS_W - 1 downto TS_SPREF));
+          elsif load_take = '1' then           -- another target: its model now, its state next clock
             m_sel <= load_model;
             init_pending <= '0';               -- an init pending was the previous target's
             init_clipped <= '0';
-            fsm <= T_PREP;                     -- its region for the next frame
+            fsm <= T_LOAD;
           elsif rearm = '1' then
             fsm <= T_PREP;
           end if;
+
+        when T_LOAD =>                         -- the record taken with load_take (ld_st)
+          target_valid  <= ld_st(0);
+          lost_st       <= ld_st(1);
+          reported_lost <= ld_st(2);
+          c8x        <= unsigned(ld_st(TS_C8Y - 1 downto TS_C8X));
+          c8y        <= unsigned(ld_st(TS_W8 - 1 downto TS_C8Y));
+          w8         <= unsigned(ld_st(TS_H8 - 1 downto TS_W8));
+          h8         <= unsigned(ld_st(TS_W0 - 1 downto TS_H8));
+          w0_8       <= unsigned(ld_st(TS_FW - 1 downto TS_W0));
+          tgt_w      <= unsigned(ld_st(TS_FH - 1 downto TS_FW));
+          tgt_h      <= unsigned(ld_st(TS_RREF - 1 downto TS_FH));
+          rho_ref    <= unsigned(ld_st(TS_SREF - 1 downto TS_RREF));
+          share_ref  <= unsigned(ld_st(TS_RHO0 - 1 downto TS_SREF));
+          rho0       <= unsigned(ld_st(TS_RHOS - 1 downto TS_RHO0));
+          rho_s      <= signed(ld_st(TS_CONS - 1 downto TS_RHOS));
+          con_s      <= signed(ld_st(TS_SPREF - 1 downto TS_CONS));
+          spread_ref <= unsigned(ld_st(TS_W - 1 downto TS_SPREF));
+          fsm <= T_PREP;                       -- its region for the next frame
 
         when T_CLIP =>
           if bc_out_valid = '1' then

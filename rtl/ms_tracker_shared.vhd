@@ -244,7 +244,7 @@ architecture rtl of ms_tracker_shared is
   signal fcount  : unsigned(15 downto 0) := (others => '0');
 
   type state_t is (S_IDLE, S_CMD, S_LIST, S_PLAN, S_ADDS, S_A_DROP, S_A_LOAD, S_A_INIT, S_A_CLK, S_A_OFFER, S_A_CODE,
-                   S_OPEN, S_STREAM, S_J_WAIT, S_J_CMT, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
+                   S_OPEN, S_STREAM, S_J_WAIT, S_J_CMT, S_J_SZ, S_J_NEXT, S_COMMIT, S_SIDE, S_E_NEXT, S_SINGLE);
   signal fsm     : state_t := S_IDLE;
   -- the jobs: run as their regions are released, while the frame streams
   type jstate_t is (J_IDLE, J_SEL, J_LOAD, J_INIT, J_IJ, J_WORD, J_END);
@@ -294,6 +294,9 @@ architecture rtl of ms_tracker_shared is
   signal pf_c8x, pf_c8y : unsigned(CENTRE_ABS_W - 1 downto 0) := (others => '0');
   signal pf_w8, pf_h8 : unsigned(SIZE_W - 1 downto 0) := (others => '0');
   signal pf_l2d : unsigned(2 downto 0) := (others => '0');
+  -- per slot: the frame's size is not the target's (registered every clock from fr_w / fr_h and the
+  -- slot's fw_a / fh_a; the walk reads it a clock after the commit's, S_J_SZ)
+  signal sz_m   : std_logic_vector(NT - 1 downto 0) := (others => '0');
 
   -- input
   signal open_in, in_frame : std_logic := '0';
@@ -671,8 +674,8 @@ begin
       st_valid_r <= '0';
       ro_valid <= '0';
       ro_close <= '0';
-      wsel <= '1' when fsm = S_J_CMT or fsm = S_J_NEXT or fsm = S_COMMIT or fsm = S_SIDE or fsm = S_E_NEXT
-              or fsm = S_SINGLE else '0';
+      wsel <= '1' when fsm = S_J_CMT or fsm = S_J_SZ or fsm = S_J_NEXT or fsm = S_COMMIT or fsm = S_SIDE
+                       or fsm = S_E_NEXT or fsm = S_SINGLE else '0';
       if wsel = '1' then
         ro_word <= side_w;
         ro_id <= k_cur;
@@ -766,10 +769,13 @@ begin
         k := j;
         pf_alloc <= alloc(k); pf_valid <= valid(k); pf_pinit <= pinit(k); pf_held <= held(k);
         pf_rejd <= rejd(k);
-        pf_size <= '1' when fr_w /= fw_a(k) or fr_h /= fh_a(k) else '0';
+        pf_size <= sz_m(k);
         pf_c8x <= c8x_a(k); pf_c8y <= c8y_a(k); pf_w8 <= w8_a(k); pf_h8 <= h8_a(k);
         pf_l2d <= hold_l2d(k);
       end if;
+      for i in 0 to NT - 1 loop
+        sz_m(i) <= '1' when fr_w /= fw_a(i) or fr_h /= fh_a(i) else '0';
+      end loop;
       -- frame events of the front end (the last one of each kind is kept: one frame at a time)
       if fe_end = '1' then
         ev_end <= '1';
@@ -1213,8 +1219,11 @@ begin
             fsm <= S_J_CMT;
           end if;
 
-        when S_J_CMT =>                                  -- the commit's clock: the walk reads after it
-          fsm <= S_J_NEXT;
+        when S_J_CMT =>                                  -- the commit's clock
+          fsm <= S_J_SZ;
+
+        when S_J_SZ =>                                   -- the size flags of the committed sizes (sz_m):
+          fsm <= S_J_NEXT;                               -- the walk reads after it
 
         when S_J_NEXT =>                                 -- slot j's word of the frame (side_w, above)
           if j = NT then

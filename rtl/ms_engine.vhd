@@ -22,11 +22,12 @@
 --   load_take (another target's record and model; an init pending is dropped: it was the previous
 --   target's, and the record does not hold one; load_state is sampled with load_take and written into
 --   the record the next clock), rearm (compute the geometry again).
--- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT, + 1 after a load); go -> res_valid:
---   the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
---   statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean shifts
---   with their confidence; the gated scale test adds about 2 x (tables + Qw load + one pass) on a
---   frame that scales.  Measured per sequence: docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).
+-- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT, + 1 after a
+--   load); go -> res_valid: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
+--   (docs/realtime.md), ~60 clocks of statistics and about 230 of confidence, loss flag, scale and
+--   resize; while lost 8 more mean shifts with their confidence; the gated scale test adds about
+--   2 x (tables + Qw load + one pass) on a frame that scales.  Measured per sequence:
+--   docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).
 -- Throughput: one job at a time; the region memory is read LANES pixels per clock (RAM_LAT clocks of
 --   read latency).
 -- Handshake: the command pulses above; res_valid / res_ready for the word (the record shows the new
@@ -229,6 +230,9 @@ architecture rtl of ms_engine is
   -- load_state registered every clock: T_LOAD writes the record from it (the clock after load_take), so
   -- the record's enable is T_LOAD's decode, not T_IDLE's command priority
   signal ld_st : std_logic_vector(load_state'range) := (others => '0');
+  -- '1' in T_RESULT's clock, set with the transition: the word and the init's references are written
+  -- under it (a register, not the state's decode, in their clock enables)
+  signal t_res : std_logic := '0';
 
   -- target state (one record per target)
   signal target_valid, init_pending, init_clipped : std_logic := '0';
@@ -773,6 +777,7 @@ begin
       init_rejected <= '0';
       geo_done <= '0';
       ld_st <= load_state;
+      t_res <= '0';
       -- the best start point so far (wide search): taken the clock after T_C2 decided it
       best_take <= '0';
       if best_take = '1' then
@@ -1109,6 +1114,7 @@ begin
           if rs_done = '1' then got(3) <= '1'; ring <= rs_ring; end if;
           if got = "1111" then
             if init_pending = '1' then
+              t_res <= '1';
               fsm <= T_RESULT;
             else
               cf_start <= '1';
@@ -1185,6 +1191,7 @@ begin
             sc_start <= '1';
             fsm <= T_SCALE;
           else
+            t_res <= '1';
             fsm <= T_RESULT;
           end if;
 
@@ -1273,35 +1280,11 @@ begin
           if rzw_done = '1' then
             w8 <= w8_n;
             h8 <= h8_n;
+            t_res <= '1';
             fsm <= T_RESULT;
           end if;
 
-        when T_RESULT =>
-          if init_pending = '1' then
-            rho_ref <= rho;
-            share_ref <= share;
-            rho0 <= rho;
-            rho_s <= signed(resize(rho, CON_W));
-            con_s <= con_x;
-            if spread /= 0 then
-              spread_ref <= spread;
-            else
-              spread_ref <= to_unsigned(SPREAD_DEFAULT, SPREAD_W);
-            end if;
-            target_valid <= '1';
-            init_pending <= '0';
-            if init_clipped = '1' then stat := ST_CLIP; else stat := ST_INIT; end if;
-            res_word <= pack(c8x, c8y, w8, h8, rho, to_unsigned(ONE16, 17), stat, to_unsigned(0, ITER_W),
-                             "00", l2d, to_unsigned(0, 4),
-                             v2_flags(not init_clipped, init_clipped, '0', '0', word_rejected, '0', word_overflow),
-                             "000", word_fcount);
-          else
-            if status_r = ST_LOST then lost_now := '1'; else lost_now := '0'; end if;
-            if lost_st_frame = '1' then srch := "000"; srch4 := to_unsigned(8, 4); else srch4 := to_unsigned(0, 4); end if;
-            res_word <= pack(c8x, c8y, w8, h8, rho, conf, status_r, r_iter, r_stop, l2d, srch4,
-                             v2_flags('0', '0', lost_now, '0', word_rejected, '0', word_overflow),
-                             "000", word_fcount);
-          end if;
+        when T_RESULT =>                       -- the word and the init's references (t_res, below)
           fsm <= T_PUSH;
 
         when T_PUSH =>                         -- the word is out on res_data
@@ -1309,6 +1292,39 @@ begin
             fsm <= T_PREP;
           end if;
       end case;
+
+      -- T_RESULT: the word, and an init's references
+      if t_res = '1' then
+        if init_pending = '1' then
+          rho_ref <= rho;
+          share_ref <= share;
+          rho0 <= rho;
+          rho_s <= signed(resize(rho, CON_W));
+          con_s <= con_x;
+          if spread /= 0 then
+            spread_ref <= spread;
+          else
+            spread_ref <= to_unsigned(SPREAD_DEFAULT, SPREAD_W);
+          end if;
+          target_valid <= '1';
+          init_pending <= '0';
+          if init_clipped = '1' then stat := ST_CLIP; else stat := ST_INIT; end if;
+          res_word <= pack(c8x, c8y, w8, h8, rho, to_unsigned(ONE16, 17), stat, to_unsigned(0, ITER_W),
+                           "00", l2d, to_unsigned(0, 4),
+                           v2_flags(not init_clipped, init_clipped, '0', '0', word_rejected, '0', word_overflow),
+                           "000", word_fcount);
+        else
+          if status_r = ST_LOST then lost_now := '1'; else lost_now := '0'; end if;
+          if lost_st_frame = '1' then
+            srch := "000"; srch4 := to_unsigned(8, 4);
+          else
+            srch4 := to_unsigned(0, 4);
+          end if;
+          res_word <= pack(c8x, c8y, w8, h8, rho, conf, status_r, r_iter, r_stop, l2d, srch4,
+                           v2_flags('0', '0', lost_now, '0', word_rejected, '0', word_overflow),
+                           "000", word_fcount);
+        end if;
+      end if;
 
       -- the references follow OK frames (ms_ref_update: one clock after ru_start)
       ru_d <= ru_start;
@@ -1332,6 +1348,7 @@ begin
         m_sel <= (others => '0');
         init_rejected <= '0';
         geo_done <= '0';
+        t_res <= '0';
         ql_issue <= '0';
         st_sel <= '0';
       end if;

@@ -18,12 +18,13 @@
 --   with SCALE_TEST_D256 > 0 the gated scale test, ms_scale and ms_resize x 2; the result word v2
 --   (frame_count, rejected and overflow from the ports) and the new record.
 -- Commands, taken while idle = 1, at most one per clock: go (run the job), init_take (an init box:
---   ms_box_clip; a box it rejects gives init_rejected, otherwise the record becomes an init pending),
+--   ms_box_clip, its verdict acted on a clock after the clip's out_valid; a box it rejects gives
+--   init_rejected, otherwise the record becomes an init pending),
 --   load_take (another target's record and model; an init pending is dropped: it was the previous
 --   target's, and the record does not hold one; load_state is sampled with load_take and written into
 --   the record the next clock), rearm (compute the geometry again).
--- Latency: geometry about 25 clocks (+ 3 with an init pending, + 4 more with SLOT_INIT, + 1 after a
---   load); go -> res_valid: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
+-- Latency: init_take -> init_rejected or the record: 6 clocks; geometry about 25 clocks (+ 3 with an
+--   init pending, + 4 more with SLOT_INIT, + 1 after a load); go -> res_valid: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
 --   (docs/realtime.md), ~60 clocks of statistics and about 230 of confidence, loss flag, scale and
 --   resize; while lost 8 more mean shifts with their confidence; the gated scale test adds about
 --   2 x (tables + Qw load + one pass) on a frame that scales.  Measured per sequence:
@@ -233,6 +234,10 @@ architecture rtl of ms_engine is
   -- '1' in T_RESULT's clock, set with the transition: the word and the init's references are written
   -- under it (a register, not the state's decode, in their clock enables)
   signal t_res : std_logic := '0';
+  -- the init box's verdict, registered every clock from ms_box_clip's registered outputs and the frame
+  -- size: T_CLIP acts on it a clock after out_valid, so the record's clock enable is a register and
+  -- T_CLIP's decode, not the compares
+  signal in_bad, clip_v, clip_rej : std_logic := '0';
 
   -- target state (one record per target)
   signal target_valid, init_pending, init_clipped : std_logic := '0';
@@ -778,6 +783,9 @@ begin
       geo_done <= '0';
       ld_st <= load_state;
       t_res <= '0';
+      in_bad <= '1' when in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W else '0';
+      clip_v <= bc_out_valid;
+      clip_rej <= bc_rejected or in_bad;
       -- the best start point so far (wide search): taken the clock after T_C2 decided it
       best_take <= '0';
       if best_take = '1' then
@@ -961,9 +969,9 @@ begin
           spread_ref <= unsigned(ld_st(TS_W - 1 downto TS_SPREF));
           fsm <= T_PREP;                       -- its region for the next frame
 
-        when T_CLIP =>
-          if bc_out_valid = '1' then
-            if bc_rejected = '1' or in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W then
+        when T_CLIP =>                         -- the verdict a clock after ms_box_clip's out_valid
+          if clip_v = '1' then
+            if clip_rej = '1' then
               init_rejected <= '1';
               fsm <= T_IDLE;
             else
@@ -1349,6 +1357,7 @@ begin
         init_rejected <= '0';
         geo_done <= '0';
         t_res <= '0';
+        clip_v <= '0';
         ql_issue <= '0';
         st_sel <= '0';
       end if;

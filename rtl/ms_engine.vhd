@@ -31,6 +31,8 @@
 --   docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).
 -- Throughput: one job at a time; the region memory is read LANES pixels per clock (RAM_LAT clocks of
 --   read latency).
+-- The record's registers are written under registers set a clock before (rec_ld, clip_ok, lf_take,
+--   t_res), not under the state's decode, where their sources allow.
 -- Handshake: the command pulses above; res_valid / res_ready for the word (the record shows the new
 --   state from then on; after the handshake the geometry of the next frame follows).
 library ieee;
@@ -237,7 +239,12 @@ architecture rtl of ms_engine is
   -- the init box's verdict, registered every clock from ms_box_clip's registered outputs and the frame
   -- size: T_CLIP acts on it a clock after out_valid, so the record's clock enable is a register and
   -- T_CLIP's decode, not the compares
-  signal in_bad, clip_v, clip_rej : std_logic := '0';
+  signal in_bad, clip_v, clip_rej, clip_ok : std_logic := '0';
+  -- '1' in T_LOAD's clock, set with the transition: the loaded record is written under it
+  signal rec_ld : std_logic := '0';
+  -- ms_loss_filter's done, registered: the smoothed rho and contrast (held by the filter) are written
+  -- under it, not under T_CONF's decode
+  signal lf_take : std_logic := '0';
 
   -- target state (one record per target)
   signal target_valid, init_pending, init_clipped : std_logic := '0';
@@ -786,6 +793,9 @@ begin
       in_bad <= '1' when in_fw < 3 or in_fh < 3 or in_fw > MAX_FRAME_W else '0';
       clip_v <= bc_out_valid;
       clip_rej <= bc_rejected or in_bad;
+      clip_ok <= bc_out_valid and not (bc_rejected or in_bad);
+      rec_ld <= '0';
+      lf_take <= lf_done;
       -- the best start point so far (wide search): taken the clock after T_C2 decided it
       best_take <= '0';
       if best_take = '1' then
@@ -945,48 +955,21 @@ begin
             m_sel <= load_model;
             init_pending <= '0';               -- an init pending was the previous target's
             init_clipped <= '0';
+            rec_ld <= '1';
             fsm <= T_LOAD;
           elsif rearm = '1' then
             fsm <= T_PREP;
           end if;
 
-        when T_LOAD =>                         -- the record taken with load_take (ld_st)
-          target_valid  <= ld_st(0);
-          lost_st       <= ld_st(1);
-          reported_lost <= ld_st(2);
-          c8x        <= unsigned(ld_st(TS_C8Y - 1 downto TS_C8X));
-          c8y        <= unsigned(ld_st(TS_W8 - 1 downto TS_C8Y));
-          w8         <= unsigned(ld_st(TS_H8 - 1 downto TS_W8));
-          h8         <= unsigned(ld_st(TS_W0 - 1 downto TS_H8));
-          w0_8       <= unsigned(ld_st(TS_FW - 1 downto TS_W0));
-          tgt_w      <= unsigned(ld_st(TS_FH - 1 downto TS_FW));
-          tgt_h      <= unsigned(ld_st(TS_RREF - 1 downto TS_FH));
-          rho_ref    <= unsigned(ld_st(TS_SREF - 1 downto TS_RREF));
-          share_ref  <= unsigned(ld_st(TS_RHO0 - 1 downto TS_SREF));
-          rho0       <= unsigned(ld_st(TS_RHOS - 1 downto TS_RHO0));
-          rho_s      <= signed(ld_st(TS_CONS - 1 downto TS_RHOS));
-          con_s      <= signed(ld_st(TS_SPREF - 1 downto TS_CONS));
-          spread_ref <= unsigned(ld_st(TS_W - 1 downto TS_SPREF));
+        when T_LOAD =>                         -- the record taken with load_take (ld_st; rec_ld, below)
           fsm <= T_PREP;                       -- its region for the next frame
 
         when T_CLIP =>                         -- the verdict a clock after ms_box_clip's out_valid
-          if clip_v = '1' then
+          if clip_v = '1' then                 -- the accepted box's record: clip_ok, below
             if clip_rej = '1' then
               init_rejected <= '1';
               fsm <= T_IDLE;
             else
-              c8x <= bc_cx;
-              c8y <= bc_cy;
-              w8 <= shift_left(resize(bc_w, SIZE_W), 8);
-              h8 <= shift_left(resize(bc_h, SIZE_W), 8);
-              w0_8 <= shift_left(resize(bc_w, SIZE_W), 8);
-              tgt_w <= in_fw;
-              tgt_h <= in_fh;
-              init_pending <= '1';
-              init_clipped <= bc_clipped;
-              target_valid <= '0';
-              lost_st <= '0';
-              reported_lost <= '0';
               fsm <= T_PREP;
             end if;
           end if;
@@ -1132,10 +1115,8 @@ begin
             end if;
           end if;
 
-        when T_CONF =>
-          if lf_done = '1' then
-            rho_s <= rho_s_n;
-            con_s <= con_s_n;
+        when T_CONF =>                         -- the smoothed rho and contrast: lf_take, below
+          if lf_take = '1' then
             got(1) <= '1';
           end if;
           if cf_done = '1' then
@@ -1301,6 +1282,45 @@ begin
           end if;
       end case;
 
+      -- T_LOAD: the record taken with load_take
+      if rec_ld = '1' then
+        target_valid  <= ld_st(0);
+        lost_st       <= ld_st(1);
+        reported_lost <= ld_st(2);
+        c8x        <= unsigned(ld_st(TS_C8Y - 1 downto TS_C8X));
+        c8y        <= unsigned(ld_st(TS_W8 - 1 downto TS_C8Y));
+        w8         <= unsigned(ld_st(TS_H8 - 1 downto TS_W8));
+        h8         <= unsigned(ld_st(TS_W0 - 1 downto TS_H8));
+        w0_8       <= unsigned(ld_st(TS_FW - 1 downto TS_W0));
+        tgt_w      <= unsigned(ld_st(TS_FH - 1 downto TS_FW));
+        tgt_h      <= unsigned(ld_st(TS_RREF - 1 downto TS_FH));
+        rho_ref    <= unsigned(ld_st(TS_SREF - 1 downto TS_RREF));
+        share_ref  <= unsigned(ld_st(TS_RHO0 - 1 downto TS_SREF));
+        rho0       <= unsigned(ld_st(TS_RHOS - 1 downto TS_RHO0));
+        rho_s      <= signed(ld_st(TS_CONS - 1 downto TS_RHOS));
+        con_s      <= signed(ld_st(TS_SPREF - 1 downto TS_CONS));
+        spread_ref <= unsigned(ld_st(TS_W - 1 downto TS_SPREF));
+      end if;
+      -- T_CLIP: an accepted init box (only T_CLIP waits for ms_box_clip, so clip_ok needs no decode)
+      if clip_ok = '1' then
+        c8x <= bc_cx;
+        c8y <= bc_cy;
+        w8 <= shift_left(resize(bc_w, SIZE_W), 8);
+        h8 <= shift_left(resize(bc_h, SIZE_W), 8);
+        w0_8 <= shift_left(resize(bc_w, SIZE_W), 8);
+        tgt_w <= in_fw;
+        tgt_h <= in_fh;
+        init_pending <= '1';
+        init_clipped <= bc_clipped;
+        target_valid <= '0';
+        lost_st <= '0';
+        reported_lost <= '0';
+      end if;
+      -- T_CONF: the loss filters' smoothed rho and contrast (only T_CONF starts them)
+      if lf_take = '1' then
+        rho_s <= rho_s_n;
+        con_s <= con_s_n;
+      end if;
       -- T_RESULT: the word, and an init's references
       if t_res = '1' then
         if init_pending = '1' then
@@ -1358,6 +1378,9 @@ begin
         geo_done <= '0';
         t_res <= '0';
         clip_v <= '0';
+        clip_ok <= '0';
+        rec_ld <= '0';
+        lf_take <= '0';
         ql_issue <= '0';
         st_sel <= '0';
       end if;

@@ -24,10 +24,11 @@
 --   target's, and the record does not hold one; load_state is sampled with load_take and written into
 --   the record the next clock), rearm (compute the geometry again).
 -- Latency: init_take -> init_rejected or the record: 6 clocks; geometry about 25 clocks (+ 3 with an
---   init pending, + 4 more with SLOT_INIT, + 1 after a load); go -> res_valid: the kernel tables (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift
---   (docs/realtime.md), ~60 clocks of statistics and about 230 of confidence, loss flag, scale and
---   resize; while lost 8 more mean shifts with their confidence; the gated scale test adds about
---   2 x (tables + Qw load + one pass) on a frame that scales.  Measured per sequence:
+--   init pending, + 4 more with SLOT_INIT, + 1 after a load); go -> res_valid: the kernel tables
+--   (<= 289 clocks), the Qw load (N_BINS + 6), the mean shift (docs/realtime.md), ~60 clocks of
+--   statistics and about 230 of confidence, loss flag, scale and resize; while lost 8 more mean
+--   shifts with their confidence; the gated scale test adds about 2 x (tables + Qw load + one pass)
+--   on a frame that scales.  Measured per sequence:
 --   docs/blocks/ms_tracker_v2.md (studies/v2_latency.py).
 -- Throughput: one job at a time; the region memory is read LANES pixels per clock (RAM_LAT clocks of
 --   read latency).

@@ -33,7 +33,8 @@
 -- Throughput: one job at a time; the region memory is read LANES pixels per clock (RAM_LAT clocks of
 --   read latency).
 -- The record's registers are written under registers set a clock before (rec_ld, clip_ok, lf_take,
---   t_res), not under the state's decode, where their sources allow.
+--   t_res), and the spread and ring share under their blocks' done, not under the state's decode,
+--   where their sources allow.
 -- Handshake: the command pulses above; res_valid / res_ready for the word (the record shows the new
 --   state from then on; after the handshake the geometry of the next frame follows).
 library ieee;
@@ -1102,8 +1103,8 @@ begin
         when T_STATS =>
           if fu_done = '1' then got(0) <= '1'; rho <= fu_rho; end if;
           if sh_done = '1' then got(1) <= '1'; share <= sh_share; end if;
-          if sp_done = '1' then got(2) <= '1'; spread <= sp_spread; end if;
-          if rs_done = '1' then got(3) <= '1'; ring <= rs_ring; end if;
+          if sp_done = '1' then got(2) <= '1'; end if;   -- (spread, ring: sp_done, rs_done, below)
+          if rs_done = '1' then got(3) <= '1'; end if;
           if got = "1111" then
             if init_pending = '1' then
               t_res <= '1';
@@ -1316,6 +1317,13 @@ begin
         target_valid <= '0';
         lost_st <= '0';
         reported_lost <= '0';
+      end if;
+      -- T_STATS: the spread and the ring share (only T_STATS0 starts ms_spread and ms_ring_share)
+      if sp_done = '1' then
+        spread <= sp_spread;
+      end if;
+      if rs_done = '1' then
+        ring <= rs_ring;
       end if;
       -- T_CONF: the loss filters' smoothed rho and contrast (only T_CONF starts them)
       if lf_take = '1' then

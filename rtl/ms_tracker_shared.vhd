@@ -332,6 +332,7 @@ architecture rtl of ms_tracker_shared is
   signal c_init_x, c_init_y : signed(COORD_W + 1 downto 0) := (others => '0');
   signal c_init_w, c_init_h : unsigned(COORD_W downto 0) := (others => '0');
   signal c_init_fw, c_init_fh : unsigned(COORD_W - 1 downto 0) := (others => '0');
+  signal ini_slot : slot_t := (others => '0');                   -- the slot c_init_* are loaded from
   signal c_state  : std_logic_vector(TS_W - 1 downto 0) := (others => '0');
   signal c_model  : unsigned(clog2(NT) - 1 downto 0) := (others => '0');
   signal e_idle, e_geo_done, e_init_rej, e_res_valid, e_res_ready, e_busy : std_logic;
@@ -733,6 +734,12 @@ begin
       g_y1 <= shift_left(rect_y + rect_h, idx(l2d));
       g_rel <= shift_left(resize(rect_y + rect_h, COORD_W + 1), idx(l2d)) + 1;
       g_next <= shift_left(reg_y, idx(l2d));
+      -- the init box and frame size for the engine, loaded every clock from the slot that a register
+      -- selects (ini_slot: the job's slot from J_SEL, the add's from its S_A_LOAD), so no decode of
+      -- either state machine reaches these registers; the engine takes them with cmd_init
+      c_init_x <= bx_a(idx(ini_slot)); c_init_y <= by_a(idx(ini_slot));
+      c_init_w <= bw_a(idx(ini_slot)); c_init_h <= bh_a(idx(ini_slot));
+      c_init_fw <= fw_a(idx(ini_slot)); c_init_fh <= fh_a(idx(ini_slot));
       -- the per-slot writes, each under its own registered enable (no decode of the sequencer's state
       -- in a clock enable that fans out to a slot's whole record)
       for i in 0 to NT - 1 loop
@@ -828,11 +835,10 @@ begin
           cmd_load <= '1';                               -- (c_state, above: an AND-OR under the one-hot
           j_ld <= (others => '0');                       -- slot; an init pending loads an empty record)
           c_model <= resize(j_slot, clog2(NT));
+          ini_slot <= j_slot;
           jfsm <= J_LOAD;
-        when J_LOAD =>                                   -- (the init's box every clock: the engine takes it
-          kj := idx(j_slot);                             -- with cmd_init)
-          c_init_x <= bx_a(kj); c_init_y <= by_a(kj); c_init_w <= bw_a(kj); c_init_h <= bh_a(kj);
-          c_init_fw <= fw_a(kj); c_init_fh <= fh_a(kj);
+        when J_LOAD =>                                   -- (the init's box: c_init_*, above; the engine
+          kj := idx(j_slot);                             -- takes it with cmd_init)
           if e_geo_done = '1' then
             if pinit(kj) = '1' then
               cmd_init <= '1';
@@ -1075,6 +1081,7 @@ begin
               if (pass_b = '0' and pinit(k) = '1') or (pass_b = '1' and waiting(k) = '1') then
                 cmd_load <= '1';                           -- an empty record (j_ld is clear: c_state),
                 c_model <= resize(k_cur, clog2(NT));       -- the target's model
+                ini_slot <= k_cur;
                 fsm <= S_A_LOAD;
               end if;
               j <= j + 1;
@@ -1101,10 +1108,7 @@ begin
           drop_ord(k_cur);                               -- the next entry moves into place j
           fsm <= S_ADDS;
 
-        when S_A_LOAD =>                                 -- (the add's box every clock, as in J_LOAD)
-          k := idx(k_cur);
-          c_init_x <= bx_a(k); c_init_y <= by_a(k); c_init_w <= bw_a(k); c_init_h <= bh_a(k);
-          c_init_fw <= fw_a(k); c_init_fh <= fh_a(k);
+        when S_A_LOAD =>                                 -- (the add's box: c_init_*, above)
           if e_geo_done = '1' then
             cmd_init <= '1';
             fsm <= S_A_INIT;

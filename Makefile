@@ -27,7 +27,7 @@ typecheck: setup
 # `make test` = the simulation and Python tests (pytest -m "not synth and not long and not extra") and,
 # in parallel on the second core, the ECP5 netlist build of the default core (tb/test_synth.py, marker
 # `synth`: GHDL -> yosys synth_ecp5 -> nextpnr-ecp5, seed 1; fits, Fmax floor, resource ceilings)
-# followed by the long co-simulations (marker `long`, Verilator: core v2 on 260 real frames (1,545 with test-extra), the
+# followed by the long co-simulations (marker `long`, Verilator: core v2 on 120 real frames (1,545 with test-extra), the
 # paper core on 760, the 1080p60 / 720p60 real-time checks of both cores, core v2's stream faults;
 # GHDL: core v2's AXI-Lite top).  Tests listed in tb/conftest.py CI_EXTRA (marker `extra`) are left
 # to `make test-extra` in both halves.
@@ -51,7 +51,7 @@ test-synth-only:
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" --durations=60 -p no:cacheprovider $(ARGS); b=$$?; \
 	test $$a -eq 0 -o $$a -eq 5 && test $$b -eq 0 -o $$b -eq 5  # 5: nothing selected (ARGS)
 
-# the long co-simulations alone (core v2 on 260 real frames (1,545 with test-extra), the paper core on 760, the real-time checks,
+# the long co-simulations alone (core v2 on 120 real frames (1,545 with test-extra), the paper core on 760, the real-time checks,
 # core v2's stream faults; Verilator; part of `make test`)
 test-long: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" -p no:cacheprovider $(ARGS)

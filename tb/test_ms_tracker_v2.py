@@ -300,9 +300,9 @@ def test_tracker_v2_joint_fastsim(name, n, pin, pout):
 
 #: the long run (>= 1,500 real frames): whole sequences, 1,545 frames in all (name, frames,
 #: input-gap %, result back-pressure %): MotorRolling is 640x360 (D = 2), Deer 704x400 (lost at D = 4),
-#: Girl 128x96; Couple and Deer are streamed with random input gaps and result back-pressure; losses
-#: and re-acquisitions on Couple (46-48), Crossing, Deer, Subway (docs/blocks/ms_tracker_v2.md)
-LONG_RUNS = [("Girl", 500, 0, 0), ("Couple", 140, 20, 30), ("Crossing", 120, 0, 0), ("Subway", 175, 0, 0),
+#: Girl 128x96; Couple, Crossing and Deer are streamed with random input gaps and result back-pressure;
+#: losses and re-acquisitions on Couple (46-48), Crossing, Deer, Subway (docs/blocks/ms_tracker_v2.md)
+LONG_RUNS = [("Girl", 500, 0, 0), ("Couple", 140, 20, 30), ("Crossing", 120, 20, 30), ("Subway", 175, 0, 0),
              ("Football1", 74, 0, 0), ("Deer", 71, 20, 30), ("MotorRolling", 164, 0, 0), ("bag_vot", 196, 0, 0),
              ("ball1_vot", 105, 0, 0)]
 

@@ -57,8 +57,9 @@ test-long: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -m "long and not extra" -p no:cacheprovider $(ARGS)
 
 # not in `make test` (CI time): PPC 2/4 on real frames (Verilator, plain and throttled), the PPC
-# real-time modes (2160p30 at PPC 4; MSTRACK_RT_PPC_EXTRA=1 adds 1080p60 at PPC 2) and the test cases
-# of tb/conftest.py CI_EXTRA (each names what covers it in `make test`)
+# real-time modes (2160p30 at PPC 4; MSTRACK_RT_PPC_EXTRA=1 adds 1080p60 at PPC 2), the wheel installed
+# with its dependencies from PyPI into a fresh venv (tests/test_release.py) and the test cases of
+# tb/conftest.py CI_EXTRA (each names what covers it in `make test`)
 test-extra: setup
 	MSTRACK_REQUIRE_TOOLS=1 $(PY) -m pytest -q -s -m extra -p no:cacheprovider $(ARGS)
 

@@ -325,6 +325,10 @@ CI_EXTRA: dict[str, str] = {
         "on CI seeds with 400 idle clocks after each line so that jobs run while their frame streams) and "
         "test_ms_tracker_shared (a short line and a cut under GHDL); this case: faults placed after jobs of their "
         "frame have ended (counted from the core's own signals), under GHDL, about 6 minutes",
+    "tb/test_ms_bg_model.py::test_ms_bg_model_verilator[colour3]":
+        "test_ms_bg_model_verilator[orient9] (the same block and bench as a netlist, with 9 orientation banks) "
+        "and test_ms_bg_model_ghdl[small] / test_ms_bg_model_real_ghdl[colour3] (colour "
+        "generics on the RTL); this case: its own Verilator build, 55 s",
 
 }
 

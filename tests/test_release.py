@@ -1,9 +1,13 @@
 """The release: `python -m build` gives an sdist and a wheel, and the wheel works in a fresh venv.
 
-The wheel is installed, with its dependencies pinned by requirements.lock, into a new virtual
-environment that shares nothing with the project's; there ``mstrack --version`` must print the
-package version of pyproject.toml and the tool line, and ``mstrack track`` must track a short
-generated video to its last frame.  CHANGELOG.md must have a section for that version.
+``test_wheel_in_fresh_venv`` (`make test-extra`, marker ``extra``): the wheel is installed, with its
+dependencies pinned by requirements.lock and fetched by pip, into a new virtual environment that shares
+nothing with the project's.  ``test_wheel_in_new_venv_with_the_locked_dependencies`` (`make test`): the
+wheel alone (``--no-deps``) in a new virtual environment that sees the project's installed dependencies
+(the versions requirements.lock pins) through a path file; there every requirement of the wheel must be
+installed at a version it allows.  In both, ``mstrack --version`` must print the package version of pyproject.toml and the
+tool line, and ``mstrack track`` must track a short generated video to its last frame.  CHANGELOG.md must
+have a section for that version.
 """
 from __future__ import annotations
 
@@ -13,6 +17,7 @@ import re
 import shutil
 import subprocess
 import sys
+import sysconfig
 import tarfile
 import tomllib
 import zipfile
@@ -96,6 +101,7 @@ def _video(path: Path, n: int = 12) -> tuple[int, int, int, int]:
     return 30, 40, 30, 30
 
 
+@pytest.mark.extra
 def test_wheel_in_fresh_venv(dist: Path, tmp_path: Path) -> None:
     wheel = next(dist.glob("mstrack-*.whl"))
     venv = tmp_path / "venv"
@@ -104,6 +110,50 @@ def test_wheel_in_fresh_venv(dist: Path, tmp_path: Path) -> None:
     env = {k: val for k, val in os.environ.items() if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
     env["PIP_CONSTRAINT"] = str(ROOT / "requirements.lock")  # what CI tested is what gets installed
     _run([str(py), "-m", "pip", "install", "-q", str(wheel)], timeout=900, env=env)
+    _check_installed(venv, tmp_path, env)
+
+
+def test_wheel_in_new_venv_with_the_locked_dependencies(dist: Path, tmp_path: Path) -> None:
+    wheel = next(dist.glob("mstrack-*.whl"))
+    venv = tmp_path / "venv"
+    _run([sys.executable, "-m", "venv", str(venv)], timeout=120)
+    py = venv / "bin" / "python"
+    env = {k: val for k, val in os.environ.items() if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
+    _run([str(py), "-m", "pip", "install", "-q", "--no-deps", str(wheel)], timeout=300, env=env)
+    # the dependencies: this interpreter's site-packages (installed from requirements.lock), after the new
+    # venv's own (a path file adds a directory only: the checkout's editable install stays out)
+    own = _run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"], timeout=60,
+               env=env).stdout.strip()
+    (Path(own) / "zz_locked_deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    _run([str(py), "-c", _REQUIREMENTS_MET], timeout=120, env=env, cwd=tmp_path)
+    _check_installed(venv, tmp_path, env)
+
+
+#: run in the new venv: every requirement of the installed wheel (no extras) is installed at a version it allows
+_REQUIREMENTS_MET = """
+import sys
+from importlib.metadata import PackageNotFoundError, distribution, version
+from packaging.requirements import Requirement
+d = distribution("mstrack")
+assert str(d.locate_file("")).startswith(sys.prefix), d.locate_file("")
+bad = []
+for text in d.requires or []:
+    r = Requirement(text)
+    if r.marker is not None and not r.marker.evaluate({"extra": ""}):
+        continue
+    try:
+        v = version(r.name)
+    except PackageNotFoundError:
+        bad.append(f"{r}: not installed")
+        continue
+    if not r.specifier.contains(v, prereleases=True):
+        bad.append(f"{r}: {v} installed")
+assert d.requires and not bad, bad
+"""
+
+
+def _check_installed(venv: Path, tmp_path: Path, env: dict[str, str]) -> None:
+    py = venv / "bin" / "python"
     # the installed package is the wheel's, not this checkout's
     where = _run([str(py), "-c", "import mstrack, sys; print(mstrack.__file__)"], timeout=60, env=env,
                  cwd=tmp_path).stdout.strip()

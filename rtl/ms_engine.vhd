@@ -34,7 +34,9 @@
 --   read latency).
 -- The record's registers are written under registers set a clock before (rec_ld, clip_ok, lf_take,
 --   t_res), and the spread and ring share under their blocks' done, not under the state's decode,
---   where their sources allow.
+--   where their sources allow; the final statistics (st_fin) under run_ms and fin_best; the region's
+--   last column and row and the scale test's fit verdict are
+--   registered a state before the compares and decisions that use them (T_RECT2, T_ST_FIT).
 -- Handshake: the command pulses above; res_valid / res_ready for the word (the record shows the new
 --   state from then on; after the handshake the geometry of the next frame follows).
 library ieee;
@@ -296,6 +298,9 @@ architecture rtl of ms_engine is
   signal reg_w, reg_h : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal hi_x, hi_y   : unsigned(REGION_W - 1 downto 0) := (others => '0');
   signal reg_w_c, reg_h_c : unsigned(COORD_W - 1 downto 0);
+  -- the region's last column and row (reg_x + reg_w - 1, reg_y + reg_h - 1, mod 2**COORD_W), registered with
+  -- the region, so that T_RECT2 compares registers
+  signal reg_x1, reg_y1 : unsigned(COORD_W - 1 downto 0) := (others => '0');
   -- the region (ms_region_v2, started when the window sizes are known); S - 2 per axis for the init box
   type rg_pair_t is array (0 to 1) of signed(COORD_W + 2 downto 0);
   signal rg_s2        : rg_pair_t;
@@ -342,6 +347,11 @@ architecture rtl of ms_engine is
   signal dec_l2       : unsigned(1 downto 0);
   signal ws_in_valid, ws_w_valid, ws_h_valid : std_logic := '0';
   signal ws_w, ws_h   : unsigned(WIN_W - 1 downto 0);
+  signal ws_ex, ws_ey : unsigned(HALF_W - 1 downto 0);  -- (ws_w - 1) >> 1, (ws_h - 1) >> 1 as ex_r, ey_r take them
+  signal st_fit       : std_logic := '0';               -- the scale test's window fits the region (T_ST_FIT)
+  -- st_fin's two writes under registers: run_ms (fsm = T_RUN, as a flip-flop) with c_done, and fin_best
+  -- (set in T_C2: high in T_CNEXT when the search ends and the last start point is not the best)
+  signal run_ms, fin_best : std_logic := '0';
   signal bs_w_valid, bs_h_valid : std_logic;
   signal bs_w, bs_h   : unsigned(COORD_W - 1 downto 0);
 
@@ -761,6 +771,8 @@ begin
   end generate;
 
   reg_w_c <= resize(reg_w, COORD_W);
+  ws_ex <= resize(shift_right(ws_w - 1, 1), HALF_W);
+  ws_ey <= resize(shift_right(ws_h - 1, 1), HALF_W);
   reg_h_c <= resize(reg_h, COORD_W);
 
   -- window-size limits: min(MAX_WINDOW, decimated size - 2)
@@ -800,8 +812,21 @@ begin
       lf_take <= lf_done;
       -- the best start point so far (wide search): taken the clock after T_C2 decided it
       best_take <= '0';
+      fin_best <= '0';
       if best_take = '1' then
         best_cx <= r_cx; best_cy <= r_cy; best_s <= r_s; best_st <= st_fin; best_conf <= conf;
+      end if;
+
+      -- the final statistics: the run's (its last or, at a rho stop, the pass before) or the best start point's
+      if run_ms = '1' and c_done = '1' then
+        if c_stop = STOP_RHO then
+          st_fin <= st_prev;
+        else
+          st_fin <= st_cur;
+        end if;
+      end if;
+      if fin_best = '1' then
+        st_fin <= best_st;
       end if;
 
       -- statistics of the last two passes
@@ -875,6 +900,8 @@ begin
           if rv_out_valid = '1' then
             reg_x <= rv_reg_x; reg_w <= rv_reg_w; hi_x <= rv_hi_x;
             reg_y <= rv_reg_y; reg_h <= rv_reg_h; hi_y <= rv_hi_y;
+            reg_x1 <= rv_reg_x + resize(rv_reg_w, COORD_W) - 1;
+            reg_y1 <= rv_reg_y + resize(rv_reg_h, COORD_W) - 1;
             if init_pending = '1' then
               fsm <= T_BOX;
             else
@@ -930,8 +957,8 @@ begin
         when T_RECT2 =>                        -- with the region: the smallest rectangle holding both
           rect_x <= umin(rc_x0, reg_x);
           rect_y <= umin(rc_y0, reg_y);
-          if rc_x1 < reg_x + reg_w_c - 1 then rc_x1 <= reg_x + reg_w_c - 1; end if;
-          if rc_y1 < reg_y + reg_h_c - 1 then rc_y1 <= reg_y + reg_h_c - 1; end if;
+          if rc_x1 < reg_x1 then rc_x1 <= reg_x1; end if;
+          if rc_y1 < reg_y1 then rc_y1 <= reg_y1; end if;
           fsm <= T_RECT3;
 
         when T_RECT3 =>
@@ -1024,6 +1051,7 @@ begin
             end if;
             cand <= (others => '0');
             eng_start <= '1';
+            run_ms <= '1';
             fsm <= T_RUN;
           end if;
 
@@ -1033,11 +1061,7 @@ begin
             if cand = 0 then                     -- iterations and stop of the centre's run
               r_iter <= c_iter; r_stop <= c_stop;
             end if;
-            if c_stop = STOP_RHO then
-              st_fin <= st_prev;
-            else
-              st_fin <= st_cur;
-            end if;
+            run_ms <= '0';                     -- st_fin: above, under run_ms and c_done
             fsm <= T_C0;
           end if;
 
@@ -1062,6 +1086,8 @@ begin
             -- drives one flip-flop and not the enables of the whole best_* record
             if cand = 0 or conf > best_conf then
               best_take <= '1';
+            elsif not (lost_st = '1' and init_pending = '0' and cand /= 8) then
+              fin_best <= '1';                 -- T_CNEXT ends the search on a start point that is not the best
             end if;
             fsm <= T_CNEXT;
           end if;
@@ -1087,10 +1113,11 @@ begin
             eng_cy <= unsigned(syo(CENTRE_ABS_W - 1 downto 0));
             cand <= cand + 1;
             eng_start <= '1';
+            run_ms <= '1';
             fsm <= T_RUN;
           else
             if best_take = '0' then            -- else this start point is the best: r_*, st_fin hold it
-              r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s; st_fin <= best_st;
+              r_cx <= best_cx; r_cy <= best_cy; r_s <= best_s;   -- st_fin: above, under fin_best
             end if;
             fsm <= T_STATS0;
           end if;
@@ -1209,15 +1236,17 @@ begin
           if ws_w_valid = '1' then
             wd <= ws_w;
             hd <= ws_h;
-            ex_r <= resize(shift_right(ws_w - 1, 1), HALF_W);
-            ey_r <= resize(shift_right(ws_h - 1, 1), HALF_W);
+            ex_r <= ws_ex;
+            ey_r <= ws_ey;
+            -- the fit verdict registered here, so that T_ST_FIT decides on a flip-flop
+            st_fit <= '1' when st_rx >= rg_s(resize(ws_ex, COORD_W)) and st_ry >= rg_s(resize(ws_ey, COORD_W))
+                               and st_rx + rg_s(resize(ws_ex, COORD_W)) < rg_s(reg_w_c)
+                               and st_ry + rg_s(resize(ws_ey, COORD_W)) < rg_s(reg_h_c) else '0';
             fsm <= T_ST_FIT;
           end if;
 
         when T_ST_FIT =>                       -- a window that leaves the captured region does not count
-          if st_rx >= rg_s(resize(ex_r, COORD_W)) and st_ry >= rg_s(resize(ey_r, COORD_W))
-             and st_rx + rg_s(resize(ex_r, COORD_W)) < rg_s(reg_w_c)
-             and st_ry + rg_s(resize(ey_r, COORD_W)) < rg_s(reg_h_c) then
+          if st_fit = '1' then                 -- (registered in T_ST_WS_WAIT)
             hi_x <= reg_w - 1 - resize(ex_r, REGION_W);
             hi_y <= reg_h - 1 - resize(ey_r, REGION_W);
             kt_start <= '1';
@@ -1390,6 +1419,8 @@ begin
         clip_ok <= '0';
         rec_ld <= '0';
         lf_take <= '0';
+        run_ms <= '0';
+        fin_best <= '0';
         ql_issue <= '0';
         st_sel <= '0';
       end if;

@@ -35,8 +35,8 @@
 -- The record's registers are written under registers set a clock before (rec_ld, clip_ok, lf_take,
 --   t_res), and the spread and ring share under their blocks' done, not under the state's decode,
 --   where their sources allow; the final statistics (st_fin) under run_ms and fin_best; the region's
---   last column and row and the scale test's fit verdict are
---   registered a state before the compares and decisions that use them (T_RECT2, T_ST_FIT).
+--   last column and row and the scale test's fit verdict are registered a state before the compares and
+--   decisions that use them (T_RECT2, T_ST_FIT).
 -- Handshake: the command pulses above; res_valid / res_ready for the word (the record shows the new
 --   state from then on; after the handshake the geometry of the next frame follows).
 library ieee;

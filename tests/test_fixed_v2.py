@@ -5,6 +5,7 @@ rounding or width slip in mstrack/fixed/blocks_v2.py shows as a mismatch.
 """
 from __future__ import annotations
 
+import functools
 import math
 from fractions import Fraction
 from pathlib import Path
@@ -405,27 +406,23 @@ def test_region_max_v2_bounds_the_fixed_model_regions(scene, monkeypatch):
         assert big > 191 and r.extra["decimation"] == 4, (sizes, r.extra["decimation"])
 
 
+@functools.cache
 def _dev_set_runs(model: str) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Tracker(model=model, preset="v2") on every dev sequence, through the public API: per sequence the
     boxes (init frame first), the ok flags of the updates and the ground truth.  Computed once per model for
-    the two tests below (the same runs; the cache lives as long as the test module)."""
-    if model not in _DEV_RUNS:
-        from mstrack.io.data import load_dataset
-        out = []
-        for seq in load_dataset(SEQ_ROOT):
-            trk = Tracker(model=model, preset="v2")
-            boxes, oks = [], []
-            for i, fr in enumerate(seq.frames()):
-                r = trk.init(fr, seq.init_box()) if i == 0 else trk.update(fr)
-                boxes.append(r.box.as_tuple())
-                if i:
-                    oks.append(r.ok)
-            out.append((np.array(boxes, dtype=float), np.array(oks, dtype=bool), seq.gt[:len(boxes)]))
-        _DEV_RUNS[model] = out
-    return _DEV_RUNS[model]
-
-
-_DEV_RUNS: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = {}
+    the two tests below (the same runs)."""
+    from mstrack.io.data import load_dataset
+    out = []
+    for seq in load_dataset(SEQ_ROOT):
+        trk = Tracker(model=model, preset="v2")
+        boxes, oks = [], []
+        for i, fr in enumerate(seq.frames()):
+            r = trk.init(fr, seq.init_box()) if i == 0 else trk.update(fr)
+            boxes.append(r.box.as_tuple())
+            if i:
+                oks.append(r.ok)
+        out.append((np.array(boxes, dtype=float), np.array(oks, dtype=bool), seq.gt[:len(boxes)]))
+    return out
 
 
 @pytest.mark.skipif(not SEQ_ROOT.is_dir(), reason=f"real sequences not found at {SEQ_ROOT} (../shared absent)")

@@ -101,25 +101,26 @@ def _video(path: Path, n: int = 12) -> tuple[int, int, int, int]:
     return 30, 40, 30, 30
 
 
-@pytest.mark.extra
-def test_wheel_in_fresh_venv(dist: Path, tmp_path: Path) -> None:
-    wheel = next(dist.glob("mstrack-*.whl"))
+def _new_venv(tmp_path: Path) -> tuple[Path, Path, dict[str, str]]:
+    """A new virtual environment under *tmp_path*: (its dir, its python, an environment without this one's)."""
     venv = tmp_path / "venv"
     _run([sys.executable, "-m", "venv", str(venv)], timeout=120)
-    py = venv / "bin" / "python"
     env = {k: val for k, val in os.environ.items() if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
+    return venv, venv / "bin" / "python", env
+
+
+@pytest.mark.extra
+def test_wheel_in_fresh_venv(dist: Path, tmp_path: Path) -> None:
+    venv, py, env = _new_venv(tmp_path)
     env["PIP_CONSTRAINT"] = str(ROOT / "requirements.lock")  # what CI tested is what gets installed
-    _run([str(py), "-m", "pip", "install", "-q", str(wheel)], timeout=900, env=env)
+    _run([str(py), "-m", "pip", "install", "-q", str(next(dist.glob("mstrack-*.whl")))], timeout=900, env=env)
     _check_installed(venv, tmp_path, env)
 
 
 def test_wheel_in_new_venv_with_the_locked_dependencies(dist: Path, tmp_path: Path) -> None:
-    wheel = next(dist.glob("mstrack-*.whl"))
-    venv = tmp_path / "venv"
-    _run([sys.executable, "-m", "venv", str(venv)], timeout=120)
-    py = venv / "bin" / "python"
-    env = {k: val for k, val in os.environ.items() if not k.startswith(("PYTHON", "VIRTUAL_ENV"))}
-    _run([str(py), "-m", "pip", "install", "-q", "--no-deps", str(wheel)], timeout=300, env=env)
+    venv, py, env = _new_venv(tmp_path)
+    _run([str(py), "-m", "pip", "install", "-q", "--no-deps", str(next(dist.glob("mstrack-*.whl")))],
+         timeout=300, env=env)
     # the dependencies: this interpreter's site-packages (installed from requirements.lock), after the new
     # venv's own (a path file adds a directory only: the checkout's editable install stays out)
     own = _run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"], timeout=60,
